@@ -1,0 +1,109 @@
+# jdem — build, test and run.  `make demo` and `make test` are the whole set-up on a fresh
+# Debian machine: both install what is missing (make deps) before they build.
+#
+#   make            build/jdem and build/liggghts-jdem
+#   make deps       install the Debian packages the project needs (as root), else print the command
+#   make test       unit tests (also under ASan+UBSan), engine tests, Chung–Ooi checks, cross-engine
+#   make demo       build and run the eight Chung–Ooi tests; report in out/chung_ooi/report.md
+#   make chung-ooi  the Chung–Ooi runs and report only (no dependency check)
+
+SHELL := /bin/bash
+PY    := /usr/bin/python3
+CC    := gcc
+CXX   := mpicxx
+
+DEB_PACKAGES := gcc g++ make pkg-config libyaml-dev libhdf5-dev libcmocka-dev \
+                python3-numpy python3-h5py python3-matplotlib python3-yaml \
+                liggghts libliggghts-dev mpi-default-dev mpi-default-bin
+
+VERSION  := 0.1.0
+WARN     := -Wall -Wextra -Werror
+PKG_CFLAGS := $(shell pkg-config --cflags yaml-0.1 hdf5 2>/dev/null)
+PKG_LIBS   := $(shell pkg-config --libs yaml-0.1 hdf5 2>/dev/null) -lm
+CFLAGS   := -std=c11 -O2 -g $(WARN) -D_POSIX_C_SOURCE=200809L -DJDEM_VERSION=\"$(VERSION)\" \
+            -Ikernel -Iio -Istepper $(PKG_CFLAGS)
+SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+
+KERNEL_SRC  := $(wildcard kernel/*.c)
+IO_SRC      := $(wildcard io/*.c)
+STEPPER_SRC := $(wildcard stepper/*.c)
+PLUGIN_SRC  := $(wildcard liggghts_plugin/*.cpp)
+UNIT_SRC    := $(wildcard tests/unit/*.c)
+HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)
+
+.PHONY: all deps test demo chung-ooi unit clean
+all: build/jdem build/liggghts-jdem
+
+# ---------------------------------------------------------------------------------------------
+# Dependencies (Debian only)
+deps:
+	@missing=$$(for p in $(DEB_PACKAGES); do \
+	    dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; \
+	  done); \
+	if [ -z "$$missing" ]; then echo "deps: all Debian packages present"; exit 0; fi; \
+	cmd="apt-get install -y --no-install-recommends $$(echo $$missing)"; \
+	if [ "$$(id -u)" = 0 ]; then \
+	  echo "deps: installing $$(echo $$missing)"; \
+	  export DEBIAN_FRONTEND=noninteractive; apt-get update -qq && $$cmd -qq >/dev/null; \
+	else echo "deps: missing packages; run as root:  apt-get update && $$cmd"; exit 1; fi
+
+# ---------------------------------------------------------------------------------------------
+# Standalone engine (C11) and its sanitizer twin
+build/obj/%.o: %.c $(HEADERS)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -c $< -o $@
+
+build/san/%.o: %.c $(HEADERS)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(SANFLAGS) -c $< -o $@
+
+build/jdem: $(patsubst %.c,build/obj/%.o,$(KERNEL_SRC) $(IO_SRC) $(STEPPER_SRC))
+	$(CC) $(CFLAGS) $^ -o $@ $(PKG_LIBS)
+
+build/san/jdem: $(patsubst %.c,build/san/%.o,$(KERNEL_SRC) $(IO_SRC) $(STEPPER_SRC))
+	$(CC) $(CFLAGS) $(SANFLAGS) $^ -o $@ $(PKG_LIBS)
+
+# ---------------------------------------------------------------------------------------------
+# LIGGGHTS plugin: Debian's libliggghts + our styles; the kernel and the H5MD writer are the same
+# C objects as in the stepper (compiled position-independent).
+PLUGIN_CXXFLAGS := -std=c++11 -O2 -g -Wall -Wextra -Werror -Wno-unused-parameter -fPIC \
+                   -Ikernel -Iio -isystem /usr/include/liggghts $(PKG_CFLAGS)
+build/pic/%.o: %.c $(HEADERS)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -fPIC -c $< -o $@
+build/plugin/%.o: %.cpp $(wildcard liggghts_plugin/*.h) $(HEADERS)
+	@mkdir -p $(dir $@)
+	$(CXX) $(PLUGIN_CXXFLAGS) -c $< -o $@
+build/liggghts-jdem: $(patsubst %.cpp,build/plugin/%.o,$(PLUGIN_SRC)) \
+                     $(patsubst %.c,build/pic/%.o,$(KERNEL_SRC) $(IO_SRC))
+	$(CXX) $^ -o $@ -lliggghts $(PKG_LIBS)
+
+# ---------------------------------------------------------------------------------------------
+# Unit tests of the kernel (cmocka), plain and sanitized
+build/test_unit: $(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC) $(HEADERS)
+	@mkdir -p build
+	$(CC) $(CFLAGS) -Itests/unit $(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC) -o $@ $(PKG_LIBS) -lcmocka
+build/san/test_unit: $(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC) $(HEADERS)
+	@mkdir -p build/san
+	$(CC) $(CFLAGS) $(SANFLAGS) -Itests/unit $(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC) -o $@ $(PKG_LIBS) -lcmocka
+
+unit: build/test_unit build/san/test_unit
+	build/test_unit
+	build/san/test_unit
+
+# ---------------------------------------------------------------------------------------------
+# The suites.  tests/run_tests.py runs every check and prints "N passed, N failed".
+test: deps
+	$(MAKE) all build/san/jdem build/test_unit build/san/test_unit
+	$(PY) tests/run_tests.py
+
+chung-ooi: build/jdem build/liggghts-jdem
+	$(PY) scripts/chung_ooi.py run --out out/chung_ooi
+
+demo: deps
+	$(MAKE) all
+	$(MAKE) chung-ooi
+	@echo "report: out/chung_ooi/report.md"
+
+clean:
+	rm -rf build out

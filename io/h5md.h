@@ -1,0 +1,85 @@
+/*
+ * h5md.h — the trajectory writer shared by both engines (the standalone stepper and the
+ * LIGGGHTS dump style `h5md/jdem`).  C11 on top of the HDF5 C library; it writes the H5MD 1.1
+ * layout fixed in DESIGN.md plus an XDMF sidecar so that ParaView opens the file directly.
+ *
+ * Layout (all floating-point data float64, SI units; N particles sorted by id; F frames):
+ *   /h5md                       attrs version = [1, 1]; groups author (attr name), creator
+ *                               (attrs name, version)
+ *   /parameters                 attrs engine, scene_name, case_name, dt [s]; dataset "scene"
+ *                               (variable-length string: the resolved scene, YAML) when given
+ *   /particles/all/box          attrs dimension = 3, boundary = ["none","none","none"]
+ *   /particles/all/{id,species,radius,mass}        [N] time-independent (int64, int32, f64, f64)
+ *   /particles/all/{position,velocity,angular_velocity,force,torque}/{step,time,value}
+ *                               step [F] int64, time [F] f64, value [F][N][3] f64
+ *   /observables/NAME/{step,time,value}            value [F] f64 (counts stored as f64 too)
+ *   /connectivity/...           reserved for bonds (issue 4)
+ *
+ * Fault safety: the file is written as PATH.part and renamed to PATH by jd_h5md_close(ok = 1);
+ * every frame is flushed, so a run that dies leaves a readable PATH.part with every frame so far.
+ * jd_h5md_close(ok = 0) keeps it under PATH.part (an aborted run never masquerades as complete).
+ */
+#ifndef JDEM_IO_H5MD_H
+#define JDEM_IO_H5MD_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct jd_h5md jd_h5md;
+
+/* Static description of the particle set (arrays of n entries, sorted by id). */
+typedef struct jd_h5md_particles {
+    size_t n;
+    const int64_t *id;
+    const int32_t *species; /* index into the scene's material list (0-based) */
+    const double *radius;   /* [m]  */
+    const double *mass;     /* [kg] */
+} jd_h5md_particles;
+
+/* Run metadata written under /parameters.  Any pointer may be NULL. */
+typedef struct jd_h5md_meta {
+    const char *creator;         /* "jdem" or "liggghts-jdem" */
+    const char *creator_version; /* e.g. "0.1.0" */
+    const char *scene_name;
+    const char *case_name;
+    const char *scene_yaml;      /* the resolved scene text, stored as /parameters/scene */
+    double dt;                   /* [s] */
+} jd_h5md_meta;
+
+/* One frame of per-particle data, each an array of 3n doubles (x0 y0 z0 x1 ...), sorted by id.
+ * Any of velocity..torque may be NULL, in which case that group is not written for this run
+ * (decide at the first frame and keep it). */
+typedef struct jd_h5md_frame {
+    int64_t step;
+    double time; /* [s] */
+    const double *position;
+    const double *velocity;
+    const double *angular_velocity;
+    const double *force;
+    const double *torque;
+} jd_h5md_frame;
+
+/* Create PATH.part.  Returns NULL and writes a one-line reason into err on failure. */
+jd_h5md *jd_h5md_create(const char *path, const jd_h5md_meta *meta,
+                        const jd_h5md_particles *particles, char *err, size_t errlen);
+
+/* Append one frame (flushes).  Returns 0 on success, -1 with a reason in err. */
+int jd_h5md_write_frame(jd_h5md *h, const jd_h5md_frame *frame, char *err, size_t errlen);
+
+/* Append one scalar sample to /observables/NAME (created on first use).  Observables may be
+ * sampled on their own schedule.  Returns 0 or -1 with a reason in err. */
+int jd_h5md_write_observable(jd_h5md *h, const char *name, int64_t step, double time,
+                             double value, char *err, size_t errlen);
+
+/* Close the file.  ok = 1: rename PATH.part to PATH and write the XDMF sidecar (PATH with its
+ * extension replaced by .xdmf).  ok = 0: leave PATH.part.  Returns 0 or -1 with err. */
+int jd_h5md_close(jd_h5md *h, int ok, char *err, size_t errlen);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* JDEM_IO_H5MD_H */

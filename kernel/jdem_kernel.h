@@ -1,0 +1,418 @@
+/*
+ * jdem_kernel.h — the contact laws of Jiang (2021), the single source of jdem's physics.
+ *
+ * Pure C11. No I/O, no allocation, no globals, no engine types: both engines (the standalone
+ * stepper `jdem` and the LIGGGHTS plugin) call these functions on the same per-contact state.
+ * Every equation and every choice is explained, with its evidence, in docs/model.md; the
+ * section numbers below (§) refer to that page.
+ *
+ * Units are SI throughout: m, s, kg, N, N·m, J, Pa, rad.
+ *
+ * Conventions for one contact between body a and body b:
+ *   - n is the unit normal pointing from a to b. For a wall contact a is the particle and b is the
+ *     wall, so n points from the particle centre towards the wall.
+ *   - delta > 0 is the overlap (eq. 1: R_a + R_b - |x_b - x_a|; wall: R_a - distance to the wall).
+ *   - ra = x_C - x_a and rb = x_C - x_b are the lever arms from the centres to the contact point
+ *     x_C (sphere–sphere: x_C = x_a + (R_a - delta/2) n).  For a wall, rb is unused.
+ *   - vrel = (v_b + w_b x rb) - (v_a + w_a x ra) is the velocity of b's material point at the
+ *     contact relative to a's (eq. 6).  For a wall, v_b is the wall's velocity and w_b = 0.
+ *   - The kernel returns the force on b; the force on a is its negative.
+ *
+ * Hot-path functions are `static inline` here so that each engine inlines them into force loops
+ * specialised at compile time for the scene's feature set (the `features` argument is meant to be
+ * a compile-time constant at every call site; see JD_F_*).  Set-up functions (damping mappings,
+ * time-step bounds) live in jdem_kernel.c.
+ */
+#ifndef JDEM_KERNEL_H
+#define JDEM_KERNEL_H
+
+#include <math.h>
+#include <stdint.h>
+
+/* pi as LIGGGHTS spells it (MY_PI), so that masses agree bit for bit. */
+#define JD_PI 3.14159265358979323846
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------------------------ */
+/* Feature flags: which laws a force loop evaluates.  A scene pays only for what it uses.      */
+/* ------------------------------------------------------------------------------------------ */
+enum {
+    JD_F_DAMPING = 1u << 0,  /* viscous normal/tangential/rolling dashpots and Luding's end rule */
+    JD_F_FRICTION = 1u << 1, /* cumulative tangential spring with Coulomb cap (mu > 0)           */
+    JD_F_ROLLING = 1u << 2,  /* rolling resistance spring with cap (eta > 0)                     */
+    JD_F_MU_R = 1u << 3,     /* mu_R != 1: reduced rotational slip while sliding (eq. 76)        */
+    JD_F_ENERGY = 1u << 4    /* accumulate the dissipated energies in the contact state          */
+};
+
+/* How the stored tangential displacement xi behaves while sliding (§4.4). */
+typedef enum {
+    JD_XI_COULOMB = 0,      /* xi is reset so that K_t |xi| = mu F_n (Di Maio & Di Renzo 2004) */
+    JD_XI_UNCONSTRAINED = 1 /* xi keeps accumulating (the seed's literal Cundall–Strack reading) */
+} jd_xi_limit;
+
+/* Sphere–wall normal stiffness rule (§3.3). */
+typedef enum {
+    JD_WALL_HERTZ = 0,   /* exact Hertz against a rigid plane: E* = E/(1-nu^2), R* = R (default) */
+    JD_WALL_JIANG2021 = 1 /* the seed's literal K_n = 2 K_p, which is 1/sqrt(2) of Hertz          */
+} jd_wall_rule;
+
+/* Mapping from the input restitution coefficient e to the damping ratio gamma (§7). */
+typedef enum {
+    JD_DAMP_JIANG2021 = 0, /* gamma = -ln e / sqrt(pi^2 + ln^2 e) (eq. 30), the seed's default   */
+    JD_DAMP_EXACT = 1      /* gamma chosen so that a Hertz impact with Luding's end rule
+                              rebounds with exactly e (solved once, jd_gamma_exact)             */
+} jd_damping_map;
+
+/* ------------------------------------------------------------------------------------------ */
+/* Coefficients of one interaction (species pair, or species–wall), fixed for a run.           */
+/* ------------------------------------------------------------------------------------------ */
+typedef struct jd_pair_coeffs {
+    double gamma;  /* damping ratio, dimensionless, >= 0 (0: no damping)                          */
+    double mu;     /* Coulomb friction coefficient, dimensionless, >= 0                           */
+    double eta;    /* rolling friction coefficient, dimensionless (cap = eta * r_roll * F_n)      */
+    double mu_r;   /* rotational-slip reduction factor while sliding, in [0, 1] (eq. 76)          */
+    int xi_limit;  /* jd_xi_limit                                                                  */
+} jd_pair_coeffs;
+
+/* ------------------------------------------------------------------------------------------ */
+/* Geometry and kinematics of one contact at the current step (filled by the engine).          */
+/* ------------------------------------------------------------------------------------------ */
+typedef struct jd_contact_geom {
+    double n[3];   /* unit normal a -> b                                                   [-]    */
+    double delta;  /* overlap, > 0                                                         [m]    */
+    double ra[3];  /* x_C - x_a                                                            [m]    */
+    double rb[3];  /* x_C - x_b (ignored for walls)                                        [m]    */
+    double k_n;    /* Hertz prefactor: K_n = k_n sqrt(delta), F_el = k_n delta^1.5        [N/m^1.5] */
+    double m_eff;  /* effective mass m_a m_b/(m_a+m_b); wall: m_a                          [kg]   */
+    double i_eff;  /* effective moment of inertia I_a I_b/(I_a+I_b); wall: I_a             [kg m^2] */
+    double r_roll; /* rolling radius R_a R_b/(R_a+R_b); wall: R_a                          [m]    */
+} jd_contact_geom;
+
+typedef struct jd_kinematics {
+    double va[3], wa[3]; /* velocity [m/s] and angular velocity [rad/s] of a                     */
+    double vb[3], wb[3]; /* of b (wall: its velocity, and zero angular velocity)                 */
+} jd_kinematics;
+
+/* ------------------------------------------------------------------------------------------ */
+/* Per-contact history.  A plain array of doubles so that LIGGGHTS' contact-history machinery  */
+/* can store and migrate it (jd_contact_state_newton lists which entries flip sign i<->j).     */
+/* Zero-initialised state means "contact just detected" (t_0 of eq. 9).                        */
+/* ------------------------------------------------------------------------------------------ */
+typedef struct jd_contact_state {
+    double xi[3];    /* cumulative tangential displacement, kept in the tangent plane      [m]    */
+    double u_spring; /* tangential + rolling spring energy after the last evaluation       [J]    */
+    double e_damp;   /* energy dissipated by the dashpots (incl. energy lost at Luding's end) [J] */
+    double e_fric;   /* energy dissipated by the tangential and rolling sliders            [J]    */
+    double flags;    /* JD_S_* bits stored as a small integer value                         [-]    */
+} jd_contact_state;
+
+enum { JD_S_ENDED = 1, JD_S_SLIDING = 2 };
+
+#define JD_CONTACT_STATE_LEN 7 /* doubles in jd_contact_state */
+/* 1 where the entry is a vector component that changes sign when a and b swap, else 0. */
+static const int jd_contact_state_newton[JD_CONTACT_STATE_LEN] = {1, 1, 1, 0, 0, 0, 0};
+
+/* Rolling history, only allocated by scenes with rolling resistance. */
+typedef struct jd_rolling_state {
+    double theta[3]; /* cumulative relative rotation (w_b - w_a) dt                       [rad]  */
+} jd_rolling_state;
+
+#define JD_ROLLING_STATE_LEN 3
+static const int jd_rolling_state_newton[JD_ROLLING_STATE_LEN] = {1, 1, 1};
+
+/* What one evaluation returns. */
+typedef struct jd_contact_result {
+    double f[3];  /* force on b (on a: -f)                                                 [N]    */
+    double ta[3]; /* torque on a about its centre                                          [N m]  */
+    double tb[3]; /* torque on b about its centre (walls: ignore)                          [N m]  */
+    double fn;    /* normal force magnitude, >= 0                                          [N]    */
+} jd_contact_result;
+
+/* ------------------------------------------------------------------------------------------ */
+/* Small vector helpers (internal).                                                            */
+/* ------------------------------------------------------------------------------------------ */
+static inline double jd_dot(const double a[3], const double b[3]) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+static inline void jd_cross(const double a[3], const double b[3], double out[3]) {
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Material and stiffness rules (§3).                                                          */
+/* ------------------------------------------------------------------------------------------ */
+
+/* Per-particle Hertz prefactor of eq. (4): k_p = 2 G sqrt(2R) / (3 (1 - nu)), G = E/(2(1+nu)),
+ * so that K_p = k_p sqrt(delta).  E [Pa], nu [-], R [m] -> [N/m^1.5]. */
+static inline double jd_hertz_prefactor(double E, double nu, double R) {
+    const double G = E / (2.0 * (1.0 + nu));
+    return 2.0 * G * sqrt(2.0 * R) / (3.0 * (1.0 - nu));
+}
+
+/* Sphere–sphere rule of eq. (5): the harmonic mean 2 k_a k_b/(k_a + k_b) [N/m^1.5]. */
+static inline double jd_kn_pair(double kp_a, double kp_b) {
+    return 2.0 * kp_a * kp_b / (kp_a + kp_b);
+}
+
+/* Sphere–wall rule (§3.3): exact Hertz (4/3) E/(1-nu^2) sqrt(R), or the seed's 2 k_p [N/m^1.5]. */
+static inline double jd_kn_wall(int wall_rule, double E, double nu, double R) {
+    if (wall_rule == JD_WALL_JIANG2021) return 2.0 * jd_hertz_prefactor(E, nu, R);
+    return 4.0 / 3.0 * E / (1.0 - nu * nu) * sqrt(R);
+}
+
+/* Mass and moment of inertia of a solid sphere, written exactly as LIGGGHTS computes them
+ * (`set density`: 4 pi/3 r^3 rho; fix nve/sphere: I = 0.4 m r^2) so that the engines agree to
+ * round-off. */
+static inline double jd_sphere_mass(double R, double rho) {
+    return 4.0 * JD_PI / 3.0 * R * R * R * rho;
+}
+static inline double jd_sphere_inertia(double m, double R) { return 0.4 * m * R * R; }
+
+/* ------------------------------------------------------------------------------------------ */
+/* Set-up functions (jdem_kernel.c).                                                           */
+/* ------------------------------------------------------------------------------------------ */
+
+/* Eq. (30): gamma = -ln e / sqrt(pi^2 + ln^2 e), e in (0, 1]. */
+double jd_gamma_jiang2021(double e);
+
+/* Restitution coefficient produced by damping ratio gamma for a Hertz contact with the seed's
+ * C_n = 2 gamma sqrt(m K_n) and Luding's end rule, in the limit dt -> 0.  It depends on gamma
+ * only (independent of mass, stiffness and speed).  Integrates the dimensionless equation
+ * x'' = -x^1.5 - 2 gamma x^0.25 x' with classical RK4 (relative accuracy about 1e-7). */
+double jd_restitution_for_gamma(double gamma);
+
+/* Inverse of jd_restitution_for_gamma: the gamma that rebounds with exactly e, e in (0, 1].
+ * Returns 0 for e >= 1. */
+double jd_gamma_exact(double e);
+
+/* gamma for a mapping (jd_damping_map) and input restitution e. */
+double jd_gamma_for(int damping_map, double e);
+
+/* Rayleigh time step of eq. (34): pi R sqrt(rho/G) / (0.1631 nu + 0.876605) [s]. */
+double jd_rayleigh_step(double R, double rho, double E, double nu);
+
+/* Duration of an undamped Hertz impact, F = k_n delta^1.5, effective mass m_eff [kg],
+ * approach speed v [m/s]: t_c = 2 tau (m/k)^(2/5) v^(-1/5) with the exact constant [s]. */
+double jd_hertz_contact_time(double m_eff, double k_n, double v);
+
+/* Peak overlap [m] and peak force [N] of the same impact. */
+double jd_hertz_peak_overlap(double m_eff, double k_n, double v);
+double jd_hertz_peak_force(double m_eff, double k_n, double v);
+
+/* ------------------------------------------------------------------------------------------ */
+/* The contact laws.                                                                           */
+/* ------------------------------------------------------------------------------------------ */
+
+/* Reset the history when the bodies separate (delta <= 0): the next overlap is a new contact.
+ * The dissipated-energy accumulators are kept (they are cumulative per pair); engines that
+ * drop the pair read them first. */
+static inline void jd_contact_separate(jd_contact_state *s, jd_rolling_state *r) {
+    s->xi[0] = s->xi[1] = s->xi[2] = 0.0;
+    s->u_spring = 0.0;
+    s->flags = 0.0;
+    if (r) r->theta[0] = r->theta[1] = r->theta[2] = 0.0;
+}
+
+/* Keep a stored tangential vector in the current tangent plane: remove its normal component and
+ * rescale it to its previous length, so that a turning contact frame neither creates nor destroys
+ * spring energy (§4.3). */
+static inline void jd_rotate_into_plane(double v[3], const double n[3]) {
+    const double len2 = jd_dot(v, v);
+    if (len2 == 0.0) return;
+    const double vn = jd_dot(v, n);
+    v[0] -= vn * n[0];
+    v[1] -= vn * n[1];
+    v[2] -= vn * n[2];
+    const double new2 = jd_dot(v, v);
+    if (new2 > 0.0) {
+        const double s = sqrt(len2 / new2);
+        v[0] *= s;
+        v[1] *= s;
+        v[2] *= s;
+    }
+}
+
+/* Normal law (§3, §7, §8): F_n = K_n delta + C_n d(delta)/dt with K_n = k_n sqrt(delta) and
+ * C_n = 2 gamma sqrt(m_eff K_n).  ddelta is the overlap rate [m/s].  Returns the unclamped force
+ * [N] (it is negative only while unloading with strong damping: Luding's end of collision);
+ * *c_n receives C_n [N s/m] and *k_sec the secant stiffness K_n [N/m]. */
+static inline double jd_normal_force(double k_n, double delta, double ddelta, double gamma,
+                                     double m_eff, double *k_sec, double *c_n) {
+    const double K = k_n * sqrt(delta);
+    const double C = 2.0 * gamma * sqrt(m_eff * K);
+    *k_sec = K;
+    *c_n = C;
+    return K * delta + C * ddelta;
+}
+
+/* Elastic energy of the normal spring: integral of k_n d^1.5 = 0.4 k_n delta^2.5 [J]. */
+static inline double jd_normal_energy(double k_n, double delta) {
+    return 0.4 * k_n * delta * delta * sqrt(delta);
+}
+
+/* Coulomb-capped spring–dashpot of eqs. (9)–(11), (31) on one stored vector (tangential xi with
+ * stiffness K and dashpot C, or rolling theta with K_r, C_r).  rate is the relative velocity
+ * (vt or w_rel), cap the magnitude limit (mu F_n, or eta r F_n).  On return out holds the force
+ * (or moment) on b; the return value is 1 when the cap was active (sliding).  With
+ * JD_XI_COULOMB the stored vector is reset to -out/K while sliding (the dashpot is off while
+ * sliding, as the seed states), so K |stored| never exceeds the cap. */
+static inline int jd_capped_spring(double stored[3], const double rate[3], double K, double C,
+                                   double cap, double dt, int xi_limit, double out[3]) {
+    stored[0] += rate[0] * dt;
+    stored[1] += rate[1] * dt;
+    stored[2] += rate[2] * dt;
+    out[0] = -K * stored[0] - C * rate[0];
+    out[1] = -K * stored[1] - C * rate[1];
+    out[2] = -K * stored[2] - C * rate[2];
+    const double m2 = jd_dot(out, out);
+    if (m2 <= cap * cap) return 0;
+    const double s = cap / sqrt(m2);
+    out[0] *= s;
+    out[1] *= s;
+    out[2] *= s;
+    if (xi_limit == JD_XI_COULOMB && K > 0.0) {
+        stored[0] = -out[0] / K;
+        stored[1] = -out[1] / K;
+        stored[2] = -out[2] / K;
+    }
+    return 1;
+}
+
+/* One evaluation of a contact (the reference algorithm of docs/model.md §9).
+ *
+ * features: JD_F_* bits, a compile-time constant at the call site.
+ * c, g, k:  coefficients, geometry (g->delta > 0) and kinematics.
+ * dt:       time step [s] (the springs accumulate rate * dt).
+ * s:        contact history, updated.   r: rolling history (NULL unless JD_F_ROLLING).
+ * out:      force on b and the torques on a and b; all zero when the contact has ended.
+ * Returns 1 while the contact carries force, 0 once it has ended (Luding's rule: the total
+ * normal force reached zero while unloading; it stays ended until the bodies separate or start
+ * approaching again, which begins a new contact). */
+static inline int jd_contact(const unsigned features, const jd_pair_coeffs *c,
+                             const jd_contact_geom *g, const jd_kinematics *k, double dt,
+                             jd_contact_state *s, jd_rolling_state *r, jd_contact_result *out) {
+    /* Relative velocity at the contact point, eq. (6). */
+    double wxa[3], wxb[3];
+    jd_cross(k->wa, g->ra, wxa);
+    jd_cross(k->wb, g->rb, wxb);
+    double vrel[3];
+    for (int d = 0; d < 3; d++) vrel[d] = (k->vb[d] + wxb[d]) - (k->va[d] + wxa[d]);
+    const double vn = jd_dot(vrel, g->n);
+    const double ddelta = -vn; /* overlap rate */
+    int flags = (int)s->flags;
+
+    for (int d = 0; d < 3; d++) out->f[d] = out->ta[d] = out->tb[d] = 0.0;
+    out->fn = 0.0;
+
+    if (flags & JD_S_ENDED) {
+        if (ddelta <= 0.0) return 0; /* still separating after the end of the collision */
+        jd_contact_separate(s, r);   /* a new approach while still overlapping: new contact */
+        flags = 0;
+    }
+
+    /* Normal law. */
+    const double gamma = (features & JD_F_DAMPING) ? c->gamma : 0.0;
+    double Kn, Cn;
+    double fn = jd_normal_force(g->k_n, g->delta, ddelta, gamma, g->m_eff, &Kn, &Cn);
+    if (features & JD_F_DAMPING) {
+        if (fn <= 0.0) {
+            /* Luding's end of collision: no tensile force; history resets; the energy still
+             * stored in the springs is never returned, so it counts as dissipated. */
+            if (features & JD_F_ENERGY)
+                s->e_damp += jd_normal_energy(g->k_n, g->delta) + s->u_spring;
+            jd_contact_separate(s, r);
+            s->flags = (double)JD_S_ENDED;
+            return 0;
+        }
+        if (features & JD_F_ENERGY) s->e_damp += Cn * ddelta * ddelta * dt;
+    }
+    out->fn = fn;
+    double f[3] = {fn * g->n[0], fn * g->n[1], fn * g->n[2]};
+    double m_roll[3] = {0.0, 0.0, 0.0};
+    double u_new = 0.0;
+
+    if (features & JD_F_FRICTION) {
+        double vt[3];
+        for (int d = 0; d < 3; d++) vt[d] = vrel[d] - vn * g->n[d];
+        double vt_law[3] = {vt[0], vt[1], vt[2]};
+        if ((features & JD_F_MU_R) && (flags & JD_S_SLIDING)) {
+            /* eq. (76): while sliding only mu_R of the rotational slip acts on the spring. */
+            const double red = 1.0 - c->mu_r;
+            double wr[3];
+            for (int d = 0; d < 3; d++) wr[d] = wxb[d] - wxa[d];
+            const double wrn = jd_dot(wr, g->n);
+            for (int d = 0; d < 3; d++) vt_law[d] -= red * (wr[d] - wrn * g->n[d]);
+        }
+        jd_rotate_into_plane(s->xi, g->n);
+        const double Kt = Kn, Ct = Cn; /* K_t = K_n (Sec. 2.3.2), hence C_t = C_n (eq. 29) */
+        double ft[3];
+        const int sliding = jd_capped_spring(s->xi, vt_law, Kt, Ct, c->mu * fn, dt, c->xi_limit, ft);
+        flags = sliding ? (flags | JD_S_SLIDING) : (flags & ~JD_S_SLIDING);
+        for (int d = 0; d < 3; d++) f[d] += ft[d];
+        if (features & JD_F_ENERGY) {
+            /* Spring energy: the part of the force the spring carries. */
+            double fs[3];
+            for (int d = 0; d < 3; d++) fs[d] = sliding ? ft[d] : -Kt * s->xi[d];
+            const double ut = Kt > 0.0 ? 0.5 * jd_dot(fs, fs) / Kt : 0.0;
+            const double work = jd_dot(ft, vt) * dt; /* done on the bodies */
+            const double dash = sliding ? 0.0 : Ct * jd_dot(vt, vt) * dt;
+            s->e_damp += dash;
+            s->e_fric -= work + dash;
+            u_new += ut;
+        }
+    }
+
+    if (features & JD_F_ROLLING) {
+        double wrel[3];
+        for (int d = 0; d < 3; d++) wrel[d] = k->wb[d] - k->wa[d];
+        const double Kr = Kn * g->r_roll * g->r_roll;   /* K_r = K_t r^2 */
+        const double Cr = 2.0 * gamma * sqrt(g->i_eff * Kr); /* eq. (32) */
+        const int rsl = jd_capped_spring(r->theta, wrel, Kr, Cr, c->eta * g->r_roll * fn, dt,
+                                         c->xi_limit, m_roll);
+        if (features & JD_F_ENERGY) {
+            double ms[3];
+            for (int d = 0; d < 3; d++) ms[d] = rsl ? m_roll[d] : -Kr * r->theta[d];
+            const double ur = Kr > 0.0 ? 0.5 * jd_dot(ms, ms) / Kr : 0.0;
+            const double work = jd_dot(m_roll, wrel) * dt;
+            const double dash = rsl ? 0.0 : Cr * jd_dot(wrel, wrel) * dt;
+            s->e_damp += dash;
+            s->e_fric -= work + dash;
+            u_new += ur;
+        }
+    }
+
+    if (features & JD_F_ENERGY) {
+        /* The change of stored spring energy is not dissipation: take it out of the slider term. */
+        s->e_fric -= u_new - s->u_spring;
+        s->u_spring = u_new;
+    }
+    s->flags = (double)flags;
+
+    /* Assemble: force on b, torques about each centre (eq. 19), rolling moment on b. */
+    double fa[3] = {-f[0], -f[1], -f[2]};
+    jd_cross(g->ra, fa, out->ta);
+    jd_cross(g->rb, f, out->tb);
+    for (int d = 0; d < 3; d++) {
+        out->f[d] = f[d];
+        out->ta[d] -= m_roll[d];
+        out->tb[d] += m_roll[d];
+    }
+    return 1;
+}
+
+/* Energy stored in a contact (normal spring + tangential and rolling springs) [J]; zero once
+ * the contact has ended. */
+static inline double jd_contact_elastic_energy(const jd_contact_geom *g, const jd_contact_state *s) {
+    if (((int)s->flags) & JD_S_ENDED) return 0.0;
+    return jd_normal_energy(g->k_n, g->delta) + s->u_spring;
+}
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* JDEM_KERNEL_H */

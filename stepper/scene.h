@@ -1,0 +1,106 @@
+/*
+ * scene.h — a resolved scene: one case of a scene file (docs/scenes.md) with every default filled
+ * in, every generator expanded and every value validated.  Produced by scene_load(), consumed by
+ * the simulation (sim.h) and by scene_emit_yaml() (`jdem resolve`, read by the LIGGGHTS deck
+ * generator).  SI units throughout.
+ */
+#ifndef JDEM_SCENE_H
+#define JDEM_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#define JD_NAME_MAX 64
+
+typedef struct jd_material {
+    char name[JD_NAME_MAX];
+    int has_elastic;          /* 0 for a material used only by walls (no E, nu, density) */
+    double youngs_modulus;    /* [Pa] */
+    double poisson_ratio;     /* [-]  */
+    double density;           /* [kg/m^3] */
+    double restitution;       /* (0, 1] */
+    double friction;          /* >= 0 */
+    double rolling_friction;  /* >= 0, dimensionless eta */
+} jd_material;
+
+/* Coefficients of an (unordered) pair of materials, after the interaction rules. */
+typedef struct jd_interaction {
+    double restitution, friction, rolling_friction;
+} jd_interaction;
+
+typedef enum { JD_WALL_PLANE = 0, JD_WALL_CYLINDER = 1 } jd_wall_type;
+
+typedef struct jd_wall {
+    char name[JD_NAME_MAX];
+    int type;                 /* jd_wall_type */
+    int material;             /* index into materials */
+    double velocity[3];       /* [m/s] */
+    /* plane */
+    double corners[4][3];     /* [m], counter-clockwise seen from the active side */
+    double normal[3];         /* unit normal of the active side: (P2-P1) x (P3-P1) normalised */
+    /* cylinder */
+    double axis[2][3];        /* [m] end points of the axis segment */
+    double radius;            /* [m] */
+    int inside;               /* 0: obstacle (contact on the outer surface), 1: container */
+} jd_wall;
+
+typedef struct jd_scene {
+    char path[1024];          /* the scene file */
+    char name[JD_NAME_MAX];   /* scene name */
+    char case_name[2 * JD_NAME_MAX];
+    char description[512];
+
+    /* time */
+    double dt;                /* [s] */
+    int64_t steps;            /* from steps, or ceil(end_time/dt) */
+    double max_impact_speed;  /* [m/s], resolved (given, or estimated as docs/scenes.md says) */
+
+    /* output */
+    int64_t output_every;
+    int64_t observables_every;
+
+    double gravity[3];        /* [m/s^2] */
+
+    /* model options (kernel enums) */
+    int wall_rule;            /* jd_wall_rule */
+    int damping_map;          /* jd_damping_map */
+    int xi_limit;             /* jd_xi_limit */
+    double mu_r;
+
+    size_t n_materials;
+    jd_material *materials;
+    jd_interaction *interactions; /* n_materials x n_materials, symmetric, row-major */
+
+    /* particles, sorted by id; structure of arrays */
+    size_t n_particles;
+    int64_t *id;
+    int32_t *material;        /* index into materials */
+    double *radius;           /* [m] */
+    double *position;         /* 3n [m] */
+    double *velocity;         /* 3n [m/s] */
+    double *angular_velocity; /* 3n [rad/s] */
+
+    size_t n_walls;
+    jd_wall *walls;
+} jd_scene;
+
+/* List the case names of a scene file.  Returns the number of cases (>= 1) and an array of
+ * names in *names (free with scene_free_names), or -1 with a message in err. */
+int scene_list_cases(const char *path, char ***names, char *err, size_t errlen);
+void scene_free_names(char **names, int n);
+
+/* Load one case (case_name NULL: the scene must have exactly one case).  Returns 0, or -1 with
+ * a message "FILE:LINE: key 'a.b.c': what is wrong; what would be valid" in err. */
+int scene_load(const char *path, const char *case_name, jd_scene *scene, char *err, size_t errlen);
+
+/* Write the resolved scene as YAML in the scene-file schema (no sweep, no generate, every
+ * default explicit, numbers with 17 significant digits).  Returns 0 or -1. */
+int scene_emit_yaml(const jd_scene *scene, FILE *out);
+
+/* The same text in a malloc'ed string (for /parameters/scene); NULL on failure. */
+char *scene_yaml_string(const jd_scene *scene);
+
+void scene_free(jd_scene *scene);
+
+#endif /* JDEM_SCENE_H */
