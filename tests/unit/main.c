@@ -1,0 +1,10 @@
+/* main.c — runs every unit-test suite of tests/unit; exit status is the number of failures. */
+#include "unit.h"
+
+int main(void) {
+    int failed = 0;
+    failed += run_kernel_tests();
+    failed += run_geometry_tests();
+    failed += run_h5md_tests();
+    return failed;
+}
