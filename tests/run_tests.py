@@ -1,0 +1,76 @@
+#!/usr/bin/python3
+"""Run every test suite of jdem and print one closing line "N passed, N failed".
+
+Each suite is a command.  Suites print one line per check, "PASS name" or "FAIL name: detail";
+cmocka suites print their own "[       OK ]" / "[  FAILED  ]" lines.  A suite that exits non-zero
+without reporting a failed check counts as one failed check, so a crash can never pass.
+
+Usage: tests/run_tests.py [SUITE ...]     (default: all, in order)
+"""
+import re
+import subprocess
+import sys
+import time
+
+PY = "/usr/bin/python3"
+
+# name, command, output style.  Sanitizer builds run the same checks as the plain ones.
+SUITES = [
+    ("unit", ["build/test_unit"], "cmocka"),
+    ("unit-sanitized", ["build/san/test_unit"], "cmocka"),
+]
+
+CMOCKA_OK = re.compile(r"^\[\s+OK\s+\] (\S+)")
+CMOCKA_FAIL = re.compile(r"^\[\s+FAILED\s+\] (\S+)$")
+
+
+def count(style, text):
+    """Return (passed, failed, failure lines) found in a suite's output."""
+    passed, failed = 0, []
+    for line in text.splitlines():
+        if style == "cmocka":
+            if CMOCKA_OK.match(line):
+                passed += 1
+            elif CMOCKA_FAIL.match(line) and "test(s)" not in line:
+                failed.append(line)
+        elif line.startswith("PASS "):
+            passed += 1
+        elif line.startswith("FAIL "):
+            failed.append(line)
+    return passed, failed
+
+
+def run_suite(name, cmd, style):
+    start = time.monotonic()
+    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    elapsed = time.monotonic() - start
+    passed, failed = count(style, proc.stdout)
+    if proc.returncode != 0 and not failed:
+        tail = "\n".join(proc.stdout.splitlines()[-15:])
+        failed.append(f"FAIL {name}: exit status {proc.returncode}\n{tail}")
+    print(f"== {name}: {passed} passed, {len(failed)} failed ({elapsed:.1f} s)", flush=True)
+    for line in failed:
+        print("   " + line, flush=True)
+    return passed, len(failed)
+
+
+def main(argv):
+    wanted = set(argv[1:])
+    unknown = wanted - {s[0] for s in SUITES}
+    if unknown:
+        print(f"unknown suite(s): {', '.join(sorted(unknown))}; "
+              f"valid: {', '.join(s[0] for s in SUITES)}", file=sys.stderr)
+        return 2
+    total_pass = total_fail = 0
+    for name, cmd, style in SUITES:
+        if wanted and name not in wanted:
+            continue
+        p, f = run_suite(name, cmd, style)
+        total_pass += p
+        total_fail += f
+    print(f"{total_pass} passed, {total_fail} failed")
+    return 1 if total_fail else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
