@@ -20,7 +20,7 @@ VERSION  := 0.1.0
 WARN     := -Wall -Wextra -Werror
 PKG_CFLAGS := $(shell pkg-config --cflags yaml-0.1 hdf5 2>/dev/null)
 PKG_LIBS   := $(shell pkg-config --libs yaml-0.1 hdf5 2>/dev/null) -lm
-CFLAGS   := -std=c11 -O2 -g $(WARN) -D_POSIX_C_SOURCE=200809L -DJDEM_VERSION=\"$(VERSION)\" \
+CFLAGS   := -std=c11 -O2 -g -ffp-contract=off $(WARN) -D_POSIX_C_SOURCE=200809L -DJDEM_VERSION=\"$(VERSION)\" \
             -Ikernel -Iio -Istepper $(PKG_CFLAGS)
 SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 
@@ -66,7 +66,7 @@ build/san/jdem: $(patsubst %.c,build/san/%.o,$(KERNEL_SRC) $(IO_SRC) $(STEPPER_S
 # ---------------------------------------------------------------------------------------------
 # LIGGGHTS plugin: Debian's libliggghts + our styles; the kernel and the H5MD writer are the same
 # C objects as in the stepper (compiled position-independent).
-PLUGIN_CXXFLAGS := -std=c++11 -O2 -g -Wall -Wextra -Werror -Wno-unused-parameter -fPIC \
+PLUGIN_CXXFLAGS := -std=c++11 -O2 -g -ffp-contract=off -Wall -Wextra -Werror -Wno-unused-parameter -fPIC \
                    -Ikernel -Iio -isystem /usr/include/liggghts $(PKG_CFLAGS)
 build/pic/%.o: %.c $(HEADERS)
 	@mkdir -p $(dir $@)
