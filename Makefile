@@ -27,6 +27,7 @@ SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit
 KERNEL_SRC  := $(wildcard kernel/*.c)
 IO_SRC      := $(wildcard io/*.c)
 STEPPER_SRC := $(wildcard stepper/*.c)
+SCENE_SRC   := $(wildcard stepper/scene*.c)
 PLUGIN_SRC  := $(wildcard liggghts_plugin/*.cpp)
 UNIT_SRC    := $(wildcard tests/unit/*.c)
 HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)
@@ -67,7 +68,7 @@ build/san/jdem: $(patsubst %.c,build/san/%.o,$(KERNEL_SRC) $(IO_SRC) $(STEPPER_S
 # LIGGGHTS plugin: Debian's libliggghts + our styles; the kernel and the H5MD writer are the same
 # C objects as in the stepper (compiled position-independent).
 PLUGIN_CXXFLAGS := -std=c++11 -O2 -g -ffp-contract=off -Wall -Wextra -Werror -Wno-unused-parameter -fPIC \
-                   -Ikernel -Iio -isystem /usr/include/liggghts $(PKG_CFLAGS)
+                   -DOMPI_SKIP_MPICXX -DJDEM_VERSION=\"$(VERSION)\" -Ikernel -Iio -isystem /usr/include/liggghts $(PKG_CFLAGS)
 build/pic/%.o: %.c $(HEADERS)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -fPIC -c $< -o $@
@@ -76,7 +77,7 @@ build/plugin/%.o: %.cpp $(wildcard liggghts_plugin/*.h) $(HEADERS)
 	$(CXX) $(PLUGIN_CXXFLAGS) -c $< -o $@
 build/liggghts-jdem: $(patsubst %.cpp,build/plugin/%.o,$(PLUGIN_SRC)) \
                      $(patsubst %.c,build/pic/%.o,$(KERNEL_SRC) $(IO_SRC))
-	$(CXX) $^ -o $@ -lliggghts $(PKG_LIBS)
+	$(CXX) $^ -o $@ -lliggghts $(PKG_LIBS) -ldl
 
 # ---------------------------------------------------------------------------------------------
 # Unit tests of the kernel (cmocka), plain and sanitized
@@ -87,6 +88,13 @@ build/san/test_unit: $(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC) $(HEADERS)
 	@mkdir -p build/san
 	$(CC) $(CFLAGS) $(SANFLAGS) -Itests/unit $(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC) -o $@ $(PKG_LIBS) -lcmocka
 
+# The scene reader's test program (malformed scenes with their exact messages; round trips)
+build/scene_check: tests/engine/scene_check.c $(SCENE_SRC) $(HEADERS)
+	$(CC) $(CFLAGS) tests/engine/scene_check.c $(SCENE_SRC) -o $@ $(PKG_LIBS)
+build/san/scene_check: tests/engine/scene_check.c $(SCENE_SRC) $(HEADERS)
+	@mkdir -p build/san
+	$(CC) $(CFLAGS) $(SANFLAGS) tests/engine/scene_check.c $(SCENE_SRC) -o $@ $(PKG_LIBS)
+
 unit: build/test_unit build/san/test_unit
 	build/test_unit
 	build/san/test_unit
@@ -94,7 +102,7 @@ unit: build/test_unit build/san/test_unit
 # ---------------------------------------------------------------------------------------------
 # The suites.  tests/run_tests.py runs every check and prints "N passed, N failed".
 test: deps
-	$(MAKE) all build/san/jdem build/test_unit build/san/test_unit
+	$(MAKE) all build/san/jdem build/test_unit build/san/test_unit build/scene_check build/san/scene_check
 	$(PY) tests/run_tests.py
 
 chung-ooi: build/jdem build/liggghts-jdem

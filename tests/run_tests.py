@@ -18,6 +18,8 @@ PY = "/usr/bin/python3"
 SUITES = [
     ("unit", ["build/test_unit"], "cmocka"),
     ("unit-sanitized", ["build/san/test_unit"], "cmocka"),
+    ("scenes", ["build/scene_check", "tests/scenes"], "lines"),
+    ("scenes-sanitized", ["build/san/scene_check", "tests/scenes"], "lines"),
 ]
 
 CMOCKA_OK = re.compile(r"^\[\s+OK\s+\] (\S+)")

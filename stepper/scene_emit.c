@@ -1,0 +1,256 @@
+/*
+ * scene_emit.c — a resolved jd_scene as YAML in the scene-file schema (docs/scenes.md), written
+ * with libyaml's emitter: every default explicit, no sweep and no generate, numbers with %.17g
+ * so that scene_load() of the output reproduces every double bit for bit.
+ *
+ * The output adds one key to the documented schema: `case`, the case name, so that a resolved
+ * sweep case loads back under its own name.
+ */
+#include <inttypes.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <yaml.h>
+
+#include "scene.h"
+
+/* Each emitter helper returns 0 on success and 1 on failure, so calls chain with ||. */
+
+static int emit(yaml_emitter_t *e, yaml_event_t *ev, int ok) {
+    return !ok || !yaml_emitter_emit(e, ev);
+}
+
+static int scalar(yaml_emitter_t *e, const char *text, yaml_scalar_style_t style) {
+    yaml_event_t ev;
+    int ok = yaml_scalar_event_initialize(&ev, NULL, NULL, (yaml_char_t *)text, (int)strlen(text),
+                                          1, 1, style);
+    return emit(e, &ev, ok);
+}
+
+/* Strings that other YAML readers (PyYAML in scripts/) would type as numbers, booleans or null
+ * are quoted; jdem itself reads any scalar as a string where a name is expected. */
+static int looks_typed(const char *s) {
+    static const char *const words[] = {"true", "false", "yes", "no", "on", "off", "y", "n",
+                                        "null", "~", NULL};
+    char *end;
+    if (!*s) return 1;
+    strtod(s, &end);
+    if (*end == '\0') return 1;
+    for (size_t i = 0; words[i]; i++)
+        if (strcasecmp(s, words[i]) == 0) return 1;
+    return s[0] == '.'; /* .inf, .nan */
+}
+
+static int str(yaml_emitter_t *e, const char *s) {
+    return scalar(e, s, looks_typed(s) ? YAML_DOUBLE_QUOTED_SCALAR_STYLE : YAML_ANY_SCALAR_STYLE);
+}
+
+/* %.17g reproduces every double exactly.  "1e-08" gets a ".0" ("1.0e-08") because YAML 1.1
+ * readers such as PyYAML only type a scalar with an exponent as a float if it has a dot. */
+static int num(yaml_emitter_t *e, double v) {
+    char buf[40];
+    snprintf(buf, sizeof buf, "%.17g", v);
+    char *exp = strchr(buf, 'e');
+    if (exp && !strchr(buf, '.')) {
+        memmove(exp + 2, exp, strlen(exp) + 1);
+        memcpy(exp, ".0", 2);
+    }
+    return scalar(e, buf, YAML_PLAIN_SCALAR_STYLE);
+}
+
+static int integer(yaml_emitter_t *e, int64_t v) {
+    char buf[32];
+    snprintf(buf, sizeof buf, "%" PRId64, v);
+    return scalar(e, buf, YAML_PLAIN_SCALAR_STYLE);
+}
+
+static int map_start(yaml_emitter_t *e, int flow) {
+    yaml_event_t ev;
+    int ok = yaml_mapping_start_event_initialize(
+        &ev, NULL, NULL, 1, flow ? YAML_FLOW_MAPPING_STYLE : YAML_BLOCK_MAPPING_STYLE);
+    return emit(e, &ev, ok);
+}
+
+static int map_end(yaml_emitter_t *e) {
+    yaml_event_t ev;
+    return emit(e, &ev, yaml_mapping_end_event_initialize(&ev));
+}
+
+static int seq_start(yaml_emitter_t *e, int flow) {
+    yaml_event_t ev;
+    int ok = yaml_sequence_start_event_initialize(
+        &ev, NULL, NULL, 1, flow ? YAML_FLOW_SEQUENCE_STYLE : YAML_BLOCK_SEQUENCE_STYLE);
+    return emit(e, &ev, ok);
+}
+
+static int seq_end(yaml_emitter_t *e) {
+    yaml_event_t ev;
+    return emit(e, &ev, yaml_sequence_end_event_initialize(&ev));
+}
+
+static int vec(yaml_emitter_t *e, const double *v, int n) {
+    if (seq_start(e, 1)) return 1;
+    for (int i = 0; i < n; i++)
+        if (num(e, v[i])) return 1;
+    return seq_end(e);
+}
+
+static int key_num(yaml_emitter_t *e, const char *key, double v) {
+    return str(e, key) || num(e, v);
+}
+static int key_int(yaml_emitter_t *e, const char *key, int64_t v) {
+    return str(e, key) || integer(e, v);
+}
+static int key_str(yaml_emitter_t *e, const char *key, const char *v) {
+    return str(e, key) || str(e, v);
+}
+static int key_vec(yaml_emitter_t *e, const char *key, const double *v) {
+    return str(e, key) || vec(e, v, 3);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+
+static const char *const WALL_RULES[] = {"hertz", "jiang2021"};
+static const char *const DAMPING_MAPS[] = {"jiang2021", "exact_restitution"};
+static const char *const XI_LIMITS[] = {"coulomb", "unconstrained"};
+
+static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
+    return key_int(e, "jdem_scene", 1) || key_str(e, "name", s->name) ||
+           key_str(e, "case", s->case_name) || key_str(e, "description", s->description) ||
+           str(e, "time") || map_start(e, 0) || key_num(e, "dt", s->dt) ||
+           key_int(e, "steps", s->steps) || key_num(e, "max_impact_speed", s->max_impact_speed) ||
+           map_end(e) || str(e, "output") || map_start(e, 0) ||
+           key_int(e, "every", s->output_every) ||
+           key_int(e, "observables_every", s->observables_every) || map_end(e) ||
+           key_vec(e, "gravity", s->gravity) || str(e, "model") || map_start(e, 0) ||
+           key_str(e, "wall_rule", WALL_RULES[s->wall_rule]) ||
+           key_str(e, "damping", DAMPING_MAPS[s->damping_map]) ||
+           key_str(e, "tangential_limit", XI_LIMITS[s->xi_limit]) || key_num(e, "mu_r", s->mu_r) ||
+           map_end(e);
+}
+
+static int emit_material(yaml_emitter_t *e, const jd_material *m) {
+    if (str(e, m->name) || map_start(e, 0)) return 1;
+    if (m->has_elastic &&
+        (key_num(e, "youngs_modulus", m->youngs_modulus) ||
+         key_num(e, "poisson_ratio", m->poisson_ratio) || key_num(e, "density", m->density)))
+        return 1;
+    return key_num(e, "restitution", m->restitution) || key_num(e, "friction", m->friction) ||
+           key_num(e, "rolling_friction", m->rolling_friction) || map_end(e);
+}
+
+/* Every unordered pair, the like ones included (an entry may override a like pair). */
+static int emit_interactions(yaml_emitter_t *e, const jd_scene *s) {
+    if (str(e, "interactions") || seq_start(e, 0)) return 1;
+    for (size_t a = 0; a < s->n_materials; a++)
+        for (size_t b = a; b < s->n_materials; b++) {
+            const jd_interaction *x = &s->interactions[a * s->n_materials + b];
+            if (map_start(e, 1) || str(e, "materials") || seq_start(e, 1) ||
+                str(e, s->materials[a].name) || str(e, s->materials[b].name) || seq_end(e) ||
+                key_num(e, "restitution", x->restitution) ||
+                key_num(e, "friction", x->friction) ||
+                key_num(e, "rolling_friction", x->rolling_friction) || map_end(e))
+                return 1;
+        }
+    return seq_end(e);
+}
+
+/* One flow mapping per particle: one line each, so large scenes stay greppable. */
+static int emit_particles(yaml_emitter_t *e, const jd_scene *s) {
+    if (str(e, "particles") || seq_start(e, 0)) return 1;
+    for (size_t i = 0; i < s->n_particles; i++)
+        if (map_start(e, 1) || key_int(e, "id", s->id[i]) ||
+            key_str(e, "material", s->materials[s->material[i]].name) ||
+            key_num(e, "radius", s->radius[i]) || key_vec(e, "position", &s->position[3 * i]) ||
+            key_vec(e, "velocity", &s->velocity[3 * i]) ||
+            key_vec(e, "angular_velocity", &s->angular_velocity[3 * i]) || map_end(e))
+            return 1;
+    return seq_end(e);
+}
+
+static int emit_points(yaml_emitter_t *e, const char *key, const double (*p)[3], int n) {
+    if (str(e, key) || seq_start(e, 1)) return 1;
+    for (int i = 0; i < n; i++)
+        if (vec(e, p[i], 3)) return 1;
+    return seq_end(e);
+}
+
+static int emit_wall(yaml_emitter_t *e, const jd_scene *s, const jd_wall *w) {
+    const int plane = w->type == JD_WALL_PLANE;
+    if (map_start(e, 0) || key_str(e, "name", w->name) ||
+        key_str(e, "type", plane ? "plane" : "cylinder"))
+        return 1;
+    if (plane ? emit_points(e, "corners", w->corners, 4)
+              : emit_points(e, "axis", w->axis, 2) || key_num(e, "radius", w->radius) ||
+                    key_str(e, "side", w->inside ? "inside" : "outside"))
+        return 1;
+    return key_str(e, "material", s->materials[w->material].name) ||
+           key_vec(e, "velocity", w->velocity) || map_end(e);
+}
+
+static int emit_scene(yaml_emitter_t *e, const jd_scene *s) {
+    yaml_event_t ev;
+    if (emit(e, &ev, yaml_stream_start_event_initialize(&ev, YAML_UTF8_ENCODING)) ||
+        emit(e, &ev, yaml_document_start_event_initialize(&ev, NULL, NULL, NULL, 1)) ||
+        map_start(e, 0) || emit_header(e, s) || str(e, "materials") || map_start(e, 0))
+        return 1;
+    for (size_t i = 0; i < s->n_materials; i++)
+        if (emit_material(e, &s->materials[i])) return 1;
+    if (map_end(e) || emit_interactions(e, s) || emit_particles(e, s) || str(e, "walls") ||
+        seq_start(e, 0))
+        return 1;
+    for (size_t i = 0; i < s->n_walls; i++)
+        if (emit_wall(e, s, &s->walls[i])) return 1;
+    return seq_end(e) || map_end(e) ||
+           emit(e, &ev, yaml_document_end_event_initialize(&ev, 1)) ||
+           emit(e, &ev, yaml_stream_end_event_initialize(&ev)) || !yaml_emitter_flush(e);
+}
+
+/* Emit with an output already attached to the emitter; 0 or -1. */
+static int emit_with(yaml_emitter_t *e, const jd_scene *s) {
+    yaml_emitter_set_unicode(e, 1);
+    yaml_emitter_set_width(e, -1); /* no line folding: one particle per line */
+    int rc = emit_scene(e, s) ? -1 : 0;
+    yaml_emitter_delete(e);
+    return rc;
+}
+
+int scene_emit_yaml(const jd_scene *scene, FILE *out) {
+    yaml_emitter_t e;
+    if (!yaml_emitter_initialize(&e)) return -1;
+    yaml_emitter_set_output_file(&e, out);
+    return emit_with(&e, scene);
+}
+
+typedef struct strbuf {
+    char *p;
+    size_t n, cap;
+} strbuf;
+
+static int append(void *data, unsigned char *buffer, size_t size) {
+    strbuf *b = data;
+    if (b->n + size + 1 > b->cap) {
+        size_t cap = b->cap ? b->cap : 4096;
+        while (cap < b->n + size + 1) cap *= 2;
+        char *p = realloc(b->p, cap);
+        if (!p) return 0;
+        b->p = p;
+        b->cap = cap;
+    }
+    memcpy(b->p + b->n, buffer, size);
+    b->n += size;
+    b->p[b->n] = '\0';
+    return 1;
+}
+
+char *scene_yaml_string(const jd_scene *scene) {
+    yaml_emitter_t e;
+    strbuf b = {0};
+    if (!yaml_emitter_initialize(&e)) return NULL;
+    yaml_emitter_set_output(&e, append, &b);
+    if (emit_with(&e, scene) != 0 || !b.p) {
+        free(b.p);
+        return NULL;
+    }
+    return b.p;
+}
