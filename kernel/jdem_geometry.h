@@ -1,12 +1,26 @@
 /*
- * jdem_geometry.h — contact detection geometry shared by both engines: sphere–sphere, sphere vs
- * finite plane (the seed's four-corner walls, Sec. 2.7.1) and sphere vs finite cylinder.
- * Pure C11, no I/O, no allocation, no globals.  Fills the geometric part of jd_contact_geom
- * (n, delta, ra, rb, r_roll); the engine adds k_n, m_eff and i_eff, which depend on materials.
- * Conventions as in jdem_kernel.h: body a is the particle (or the first sphere), n points a -> b.
+ * jdem_geometry.h — contact geometry of a sphere against a sphere, a finite planar
+ * quadrilateral and a finite cylinder, in the kernel's conventions (jdem_kernel.h): the single
+ * source of the geometry that both engines feed to jd_contact().
+ *
+ * Pure C11. No I/O, no allocation, no globals.  Units SI (m).  The per-candidate tests are
+ * `static inline` (they run in the force loops); set-up (plane normals) is in jdem_geometry.c.
+ *
+ * Each test fills the geometric fields of jd_contact_geom — n (unit normal from a to b), delta
+ * (overlap > 0), ra = x_C - x_a, rb = x_C - x_b, r_roll — and leaves the material fields
+ * (k_n, m_eff, i_eff) to the engine.  For a wall contact a is the particle and b the wall:
+ * rb = 0 (the kernel ignores it since w_b = 0), r_roll = R, and the contact point is the wall
+ * point nearest to the centre, x_C = x + (R - delta) n.
+ *
+ * Moving walls: the engine translates the wall (corners / axis end points) before the test.
+ *
+ * Both engines call these functions, so they open and close contacts at the same steps and
+ * feed the kernel bit-identical geometry.
  */
-#ifndef JDEM_GEOMETRY_H
-#define JDEM_GEOMETRY_H
+#ifndef JDEM_KERNEL_GEOMETRY_H
+#define JDEM_KERNEL_GEOMETRY_H
+
+#include <math.h>
 
 #include "jdem_kernel.h"
 
@@ -14,110 +28,123 @@
 extern "C" {
 #endif
 
-/* A finite planar quadrilateral wall. */
-typedef struct jd_plane {
-    double p[4][3]; /* corners, counter-clockwise seen from the active side      [m] */
-    double n[3];    /* unit normal of the active side: (P2-P1) x (P3-P1) / |..|  [-] */
-} jd_plane;
+/* Results of the set-up functions. */
+enum {
+    JD_GEOM_OK = 0,
+    JD_GEOM_DEGENERATE = 1, /* zero-area plane (P1, P2, P3 collinear) or zero-length axis */
+    JD_GEOM_NOT_PLANAR = 2  /* P4 is off the plane of P1, P2, P3 by more than the tolerance */
+};
 
-/* A finite cylinder: axis segment a0 -> a1, radius rc. */
-typedef struct jd_cylinder {
-    double a0[3], a1[3]; /* axis end points                                       [m] */
-    double rc;           /* radius                                                [m] */
-    int inside;          /* 0: contact on the outer surface (an obstacle); 1: a container */
-} jd_cylinder;
+/* ------------------------------------------------------------------------------------------ */
+/* Sphere–sphere                                                                               */
+/* ------------------------------------------------------------------------------------------ */
 
-enum { JD_GEOM_OK = 0, JD_GEOM_DEGENERATE = 1, JD_GEOM_NOT_PLANAR = 2 };
-
-/* Set up a plane from four corners: computes the unit normal and checks that the corners are
- * not collinear and lie in one plane (relative tolerance rel_tol of the wall size).
- * Returns JD_GEOM_OK, JD_GEOM_DEGENERATE or JD_GEOM_NOT_PLANAR. */
-int jd_plane_init(jd_plane *w, const double corners[4][3], double rel_tol);
-
-/* Translate a wall rigidly by d [m] (moving walls). */
-void jd_plane_translate(jd_plane *w, const double d[3]);
-void jd_cylinder_translate(jd_cylinder *c, const double d[3]);
-
-/* Sphere a (centre xa, radius Ra) against sphere b.  Returns 1 and fills n, delta, ra, rb,
- * r_roll when they overlap (d^2 < (Ra+Rb)^2, the LIGGGHTS criterion), else 0. */
+/* Sphere a (centre xa [m], radius Ra [m]) against sphere b (xb, Rb).  Contact when
+ * rsq < (Ra + Rb)^2, rsq = |xb - xa|^2 (LIGGGHTS' test), with delta > 0 and r > 0.  Fills
+ * n = (xb - xa)/r (as (xb - xa) * (1/r)), delta = Ra + Rb - r,
+ * ra = (Ra - delta/2) n (= x_C - xa), rb = ra - (xb - xa) (= x_C - xb),
+ * r_roll = Ra Rb/(Ra + Rb) [m], and returns 1; returns 0 without contact. */
 static inline int jd_geom_spheres(const double xa[3], double Ra, const double xb[3], double Rb,
                                   jd_contact_geom *g) {
-    const double dx = xb[0] - xa[0], dy = xb[1] - xa[1], dz = xb[2] - xa[2];
-    const double rsq = dx * dx + dy * dy + dz * dz;
+    const double dx[3] = {xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]};
+    const double rsq = jd_dot(dx, dx);
     const double radsum = Ra + Rb;
     if (rsq >= radsum * radsum) return 0;
-    const double r = sqrt(rsq);
-    const double rinv = 1.0 / r;
-    g->n[0] = dx * rinv;
-    g->n[1] = dy * rinv;
-    g->n[2] = dz * rinv;
-    g->delta = radsum - r;
-    const double la = Ra - 0.5 * g->delta; /* x_C = x_a + (R_a - delta/2) n */
-    for (int d = 0; d < 3; d++) {
-        g->ra[d] = la * g->n[d];
-        g->rb[d] = g->ra[d] - (xb[d] - xa[d]);
+    const double d = sqrt(rsq);
+    const double delta = radsum - d;
+    if (!(delta > 0.0) || d == 0.0) return 0;
+    const double rinv = 1.0 / d;
+    const double la = Ra - 0.5 * delta; /* |x_C - x_a| [m] */
+    for (int k = 0; k < 3; k++) {
+        g->n[k] = dx[k] * rinv;
+        g->ra[k] = la * g->n[k];
+        g->rb[k] = g->ra[k] - dx[k];
     }
+    g->delta = delta;
     g->r_roll = Ra * Rb / radsum;
     return 1;
 }
 
-/* Sphere (centre x, radius R) against a finite plane, active side only: contact when the signed
- * distance s = n_w.(x - P1) satisfies 0 < s < R and the projection x_C = x - s n_w lies inside the
- * quadrilateral (eq. 36 with a unit normal; the inside test uses cross products, erratum 11).
- * Contacts with the edges and corners of the quadrilateral are not modelled.  n = -n_w. */
-static inline int jd_geom_plane(const jd_plane *w, const double x[3], double R, jd_contact_geom *g) {
-    double rel[3] = {x[0] - w->p[0][0], x[1] - w->p[0][1], x[2] - w->p[0][2]};
-    const double s = jd_dot(w->n, rel);
-    if (!(s > 0.0 && s < R)) return 0;
-    double xc[3];
-    for (int d = 0; d < 3; d++) xc[d] = x[d] - s * w->n[d];
+/* ------------------------------------------------------------------------------------------ */
+/* Finite planar quadrilateral (seed Sec. 2.7.1)                                               */
+/* ------------------------------------------------------------------------------------------ */
+
+typedef struct jd_plane {
+    double p[4][3]; /* corners [m], counter-clockwise seen from the active side               */
+    double n[3];    /* unit normal of the active side, (P2-P1) x (P3-P1) normalised [-]        */
+} jd_plane;
+
+/* Copy the corners and compute the unit normal.  tol [-]: P4 may be off the plane of P1..P3 by
+ * at most tol times the longest corner-to-P1 distance.  Returns JD_GEOM_OK,
+ * JD_GEOM_DEGENERATE or JD_GEOM_NOT_PLANAR. */
+int jd_plane_init(jd_plane *w, const double corners[4][3], double tol);
+
+/* Sphere (centre x [m], radius R [m]) against plane w.  s = n_w.(x - P1) is the signed
+ * distance; contact when 0 < s < R and the projection x_C = x - s n_w lies inside the quad
+ * (((P_{k+1} - P_k) x (x_C - P_k)).n_w >= 0 for the four edges; edge and corner contacts of a
+ * centre projecting outside are not modelled).  Fills n = -n_w, delta = R - s,
+ * ra = (R - delta) n, rb = 0, r_roll = R; returns 1, or 0 without contact. */
+static inline int jd_geom_plane(const jd_plane *w, const double x[3], double R,
+                                jd_contact_geom *g) {
+    const double rel[3] = {x[0] - w->p[0][0], x[1] - w->p[0][1], x[2] - w->p[0][2]};
+    const double sd = jd_dot(w->n, rel);
+    if (!(sd > 0.0 && sd < R)) return 0;
+    const double xc[3] = {x[0] - sd * w->n[0], x[1] - sd * w->n[1], x[2] - sd * w->n[2]};
     for (int k = 0; k < 4; k++) {
-        const double *p0 = w->p[k], *p1 = w->p[(k + 1) & 3];
-        const double e[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-        const double c[3] = {xc[0] - p0[0], xc[1] - p0[1], xc[2] - p0[2]};
+        const double *p = w->p[k], *q = w->p[(k + 1) & 3];
+        const double e[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        const double c[3] = {xc[0] - p[0], xc[1] - p[1], xc[2] - p[2]};
         double cr[3];
         jd_cross(e, c, cr);
         if (jd_dot(cr, w->n) < 0.0) return 0;
     }
-    for (int d = 0; d < 3; d++) {
-        g->n[d] = -w->n[d];
-        g->ra[d] = xc[d] - x[d];
-        g->rb[d] = 0.0;
+    g->delta = R - sd;
+    const double la = R - g->delta;
+    for (int k = 0; k < 3; k++) {
+        g->n[k] = -w->n[k];
+        g->ra[k] = la * g->n[k];
+        g->rb[k] = 0.0;
     }
-    g->delta = R - s;
     g->r_roll = R;
     return 1;
 }
 
-/* Sphere against a finite cylinder: the centre's projection onto the axis must lie within the
- * segment.  Outside: delta = R + rc - d, n from the centre towards the axis.  Inside (container):
- * delta = d + R - rc, n from the axis through the centre.  The contact point is on the cylinder
- * surface along n. */
+/* ------------------------------------------------------------------------------------------ */
+/* Finite cylinder (lateral surface only, no end caps)                                         */
+/* ------------------------------------------------------------------------------------------ */
+
+typedef struct jd_cylinder {
+    double a0[3], a1[3]; /* end points of the axis segment                              [m] */
+    double rc;           /* cylinder radius                                             [m] */
+    int inside;          /* 0: obstacle (outer surface); 1: container (inner surface)   [-] */
+} jd_cylinder;
+
+/* Sphere (x [m], R [m]) against cylinder c.  With u = (a1 - a0)/|a1 - a0| the centre projects
+ * to t = (x - a0).u, which must satisfy 0 <= t <= |a1 - a0|; d > 0 is the distance from the
+ * axis.  Obstacle: delta = R + rc - d, n towards the axis; container: delta = d + R - rc,
+ * n away from the axis.  Fills n, delta, ra = (R - delta) n, rb = 0, r_roll = R; returns 1, or
+ * 0 without contact (also for a zero-length axis or a centre on the axis). */
 static inline int jd_geom_cylinder(const jd_cylinder *c, const double x[3], double R,
                                    jd_contact_geom *g) {
-    const double ax[3] = {c->a1[0] - c->a0[0], c->a1[1] - c->a0[1], c->a1[2] - c->a0[2]};
+    const double ab[3] = {c->a1[0] - c->a0[0], c->a1[1] - c->a0[1], c->a1[2] - c->a0[2]};
+    const double len = sqrt(jd_dot(ab, ab));
+    if (!(len > 0.0)) return 0;
+    const double u[3] = {ab[0] / len, ab[1] / len, ab[2] / len};
     const double rel[3] = {x[0] - c->a0[0], x[1] - c->a0[1], x[2] - c->a0[2]};
-    const double len2 = jd_dot(ax, ax);
-    const double t = jd_dot(rel, ax);
-    if (t < 0.0 || t > len2) return 0;
-    const double f = t / len2;
-    double radial[3]; /* from the axis to the centre */
-    for (int d = 0; d < 3; d++) radial[d] = rel[d] - f * ax[d];
-    const double dist = sqrt(jd_dot(radial, radial));
-    double delta;
-    if (c->inside) {
-        delta = dist + R - c->rc;
-        if (!(delta > 0.0) || dist == 0.0) return 0;
-        for (int d = 0; d < 3; d++) g->n[d] = radial[d] / dist;
-    } else {
-        delta = R + c->rc - dist;
-        if (!(delta > 0.0) || dist == 0.0) return 0;
-        for (int d = 0; d < 3; d++) g->n[d] = -radial[d] / dist;
-    }
-    g->delta = delta;
-    for (int d = 0; d < 3; d++) {
-        g->ra[d] = (R - delta) * g->n[d];
-        g->rb[d] = 0.0;
+    const double t = jd_dot(rel, u);
+    if (!(t >= 0.0 && t <= len)) return 0;
+    const double r[3] = {rel[0] - t * u[0], rel[1] - t * u[1], rel[2] - t * u[2]};
+    const double d = sqrt(jd_dot(r, r));
+    if (d == 0.0) return 0;
+    const double dl = c->inside ? d + R - c->rc : R + c->rc - d;
+    if (!(dl > 0.0)) return 0;
+    const double sgn = (c->inside ? 1.0 : -1.0) / d;
+    g->delta = dl;
+    const double la = R - dl;
+    for (int k = 0; k < 3; k++) {
+        g->n[k] = sgn * r[k];
+        g->ra[k] = la * g->n[k];
+        g->rb[k] = 0.0;
     }
     g->r_roll = R;
     return 1;
@@ -126,4 +153,4 @@ static inline int jd_geom_cylinder(const jd_cylinder *c, const double x[3], doub
 #ifdef __cplusplus
 }
 #endif
-#endif /* JDEM_GEOMETRY_H */
+#endif /* JDEM_KERNEL_GEOMETRY_H */

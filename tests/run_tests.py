@@ -7,6 +7,7 @@ without reporting a failed check counts as one failed check, so a crash can neve
 
 Usage: tests/run_tests.py [SUITE ...]     (default: all, in order)
 """
+import os
 import re
 import subprocess
 import sys
@@ -14,13 +15,19 @@ import time
 
 PY = "/usr/bin/python3"
 
-# name, command, output style.  Sanitizer builds run the same checks as the plain ones.
+ENGINE_TESTS = ["neighbour", "free_flight", "hertz_impact", "energy_balance", "guard"]
+SANITIZED = {"JDEM": "build/san/jdem"}
+
+# name, command, output style, extra environment.  Sanitizer builds run the same checks.
 SUITES = [
-    ("unit", ["build/test_unit"], "cmocka"),
-    ("unit-sanitized", ["build/san/test_unit"], "cmocka"),
-    ("scenes", ["build/scene_check", "tests/scenes"], "lines"),
-    ("scenes-sanitized", ["build/san/scene_check", "tests/scenes"], "lines"),
+    ("unit", ["build/test_unit"], "cmocka", {}),
+    ("unit-sanitized", ["build/san/test_unit"], "cmocka", {}),
+    ("scenes", ["build/scene_check", "tests/scenes"], "lines", {}),
+    ("scenes-sanitized", ["build/san/scene_check", "tests/scenes"], "lines", {}),
 ]
+SUITES += [(f"engine-{t}", [PY, f"tests/engine/test_{t}.py"], "lines", {}) for t in ENGINE_TESTS]
+SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines", SANITIZED)
+           for t in ENGINE_TESTS]
 
 CMOCKA_OK = re.compile(r"^\[\s+OK\s+\] (\S+)")
 CMOCKA_FAIL = re.compile(r"^\[\s+FAILED\s+\] (\S+)$")
@@ -42,9 +49,10 @@ def count(style, text):
     return passed, failed
 
 
-def run_suite(name, cmd, style):
+def run_suite(name, cmd, style, env):
     start = time.monotonic()
-    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                          env={**os.environ, **env})
     elapsed = time.monotonic() - start
     passed, failed = count(style, proc.stdout)
     if proc.returncode != 0 and not failed:
@@ -64,10 +72,10 @@ def main(argv):
               f"valid: {', '.join(s[0] for s in SUITES)}", file=sys.stderr)
         return 2
     total_pass = total_fail = 0
-    for name, cmd, style in SUITES:
+    for name, cmd, style, env in SUITES:
         if wanted and name not in wanted:
             continue
-        p, f = run_suite(name, cmd, style)
+        p, f = run_suite(name, cmd, style, env)
         total_pass += p
         total_fail += f
     print(f"{total_pass} passed, {total_fail} failed")

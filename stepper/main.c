@@ -1,0 +1,252 @@
+/*
+ * main.c — the `jdem` command line (docs/scenes.md).
+ *
+ * Exit status: 0 success, 2 usage or input error (bad option, bad scene, unsafe time step),
+ * 1 runtime failure (cannot write the output, simulation diverged, out of memory).  A failed run
+ * never leaves a file under the final output name: the writer works on OUT.part and renames it
+ * only at a successful close.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "h5md.h"
+#include "scene.h"
+#include "sim.h"
+
+#ifndef JDEM_VERSION
+#define JDEM_VERSION "unknown"
+#endif
+
+enum { EXIT_RUNTIME = 1, EXIT_USAGE = 2 };
+
+static const char usage_text[] =
+    "usage: jdem COMMAND SCENE [OPTIONS]\n"
+    "\n"
+    "jdem, a discrete element engine for granular materials (the contact laws of Jiang 2021).\n"
+    "A scene file (YAML, see docs/scenes.md) describes materials, particles, walls, gravity,\n"
+    "time step and output; a sweep turns it into several cases.\n"
+    "\n"
+    "commands:\n"
+    "  cases SCENE              list the case names of SCENE, one per line\n"
+    "  run SCENE                run one case and write its trajectory (H5MD)\n"
+    "  resolve SCENE            print the case as YAML with every default explicit and every\n"
+    "                           generator expanded (the input of the LIGGGHTS deck generator)\n"
+    "  --help, -h               print this help\n"
+    "  --version                print the version\n"
+    "\n"
+    "options:\n"
+    "  --case NAME              the case to run or resolve (required when SCENE has several)\n"
+    "  -o, --output OUT.h5      trajectory file (run; default out/SCENE_NAME/CASE.jdem.h5,\n"
+    "                           directories are created).  Written as OUT.h5.part and renamed\n"
+    "                           when the run completes, so OUT.h5 is never a truncated file\n"
+    "  --force                  run even if the time step is unsafe (run)\n"
+    "  --quiet                  no summary and no progress line on stderr (run)\n"
+    "\n"
+    "time-step guard (run): dt must not exceed 20 % of the Rayleigh time step of the smallest\n"
+    "sphere, nor 1/50 of the shortest Hertz contact time at time.max_impact_speed; otherwise\n"
+    "the run is refused (exit status 2) unless --force is given.\n"
+    "\n"
+    "environment:\n"
+    "  JDEM_NEIGHBOUR=allpairs  debugging aid: evaluate every particle pair and every\n"
+    "                           particle-wall pair each step (O(N^2)) instead of the Verlet\n"
+    "                           list; results must agree with the default path\n"
+    "\n"
+    "exit status: 0 success, 1 runtime failure, 2 usage or input error.\n";
+
+typedef struct cli {
+    const char *command, *scene, *case_name, *output;
+    int force, quiet;
+} cli;
+
+static int usage_error(const char *msg, const char *arg) {
+    fprintf(stderr, "jdem: %s%s%s\n", msg, arg ? ": " : "", arg ? arg : "");
+    fprintf(stderr, "Try 'jdem --help'.\n");
+    return EXIT_USAGE;
+}
+
+/* Returns 0, or an exit status. */
+static int parse(int argc, char **argv, cli *c) {
+    memset(c, 0, sizeof *c);
+    for (int k = 1; k < argc; k++) {
+        const char *a = argv[k];
+        const int has_value = k + 1 < argc;
+        if (!strcmp(a, "--case")) {
+            if (!has_value) return usage_error("--case needs a value", NULL);
+            c->case_name = argv[++k];
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            if (!has_value) return usage_error("-o needs a value", NULL);
+            c->output = argv[++k];
+        } else if (!strcmp(a, "--force")) {
+            c->force = 1;
+        } else if (!strcmp(a, "--quiet")) {
+            c->quiet = 1;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return usage_error("unknown option", a);
+        } else if (!c->command) {
+            c->command = a;
+        } else if (!c->scene) {
+            c->scene = a;
+        } else {
+            return usage_error("unexpected argument", a);
+        }
+    }
+    if (!c->command) return usage_error("missing command", NULL);
+    if (strcmp(c->command, "cases") && strcmp(c->command, "run") && strcmp(c->command, "resolve"))
+        return usage_error("unknown command", c->command);
+    if (!c->scene) return usage_error("missing SCENE", NULL);
+    if (strcmp(c->command, "run") && (c->output || c->force || c->quiet))
+        return usage_error("-o, --force and --quiet apply to 'run' only", NULL);
+    if (!strcmp(c->command, "cases") && c->case_name)
+        return usage_error("--case does not apply to 'cases'", NULL);
+    return 0;
+}
+
+static int cmd_cases(const cli *c) {
+    char err[1024];
+    char **names = NULL;
+    const int n = scene_list_cases(c->scene, &names, err, sizeof err);
+    if (n < 0) {
+        fprintf(stderr, "jdem: %s\n", err);
+        return EXIT_USAGE;
+    }
+    for (int k = 0; k < n; k++) printf("%s\n", names[k]);
+    scene_free_names(names, n);
+    return 0;
+}
+
+static int load(const cli *c, jd_scene *sc) {
+    char err[1024];
+    if (scene_load(c->scene, c->case_name, sc, err, sizeof err) != 0) {
+        fprintf(stderr, "jdem: %s\n", err);
+        return EXIT_USAGE;
+    }
+    return 0;
+}
+
+static int cmd_resolve(const cli *c) {
+    jd_scene sc;
+    int rc = load(c, &sc);
+    if (rc) return rc;
+    if (scene_emit_yaml(&sc, stdout) != 0 || fflush(stdout) != 0) {
+        fprintf(stderr, "jdem: cannot write the resolved scene\n");
+        rc = EXIT_RUNTIME;
+    }
+    scene_free(&sc);
+    return rc;
+}
+
+/* mkdir -p of the directory part of path. */
+static int make_parent_dirs(const char *path, char *err, size_t errlen) {
+    char buf[4096];
+    if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) {
+        snprintf(err, errlen, "output path too long");
+        return -1;
+    }
+    for (char *p = buf + 1; *p; p++) {
+        if (*p != '/') continue;
+        *p = '\0';
+        if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
+            snprintf(err, errlen, "cannot create directory %.900s: %s", buf, strerror(errno));
+            return -1;
+        }
+        *p = '/';
+    }
+    return 0;
+}
+
+/* The guard's verdict; prints the summary.  Returns 0 to go ahead, else an exit status. */
+static int check_time_step(const jd_scene *sc, const cli *c) {
+    jd_guard g;
+    sim_guard(sc, &g);
+    if (!c->quiet) {
+        fprintf(stderr, "jdem: dt = %.6g s; 20 %% Rayleigh bound = %.6g s; shortest contact time = %.6g s",
+                sc->dt, g.rayleigh_bound, g.contact_time);
+        if (isfinite(g.contact_time))
+            fprintf(stderr, " at %.6g m/s (%.1f steps per contact)\n", sc->max_impact_speed,
+                    g.contact_time / sc->dt);
+        else
+            fprintf(stderr, " (no impact to resolve)\n");
+    }
+    if (!g.violated) return 0;
+    if (!c->force) {
+        fprintf(stderr,
+                "jdem: time step %g s is unsafe: it exceeds %s (%.6g s); largest safe dt = %.6g s. "
+                "Use --force to run anyway.\n",
+                sc->dt, g.violated, g.violated_value, g.safe_dt);
+        return EXIT_USAGE;
+    }
+    fprintf(stderr, "jdem: warning: time step %g s exceeds %s (%.6g s); running anyway (--force)\n",
+            sc->dt, g.violated, g.violated_value);
+    return 0;
+}
+
+static int cmd_run(const cli *c) {
+    jd_scene sc;
+    int rc = load(c, &sc);
+    if (rc) return rc;
+    char err[1024] = "";
+    char out[4096];
+    jd_sim sim;
+    int sim_ok = 0;
+    jd_h5md *h = NULL;
+    char *yaml = NULL;
+    if ((rc = check_time_step(&sc, c)) != 0) goto done;
+    rc = EXIT_RUNTIME;
+    if (c->output)
+        snprintf(out, sizeof out, "%s", c->output);
+    else if (snprintf(out, sizeof out, "out/%s/%s.jdem.h5", sc.name, sc.case_name) >= (int)sizeof out)
+        goto done;
+    if (make_parent_dirs(out, err, sizeof err) != 0) goto fail;
+    if (sim_init(&sim, &sc, getenv("JDEM_NEIGHBOUR") && !strcmp(getenv("JDEM_NEIGHBOUR"), "allpairs"),
+                 err, sizeof err) != 0)
+        goto fail;
+    sim_ok = 1;
+    yaml = scene_yaml_string(&sc);
+    const jd_h5md_meta meta = {.creator = "jdem", .creator_version = JDEM_VERSION,
+                               .scene_name = sc.name, .case_name = sc.case_name,
+                               .scene_yaml = yaml, .dt = sc.dt};
+    const jd_h5md_particles parts = {.n = sc.n_particles, .id = sc.id, .species = sim.species,
+                                     .radius = sim.radius, .mass = sim.mass};
+    if (!(h = jd_h5md_create(out, &meta, &parts, err, sizeof err))) goto fail;
+    if (sim_run(&sim, h, !c->quiet, err, sizeof err) != 0) {
+        char err2[256];
+        jd_h5md_close(h, 0, err2, sizeof err2);
+        fprintf(stderr, "jdem: %s; the partial trajectory is in %s.part\n", err, out);
+        goto done;
+    }
+    if (jd_h5md_close(h, 1, err, sizeof err) != 0) goto fail;
+    if (!c->quiet)
+        fprintf(stderr, "jdem: wrote %s (%lld steps, %lld neighbour builds)\n", out,
+                (long long)sim.step, (long long)sim.n_builds);
+    rc = 0;
+    goto done;
+fail:
+    fprintf(stderr, "jdem: %s\n", err[0] ? err : "output path too long");
+done:
+    free(yaml);
+    if (sim_ok) sim_free(&sim);
+    scene_free(&sc);
+    return rc;
+}
+
+int main(int argc, char **argv) {
+    for (int k = 1; k < argc; k++) {
+        if (!strcmp(argv[k], "--help") || !strcmp(argv[k], "-h")) {
+            fputs(usage_text, stdout);
+            return 0;
+        }
+        if (!strcmp(argv[k], "--version")) {
+            printf("jdem %s\n", JDEM_VERSION);
+            return 0;
+        }
+    }
+    cli c;
+    const int rc = parse(argc, argv, &c);
+    if (rc) return rc;
+    if (!strcmp(c.command, "cases")) return cmd_cases(&c);
+    if (!strcmp(c.command, "resolve")) return cmd_resolve(&c);
+    return cmd_run(&c);
+}

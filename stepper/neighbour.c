@@ -1,0 +1,275 @@
+/*
+ * neighbour.c — contact candidates.
+ *
+ * A cell list (cell edge >= 2 R_max + skin) yields a half Verlet list of the pairs i < j whose
+ * surfaces are closer than the skin, and a list of (particle, wall) candidates within the skin
+ * of a wall.  The lists are rebuilt only when some particle, or some wall, has moved more than
+ * skin/2 since the last build: then no pair can have closed a gap of one skin in between, so no
+ * contact is missed.
+ *
+ * Both lists are sorted by (i, j), which fixes the force summation order (deterministic) and
+ * lets the contact history be carried over to a new list by one merge of the two sorted lists.
+ * Entries that are not carried over are dropped after their dissipated energies are added to
+ * the run's totals, so the dissipation observables lose nothing at a rebuild.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim.h"
+
+static int list_reserve(jd_contact_list *l, size_t need, int rolling) {
+    if (need <= l->cap) return 0;
+    size_t cap = l->cap ? l->cap : 256;
+    while (cap < need) cap += cap / 2;
+    int32_t *i = realloc(l->i, cap * sizeof *i);
+    if (i) l->i = i;
+    int32_t *j = realloc(l->j, cap * sizeof *j);
+    if (j) l->j = j;
+    jd_contact_state *st = realloc(l->state, cap * sizeof *st);
+    if (st) l->state = st;
+    jd_rolling_state *r = rolling ? realloc(l->roll, cap * sizeof *r) : NULL;
+    if (r) l->roll = r;
+    if (!i || !j || !st || (rolling && !r)) return -1;
+    l->cap = cap;
+    return 0;
+}
+
+static int list_push(jd_contact_list *l, int32_t i, int32_t j, int rolling) {
+    if (l->n == l->cap && list_reserve(l, l->n + 1, rolling) != 0) return -1;
+    l->i[l->n] = i;
+    l->j[l->n] = j;
+    l->n++;
+    return 0;
+}
+
+void sim_contact_list_free(jd_contact_list *l) {
+    free(l->i);
+    free(l->j);
+    free(l->state);
+    free(l->roll);
+    memset(l, 0, sizeof *l);
+}
+
+static int key_less(const jd_contact_list *a, size_t p, const jd_contact_list *b, size_t q) {
+    return a->i[p] < b->i[q] || (a->i[p] == b->i[q] && a->j[p] < b->j[q]);
+}
+
+/* Give every entry of nw the history of the same (i, j) in old, or a fresh (zero) history. */
+static void carry_over(jd_sim *s, const jd_contact_list *old, jd_contact_list *nw) {
+    size_t a = 0;
+    for (size_t b = 0; b < nw->n; b++) {
+        for (; a < old->n && key_less(old, a, nw, b); a++) {
+            s->e_damp_dropped += old->state[a].e_damp;
+            s->e_fric_dropped += old->state[a].e_fric;
+        }
+        if (a < old->n && !key_less(nw, b, old, a)) {
+            nw->state[b] = old->state[a];
+            if (nw->roll) nw->roll[b] = old->roll[a];
+            a++;
+        } else {
+            memset(&nw->state[b], 0, sizeof nw->state[b]);
+            if (nw->roll) memset(&nw->roll[b], 0, sizeof nw->roll[b]);
+        }
+    }
+    for (; a < old->n; a++) {
+        s->e_damp_dropped += old->state[a].e_damp;
+        s->e_fric_dropped += old->state[a].e_fric;
+    }
+}
+
+/* Can particle i touch wall w before the next rebuild (relative motion <= skin)?  The kernel's
+ * contact tests with every distance widened by the skin. */
+static int wall_candidate(const jd_sim_wall *w, const double *x, double R, double skin) {
+    if (w->type == JD_WALL_PLANE) {
+        const jd_plane *pl = &w->plane;
+        const double rel[3] = {x[0] - pl->p[0][0], x[1] - pl->p[0][1], x[2] - pl->p[0][2]};
+        const double sd = jd_dot(pl->n, rel);
+        if (!(sd > -skin && sd < R + skin)) return 0;
+        /* projection within skin of the quadrilateral: signed distance to each edge line */
+        for (int k = 0; k < 4; k++) {
+            const double *p = pl->p[k], *q = pl->p[(k + 1) & 3];
+            const double e[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+            const double c[3] = {x[0] - p[0], x[1] - p[1], x[2] - p[2]};
+            double cr[3];
+            jd_cross(e, c, cr);
+            if (jd_dot(cr, pl->n) < -skin * sqrt(jd_dot(e, e))) return 0;
+        }
+        return 1;
+    }
+    const jd_cylinder *cy = &w->cyl;
+    const double ab[3] = {cy->a1[0] - cy->a0[0], cy->a1[1] - cy->a0[1], cy->a1[2] - cy->a0[2]};
+    const double len = sqrt(jd_dot(ab, ab));
+    const double rel[3] = {x[0] - cy->a0[0], x[1] - cy->a0[1], x[2] - cy->a0[2]};
+    const double t = jd_dot(rel, ab) / len;
+    if (!(t > -skin && t < len + skin)) return 0;
+    const double d = sqrt(fmax(jd_dot(rel, rel) - t * t, 0.0)); /* distance from the axis */
+    return cy->inside ? d > cy->rc - R - skin : d < cy->rc + R + skin;
+}
+
+static int build_wall_list(jd_sim *s, jd_contact_list *l) {
+    const int rolling = (s->features & JD_F_ROLLING) != 0;
+    for (size_t i = 0; i < s->n; i++)
+        for (size_t w = 0; w < s->n_walls; w++)
+            if ((s->allpairs || wall_candidate(&s->walls[w], s->x + 3 * i, s->radius[i], s->skin)) &&
+                list_push(l, (int32_t)i, (int32_t)w, rolling) != 0)
+                return -1;
+    return 0;
+}
+
+static void sort_segment(int32_t *j, size_t n) { /* insertion sort: a few dozen entries */
+    for (size_t a = 1; a < n; a++) {
+        const int32_t v = j[a];
+        size_t b = a;
+        for (; b > 0 && j[b - 1] > v; b--) j[b] = j[b - 1];
+        j[b] = v;
+    }
+}
+
+/* Sort particles into cells (counting sort, so each cell lists its particles in index order). */
+static int bin_particles(jd_sim *s, double h, const double lo[3], const int nc[3]) {
+    const size_t ncell = (size_t)nc[0] * (size_t)nc[1] * (size_t)nc[2];
+    if (ncell + 1 > s->cell_cap) {
+        int32_t *cs = realloc(s->cell_start, (ncell + 1) * sizeof *cs);
+        if (!cs) return -1;
+        s->cell_start = cs;
+        s->cell_cap = ncell + 1;
+    }
+    memset(s->cell_start, 0, (ncell + 1) * sizeof *s->cell_start);
+    for (size_t i = 0; i < s->n; i++) {
+        int c[3];
+        for (int d = 0; d < 3; d++) {
+            c[d] = (int)((s->x[3 * i + d] - lo[d]) / h);
+            c[d] = c[d] < 0 ? 0 : c[d] >= nc[d] ? nc[d] - 1 : c[d];
+        }
+        s->cell_of[i] = (int32_t)(((size_t)c[2] * (size_t)nc[1] + (size_t)c[1]) * (size_t)nc[0] + (size_t)c[0]);
+        s->cell_start[s->cell_of[i] + 1]++;
+    }
+    for (size_t c = 0; c < ncell; c++) s->cell_start[c + 1] += s->cell_start[c];
+    for (size_t i = 0; i < s->n; i++) s->cell_items[s->cell_start[s->cell_of[i]]++] = (int32_t)i;
+    for (size_t c = ncell; c > 0; c--) s->cell_start[c] = s->cell_start[c - 1]; /* undo the shift */
+    s->cell_start[0] = 0;
+    return 0;
+}
+
+static int build_pair_list_cells(jd_sim *s, jd_contact_list *l, char *err, size_t errlen) {
+    if (s->n < 2) return 0;
+    const int rolling = (s->features & JD_F_ROLLING) != 0;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double rmax = 0.0;
+    for (size_t i = 0; i < s->n; i++) {
+        for (int d = 0; d < 3; d++) {
+            const double xd = s->x[3 * i + d];
+            if (!isfinite(xd)) {
+                snprintf(err, errlen, "particle %lld has a non-finite position at step %lld",
+                         (long long)s->scene->id[i], (long long)s->step);
+                return -1;
+            }
+            lo[d] = fmin(lo[d], xd);
+            hi[d] = fmax(hi[d], xd);
+        }
+        rmax = fmax(rmax, s->radius[i]);
+    }
+    /* cell edge >= the largest interaction range, grown if the box would need more than
+     * about 8 cells per particle (sparse or scattered systems) */
+    double h = 2.0 * rmax + s->skin;
+    const double max_cells = 8.0 * (double)s->n + 64.0;
+    double cells = 1.0;
+    for (int d = 0; d < 3; d++) cells *= floor((hi[d] - lo[d]) / h) + 1.0;
+    if (cells > max_cells) h *= cbrt(cells / max_cells) * 1.01;
+    int nc[3];
+    for (int d = 0; d < 3; d++) nc[d] = (int)floor((hi[d] - lo[d]) / h) + 1;
+    if (bin_particles(s, h, lo, nc) != 0) goto oom;
+
+    for (size_t i = 0; i < s->n; i++) {
+        const int32_t ci = s->cell_of[i];
+        const int c[3] = {ci % nc[0], (ci / nc[0]) % nc[1], ci / (nc[0] * nc[1])};
+        const double *xi = s->x + 3 * i;
+        const double ri = s->radius[i];
+        const size_t first = l->n;
+        for (int dz = -1; dz <= 1; dz++) {
+            const int z = c[2] + dz;
+            if (z < 0 || z >= nc[2]) continue;
+            for (int dy = -1; dy <= 1; dy++) {
+                const int y = c[1] + dy;
+                if (y < 0 || y >= nc[1]) continue;
+                for (int dx = -1; dx <= 1; dx++) {
+                    const int x = c[0] + dx;
+                    if (x < 0 || x >= nc[0]) continue;
+                    const size_t cell = ((size_t)z * (size_t)nc[1] + (size_t)y) * (size_t)nc[0] + (size_t)x;
+                    for (int32_t q = s->cell_start[cell]; q < s->cell_start[cell + 1]; q++) {
+                        const int32_t j = s->cell_items[q];
+                        if ((size_t)j <= i) continue;
+                        const double *xj = s->x + 3 * (size_t)j;
+                        const double d[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
+                        const double range = ri + s->radius[j] + s->skin;
+                        if (jd_dot(d, d) < range * range &&
+                            list_push(l, (int32_t)i, j, rolling) != 0)
+                            goto oom;
+                    }
+                }
+            }
+        }
+        sort_segment(l->j + first, l->n - first);
+    }
+    return 0;
+oom:
+    snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", l->n);
+    return -1;
+}
+
+static int build_pair_list_all(jd_sim *s, jd_contact_list *l) {
+    const int rolling = (s->features & JD_F_ROLLING) != 0;
+    for (size_t i = 0; i < s->n; i++)
+        for (size_t j = i + 1; j < s->n; j++)
+            if (list_push(l, (int32_t)i, (int32_t)j, rolling) != 0) return -1;
+    return 0;
+}
+
+/* Build a new list into `spare`, carry the history over, swap. */
+int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
+    jd_contact_list *nw = &s->spare;
+    nw->n = 0;
+    if (s->allpairs) {
+        if (build_pair_list_all(s, nw) != 0) {
+            snprintf(err, errlen, "out of memory building the all-pairs list (%zu particles)", s->n);
+            return -1;
+        }
+    } else if (build_pair_list_cells(s, nw, err, errlen) != 0) {
+        return -1;
+    }
+    carry_over(s, &s->pairs, nw);
+    jd_contact_list t = s->pairs;
+    s->pairs = *nw;
+    *nw = t;
+
+    nw->n = 0;
+    if (build_wall_list(s, nw) != 0) {
+        snprintf(err, errlen, "out of memory building the wall candidate list");
+        return -1;
+    }
+    carry_over(s, &s->wall_pairs, nw);
+    t = s->wall_pairs;
+    s->wall_pairs = *nw;
+    *nw = t;
+
+    memcpy(s->x_build, s->x, 3 * s->n * sizeof *s->x);
+    for (size_t w = 0; w < s->n_walls; w++) memset(s->walls[w].disp, 0, sizeof s->walls[w].disp);
+    s->n_builds++;
+    return 0;
+}
+
+int sim_neighbour_stale(const jd_sim *s) {
+    if (s->allpairs) return 0;
+    const double lim = 0.25 * s->skin * s->skin; /* (skin/2)^2 */
+    for (size_t w = 0; w < s->n_walls; w++)
+        if (jd_dot(s->walls[w].disp, s->walls[w].disp) > lim) return 1;
+    for (size_t i = 0; i < s->n; i++) {
+        const double d[3] = {s->x[3 * i] - s->x_build[3 * i], s->x[3 * i + 1] - s->x_build[3 * i + 1],
+                             s->x[3 * i + 2] - s->x_build[3 * i + 2]};
+        /* !(<=) so that a NaN position forces a rebuild, which reports it */
+        if (!(jd_dot(d, d) <= lim)) return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,64 @@
+/*
+ * observables.c — the /observables of docs/scenes.md.  Called after the final half kick, so
+ * velocities are full-step values; positions (and hence contact geometry) are those the step's
+ * forces were computed at, so the elastic energy matches the contact states.
+ */
+#include "geometry.h"
+#include "sim.h"
+
+const char *const jd_observable_names[JD_N_OBSERVABLES] = {
+    "kinetic_energy", "rotational_energy", "elastic_energy",   "gravitational_energy",
+    "damping_dissipation", "friction_dissipation", "wall_work", "contacts", "wall_contacts"};
+
+void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES]) {
+    const double v[JD_N_OBSERVABLES] = {o->kinetic_energy,      o->rotational_energy,
+                                        o->elastic_energy,      o->gravitational_energy,
+                                        o->damping_dissipation, o->friction_dissipation,
+                                        o->wall_work,           o->contacts,
+                                        o->wall_contacts};
+    for (int k = 0; k < JD_N_OBSERVABLES; k++) out[k] = v[k];
+}
+
+/* Dissipation of every listed entry, including separated pairs still in the list (their
+ * accumulators survive jd_contact_separate). */
+static void list_energies(const jd_contact_list *l, double *damp, double *fric) {
+    for (size_t c = 0; c < l->n; c++) {
+        *damp += l->state[c].e_damp;
+        *fric += l->state[c].e_fric;
+    }
+}
+
+static int carries_force(const jd_contact_state *st) {
+    return !(((int)st->flags) & JD_S_ENDED);
+}
+
+void sim_observables(const jd_sim *s, jd_observables *o) {
+    *o = (jd_observables){0};
+    for (size_t i = 0; i < s->n; i++) {
+        const double *v = s->v + 3 * i, *w = s->omega + 3 * i, *x = s->x + 3 * i;
+        o->kinetic_energy += 0.5 * s->mass[i] * jd_dot(v, v);
+        o->rotational_energy += 0.5 * s->inertia[i] * jd_dot(w, w);
+        o->gravitational_energy -= s->mass[i] * jd_dot(s->g, x);
+    }
+    for (size_t c = 0; c < s->pairs.n; c++) {
+        jd_contact_geom g;
+        const jd_contact_state *st = &s->pairs.state[c];
+        if (!sim_pair_geom(s, 0u, s->pairs.i[c], s->pairs.j[c], &g) || !carries_force(st)) continue;
+        o->elastic_energy += jd_contact_elastic_energy(&g, st);
+        o->contacts += 1.0;
+    }
+    for (size_t c = 0; c < s->wall_pairs.n; c++) {
+        jd_contact_geom g;
+        const jd_contact_state *st = &s->wall_pairs.state[c];
+        if (!sim_wall_geom(s, s->wall_pairs.i[c], &s->walls[s->wall_pairs.j[c]], &g) ||
+            !carries_force(st))
+            continue;
+        o->elastic_energy += jd_contact_elastic_energy(&g, st);
+        o->wall_contacts += 1.0;
+    }
+    o->damping_dissipation = s->e_damp_dropped;
+    o->friction_dissipation = s->e_fric_dropped;
+    list_energies(&s->pairs, &o->damping_dissipation, &o->friction_dissipation);
+    list_energies(&s->wall_pairs, &o->damping_dissipation, &o->friction_dissipation);
+    o->wall_work = s->wall_work;
+}

@@ -1,0 +1,153 @@
+/*
+ * sim.h — the standalone engine: state of one run and the functions that advance it.
+ *
+ * One file per mechanism (REBOUND style):
+ *   sim.c          set-up from a resolved scene, the run loop with output, tear-down
+ *   neighbour.c    cell list -> half Verlet list with skin, wall candidates, history carry-over
+ *   walls.c        wall set-up and rigid translation
+ *   geometry.h     contact geometry (kernel/jdem_geometry.h) plus material fields (inline)
+ *   forces.c       force loops, specialised at compile time for the scene's feature set
+ *   integrate.c    one velocity-Verlet step exactly as LIGGGHTS fix nve/sphere
+ *   observables.c  energies and contact counts
+ *   guard.c        the time-step guard
+ *   progress.c     the progress line on stderr
+ *
+ * Data layout.  Particle vectors (x, v, omega, f, torque) are arrays of 3n doubles, x0 y0 z0 x1
+ * ...: the kernel takes double[3] arguments, so a contact passes &x[3i] without gathering; the
+ * three components of one particle share a cache line (a contact reads all three at once); and
+ * the H5MD writer takes exactly this layout, so frames are written without a copy.  Per-particle
+ * constants are separate arrays (structure of arrays) so that each loop streams only what it
+ * uses.  All indices are the scene's order (sorted by id); pairs are always i < j.
+ */
+#ifndef JDEM_SIM_H
+#define JDEM_SIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "jdem_geometry.h"
+#include "jdem_kernel.h"
+#include "scene.h"
+
+/* A list of contact candidates (i, j) sorted by (i, j), with the history of each contact stored
+ * alongside.  For particle pairs j is a particle index (> i); for wall candidates a wall index.
+ * Buffers grow geometrically and are reused across rebuilds (no allocation per contact). */
+typedef struct jd_contact_list {
+    size_t n, cap;
+    int32_t *i, *j;
+    jd_contact_state *state;
+    jd_rolling_state *roll; /* NULL unless the scene has rolling resistance */
+} jd_contact_list;
+
+/* A wall as the engine moves it: the kernel's shape (translated in place) plus what the engine
+ * needs around it. */
+typedef struct jd_sim_wall {
+    int type;          /* jd_wall_type: which of plane / cyl is used */
+    int material;      /* index into the scene's materials */
+    double v[3];       /* translation velocity [m/s] */
+    jd_plane plane;
+    jd_cylinder cyl;
+    double disp[3];    /* translation since the last neighbour build [m] */
+} jd_sim_wall;
+
+typedef struct jd_sim {
+    const jd_scene *scene;
+    size_t n;          /* particles */
+    double dt;         /* [s] */
+    int64_t step;      /* steps done */
+    unsigned features; /* JD_F_* bits of the force loops, fixed for the run */
+
+    /* particle state, 3n each */
+    double *x, *v, *omega, *f, *torque;
+    /* per-particle constants */
+    int32_t *species;
+    double *radius, *mass, *inertia;
+    double *kp;        /* Hertz prefactor jd_hertz_prefactor(E, nu, R) */
+    double *kw;        /* wall prefactor jd_kn_wall(rule, E, nu, R) */
+    double *dtfm;      /* 0.5 dt / m, as fix nve/sphere */
+    double *dtirot;    /* (0.5 dt / 0.4) / (r r m), as fix nve/sphere */
+
+    size_t n_materials;
+    jd_pair_coeffs *coeffs; /* n_materials^2, row-major: coefficients of (material a, material b) */
+    double g[3];
+
+    size_t n_walls;
+    jd_sim_wall *walls;
+
+    /* neighbour search */
+    int allpairs;      /* debugging reference: every pair, never rebuilt (JDEM_NEIGHBOUR=allpairs) */
+    double skin;       /* [m] */
+    double *x_build;   /* positions at the last build, 3n */
+    jd_contact_list pairs, wall_pairs, spare;
+    int64_t n_builds;
+    int32_t *cell_of, *cell_items, *cell_start;
+    size_t cell_cap;   /* capacity of cell_start */
+
+    /* energy bookkeeping */
+    double e_damp_dropped, e_fric_dropped; /* accumulators of contacts dropped from the lists */
+    double wall_work;  /* work done on the particles by the walls [J] */
+} jd_sim;
+
+/* sim.c */
+/* Set up from a loaded scene (kept by pointer; it must outlive the sim) and compute the forces
+ * of step 0 (LIGGGHTS `setup`).  Returns 0, or -1 with a reason in err. */
+int sim_init(jd_sim *s, const jd_scene *scene, int allpairs, char *err, size_t errlen);
+void sim_free(jd_sim *s);
+
+struct jd_h5md;
+/* Run scene->steps steps writing frames and observables to h (which may be NULL: no output).
+ * show_progress: print the progress line on stderr.  Returns 0, or -1 with a reason in err. */
+int sim_run(jd_sim *s, struct jd_h5md *h, int show_progress, char *err, size_t errlen);
+
+/* neighbour.c */
+int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
+int sim_neighbour_stale(const jd_sim *s); /* 1 when a rebuild is due */
+void sim_contact_list_free(jd_contact_list *l);
+
+/* walls.c */
+int sim_walls_init(jd_sim *s, char *err, size_t errlen);
+void sim_walls_move(jd_sim *s);
+
+/* forces.c: zero f and torque, then pair forces, wall forces, gravity. */
+void sim_compute_forces(jd_sim *s);
+
+/* integrate.c: one full step.  Returns 0, or -1 with a reason in err. */
+int sim_step(jd_sim *s, char *err, size_t errlen);
+
+/* observables.c */
+typedef struct jd_observables {
+    double kinetic_energy, rotational_energy, elastic_energy, gravitational_energy;
+    double damping_dissipation, friction_dissipation, wall_work;
+    double contacts, wall_contacts;
+} jd_observables;
+#define JD_N_OBSERVABLES 9
+extern const char *const jd_observable_names[JD_N_OBSERVABLES];
+void sim_observables(const jd_sim *s, jd_observables *o);
+void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES]);
+
+/* guard.c: time-step bounds of a scene. */
+typedef struct jd_guard {
+    double rayleigh_bound;   /* 0.2 x the smallest Rayleigh step [s]; INFINITY without particles */
+    double contact_time;     /* shortest Hertz contact time at max_impact_speed [s]; INFINITY if none */
+    double contact_bound;    /* contact_time / JD_GUARD_STEPS_PER_CONTACT [s] */
+    double safe_dt;          /* min of the two bounds [s] */
+    const char *violated;    /* description of the tightest violated bound, or NULL when safe */
+    double violated_value;   /* its value [s] */
+} jd_guard;
+#define JD_GUARD_RAYLEIGH_FRACTION 0.2
+#define JD_GUARD_STEPS_PER_CONTACT 50.0
+void sim_guard(const jd_scene *scene, jd_guard *g);
+
+/* progress.c */
+typedef struct jd_progress {
+    int enabled, tty;
+    int64_t total;
+    size_t n;
+    double t_start, t_last; /* CLOCK_MONOTONIC seconds */
+    int printed;
+} jd_progress;
+void progress_start(jd_progress *p, int enabled, int64_t total_steps, size_t n_particles);
+void progress_update(jd_progress *p, int64_t step, double sim_time);
+void progress_finish(jd_progress *p);
+
+#endif /* JDEM_SIM_H */
