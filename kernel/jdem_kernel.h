@@ -102,26 +102,32 @@ typedef struct jd_kinematics {
 /* Zero-initialised state means "contact just detected" (t_0 of eq. 9).                        */
 /* ------------------------------------------------------------------------------------------ */
 typedef struct jd_contact_state {
-    double xi[3];    /* cumulative tangential displacement, kept in the tangent plane      [m]    */
-    double u_spring; /* tangential + rolling spring energy after the last evaluation       [J]    */
-    double e_damp;   /* energy dissipated by the dashpots (incl. energy lost at Luding's end) [J] */
-    double e_fric;   /* energy dissipated by the tangential and rolling sliders            [J]    */
-    double flags;    /* JD_S_* bits stored as a small integer value                         [-]    */
+    double xi[3];     /* cumulative tangential displacement, kept in the tangent plane     [m]    */
+    double flags;     /* JD_S_* bits stored as a small integer value                        [-]    */
+    /* Energy bookkeeping (JD_F_ENERGY), second order in dt like the velocity-Verlet integrator:
+     * the work of a step is the average of the forces at its two ends times the displacement. */
+    double f_prev[3]; /* force on b at the previous evaluation                             [N]    */
+    double fd_prev;   /* normal dashpot force C_n d(delta)/dt at the previous evaluation   [N]    */
+    double u_prev;    /* energy stored in the contact's springs at the previous evaluation [J]    */
+    double e_damp;    /* energy dissipated by the dashpots and lost at Luding's end       [J]    */
+    double e_fric;    /* energy dissipated by the tangential and rolling springs/sliders  [J]    */
 } jd_contact_state;
 
 enum { JD_S_ENDED = 1, JD_S_SLIDING = 2 };
 
-#define JD_CONTACT_STATE_LEN 7 /* doubles in jd_contact_state */
+#define JD_CONTACT_STATE_LEN 11 /* doubles in jd_contact_state */
 /* 1 where the entry is a vector component that changes sign when a and b swap, else 0. */
-static const int jd_contact_state_newton[JD_CONTACT_STATE_LEN] = {1, 1, 1, 0, 0, 0, 0};
+static const int jd_contact_state_newton[JD_CONTACT_STATE_LEN] = {1, 1, 1, 0, 1, 1, 1,
+                                                                  0, 0, 0, 0};
 
 /* Rolling history, only allocated by scenes with rolling resistance. */
 typedef struct jd_rolling_state {
-    double theta[3]; /* cumulative relative rotation (w_b - w_a) dt                       [rad]  */
+    double theta[3];  /* cumulative relative rotation (w_b - w_a) dt                      [rad]  */
+    double m_prev[3]; /* rolling moment on b at the previous evaluation (JD_F_ENERGY)     [N m]  */
 } jd_rolling_state;
 
-#define JD_ROLLING_STATE_LEN 3
-static const int jd_rolling_state_newton[JD_ROLLING_STATE_LEN] = {1, 1, 1};
+#define JD_ROLLING_STATE_LEN 6
+static const int jd_rolling_state_newton[JD_ROLLING_STATE_LEN] = {1, 1, 1, 1, 1, 1};
 
 /* What one evaluation returns. */
 typedef struct jd_contact_result {
@@ -197,7 +203,7 @@ double jd_gamma_for(int damping_map, double e);
 double jd_rayleigh_step(double R, double rho, double E, double nu);
 
 /* Duration of an undamped Hertz impact, F = k_n delta^1.5, effective mass m_eff [kg],
- * approach speed v [m/s]: t_c = 2 tau (m/k)^(2/5) v^(-1/5) with the exact constant [s]. */
+ * approach speed v [m/s]: t_c = tau (m/k)^(2/5) v^(-1/5), tau = 3.2181 (docs/model.md §8) [s]. */
 double jd_hertz_contact_time(double m_eff, double k_n, double v);
 
 /* Peak overlap [m] and peak force [N] of the same impact. */
@@ -210,12 +216,13 @@ double jd_hertz_peak_force(double m_eff, double k_n, double v);
 
 /* Reset the history when the bodies separate (delta <= 0): the next overlap is a new contact.
  * The dissipated-energy accumulators are kept (they are cumulative per pair); engines that
- * drop the pair read them first. */
+ * drop the pair read them first.  Nothing is booked: the little energy still stored at the last
+ * contact step returns to the bodies during the separating step. */
 static inline void jd_contact_separate(jd_contact_state *s, jd_rolling_state *r) {
-    s->xi[0] = s->xi[1] = s->xi[2] = 0.0;
-    s->u_spring = 0.0;
-    s->flags = 0.0;
-    if (r) r->theta[0] = r->theta[1] = r->theta[2] = 0.0;
+    for (int d = 0; d < 3; d++) s->xi[d] = s->f_prev[d] = 0.0;
+    s->flags = s->fd_prev = s->u_prev = 0.0;
+    if (r)
+        for (int d = 0; d < 3; d++) r->theta[d] = r->m_prev[d] = 0.0;
 }
 
 /* Keep a stored tangential vector in the current tangent plane: remove its normal component and
@@ -304,6 +311,9 @@ static inline int jd_contact(const unsigned features, const jd_pair_coeffs *c,
     for (int d = 0; d < 3; d++) vrel[d] = (k->vb[d] + wxb[d]) - (k->va[d] + wxa[d]);
     const double vn = jd_dot(vrel, g->n);
     const double ddelta = -vn; /* overlap rate */
+    double wrel[3] = {0.0, 0.0, 0.0};
+    if (features & JD_F_ROLLING)
+        for (int d = 0; d < 3; d++) wrel[d] = k->wb[d] - k->wa[d];
     int flags = (int)s->flags;
 
     for (int d = 0; d < 3; d++) out->f[d] = out->ta[d] = out->tb[d] = 0.0;
@@ -318,23 +328,25 @@ static inline int jd_contact(const unsigned features, const jd_pair_coeffs *c,
     /* Normal law. */
     const double gamma = (features & JD_F_DAMPING) ? c->gamma : 0.0;
     double Kn, Cn;
-    double fn = jd_normal_force(g->k_n, g->delta, ddelta, gamma, g->m_eff, &Kn, &Cn);
-    if (features & JD_F_DAMPING) {
-        if (fn <= 0.0) {
-            /* Luding's end of collision: no tensile force; history resets; the energy still
-             * stored in the springs is never returned, so it counts as dissipated. */
-            if (features & JD_F_ENERGY)
-                s->e_damp += jd_normal_energy(g->k_n, g->delta) + s->u_spring;
-            jd_contact_separate(s, r);
-            s->flags = (double)JD_S_ENDED;
-            return 0;
+    const double fn = jd_normal_force(g->k_n, g->delta, ddelta, gamma, g->m_eff, &Kn, &Cn);
+    if ((features & JD_F_DAMPING) && fn <= 0.0) {
+        /* Luding's end of collision: no tensile force; history resets.  The energy still stored
+         * in the springs is never returned, so it counts as dissipated, less the work the
+         * previous step's force still does during this step (trapezoidal rule, see below). */
+        if (features & JD_F_ENERGY) {
+            double w = jd_dot(s->f_prev, vrel);
+            if (features & JD_F_ROLLING) w += jd_dot(r->m_prev, wrel);
+            s->e_damp += s->u_prev - 0.5 * w * dt;
         }
-        if (features & JD_F_ENERGY) s->e_damp += Cn * ddelta * ddelta * dt;
+        jd_contact_separate(s, r);
+        s->flags = (double)JD_S_ENDED;
+        return 0;
     }
     out->fn = fn;
     double f[3] = {fn * g->n[0], fn * g->n[1], fn * g->n[2]};
     double m_roll[3] = {0.0, 0.0, 0.0};
-    double u_new = 0.0;
+    double u_new = (features & JD_F_ENERGY) ? jd_normal_energy(g->k_n, g->delta) : 0.0;
+    double dash = 0.0; /* dashpot share of this step's dissipation [J] */
 
     if (features & JD_F_FRICTION) {
         double vt[3];
@@ -355,41 +367,45 @@ static inline int jd_contact(const unsigned features, const jd_pair_coeffs *c,
         flags = sliding ? (flags | JD_S_SLIDING) : (flags & ~JD_S_SLIDING);
         for (int d = 0; d < 3; d++) f[d] += ft[d];
         if (features & JD_F_ENERGY) {
-            /* Spring energy: the part of the force the spring carries. */
+            /* the spring carries the whole force while sliding, -K_t xi while sticking */
             double fs[3];
             for (int d = 0; d < 3; d++) fs[d] = sliding ? ft[d] : -Kt * s->xi[d];
-            const double ut = Kt > 0.0 ? 0.5 * jd_dot(fs, fs) / Kt : 0.0;
-            const double work = jd_dot(ft, vt) * dt; /* done on the bodies */
-            const double dash = sliding ? 0.0 : Ct * jd_dot(vt, vt) * dt;
-            s->e_damp += dash;
-            s->e_fric -= work + dash;
-            u_new += ut;
+            u_new += Kt > 0.0 ? 0.5 * jd_dot(fs, fs) / Kt : 0.0;
+            if (!sliding) dash += Ct * jd_dot(vt, vt) * dt;
         }
     }
 
     if (features & JD_F_ROLLING) {
-        double wrel[3];
-        for (int d = 0; d < 3; d++) wrel[d] = k->wb[d] - k->wa[d];
-        const double Kr = Kn * g->r_roll * g->r_roll;   /* K_r = K_t r^2 */
+        const double Kr = Kn * g->r_roll * g->r_roll;         /* K_r = K_t r^2 */
         const double Cr = 2.0 * gamma * sqrt(g->i_eff * Kr); /* eq. (32) */
         const int rsl = jd_capped_spring(r->theta, wrel, Kr, Cr, c->eta * g->r_roll * fn, dt,
                                          c->xi_limit, m_roll);
         if (features & JD_F_ENERGY) {
             double ms[3];
             for (int d = 0; d < 3; d++) ms[d] = rsl ? m_roll[d] : -Kr * r->theta[d];
-            const double ur = Kr > 0.0 ? 0.5 * jd_dot(ms, ms) / Kr : 0.0;
-            const double work = jd_dot(m_roll, wrel) * dt;
-            const double dash = rsl ? 0.0 : Cr * jd_dot(wrel, wrel) * dt;
-            s->e_damp += dash;
-            s->e_fric -= work + dash;
-            u_new += ur;
+            u_new += Kr > 0.0 ? 0.5 * jd_dot(ms, ms) / Kr : 0.0;
+            if (!rsl) dash += Cr * jd_dot(wrel, wrel) * dt;
         }
     }
 
     if (features & JD_F_ENERGY) {
-        /* The change of stored spring energy is not dissipation: take it out of the slider term. */
-        s->e_fric -= u_new - s->u_spring;
-        s->u_spring = u_new;
+        /* Velocity Verlet changes the bodies' kinetic energy by the average of the forces at the
+         * two ends of a step times its displacement (exactly, up to terms that cancel over a
+         * collision), so the contact books the same: work W on the bodies this step, and what it
+         * dissipated is -W less the change of its stored energy.  The normal dashpot's share is
+         * the same trapezoid on its own force; the remainder is the sliders' (friction). */
+        double w = jd_dot(s->f_prev, vrel) + jd_dot(f, vrel);
+        if (features & JD_F_ROLLING) w += jd_dot(r->m_prev, wrel) + jd_dot(m_roll, wrel);
+        const double fd = Cn * ddelta;
+        dash += 0.5 * (s->fd_prev + fd) * ddelta * dt;
+        const double diss = -0.5 * w * dt - (u_new - s->u_prev);
+        s->e_damp += dash;
+        s->e_fric += diss - dash;
+        s->fd_prev = fd;
+        s->u_prev = u_new;
+        for (int d = 0; d < 3; d++) s->f_prev[d] = f[d];
+        if (features & JD_F_ROLLING)
+            for (int d = 0; d < 3; d++) r->m_prev[d] = m_roll[d];
     }
     s->flags = (double)flags;
 
@@ -405,12 +421,9 @@ static inline int jd_contact(const unsigned features, const jd_pair_coeffs *c,
     return 1;
 }
 
-/* Energy stored in a contact (normal spring + tangential and rolling springs) [J]; zero once
- * the contact has ended. */
-static inline double jd_contact_elastic_energy(const jd_contact_geom *g, const jd_contact_state *s) {
-    if (((int)s->flags) & JD_S_ENDED) return 0.0;
-    return jd_normal_energy(g->k_n, g->delta) + s->u_spring;
-}
+/* Energy stored in a contact (normal spring + tangential and rolling springs) at its last
+ * evaluation [J] (JD_F_ENERGY); zero once the contact has ended. */
+static inline double jd_contact_elastic_energy(const jd_contact_state *s) { return s->u_prev; }
 
 #ifdef __cplusplus
 }

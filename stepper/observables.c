@@ -40,21 +40,22 @@ void sim_observables(const jd_sim *s, jd_observables *o) {
         o->rotational_energy += 0.5 * s->inertia[i] * jd_dot(w, w);
         o->gravitational_energy -= s->mass[i] * jd_dot(s->g, x);
     }
+    /* Stored energy comes from the contact state (zero for separated and ended contacts); the
+     * geometry decides which contacts count. */
     for (size_t c = 0; c < s->pairs.n; c++) {
         jd_contact_geom g;
         const jd_contact_state *st = &s->pairs.state[c];
-        if (!sim_pair_geom(s, 0u, s->pairs.i[c], s->pairs.j[c], &g) || !carries_force(st)) continue;
-        o->elastic_energy += jd_contact_elastic_energy(&g, st);
-        o->contacts += 1.0;
+        o->elastic_energy += jd_contact_elastic_energy(st);
+        if (sim_pair_geom(s, 0u, s->pairs.i[c], s->pairs.j[c], &g) && carries_force(st))
+            o->contacts += 1.0;
     }
     for (size_t c = 0; c < s->wall_pairs.n; c++) {
         jd_contact_geom g;
         const jd_contact_state *st = &s->wall_pairs.state[c];
-        if (!sim_wall_geom(s, s->wall_pairs.i[c], &s->walls[s->wall_pairs.j[c]], &g) ||
-            !carries_force(st))
-            continue;
-        o->elastic_energy += jd_contact_elastic_energy(&g, st);
-        o->wall_contacts += 1.0;
+        o->elastic_energy += jd_contact_elastic_energy(st);
+        if (sim_wall_geom(s, s->wall_pairs.i[c], &s->walls[s->wall_pairs.j[c]], &g) &&
+            carries_force(st))
+            o->wall_contacts += 1.0;
     }
     o->damping_dissipation = s->e_damp_dropped;
     o->friction_dissipation = s->e_fric_dropped;

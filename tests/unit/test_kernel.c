@@ -163,7 +163,7 @@ static void rolling_cap(void **state) {
     jd_pair_coeffs c = {.gamma = 0.0, .mu = 0.0, .eta = 0.1, .mu_r = 1.0, .xi_limit = JD_XI_COULOMB};
     jd_kinematics kin = {.wb = {0.0, 50.0, 0.0}};
     jd_contact_state s = {0};
-    jd_rolling_state r = {{0}};
+    jd_rolling_state r = {{0}, {0}};
     jd_contact_result out;
     for (int i = 0; i < 5; i++) jd_contact(JD_F_ROLLING, &c, &g, &kin, 1e-3, &s, &r, &out);
     const double cap = 0.1 * g.r_roll * k * pow(d, 1.5);
@@ -181,7 +181,7 @@ static void angular_momentum_balance(void **state) {
     jd_pair_coeffs c = {.gamma = 0.1, .mu = 0.4, .eta = 0.05, .mu_r = 1.0, .xi_limit = JD_XI_COULOMB};
     jd_kinematics kin = {.va = {0.1, 0.2, 0.5}, .wa = {3, -1, 2}, .vb = {-0.3, 0.1, -0.5}, .wb = {-2, 4, 1}};
     jd_contact_state s = {0};
-    jd_rolling_state r = {{0}};
+    jd_rolling_state r = {{0}, {0}};
     jd_contact_result out;
     jd_contact(JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING, &c, &g, &kin, 1e-6, &s, &r, &out);
     double xab[3], lever[3];
@@ -194,24 +194,30 @@ static void angular_momentum_balance(void **state) {
 }
 
 /* Luding's end of collision: an over-damped unloading contact never pulls; it ends, drops its
- * history, books its stored energy as dissipated, and stays ended while it keeps separating. */
+ * history, and books as dissipated the energy it had stored, less the work its last force still
+ * does over the ending step (trapezoidal rule); it stays ended while the bodies separate. */
 static void luding_end_of_collision(void **state) {
     (void)state;
-    const double R = 0.01, k = 2e9, d = 1e-6, m = 0.01;
+    const double R = 0.01, k = 2e9, d = 1e-6, m = 0.01, dt = 1e-7;
     jd_contact_geom g = geom_z(d, R, k, m);
     jd_pair_coeffs c = {.gamma = 2.0, .mu = 0.3, .mu_r = 1.0, .xi_limit = JD_XI_COULOMB};
-    jd_kinematics kin = {.vb = {0.01, 0.0, 1.0}}; /* b moves away fast: unloading */
-    jd_contact_state s = {.xi = {1e-9, 0, 0}};
+    jd_contact_state s = {0};
     jd_contact_result out;
     const unsigned F = JD_F_DAMPING | JD_F_FRICTION | JD_F_ENERGY;
-    assert_int_equal(jd_contact(F, &c, &g, &kin, 1e-7, &s, NULL, &out), 0);
+    jd_kinematics slow = {.vb = {0.0, 0.0, -1e-6}}; /* loading slowly: stores energy */
+    assert_int_equal(jd_contact(F, &c, &g, &slow, dt, &s, NULL, &out), 1);
+    const double f1 = out.fn, stored = s.u_prev;
+    assert_rel(stored, jd_normal_energy(k, d), 1e-14);
+    const double damp_before = s.e_damp;
+    jd_kinematics fast = {.vb = {0.01, 0.0, 1.0}}; /* b moves away fast: over-damped unloading */
+    assert_int_equal(jd_contact(F, &c, &g, &fast, dt, &s, NULL, &out), 0);
     assert_true(out.fn == 0.0 && out.f[0] == 0.0 && out.f[2] == 0.0);
-    assert_true(s.xi[0] == 0.0 && ((int)s.flags & JD_S_ENDED));
-    assert_rel(s.e_damp, jd_normal_energy(k, d), 1e-14);
-    assert_int_equal(jd_contact(F, &c, &g, &kin, 1e-7, &s, NULL, &out), 0);
+    assert_true(s.xi[0] == 0.0 && s.u_prev == 0.0 && ((int)s.flags & JD_S_ENDED));
+    assert_rel(s.e_damp - damp_before, stored - 0.5 * f1 * 1.0 * dt, 1e-12);
+    assert_int_equal(jd_contact(F, &c, &g, &fast, dt, &s, NULL, &out), 0);
     /* approaching again while still overlapping starts a new contact */
-    kin.vb[2] = -1.0;
-    assert_int_equal(jd_contact(F, &c, &g, &kin, 1e-7, &s, NULL, &out), 1);
+    fast.vb[2] = -1.0;
+    assert_int_equal(jd_contact(F, &c, &g, &fast, dt, &s, NULL, &out), 1);
     assert_true(out.fn > 0.0);
 }
 
