@@ -106,7 +106,7 @@ test: deps
 	$(PY) tests/run_tests.py
 
 chung-ooi: build/jdem build/liggghts-jdem
-	$(PY) scripts/chung_ooi.py run --out out/chung_ooi
+	$(PY) scripts/chung_ooi.py run --engines jdem,liggghts --out out/chung_ooi
 
 demo: deps
 	$(MAKE) all

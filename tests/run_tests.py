@@ -28,6 +28,14 @@ SUITES = [
 SUITES += [(f"engine-{t}", [PY, f"tests/engine/test_{t}.py"], "lines", {}) for t in ENGINE_TESTS]
 SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines", SANITIZED)
            for t in ENGINE_TESTS]
+# The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
+# `make demo` runs the full sweeps.
+CHUNG_OOI = "out/test/chung_ooi"
+SUITES += [
+    ("chung-ooi", ["sh", "-c", f"{PY} scripts/chung_ooi.py run --quick --engines jdem,liggghts "
+                   f"--out {CHUNG_OOI} && {PY} scripts/chung_ooi.py check --out {CHUNG_OOI}"],
+     "lines", {}),
+]
 
 CMOCKA_OK = re.compile(r"^\[\s+OK\s+\] (\S+)")
 CMOCKA_FAIL = re.compile(r"^\[\s+FAILED\s+\] (\S+)$")
