@@ -1,0 +1,76 @@
+#!/usr/bin/python3
+"""Evidence for a model option: run Chung–Ooi tests with each value of one `model:` option and
+print, per test and metric, the RMS and largest deviation from the references that
+scripts/chung_ooi.py uses (closed forms, rigid-body limits, the digitized Test 5 curves).
+
+    scripts/model_option_evidence.py tangential_limit coulomb unconstrained [--tests 4,5,6,8]
+
+Writes the scenes and trajectories under out/evidence/OPTION/VALUE/.  The result of this command
+is quoted in docs/model.md (choice of the tangential limit).
+"""
+import argparse
+import collections
+import os
+import sys
+
+import numpy as np
+import yaml
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import chung_ooi  # noqa: E402  (the benchmark's runner and analysis, reused as they are)
+
+SKIPPED_METRICS = {"run_wall_time_s", "force_at_end"}
+
+
+def scenes_with(option, value, work):
+    """A chung_ooi.scene_path replacement that returns each test's scene with model.OPTION set."""
+    def scene_path(test):
+        path = os.path.join(work, "scenes", f"test{test}.yaml")
+        if not os.path.exists(path):
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            with open(os.path.join(chung_ooi.ROOT, "reference_runs", "chung_ooi", f"test{test}",
+                                   "scene.yaml")) as f:
+                scene = yaml.safe_load(f)
+            scene.setdefault("model", {})[option] = value
+            with open(path, "w") as f:
+                yaml.safe_dump(scene, f)
+        return path
+    return scene_path
+
+
+def deviations(records):
+    """{(test, metric): array of |value - reference|} over the records with a reference."""
+    dev = collections.defaultdict(list)
+    for r in records:
+        if r["metric"] in SKIPPED_METRICS or r.get("reference") is None or r.get("value") is None:
+            continue
+        dev[(r["test"], r["metric"])].append(abs(r["value"] - r["reference"]))
+    return {k: np.array(v) for k, v in dev.items()}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("option")
+    parser.add_argument("values", nargs="+")
+    parser.add_argument("--tests", default="4,5,6,8")
+    args = parser.parse_args()
+    tests = [int(t) for t in args.tests.split(",")]
+    results = {}
+    for value in args.values:
+        work = os.path.join(chung_ooi.ROOT, "out", "evidence", args.option, value)
+        chung_ooi.scene_path = scenes_with(args.option, value, work)
+        chung_ooi.run_all(os.path.join(work, "out"), tests, ["jdem"], 2, False)
+        records, _ = chung_ooi.analyse_all(os.path.join(work, "out"), tests, ["jdem"], False, [])
+        results[value] = deviations(records)
+    print(f"| test | metric | " + " | ".join(f"{v}: rms / max" for v in args.values) + " |")
+    print("|---|---|" + "---|" * len(args.values))
+    for key in sorted(results[args.values[0]]):
+        cells = []
+        for value in args.values:
+            d = results[value].get(key)
+            cells.append("–" if d is None else f"{np.sqrt(np.mean(d ** 2)):.3g} / {d.max():.3g}")
+        print(f"| {key[0]} | {key[1]} | " + " | ".join(cells) + " |")
+
+
+if __name__ == "__main__":
+    main()
