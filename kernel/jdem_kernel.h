@@ -421,6 +421,22 @@ static inline int jd_contact(const unsigned features, const jd_pair_coeffs *c,
     return 1;
 }
 
+/* LIGGGHTS evaluates the forces of step 0 (`setup`) without advancing the contact history, and
+ * both engines follow it: they evaluate a copy of the history and discard it.  Afterwards this
+ * keeps, from that evaluated copy, only what the energy bookkeeping of the next evaluation starts
+ * from (previous force, dashpot force, stored energy, rolling moment), so that a contact that
+ * already exists at step 0 does not book its stored energy as created.  r and r_evaluated may be
+ * NULL (no rolling). */
+static inline void jd_contact_keep_reference(jd_contact_state *s, const jd_contact_state *evaluated,
+                                             jd_rolling_state *r,
+                                             const jd_rolling_state *r_evaluated) {
+    for (int d = 0; d < 3; d++) s->f_prev[d] = evaluated->f_prev[d];
+    s->fd_prev = evaluated->fd_prev;
+    s->u_prev = evaluated->u_prev;
+    if (r && r_evaluated)
+        for (int d = 0; d < 3; d++) r->m_prev[d] = r_evaluated->m_prev[d];
+}
+
 /* Energy stored in a contact (normal spring + tangential and rolling springs) at its last
  * evaluation [J] (JD_F_ENERGY); zero once the contact has ended. */
 static inline double jd_contact_elastic_energy(const jd_contact_state *s) { return s->u_prev; }

@@ -114,6 +114,56 @@ oom:
     return -1;
 }
 
+/* Save the contact history of a list (its first n entries), or put it back keeping the energy
+ * reference of the evaluation in between (jd_contact_keep_reference). */
+static void save_history(const jd_contact_list *l, jd_contact_state *state, jd_rolling_state *roll) {
+    memcpy(state, l->state, l->n * sizeof *state);
+    if (l->roll) memcpy(roll, l->roll, l->n * sizeof *roll);
+}
+
+static void restore_history(jd_contact_list *l, const jd_contact_state *state,
+                            const jd_rolling_state *roll) {
+    for (size_t c = 0; c < l->n; c++) {
+        const jd_contact_state evaluated = l->state[c];
+        l->state[c] = state[c];
+        if (l->roll) {
+            const jd_rolling_state r_evaluated = l->roll[c];
+            l->roll[c] = roll[c];
+            jd_contact_keep_reference(&l->state[c], &evaluated, &l->roll[c], &r_evaluated);
+        } else {
+            jd_contact_keep_reference(&l->state[c], &evaluated, NULL, NULL);
+        }
+    }
+}
+
+/* LIGGGHTS `setup`: the forces of step 0, evaluated without advancing any contact history
+ * (LIGGGHTS' shearupdate = 0, which the plugin follows), so that a scene starting with bodies in
+ * contact counts its first spring increment and its first step of dissipation once; only the
+ * energy reference of that evaluation is kept. */
+static int setup_forces(jd_sim *s, char *err, size_t errlen) {
+    jd_contact_list *lists[2] = {&s->pairs, &s->wall_pairs};
+    jd_contact_state *state[2];
+    jd_rolling_state *roll[2];
+    int ok = 1;
+    for (int k = 0; k < 2; k++) {
+        state[k] = malloc((lists[k]->n + 1) * sizeof *state[k]);
+        roll[k] = malloc((lists[k]->n + 1) * sizeof *roll[k]);
+        ok = ok && state[k] && roll[k];
+    }
+    if (ok) {
+        for (int k = 0; k < 2; k++) save_history(lists[k], state[k], roll[k]);
+        sim_compute_forces(s);
+        for (int k = 0; k < 2; k++) restore_history(lists[k], state[k], roll[k]);
+    } else {
+        snprintf(err, errlen, "out of memory");
+    }
+    for (int k = 0; k < 2; k++) {
+        free(state[k]);
+        free(roll[k]);
+    }
+    return ok ? 0 : -1;
+}
+
 static int setup(jd_sim *s, char *err, size_t errlen) {
     if (init_particles(s, err, errlen) != 0) return -1;
     if (init_coeffs(s) != 0) {
@@ -123,8 +173,7 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
     s->features = scene_features(s);
     if (sim_walls_init(s, err, errlen) != 0) return -1;
     if (sim_neighbour_build(s, err, errlen) != 0) return -1;
-    sim_compute_forces(s); /* LIGGGHTS `setup`: the forces of step 0 */
-    return 0;
+    return setup_forces(s, err, errlen);
 }
 
 int sim_init(jd_sim *s, const jd_scene *scene, int allpairs, char *err, size_t errlen) {

@@ -28,6 +28,8 @@ SUITES = [
 SUITES += [(f"engine-{t}", [PY, f"tests/engine/test_{t}.py"], "lines", {}) for t in ENGINE_TESTS]
 SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines", SANITIZED)
            for t in ENGINE_TESTS]
+# The two engines on the same scenes (bitwise or 1e-10), and LIGGGHTS on 1 vs 2 MPI ranks.
+SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {})]
 # The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
 # `make demo` runs the full sweeps.
 CHUNG_OOI = "out/test/chung_ooi"

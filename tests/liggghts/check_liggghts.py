@@ -6,7 +6,8 @@
 Builds nothing (run `make` first).  For every scene in tests/liggghts/scenes/ it runs the
 standalone engine (build/jdem run) and LIGGGHTS (scripts/liggghts_run.py) and compares the
 trajectories with scripts/compare_trajectories.py (tolerance 1e-10, scaled as documented there);
-mpi_pile.yaml is also run on 2 MPI ranks and compared with the 1-rank LIGGGHTS run.  With
+the scenes named mpi_*.yaml are also run on 2 MPI ranks and compared with the 1-rank LIGGGHTS
+run.  With
 --chung-ooi the cases of reference_runs/chung_ooi/test*/scene.yaml are checked too.
 Prints one PASS/FAIL line per check and exits 1 if any check fails.
 """
@@ -33,7 +34,15 @@ def run(cmd):
 
 def last_line(text):
     lines = [l for l in text.strip().splitlines() if l.strip()]
-    return lines[-1] if lines else ""
+    line = lines[-1] if lines else ""
+    for tag in ("PASS ", "FAIL "):  # keep one PASS/FAIL per check (tests/run_tests.py counts them)
+        if line.startswith(tag):
+            line = line[len(tag):]
+    return line
+
+
+def indented(text):
+    return "".join("    " + l + "\n" for l in text.rstrip().splitlines())
 
 
 def compare(a, b):
@@ -49,7 +58,7 @@ def main():
     a = ap.parse_args()
     for exe in (JDEM, LIG):
         if not os.access(exe, os.X_OK):
-            print("FAIL: %s is missing (run make)" % os.path.relpath(exe, ROOT))
+            print("FAIL liggghts: %s is missing (run make)" % os.path.relpath(exe, ROOT))
             return 1
     work = a.out or tempfile.mkdtemp(prefix="jdem-liggghts-")
     os.makedirs(work, exist_ok=True)
@@ -59,7 +68,7 @@ def main():
         for p in sorted(glob.glob(os.path.join(ROOT, "reference_runs", "chung_ooi", "test*", "scene.yaml"))):
             rc, out = run([JDEM, "cases", p])
             if rc != 0:
-                print("FAIL: %s: jdem cases: %s" % (os.path.relpath(p, ROOT), last_line(out)))
+                print("FAIL %s: jdem cases: %s" % (os.path.relpath(p, ROOT), last_line(out)))
                 continue
             cases += [(p, c) for c in out.split()]
 
@@ -73,32 +82,32 @@ def main():
         caseopt = ["--case", case] if case else []
         rc, out = run([JDEM, "run", scene] + caseopt + ["-o", stem + ".jdem.h5", "--quiet"])
         if rc != 0:
-            print("FAIL: %s: build/jdem run: %s" % (label, last_line(out)))
+            print("FAIL %s: build/jdem run: %s" % (label, last_line(out)))
             failures += 1
             continue
         rc, out = run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene] + caseopt +
                       ["-o", stem + ".lig.h5"])
         if rc != 0:
-            print("FAIL: %s: liggghts_run.py: %s" % (label, out.strip()[-400:]))
+            print("FAIL %s: liggghts_run.py:\n%s" % (label, indented(out.strip()[-1500:])))
             failures += 1
             continue
         ok, summary, full = compare(stem + ".jdem.h5", stem + ".lig.h5")
-        print("%s: %s jdem vs liggghts-jdem: %s" % ("PASS" if ok else "FAIL", label, summary))
+        print("%s %s: jdem vs liggghts-jdem: %s" % ("PASS" if ok else "FAIL", label, summary))
         if not ok:
             failures += 1
-            sys.stdout.write(full)
-        if name == "mpi_pile":
+            sys.stdout.write(indented(full))
+        if name.startswith("mpi_"):
             rc, out = run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene] + caseopt +
                           ["-o", stem + ".np2.h5", "--np", "2"])
             if rc != 0:
-                print("FAIL: %s: liggghts_run.py --np 2: %s" % (label, out.strip()[-400:]))
+                print("FAIL %s: liggghts_run.py --np 2:\n%s" % (label, indented(out.strip()[-1500:])))
                 failures += 1
                 continue
             ok, summary, full = compare(stem + ".lig.h5", stem + ".np2.h5")
-            print("%s: %s liggghts-jdem 1 rank vs 2 ranks: %s" % ("PASS" if ok else "FAIL", label, summary))
+            print("%s %s: liggghts-jdem 1 rank vs 2 ranks: %s" % ("PASS" if ok else "FAIL", label, summary))
             if not ok:
                 failures += 1
-                sys.stdout.write(full)
+                sys.stdout.write(indented(full))
 
     print("%d checks failed" % failures if failures else "all checks passed")
     if not a.out and not a.keep and not failures:

@@ -1,0 +1,261 @@
+/* dump_h5md_jdem.cpp — see dump_h5md_jdem.h.  Gathers the per-atom data to rank 0 (one
+ * MPI_Gatherv per frame), sorts it by id and hands it to jd_h5md_*. */
+#include "dump_h5md_jdem.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "atom.h"
+#include "error.h"
+#include "fix.h"
+#include "fix_gravity.h"
+#include "force.h"
+#include "modify.h"
+#include "output.h"
+#include "update.h"
+
+#include "fix_wall_jiang.h"
+#include "h5md.h"
+#include "jdem_kernel.h"
+#include "pair_gran_jiang.h"
+
+using namespace LAMMPS_NS;
+
+int jdem_dump_close_ok = 0;
+
+#ifndef JDEM_VERSION
+#define JDEM_VERSION "0.1.0"
+#endif
+
+enum { COL_ID = 0, COL_TYPE, COL_R, COL_M, COL_X, COL_V = COL_X + 3, COL_W = COL_V + 3,
+       COL_F = COL_W + 3, COL_T = COL_F + 3, NCOL = COL_T + 3 };
+
+DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
+    : Dump(lmp, narg, arg), h5(NULL), natoms0(-1) {
+  if (narg < 5) error->all(FLERR, "Illegal dump h5md/jdem command: dump ID group h5md/jdem N FILE.h5");
+  path = arg[4];
+  if (path.find('*') != std::string::npos || path.find('%') != std::string::npos)
+    error->all(FLERR, "dump h5md/jdem writes one file: no '*' or '%' in the file name");
+  for (int i = 5; i < narg; i += 2) {
+    if (i + 1 >= narg) error->all(FLERR, "dump h5md/jdem: keyword without a value");
+    const std::string k = arg[i];
+    if (k == "scene") scene_name = arg[i + 1];
+    else if (k == "case") case_name = arg[i + 1];
+    else if (k == "scene_yaml") {
+      if (me == 0) {
+        std::ifstream in(arg[i + 1]);
+        if (!in) error->one(FLERR, "dump h5md/jdem: cannot read the scene_yaml file");
+        std::stringstream ss;
+        ss << in.rdbuf();
+        scene_yaml = ss.str();
+      }
+    } else {
+      error->all(FLERR, "dump h5md/jdem: unknown keyword (valid: scene, case, scene_yaml)");
+    }
+  }
+  size_one = NCOL;
+
+}
+
+DumpH5mdJdem::~DumpH5mdJdem() {
+  if (h5) {
+    char err[256] = "";
+    if (jd_h5md_close(h5, jdem_dump_close_ok, err, sizeof err) != 0 && screen)
+      fprintf(screen, "WARNING: dump h5md/jdem: closing %s failed: %s\n", path.c_str(), err);
+    h5 = NULL;
+  }
+}
+
+void DumpH5mdJdem::init_style() {
+  if (!atom->sphere_flag || !atom->rmass_flag)
+    error->all(FLERR, "dump h5md/jdem requires atom_style granular (sphere)");
+  if (!atom->tag_enable) error->all(FLERR, "dump h5md/jdem requires atom IDs");
+}
+
+namespace {
+struct RowById {
+  const double *buf;
+  bool operator()(int a, int b) const { return buf[a * NCOL + COL_ID] < buf[b * NCOL + COL_ID]; }
+};
+}  // namespace
+
+void DumpH5mdJdem::write() {
+  const int nlocal = atom->nlocal;
+  const int *mask = atom->mask, *tag = atom->tag, *type = atom->type;
+  double **x = atom->x, **v = atom->v, **omega = atom->omega, **f = atom->f, **torque = atom->torque;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+
+  /* pack my atoms and the local parts of the observables */
+  std::vector<double> mine;
+  double obs[3] = {0.0, 0.0, 0.0}; /* kinetic, rotational, gravitational */
+  double g[3] = {0.0, 0.0, 0.0};
+  for (int k = 0; k < modify->nfix; k++) {
+    FixGravity *fg = dynamic_cast<FixGravity *>(modify->fix[k]);
+    if (fg) {
+      double gk[3];
+      fg->get_gravity(gk);
+      for (int d = 0; d < 3; d++) g[d] += gk[d];
+    }
+  }
+  for (int i = 0; i < nlocal; i++) {
+    if (!(mask[i] & groupbit)) continue;
+    double row[NCOL];
+    row[COL_ID] = tag[i];
+    row[COL_TYPE] = type[i];
+    row[COL_R] = radius[i];
+    row[COL_M] = rmass[i];
+    for (int d = 0; d < 3; d++) {
+      row[COL_X + d] = x[i][d];
+      row[COL_V + d] = v[i][d];
+      row[COL_W + d] = omega[i][d];
+      row[COL_F + d] = f[i][d];
+      row[COL_T + d] = torque[i][d];
+    }
+    mine.insert(mine.end(), row, row + NCOL);
+    const double m = rmass[i];
+    obs[0] += 0.5 * m * jd_dot(v[i], v[i]);
+    obs[1] += 0.5 * jd_sphere_inertia(m, radius[i]) * jd_dot(omega[i], omega[i]);
+    obs[2] -= m * jd_dot(g, x[i]);
+  }
+
+  /* contact observables from our pair style and walls */
+  PairGranJiang *pair = dynamic_cast<PairGranJiang *>(force->pair);
+  double cobs[7] = {0, 0, 0, 0, 0, 0, 0}; /* elastic, damp, fric, wall_work, contacts, wall_contacts */
+  if (pair) {
+    cobs[0] += pair->e_elastic_now;
+    cobs[1] += pair->e_damp_cum;
+    cobs[2] += pair->e_fric_cum;
+    cobs[4] += pair->contacts_now;
+    for (int k = 0; k < modify->nfix; k++) {
+      FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
+      if (!w) continue;
+      cobs[0] += w->e_elastic_now;
+      cobs[1] += w->e_damp_cum;
+      cobs[2] += w->e_fric_cum;
+      cobs[3] += w->work_cum;
+      cobs[5] += w->contacts_now;
+    }
+  }
+  double all_obs[3], all_cobs[7];
+  MPI_Reduce(obs, all_obs, 3, MPI_DOUBLE, MPI_SUM, 0, world);
+  MPI_Reduce(cobs, all_cobs, 7, MPI_DOUBLE, MPI_SUM, 0, world);
+
+  /* gather the rows on rank 0 */
+  const int nme_d = (int)mine.size();
+  std::vector<int> counts(nprocs), displs(nprocs);
+  MPI_Gather(&nme_d, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
+  std::vector<double> all;
+  if (me == 0) {
+    int tot = 0;
+    for (int p = 0; p < nprocs; p++) {
+      displs[p] = tot;
+      tot += counts[p];
+    }
+    all.resize(tot > 0 ? tot : 1);
+  }
+  MPI_Gatherv(mine.empty() ? NULL : mine.data(), nme_d, MPI_DOUBLE, me == 0 ? all.data() : NULL,
+              counts.data(), displs.data(), MPI_DOUBLE, 0, world);
+
+  int failed = 0;
+  char err[512] = "";
+  const double dt = update->dt;
+  const bigint step = update->ntimestep;
+  const double time = update->atime + (double)(step - update->atimestep) * dt;
+  if (me == 0) {
+    size_t nat = 0;
+    for (int p = 0; p < nprocs; p++) nat += counts[p] / NCOL;
+    std::vector<int> order(nat);
+    for (size_t i = 0; i < nat; i++) order[i] = (int)i;
+    RowById cmp = {all.data()};
+    std::sort(order.begin(), order.end(), cmp);
+
+    std::vector<double> pos(3 * nat), vel(3 * nat), angv(3 * nat), frc(3 * nat), trq(3 * nat);
+    for (size_t i = 0; i < nat; i++) {
+      const double *row = &all[(size_t)order[i] * NCOL];
+      for (int d = 0; d < 3; d++) {
+        pos[3 * i + d] = row[COL_X + d];
+        vel[3 * i + d] = row[COL_V + d];
+        angv[3 * i + d] = row[COL_W + d];
+        frc[3 * i + d] = row[COL_F + d];
+        trq[3 * i + d] = row[COL_T + d];
+      }
+    }
+
+    if (!h5) {
+      std::vector<int64_t> ids(nat);
+      std::vector<int32_t> species(nat);
+      std::vector<double> rad(nat), mass(nat);
+      for (size_t i = 0; i < nat; i++) {
+        const double *row = &all[(size_t)order[i] * NCOL];
+        ids[i] = (int64_t)row[COL_ID];
+        species[i] = (int32_t)row[COL_TYPE] - 1;
+        rad[i] = row[COL_R];
+        mass[i] = row[COL_M];
+      }
+      jd_h5md_particles parts;
+      parts.n = nat;
+      parts.id = ids.data();
+      parts.species = species.data();
+      parts.radius = rad.data();
+      parts.mass = mass.data();
+      jd_h5md_meta meta;
+      std::memset(&meta, 0, sizeof meta);
+      meta.creator = "liggghts-jdem";
+      meta.creator_version = JDEM_VERSION;
+      meta.scene_name = scene_name.empty() ? NULL : scene_name.c_str();
+      meta.case_name = case_name.empty() ? NULL : case_name.c_str();
+      meta.scene_yaml = scene_yaml.empty() ? NULL : scene_yaml.c_str();
+      meta.dt = dt;
+      h5 = jd_h5md_create(path.c_str(), &meta, &parts, err, sizeof err);
+      if (!h5) failed = 1;
+      natoms0 = (bigint)nat;
+    } else if ((bigint)nat != natoms0) {
+      std::snprintf(err, sizeof err, "the number of atoms changed (%ld -> %ld); h5md/jdem needs a fixed particle set",
+                    (long)natoms0, (long)nat);
+      failed = 1;
+    }
+    if (!failed) {
+      jd_h5md_frame fr;
+      fr.step = (int64_t)step;
+      fr.time = time;
+      fr.position = pos.data();
+      fr.velocity = vel.data();
+      fr.angular_velocity = angv.data();
+      fr.force = frc.data();
+      fr.torque = trq.data();
+      if (jd_h5md_write_frame(h5, &fr, err, sizeof err) != 0) failed = 1;
+    }
+    struct { const char *name; double value; bool on; } o[] = {
+        {"kinetic_energy", all_obs[0], true},
+        {"rotational_energy", all_obs[1], true},
+        {"elastic_energy", all_cobs[0], pair != NULL},
+        {"gravitational_energy", all_obs[2], true},
+        {"damping_dissipation", all_cobs[1], pair != NULL && pair->energy},
+        {"friction_dissipation", all_cobs[2], pair != NULL && pair->energy},
+        {"wall_work", all_cobs[3], pair != NULL},
+        {"contacts", all_cobs[4], pair != NULL},
+        {"wall_contacts", all_cobs[5], pair != NULL},
+    };
+    for (size_t k = 0; !failed && k < sizeof o / sizeof o[0]; k++)
+      if (o[k].on && jd_h5md_write_observable(h5, o[k].name, (int64_t)step, time, o[k].value, err, sizeof err) != 0)
+        failed = 1;
+  }
+  /* Like the standalone engine, also write the last step of the run when it is not a multiple of
+   * N: Output::write() adds N to next_dump after this call, so aim N steps short of it.  (At
+   * set-up Output::setup() overwrites next_dump; a run shorter than N gets no last frame.) */
+  for (int k = 0; k < output->ndump; k++)
+    if (output->dump[k] == this) {
+      const bigint every = output->every_dump[k], last = update->laststep;
+      if (every > 0 && step < last && step + every > last) output->next_dump[k] = last - every;
+    }
+
+  MPI_Bcast(&failed, 1, MPI_INT, 0, world);
+  if (failed) {
+    MPI_Bcast(err, sizeof err, MPI_CHAR, 0, world);
+    std::string msg = std::string("dump h5md/jdem: ") + err;
+    error->all(FLERR, msg.c_str());
+  }
+}

@@ -1,0 +1,51 @@
+/* dump_h5md_jdem.h — `dump ID group h5md/jdem N FILE.h5 [scene NAME] [case NAME]
+ *                    [scene_yaml PATH]`: jdem's H5MD trajectory (io/h5md.h), written on rank 0
+ * through the shared C writer.
+ *
+ * Every N steps: position, velocity, angular velocity, force, torque of the group's atoms,
+ * sorted by id (species = type - 1), and the observables kinetic_energy, rotational_energy,
+ * gravitational_energy (with fix gravity) and, with pair_style gran/jiang and fix wall/jiang,
+ * elastic_energy, damping_dissipation, friction_dissipation, wall_work, contacts,
+ * wall_contacts; also the last step of a run that is not a multiple of N (runs of at least N
+ * steps), like build/jdem.  The file is FILE.h5.part while the run goes on and is renamed to FILE.h5
+ * when LIGGGHTS ends normally or at `undump`; after an error it stays FILE.h5.part.  The optional keywords only annotate
+ * /parameters.  The particle set must not change during the run. */
+#ifndef JDEM_DUMP_H5MD_JDEM_H
+#define JDEM_DUMP_H5MD_JDEM_H
+
+#include <string>
+#include <vector>
+
+#include "dump.h"
+
+struct jd_h5md;
+
+/* Set by liggghts-jdem's main() once the input script has finished, and around `undump`: the
+ * dump's destructor then completes the file (PATH.part -> PATH).  Any other destruction is
+ * LIGGGHTS' error path (Error::all deletes Output to flush dumps), which keeps PATH.part so that
+ * an aborted run never looks complete. */
+extern int jdem_dump_close_ok;
+
+namespace LAMMPS_NS {
+
+class DumpH5mdJdem : public Dump {
+ public:
+  DumpH5mdJdem(class LAMMPS *, int, char **);
+  virtual ~DumpH5mdJdem();
+  virtual void write();
+
+ protected:
+  virtual void init_style();
+  virtual void write_header(bigint) {}
+  virtual void pack(int *) {}
+  virtual void write_data(int, double *) {}
+
+ private:
+  struct jd_h5md *h5;
+  std::string path, scene_name, case_name, scene_yaml;
+  bigint natoms0;
+};
+
+}  // namespace LAMMPS_NS
+
+#endif

@@ -1,0 +1,225 @@
+/* fix_wall_jiang.cpp — see fix_wall_jiang.h.  Glue only: the geometry is jdem_geometry.h, the
+ * law jd_contact(). */
+#include "fix_wall_jiang.h"
+
+#include <cstring>
+#include <string>
+
+#include "atom.h"
+#include "error.h"
+#include "force.h"
+#include "memory.h"
+#include "update.h"
+
+#include "jdem_dispatch.h"
+#include "jdem_history.h"
+#include "pair_gran_jiang.h"
+
+using namespace LAMMPS_NS;
+using namespace FixConst;
+
+FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
+    : Fix(lmp, narg, arg), e_damp_cum(0.0), e_fric_cum(0.0), work_cum(0.0),
+      e_elastic_now(0.0), contacts_now(0.0), shape(-1), wtype(0), slen(0), hist(NULL),
+      nmax_hist(0), pair(NULL) {
+  const char *usage =
+      "Illegal fix wall/jiang command: fix ID group wall/jiang plane corners x1 y1 z1 x2 y2 z2 "
+      "x3 y3 z3 x4 y4 z4 type T [velocity vx vy vz] | cylinder axis x1 y1 z1 x2 y2 z2 radius R "
+      "side outside|inside type T [velocity vx vy vz]";
+  std::memset(&plane, 0, sizeof plane);
+  std::memset(&cyl, 0, sizeof cyl);
+  vel[0] = vel[1] = vel[2] = 0.0;
+  int iarg = 3;
+  if (narg < 4) error->all(FLERR, usage);
+  const std::string kind = arg[iarg++];
+  if (kind == "plane") {
+    shape = 0;
+    if (iarg + 13 > narg || std::strcmp(arg[iarg], "corners") != 0) error->all(FLERR, usage);
+    iarg++;
+    double c[4][3];
+    for (int p = 0; p < 4; p++)
+      for (int k = 0; k < 3; k++) c[p][k] = force->numeric(FLERR, arg[iarg++]);
+    const int rc = jd_plane_init(&plane, c, 1e-9);
+    if (rc == JD_GEOM_DEGENERATE) error->all(FLERR, "fix wall/jiang: P1, P2, P3 are collinear");
+    if (rc == JD_GEOM_NOT_PLANAR) error->all(FLERR, "fix wall/jiang: the four corners are not coplanar");
+  } else if (kind == "cylinder") {
+    shape = 1;
+    if (iarg + 7 > narg || std::strcmp(arg[iarg], "axis") != 0) error->all(FLERR, usage);
+    iarg++;
+    for (int k = 0; k < 3; k++) cyl.a0[k] = force->numeric(FLERR, arg[iarg++]);
+    for (int k = 0; k < 3; k++) cyl.a1[k] = force->numeric(FLERR, arg[iarg++]);
+    cyl.rc = -1.0;
+    cyl.inside = 0;
+  } else {
+    error->all(FLERR, usage);
+  }
+  while (iarg < narg) {
+    const std::string k = arg[iarg];
+    if (k == "type" && iarg + 1 < narg) {
+      wtype = force->inumeric(FLERR, arg[iarg + 1]);
+      iarg += 2;
+    } else if (k == "velocity" && iarg + 3 < narg) {
+      for (int d = 0; d < 3; d++) vel[d] = force->numeric(FLERR, arg[iarg + 1 + d]);
+      iarg += 4;
+    } else if (shape == 1 && k == "radius" && iarg + 1 < narg) {
+      cyl.rc = force->numeric(FLERR, arg[iarg + 1]);
+      iarg += 2;
+    } else if (shape == 1 && k == "side" && iarg + 1 < narg) {
+      const std::string s = arg[iarg + 1];
+      if (s == "outside") cyl.inside = 0;
+      else if (s == "inside") cyl.inside = 1;
+      else error->all(FLERR, "fix wall/jiang: side must be outside or inside");
+      iarg += 2;
+    } else {
+      error->all(FLERR, usage);
+    }
+  }
+  if (wtype < 1 || wtype > atom->ntypes)
+    error->all(FLERR, "fix wall/jiang: 'type T' is required, 1 <= T <= ntypes");
+  if (shape == 1) {
+    if (!(cyl.rc > 0.0)) error->all(FLERR, "fix wall/jiang: cylinder needs 'radius R' > 0");
+    double ab[3];
+    for (int k = 0; k < 3; k++) ab[k] = cyl.a1[k] - cyl.a0[k];
+    if (!(jd_dot(ab, ab) > 0.0)) error->all(FLERR, "fix wall/jiang: the cylinder axis has zero length");
+  }
+
+  pair = dynamic_cast<PairGranJiang *>(force->pair);
+  if (!pair) error->all(FLERR, "fix wall/jiang requires pair_style gran/jiang (defined before the fix)");
+  slen = pair->state_len();
+
+  create_attribute = 1;
+  grow_arrays(atom->nmax);
+  atom->add_callback(0);
+}
+
+FixWallJiang::~FixWallJiang() {
+  atom->delete_callback(id, 0);
+  memory->destroy(hist);
+}
+
+int FixWallJiang::setmask() { return POST_FORCE; }
+
+void FixWallJiang::init() {
+  pair = dynamic_cast<PairGranJiang *>(force->pair);
+  if (!pair) error->all(FLERR, "fix wall/jiang requires pair_style gran/jiang");
+  if (pair->state_len() != slen)
+    error->all(FLERR, "fix wall/jiang: pair_style gran/jiang changed its rolling option after the wall was defined");
+  if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
+    error->all(FLERR, "fix wall/jiang requires atom_style granular (sphere)");
+}
+
+/* The set-up force evaluation does not advance the history (as LIGGGHTS' pair set-up). */
+void FixWallJiang::setup(int vflag) { compute(false); }
+
+void FixWallJiang::post_force(int vflag) {
+  /* translate the wall first: x += v dt per defining point, as the standalone engine does */
+  if (vel[0] != 0.0 || vel[1] != 0.0 || vel[2] != 0.0) {
+    const double dt = update->dt;
+    for (int d = 0; d < 3; d++) {
+      const double dx = vel[d] * dt;
+      for (int c = 0; c < 4; c++) plane.p[c][d] += dx;
+      cyl.a0[d] += dx;
+      cyl.a1[d] += dx;
+    }
+  }
+  compute(true);
+}
+
+void FixWallJiang::compute(bool commit) {
+#define JD_WALL_LOOP(b) loop<(b)>(commit)
+  JD_DISPATCH(pair->features(), JD_WALL_LOOP)
+#undef JD_WALL_LOOP
+}
+
+template <unsigned F>
+void FixWallJiang::loop(bool commit) {
+  double **x = atom->x, **v = atom->v, **f = atom->f;
+  double **omega = atom->omega, **torque = atom->torque;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  const int *type = atom->type, *mask = atom->mask;
+  const int nlocal = atom->nlocal;
+  const double dt = update->dt;
+  const int rule = pair->wall_rule;
+  double e_damp = 0.0, e_fric = 0.0, e_el = 0.0, ncontacts = 0.0, work = 0.0;
+
+  for (int i = 0; i < nlocal; i++) {
+    if (!(mask[i] & groupbit)) continue;
+    const double R = radius[i];
+    double *h = hist[i];
+    jd_contact_geom g;
+    const int hit = shape == 0 ? jd_geom_plane(&plane, x[i], R, &g) : jd_geom_cylinder(&cyl, x[i], R, &g);
+    if (!hit) {
+      if (commit)
+        for (int k = 0; k < slen; k++) h[k] = 0.0;
+      continue;
+    }
+    const double m = rmass[i];
+    g.k_n = jd_kn_wall(rule, pair->youngs(type[i]), pair->poisson(type[i]), R);
+    g.m_eff = m;
+    g.i_eff = (F & JD_F_ROLLING) ? jd_sphere_inertia(m, R) : 0.0;
+    jd_kinematics k;
+    for (int d = 0; d < 3; d++) {
+      k.va[d] = v[i][d];
+      k.wa[d] = omega[i][d];
+      k.vb[d] = vel[d];
+      k.wb[d] = 0.0;
+    }
+    jd_contact_state st;
+    jd_rolling_state rs;
+    jd_rolling_state *rsp = (F & JD_F_ROLLING) ? &rs : NULL;
+    jd_load_history(h, st, rsp);
+    jd_contact_result out;
+    const int carries = jd_contact(F, &pair->coeffs(type[i], wtype), &g, &k, dt, &st, rsp, &out);
+    if (F & JD_F_ENERGY) {
+      e_damp += st.e_damp;
+      e_fric += st.e_fric;
+      st.e_damp = st.e_fric = 0.0;
+      if (carries) e_el += jd_contact_elastic_energy(&st);
+    }
+    jd_store_history(h, st, rsp, commit);
+    if (!carries) continue;
+    ncontacts += 1.0;
+    for (int d = 0; d < 3; d++) {
+      f[i][d] -= out.f[d];
+      torque[i][d] += out.ta[d];
+    }
+    work -= jd_dot(out.f, vel); /* power delivered to the particle, F_on_particle . v_wall */
+  }
+  if (commit) {
+    e_damp_cum += e_damp;
+    e_fric_cum += e_fric;
+    work_cum += work * dt;
+  }
+  e_elastic_now = e_el;
+  contacts_now = ncontacts;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Per-atom history that migrates with the atoms.                                             */
+
+void FixWallJiang::grow_arrays(int nmax) {
+  memory->grow(hist, nmax, slen, "wall/jiang:hist");
+  for (int i = nmax_hist; i < nmax; i++)
+    for (int k = 0; k < slen; k++) hist[i][k] = 0.0;
+  nmax_hist = nmax;
+}
+
+void FixWallJiang::copy_arrays(int i, int j, int delflag) {
+  for (int k = 0; k < slen; k++) hist[j][k] = hist[i][k];
+}
+
+void FixWallJiang::set_arrays(int i) {
+  for (int k = 0; k < slen; k++) hist[i][k] = 0.0;
+}
+
+int FixWallJiang::pack_exchange(int i, double *buf) {
+  for (int k = 0; k < slen; k++) buf[k] = hist[i][k];
+  return slen;
+}
+
+int FixWallJiang::unpack_exchange(int nlocal, double *buf) {
+  for (int k = 0; k < slen; k++) hist[nlocal][k] = buf[k];
+  return slen;
+}
+
+double FixWallJiang::memory_usage() { return (double)nmax_hist * slen * sizeof(double); }

@@ -1,0 +1,64 @@
+/* fix_wall_jiang.h — `fix wall/jiang`: a particle–wall contact through jdem's C kernel.
+ *
+ *   fix ID group wall/jiang plane corners x1 y1 z1 x2 y2 z2 x3 y3 z3 x4 y4 z4 type T
+ *                           [velocity vx vy vz]
+ *   fix ID group wall/jiang cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T
+ *                           [velocity vx vy vz]
+ *
+ * The plane is a finite quadrilateral, counter-clockwise seen from the active side (normal
+ * (P2-P1) x (P3-P1)); the cylinder is the lateral surface of the axis segment.  T is the
+ * wall's atom type: its coefficients (restitution, friction, rolling friction against each
+ * particle type) come from the same fix property/global tables as gran/jiang's.  The particle's
+ * own E and nu give the wall stiffness (jd_kn_wall, rule from pair_style gran/jiang).  Moving
+ * walls translate at the given velocity (x += v dt every step, as the standalone engine).
+ * Requires pair_style gran/jiang defined before the fix.  Geometry: kernel/jdem_geometry.h.
+ *
+ * History: one jd_contact_state (+ jd_rolling_state with rolling on) per atom, migrating with
+ * the atom; reset when the particle leaves the wall. */
+#ifndef JDEM_FIX_WALL_JIANG_H
+#define JDEM_FIX_WALL_JIANG_H
+
+#include "fix.h"
+
+#include "jdem_geometry.h"
+
+namespace LAMMPS_NS {
+
+class FixWallJiang : public Fix {
+ public:
+  FixWallJiang(class LAMMPS *, int, char **);
+  ~FixWallJiang();
+  int setmask();
+  void init();
+  void setup(int);
+  void post_force(int);
+
+  void grow_arrays(int);
+  void copy_arrays(int, int, int);
+  void set_arrays(int);
+  int pack_exchange(int, double *);
+  int unpack_exchange(int, double *);
+  double memory_usage();
+
+  /* Observables of this rank: cumulative dissipation and wall work [J]; at the last force
+   * evaluation the elastic energy [J] and the number of wall contacts carrying force. */
+  double e_damp_cum, e_fric_cum, work_cum, e_elastic_now, contacts_now;
+
+ private:
+  template <unsigned F> void loop(bool commit);
+  void compute(bool commit);
+
+  int shape; /* 0 plane, 1 cylinder */
+  jd_plane plane;
+  jd_cylinder cyl;
+  double vel[3];
+  int wtype;
+  int slen; /* doubles of history per atom */
+  double **hist;
+  int nmax_hist;
+  class PairGranJiang *pair;
+};
+
+}  // namespace LAMMPS_NS
+
+#endif

@@ -1,0 +1,143 @@
+/* main.cpp — liggghts-jdem: Debian's libliggghts with jdem's styles registered at start-up.
+ *
+ * Same command line as `liggghts` (-in, -var, -log, -echo, -screen, ...; works under mpirun).
+ * Registered styles:
+ *   pair_style gran/jiang   force->pair_map (public)
+ *   fix wall/jiang          modify->fix_map (private: explicit-instantiation access idiom)
+ *   dump h5md/jdem          LIGGGHTS 3.8 has no dump map: Output::add_dump() is an if-else chain
+ *                           over style_dump.h.  We interpose Output::add_dump (libliggghts.so
+ *                           calls it through its PLT, so the executable's definition wins) and
+ *                           forward every other style to the library's original via
+ *                           dlsym(RTLD_NEXT).  Output::delete_dump (undump) is interposed the
+ *                           same way, so that h5md/jdem can tell a normal end from LIGGGHTS'
+ *                           error path (Error::all deletes Output) and keep PATH.part then.
+ * Do not use the `clear` command: it re-creates Force and Modify and drops the registrations. */
+#include <dlfcn.h>
+#include <mpi.h>
+
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <string>
+
+#include "error.h"
+#include "force.h"
+#include "group.h"
+#include "input.h"
+#include "lammps.h"
+#include "memory.h"
+#include "modify.h"
+#include "output.h"
+
+#include "dump_h5md_jdem.h"
+#include "fix_wall_jiang.h"
+#include "pair_gran_jiang.h"
+
+using namespace LAMMPS_NS;
+
+/* ---- access to the private Modify::fix_map (legal: access checks are waived in explicit
+ * template instantiations) ---- */
+typedef std::map<std::string, Fix *(*)(LAMMPS *, int, char **)> FixMap;
+template <typename Tag, typename Tag::type M>
+struct Rob {
+  friend typename Tag::type get(Tag) { return M; }
+};
+struct ModifyFixMap {
+  typedef FixMap *Modify::*type;
+  friend type get(ModifyFixMap);
+};
+template struct Rob<ModifyFixMap, &Modify::fix_map>;
+
+static Pair *create_pair_gran_jiang(LAMMPS *lmp) { return new PairGranJiang(lmp); }
+static Fix *create_fix_wall_jiang(LAMMPS *lmp, int narg, char **arg) {
+  return new FixWallJiang(lmp, narg, arg);
+}
+
+static void register_jdem_styles(LAMMPS *lmp) {
+  (*lmp->force->pair_map)["gran/jiang"] = &create_pair_gran_jiang;
+  FixMap *fix_map = lmp->modify->*get(ModifyFixMap());
+  (*fix_map)["wall/jiang"] = &create_fix_wall_jiang;
+}
+
+/* ---- dump h5md/jdem: interposed Output::add_dump ---- */
+namespace LAMMPS_NS {
+void Output::add_dump(int narg, char **arg) {
+  if (narg < 3 || std::strcmp(arg[2], "h5md/jdem") != 0) {
+    typedef void (*AddDump)(Output *, int, char **);
+    static AddDump original = NULL;
+    if (!original) {
+      void *sym = dlsym(RTLD_NEXT, "_ZN9LAMMPS_NS6Output8add_dumpEiPPc");
+      if (!sym) error->all(FLERR, "liggghts-jdem: cannot find libliggghts' Output::add_dump");
+      std::memcpy(&original, &sym, sizeof original);
+    }
+    original(this, narg, arg);
+    return;
+  }
+  /* the library's add_dump, for our style */
+  if (narg < 5) error->all(FLERR, "Illegal dump command");
+  for (int idump = 0; idump < ndump; idump++)
+    if (std::strcmp(arg[0], dump[idump]->id) == 0) error->all(FLERR, "Reuse of dump ID");
+  if (group->find(arg[1]) == -1) error->all(FLERR, "Could not find dump group ID");
+  const int every = force->inumeric(FLERR, arg[3]);
+  if (every <= 0) error->all(FLERR, "Invalid dump frequency");
+  if (ndump == max_dump) {
+    max_dump += 1;
+    dump = (Dump **)memory->srealloc(dump, max_dump * sizeof(Dump *), "output:dump");
+    memory->grow(every_dump, max_dump, "output:every_dump");
+    memory->grow(next_dump, max_dump, "output:next_dump");
+    memory->grow(last_dump, max_dump, "output:last_dump");
+    var_dump = (char **)memory->srealloc(var_dump, max_dump * sizeof(char *), "output:var_dump");
+    memory->grow(ivar_dump, max_dump, "output:ivar_dump");
+  }
+  dump[ndump] = new DumpH5mdJdem(lmp, narg, arg);
+  every_dump[ndump] = every;
+  last_dump[ndump] = -1;
+  var_dump[ndump] = NULL;
+  ndump++;
+}
+
+/* `undump` ends a dump normally: let h5md/jdem complete its file (see jdem_dump_close_ok). */
+void Output::delete_dump(char *id) {
+  typedef void (*DeleteDump)(Output *, char *);
+  static DeleteDump original = NULL;
+  if (!original) {
+    void *sym = dlsym(RTLD_NEXT, "_ZN9LAMMPS_NS6Output11delete_dumpEPc");
+    if (!sym) error->all(FLERR, "liggghts-jdem: cannot find libliggghts' Output::delete_dump");
+    std::memcpy(&original, &sym, sizeof original);
+  }
+  const int saved = jdem_dump_close_ok;
+  jdem_dump_close_ok = 1;
+  original(this, id);
+  jdem_dump_close_ok = saved;
+}
+}  // namespace LAMMPS_NS
+
+static const char *jdem_help =
+    "\nStyles added by liggghts-jdem (jdem's C contact kernel; see docs/liggghts.md):\n"
+    "* Pair styles:  gran/jiang   [wall_rule hertz|jiang2021] [damping jiang2021|exact_restitution]\n"
+    "                             [tangential_limit coulomb|unconstrained] [mu_r X] [rolling on|off]\n"
+    "* Fix styles:   wall/jiang   plane corners x1 y1 z1 ... x4 y4 z4 type T [velocity vx vy vz]\n"
+    "                             cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T\n"
+    "                                 [velocity vx vy vz]\n"
+    "* Dump styles:  h5md/jdem    N FILE.h5 [scene NAME] [case NAME] [scene_yaml PATH]\n"
+    "(gran/jiang presents itself as \"gran\" to LIGGGHTS; do not use `clear` or restart files.)\n\n";
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  int me = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &me);
+  /* LIGGGHTS prints its own help and exits inside the LAMMPS constructor: print ours first. */
+  for (int i = 1; i < argc; i++)
+    if ((std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "-help") == 0) && me == 0) {
+      std::fputs(jdem_help, stdout);
+      std::fflush(stdout);
+    }
+  LAMMPS *lmp = new LAMMPS(argc, argv, MPI_COMM_WORLD);
+  register_jdem_styles(lmp);
+  lmp->input->file();
+  jdem_dump_close_ok = 1; /* the input finished: dumps complete their files */
+  delete lmp;
+  MPI_Barrier(MPI_COMM_WORLD);
+  MPI_Finalize();
+  return 0;
+}

@@ -1,0 +1,262 @@
+/* pair_gran_jiang.cpp — see pair_gran_jiang.h.  Glue only: neighbour/history bookkeeping of
+ * LIGGGHTS around jd_geom_spheres() and jd_contact(). */
+#include "pair_gran_jiang.h"
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "atom.h"
+#include "comm.h"
+#include "dump.h"
+#include "error.h"
+#include "fix_property_global.h"
+#include "force.h"
+#include "modify.h"
+#include "neigh_list.h"
+#include "neighbor.h"
+#include "output.h"
+#include "update.h"
+
+#include "jdem_dispatch.h"
+#include "jdem_history.h"
+#include "jdem_geometry.h"
+
+using namespace LAMMPS_NS;
+
+/* The history lives in LIGGGHTS' double arrays: the kernel's states must be flat doubles. */
+static_assert(sizeof(jd_contact_state) == JD_CONTACT_STATE_LEN * sizeof(double),
+              "jd_contact_state must be JD_CONTACT_STATE_LEN doubles");
+static_assert(sizeof(jd_rolling_state) == JD_ROLLING_STATE_LEN * sizeof(double),
+              "jd_rolling_state must be JD_ROLLING_STATE_LEN doubles");
+
+PairGranJiang::PairGranJiang(LAMMPS *lmp)
+    : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
+      xi_limit(JD_XI_COULOMB), mu_r(1.0), rolling(false), energy(false), e_damp_cum(0.0),
+      e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), features_(0), ntypes_(0) {}
+
+/* ---------------------------------------------------------------------------------------- */
+
+void PairGranJiang::settings(int narg, char **arg) {
+  for (int i = 0; i < narg; i += 2) {
+    if (i + 1 >= narg) error->all(FLERR, "pair_style gran/jiang: option without a value");
+    const std::string k = arg[i], val = arg[i + 1];
+    if (k == "wall_rule") {
+      if (val == "hertz") wall_rule = JD_WALL_HERTZ;
+      else if (val == "jiang2021") wall_rule = JD_WALL_JIANG2021;
+      else error->all(FLERR, "pair_style gran/jiang: wall_rule must be hertz or jiang2021");
+    } else if (k == "damping") {
+      if (val == "jiang2021") damping_map = JD_DAMP_JIANG2021;
+      else if (val == "exact_restitution") damping_map = JD_DAMP_EXACT;
+      else error->all(FLERR, "pair_style gran/jiang: damping must be jiang2021 or exact_restitution");
+    } else if (k == "tangential_limit") {
+      if (val == "coulomb") xi_limit = JD_XI_COULOMB;
+      else if (val == "unconstrained") xi_limit = JD_XI_UNCONSTRAINED;
+      else error->all(FLERR, "pair_style gran/jiang: tangential_limit must be coulomb or unconstrained");
+    } else if (k == "mu_r") {
+      mu_r = force->numeric(FLERR, arg[i + 1]);
+      if (!(mu_r >= 0.0 && mu_r <= 1.0)) error->all(FLERR, "pair_style gran/jiang: mu_r must be in [0, 1]");
+    } else if (k == "rolling") {
+      if (val == "on") rolling = true;
+      else if (val == "off") rolling = false;
+      else error->all(FLERR, "pair_style gran/jiang: rolling must be on or off");
+    } else {
+      error->all(FLERR, ("pair_style gran/jiang: unknown option '" + k +
+                         "' (valid: wall_rule, damping, tangential_limit, mu_r, rolling)").c_str());
+    }
+  }
+
+  /* Per-contact history: jd_contact_state, then jd_rolling_state when rolling is on, with the
+   * kernel's sign-flip flags.  (settings() may run again for a repeated pair_style line.) */
+  history_arg.clear();
+  dnum_pairgran = 0;
+  char name[32];
+  for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) {
+    std::snprintf(name, sizeof name, "jd_state_%d", k);
+    add_history_value(name, jd_contact_state_newton[k] ? "1" : "0");
+  }
+  if (rolling)
+    for (int k = 0; k < JD_ROLLING_STATE_LEN; k++) {
+      std::snprintf(name, sizeof name, "jd_rolling_%d", k);
+      add_history_value(name, jd_rolling_state_newton[k] ? "1" : "0");
+    }
+
+  /* FixContactHistory and check/timestep/gran find the pair by the exact name "gran". */
+  if (force->pair == this && std::strcmp(force->pair_style, "gran") != 0) {
+    delete[] force->pair_style;
+    force->pair_style = new char[5];
+    std::strcpy(force->pair_style, "gran");
+  }
+}
+
+/* ---------------------------------------------------------------------------------------- */
+
+void PairGranJiang::init_granular() {
+  const int nt = atom->ntypes;
+  ntypes_ = nt;
+  const char *me = "gran/jiang";
+  FixPropertyGlobal *fE = static_cast<FixPropertyGlobal *>(
+      modify->find_fix_property("youngsModulus", "property/global", "peratomtype", nt, 0, me));
+  FixPropertyGlobal *fnu = static_cast<FixPropertyGlobal *>(
+      modify->find_fix_property("poissonsRatio", "property/global", "peratomtype", nt, 0, me));
+  FixPropertyGlobal *fe = static_cast<FixPropertyGlobal *>(modify->find_fix_property(
+      "coefficientRestitution", "property/global", "peratomtypepair", nt, nt, me));
+  FixPropertyGlobal *fmu = static_cast<FixPropertyGlobal *>(modify->find_fix_property(
+      "coefficientFriction", "property/global", "peratomtypepair", nt, nt, me));
+  FixPropertyGlobal *feta = NULL;
+  if (rolling)
+    feta = static_cast<FixPropertyGlobal *>(modify->find_fix_property(
+        "coefficientRollingFriction", "property/global", "peratomtypepair", nt, nt, me));
+
+  E_.assign(nt + 1, 0.0);
+  nu_.assign(nt + 1, 0.0);
+  coeffs_.assign((nt + 1) * (nt + 1), jd_pair_coeffs());
+  bool any_damp = false, any_fric = false;
+  for (int i = 1; i <= nt; i++) {
+    E_[i] = fE->compute_vector(i - 1);
+    nu_[i] = fnu->compute_vector(i - 1);
+    if (!(E_[i] > 0.0) || !(nu_[i] > -1.0 && nu_[i] < 0.5))
+      error->all(FLERR, "gran/jiang: youngsModulus must be > 0 and poissonsRatio in (-1, 0.5)");
+  }
+  for (int i = 1; i <= nt; i++)
+    for (int j = 1; j <= nt; j++) {
+      jd_pair_coeffs &c = coeffs_[i * (nt + 1) + j];
+      const double e = fe->compute_array(i - 1, j - 1);
+      if (!(e > 0.0 && e <= 1.0)) error->all(FLERR, "gran/jiang: coefficientRestitution must be in (0, 1]");
+      c.gamma = jd_gamma_for(damping_map, e);
+      c.mu = fmu->compute_array(i - 1, j - 1);
+      c.eta = feta ? feta->compute_array(i - 1, j - 1) : 0.0;
+      c.mu_r = mu_r;
+      c.xi_limit = xi_limit;
+      if (c.mu < 0.0 || c.eta < 0.0) error->all(FLERR, "gran/jiang: friction coefficients must be >= 0");
+      if (c.gamma > 0.0) any_damp = true;
+      if (c.mu > 0.0) any_fric = true;
+    }
+
+  /* Energies only when a dump h5md/jdem records the observables. */
+  energy = false;
+  for (int k = 0; k < output->ndump; k++)
+    if (std::strcmp(output->dump[k]->style, "h5md/jdem") == 0) energy = true;
+
+  features_ = 0u;
+  if (any_damp) features_ |= JD_F_DAMPING;
+  if (any_fric) features_ |= JD_F_FRICTION;
+  if (rolling) features_ |= JD_F_ROLLING;
+  if (any_fric && mu_r != 1.0) features_ |= JD_F_MU_R;
+  if (energy) features_ |= JD_F_ENERGY;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+
+void PairGranJiang::compute_force(int eflag, int vflag, int addflag) {
+#define JD_PAIR_LOOP(b) loop<(b)>(eflag, vflag, addflag)
+  JD_DISPATCH(features_, JD_PAIR_LOOP)
+#undef JD_PAIR_LOOP
+}
+
+template <unsigned F>
+void PairGranJiang::loop(int eflag, int vflag, int addflag) {
+  if (eflag || vflag) ev_setup(eflag, vflag);
+  else evflag = vflag_fdotr = 0;
+
+  double **x = atom->x, **v = atom->v, **f = atom->f;
+  double **omega = atom->omega, **torque = atom->torque;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  const int *type = atom->type;
+  const int nlocal = atom->nlocal;
+  const int inum = list->inum;
+  const int *ilist = list->ilist, *numneigh = list->numneigh;
+  int **firstneigh = list->firstneigh;
+  int **firsttouch = listgranhistory->firstneigh;
+  double **firsthist = listgranhistory->firstdouble;
+  const int dn = dnum();
+  const int slen = state_len();
+  const double dt_run = update->dt;
+  /* LIGGGHTS evaluates forces without advancing the history at set-up (shearupdate 0) and for
+   * compute pair/gran/local (computeflag 0): evaluate on a copy then. */
+  const bool commit = shearupdate_ != 0;
+  const bool apply = computeflag_ != 0;
+
+  double e_damp = 0.0, e_fric = 0.0, e_el = 0.0, ncontacts = 0.0;
+
+  for (int ii = 0; ii < inum; ii++) {
+    const int i = ilist[ii];
+    const int *jlist = firstneigh[i];
+    const int jnum = numneigh[i];
+    int *touch = firsttouch[i];
+    double *allhist = firsthist[i];
+    const double Ri = radius[i], mi = rmass[i];
+    const double kpi = jd_hertz_prefactor(E_[type[i]], nu_[type[i]], Ri);
+
+    for (int jj = 0; jj < jnum; jj++) {
+      const int j = jlist[jj] & NEIGHMASK;
+      double *hist = &allhist[dn * jj];
+      jd_contact_geom g;
+      if (!jd_geom_spheres(x[i], Ri, x[j], radius[j], &g)) {
+        /* separated: our semantics reset the history now (the dissipation was harvested) */
+        if (commit && touch[jj]) {
+          touch[jj] = 0;
+          for (int k = 0; k < slen; k++) hist[k] = 0.0;
+        }
+        continue;
+      }
+      const double Rj = radius[j], mj = rmass[j];
+      g.k_n = jd_kn_pair(kpi, jd_hertz_prefactor(E_[type[j]], nu_[type[j]], Rj));
+      g.m_eff = mi * mj / (mi + mj);
+      if (F & JD_F_ROLLING) {
+        const double Ii = jd_sphere_inertia(mi, Ri), Ij = jd_sphere_inertia(mj, Rj);
+        g.i_eff = Ii * Ij / (Ii + Ij);
+      } else {
+        g.i_eff = 0.0;
+      }
+      jd_kinematics k;
+      for (int d = 0; d < 3; d++) {
+        k.va[d] = v[i][d];
+        k.wa[d] = omega[i][d];
+        k.vb[d] = v[j][d];
+        k.wb[d] = omega[j][d];
+      }
+      jd_contact_state st;
+      jd_rolling_state rs;
+      jd_rolling_state *rsp = (F & JD_F_ROLLING) ? &rs : NULL;
+      jd_load_history(hist, st, rsp);
+      jd_contact_result out;
+      const int carries = jd_contact(F, &coeffs_[type[i] * (ntypes_ + 1) + type[j]], &g, &k,
+                                     dt_run, &st, rsp, &out);
+      /* a pair with a ghost partner is evaluated on both ranks: count it half on each */
+      const double w = j < nlocal ? 1.0 : 0.5;
+      if (F & JD_F_ENERGY) {
+        e_damp += w * st.e_damp;
+        e_fric += w * st.e_fric;
+        st.e_damp = st.e_fric = 0.0;
+        if (carries) e_el += w * jd_contact_elastic_energy(&st);
+      }
+      if (carries) ncontacts += w;
+      touch[jj] = 1; /* keep the history across neighbour rebuilds while overlapping */
+      jd_store_history(hist, st, rsp, commit);
+      if (!carries || !apply) continue;
+
+      for (int d = 0; d < 3; d++) {
+        f[i][d] -= out.f[d];
+        torque[i][d] += out.ta[d];
+      }
+      if (j < nlocal) {
+        for (int d = 0; d < 3; d++) {
+          f[j][d] += out.f[d];
+          torque[j][d] += out.tb[d];
+        }
+      }
+      if (evflag)
+        ev_tally_xyz(i, j, nlocal, 0, 0.0, 0.0, -out.f[0], -out.f[1], -out.f[2],
+                     x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]);
+    }
+  }
+
+  if (commit) {
+    e_damp_cum += e_damp;
+    e_fric_cum += e_fric;
+  }
+  e_elastic_now = e_el;
+  contacts_now = ncontacts;
+  (void)addflag;
+}

@@ -1,0 +1,69 @@
+/* pair_gran_jiang.h — `pair_style gran/jiang`: LIGGGHTS' granular pair machinery (neighbour
+ * lists, contact history, MPI migration) around jdem's C contact kernel (kernel/jdem_kernel.h).
+ *
+ *   pair_style gran/jiang [wall_rule hertz|jiang2021] [damping jiang2021|exact_restitution]
+ *                         [tangential_limit coulomb|unconstrained] [mu_r X] [rolling on|off]
+ *   pair_coeff * *
+ *
+ * Materials come from fix property/global youngsModulus, poissonsRatio (peratomtype) and
+ * coefficientRestitution, coefficientFriction, coefficientRollingFriction (peratomtypepair; the
+ * last one only with rolling on), exactly like LIGGGHTS' own models.  Thin glue only: the
+ * geometry is kernel/jdem_geometry.h, the laws kernel/jdem_kernel.h.
+ *
+ * The style registers itself as "gran" (FixContactHistory and check/timestep/gran look the pair
+ * up by that name), so restart files are not supported. */
+#ifndef JDEM_PAIR_GRAN_JIANG_H
+#define JDEM_PAIR_GRAN_JIANG_H
+
+#include <vector>
+
+#include "pair_gran.h"
+
+#include "jdem_kernel.h"
+
+namespace LAMMPS_NS {
+
+class PairGranJiang : public PairGran {
+ public:
+  PairGranJiang(class LAMMPS *);
+  virtual ~PairGranJiang() {}
+
+  virtual void settings(int, char **);
+  virtual void init_granular();
+  virtual bool contact_match(const std::string, const std::string) { return false; }
+  virtual int64_t hashcode() { return 0x6a6469616e67LL; } /* "jdiang": not a built-in model */
+  virtual double stressStrainExponent() { return 1.5; }
+
+  /* Model options (kernel enums) and the feature bits of the force loop. */
+  int wall_rule, damping_map, xi_limit;
+  double mu_r;
+  bool rolling;
+  bool energy; /* JD_F_ENERGY: set when a dump h5md/jdem wants the observables */
+  unsigned features() const { return features_; }
+
+  /* Per-type data (types 1..ntypes), valid after init. */
+  double youngs(int t) const { return E_[t]; }
+  double poisson(int t) const { return nu_[t]; }
+  const jd_pair_coeffs &coeffs(int it, int jt) const { return coeffs_[it * (ntypes_ + 1) + jt]; }
+  /* Pair-history layout: jd_contact_state first, then jd_rolling_state when rolling is on. */
+  int state_len() const { return JD_CONTACT_STATE_LEN + (rolling ? JD_ROLLING_STATE_LEN : 0); }
+
+  /* Observables of this rank (pairs with a ghost partner count 1/2, so that the sums over ranks
+   * count every pair once): cumulative dissipation [J], and at the last force evaluation the
+   * elastic energy [J] and the number of contacts carrying force. */
+  double e_damp_cum, e_fric_cum, e_elastic_now, contacts_now;
+
+ protected:
+  virtual void compute_force(int eflag, int vflag, int addflag);
+  template <unsigned F> void loop(int eflag, int vflag, int addflag);
+
+ private:
+  unsigned features_;
+  int ntypes_;
+  std::vector<double> E_, nu_;
+  std::vector<jd_pair_coeffs> coeffs_;
+};
+
+}  // namespace LAMMPS_NS
+
+#endif
