@@ -36,6 +36,9 @@ import yaml
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import compare_trajectories  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PY = "/usr/bin/python3"
 JDEM = os.path.join(ROOT, "build", "jdem")
@@ -544,10 +547,36 @@ def analyse_all(out, tests, engines, quick, timings):
                     continue
                 runs[(test, case, engine)] = run
                 records += found
+    records += engine_difference_records(out, tests, engines, quick)
     for t in timings:
         records.append(record(t["test"], t["case"], t["engine"], "run_wall_time_s", t["seconds"],
                               None, None, f"exit status {t['status']}"))
     return records, runs
+
+
+ENGINE_TOLERANCE = 1e-10  # the two engines run the same kernel in the same order
+
+
+def engine_difference_records(out, tests, engines, quick):
+    """The whole trajectories of the two engines, frame by frame: the largest difference of any
+    field or observable, scaled as scripts/compare_trajectories.py documents."""
+    if set(engines) != {"jdem", "liggghts"}:
+        return []
+    recs = []
+    for test in tests:
+        for case in selected_cases(test, quick):
+            a, b = (trajectory_path(out, test, case, e) for e in ("jdem", "liggghts"))
+            if not (os.path.exists(a) and os.path.exists(b)):
+                continue
+            try:
+                worst = compare_trajectories.compare(a, b)["worst"]
+            except compare_trajectories.Unusable as e:
+                worst, note = math.inf, str(e)
+            else:
+                note = "whole trajectory, every field and observable, scaled"
+            recs.append(record(test, case, "jdem-vs-liggghts", "engine_difference", worst, 0.0,
+                               ENGINE_TOLERANCE, note))
+    return recs
 
 
 # ================================================================================================

@@ -56,47 +56,24 @@ def load(path):
     return out
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("a")
-    ap.add_argument("b")
-    ap.add_argument("--tol", type=float, default=1e-10)
-    ap.add_argument("--rows", type=int, default=12, help="frames shown in the table (plus the worst)")
-    ap.add_argument("--no-observables", action="store_true", help="compare the per-particle fields only")
-    args = ap.parse_args()
-    try:
-        A, B = load(args.a), load(args.b)
-    except (OSError, KeyError) as e:
-        print("FAIL cannot read the trajectories: %s" % e)
-        return 2
+class Unusable(Exception):
+    """The two trajectories cannot be compared (message says why)."""
 
-    ida, idb = A["id"], B["id"]
-    if sorted(ida.tolist()) != sorted(idb.tolist()):
-        print("FAIL the particle ids differ (%d vs %d particles)" % (len(ida), len(idb)))
-        return 2
-    ia = np.argsort(ida)
-    ib = np.argsort(idb)
-    fields = [k for k in FIELDS if k in A["fields"] and k in B["fields"]]
-    if "position" not in fields:
-        print("FAIL no common position data")
-        return 2
-    sa, sb = A["fields"]["position"][0], B["fields"]["position"][0]
-    common = np.intersect1d(sa, sb)
-    if len(common) == 0:
-        print("FAIL no common steps")
-        return 2
-    if len(common) != len(sa) or len(common) != len(sb):
-        print("note: %d frames in A, %d in B, %d common steps" % (len(sa), len(sb), len(common)))
 
-    def frames(X, k):
-        steps, val = X["fields"][k]
-        idx = {int(s): n for n, s in enumerate(steps)}
-        return [idx[int(s)] for s in common], val
+def frame_index(X, field, common):
+    """Indices of the common steps in X's frames of one field, and the field's dataset."""
+    steps, val = X["fields"][field]
+    idx = {int(s): n for n, s in enumerate(steps)}
+    return [idx[int(s)] for s in common], val
 
+
+def scales(A, B, fields, common):
+    """The scale of each field (see the module docstring)."""
     R = float(max(A["radius"].max(), 1e-300))
-    # scales
-    fa0, va = frames(A, "velocity") if "velocity" in fields else (None, None)
-    vscale = float(np.max(np.linalg.norm(va[fa0[0]], axis=1))) if va is not None else 0.0
+    vscale = 0.0
+    if "velocity" in fields:
+        fa, va = frame_index(A, "velocity", common)
+        vscale = float(np.max(np.linalg.norm(va[fa[0]], axis=1)))
     if vscale == 0.0:
         gabs = float(np.linalg.norm(A["gravity"]))
         vscale = np.sqrt(gabs * R) if gabs > 0 else 1.0
@@ -113,62 +90,109 @@ def main():
         scale["force"] = 1.0
     if scale.get("torque", 0.0) == 0.0:
         scale["torque"] = scale["force"] * R
+    return scale
 
-    # per-frame scaled differences
+
+def field_differences(A, B, fields, common, scale):
+    """table[frame, field]: the largest scaled difference of the field in that frame."""
+    ia, ib = np.argsort(A["id"]), np.argsort(B["id"])
     table = np.zeros((len(common), len(fields)))
     for c, k in enumerate(fields):
-        fa, va = frames(A, k)
-        fb, vb = frames(B, k)
+        fa, va = frame_index(A, k, common)
+        fb, vb = frame_index(B, k, common)
         va_all, vb_all = va[()], vb[()]
         for n in range(len(common)):
             xa = va_all[fa[n]][ia]
             xb = vb_all[fb[n]][ib]
             table[n, c] = float(np.max(np.abs(xa - xb))) / scale[k] if xa.size else 0.0
+    return table
 
-    print("A: %s (%s)\nB: %s (%s)" % (args.a, A["creator"], args.b, B["creator"]))
-    print("scales: " + ", ".join("%s %.3e" % (SHORT[k], scale[k]) for k in fields))
-    head = "%10s" % "step" + "".join("%11s" % ("d" + SHORT[k]) for k in fields)
-    print(head)
-    rows = sorted(set(np.linspace(0, len(common) - 1, min(args.rows, len(common))).astype(int).tolist()))
-    worst = int(np.argmax(table.max(axis=1)))
-    for n in rows:
+
+def observable_differences(A, B):
+    """{name: largest difference} of the observables present in both files at common steps:
+    energies relative to the largest kinetic + rotational + elastic energy of A, counts
+    absolute; and that energy scale."""
+    if "observables" not in A["file"] or "observables" not in B["file"]:
+        return {}, 1.0
+    oa, ob = A["file"]["observables"], B["file"]["observables"]
+    tot = None
+    for k in ("kinetic_energy", "rotational_energy", "elastic_energy"):
+        if k in oa:
+            val = oa[k]["value"][()]
+            tot = val if tot is None else tot[: len(val)] + val[: len(tot)]
+    escale = float(np.max(np.abs(tot))) if tot is not None and len(tot) else 0.0
+    escale = escale if escale > 0 else 1.0
+    diffs = {}
+    for k in sorted(set(oa.keys()) & set(ob.keys())):
+        cs, ka, kb = np.intersect1d(oa[k]["step"][()], ob[k]["step"][()], return_indices=True)
+        if not len(cs):
+            continue
+        d = np.abs(oa[k]["value"][()][ka] - ob[k]["value"][()][kb])
+        diffs[k] = float(d.max()) / (1.0 if k.endswith("contacts") else escale)
+    return diffs, escale
+
+
+def compare(path_a, path_b, observables=True):
+    """Compare two trajectories.  Returns a dict with the loaded files (A, B), the compared
+    fields, the common steps, the scales, the per-frame table, the observable differences and
+    `worst`, the largest scaled difference of all.  Raises Unusable."""
+    try:
+        A, B = load(path_a), load(path_b)
+    except (OSError, KeyError) as e:
+        raise Unusable("cannot read the trajectories: %s" % e)
+    if sorted(A["id"].tolist()) != sorted(B["id"].tolist()):
+        raise Unusable("the particle ids differ (%d vs %d particles)" % (len(A["id"]), len(B["id"])))
+    fields = [k for k in FIELDS if k in A["fields"] and k in B["fields"]]
+    if "position" not in fields:
+        raise Unusable("no common position data")
+    common = np.intersect1d(A["fields"]["position"][0], B["fields"]["position"][0])
+    if len(common) == 0:
+        raise Unusable("no common steps")
+    scale = scales(A, B, fields, common)
+    table = field_differences(A, B, fields, common, scale)
+    obs, escale = observable_differences(A, B) if observables else ({}, 1.0)
+    worst = max([float(table.max())] + list(obs.values()))
+    return {"A": A, "B": B, "fields": fields, "common": common, "scale": scale, "table": table,
+            "observables": obs, "energy_scale": escale, "worst": worst}
+
+
+def report(c, path_a, path_b, rows):
+    """Print the comparison as a compact table."""
+    A, B, fields, common, table = c["A"], c["B"], c["fields"], c["common"], c["table"]
+    na, nb = len(A["fields"]["position"][0]), len(B["fields"]["position"][0])
+    if len(common) != na or len(common) != nb:
+        print("note: %d frames in A, %d in B, %d common steps" % (na, nb, len(common)))
+    print("A: %s (%s)\nB: %s (%s)" % (path_a, A["creator"], path_b, B["creator"]))
+    print("scales: " + ", ".join("%s %.3e" % (SHORT[k], c["scale"][k]) for k in fields))
+    print("%10s" % "step" + "".join("%11s" % ("d" + SHORT[k]) for k in fields))
+    shown = sorted(set(np.linspace(0, len(common) - 1, min(rows, len(common))).astype(int).tolist()))
+    for n in shown:
         print("%10d" % common[n] + "".join("%11.2e" % v for v in table[n]))
+    worst = int(np.argmax(table.max(axis=1)))
     print("worst frame: step %d:" % common[worst] + "".join(
-        " d%s %.2e" % (SHORT[k], table[worst, c]) for c, k in enumerate(fields)))
-    overall = float(table.max())
+        " d%s %.2e" % (SHORT[k], table[worst, i]) for i, k in enumerate(fields)))
+    if c["observables"]:
+        print("observables (energies / %.3e J, counts absolute): %s" % (
+            c["energy_scale"], ", ".join("%s %.1e" % kv for kv in c["observables"].items())))
 
-    # observables present in both files, at common steps: energies relative to the largest
-    # kinetic + rotational + elastic energy of A, counts absolute
-    obs_worst = 0.0
-    if not args.no_observables and "observables" in A["file"] and "observables" in B["file"]:
-        oa, ob = A["file"]["observables"], B["file"]["observables"]
-        names = sorted(set(oa.keys()) & set(ob.keys()))
-        escale = 0.0
-        tot = None
-        for k in ("kinetic_energy", "rotational_energy", "elastic_energy"):
-            if k in oa:
-                val = oa[k]["value"][()]
-                tot = val if tot is None else tot[: len(val)] + val[: len(tot)]
-        if tot is not None and len(tot):
-            escale = float(np.max(np.abs(tot)))
-        escale = escale if escale > 0 else 1.0
-        parts = []
-        for k in names:
-            sa_, sb_ = oa[k]["step"][()], ob[k]["step"][()]
-            cs, ka, kb = np.intersect1d(sa_, sb_, return_indices=True)
-            if not len(cs):
-                continue
-            d = np.abs(oa[k]["value"][()][ka] - ob[k]["value"][()][kb])
-            sc = 1.0 if k.endswith("contacts") else escale
-            w = float(d.max()) / sc
-            obs_worst = max(obs_worst, w)
-            parts.append("%s %.1e" % (k, w))
-        if parts:
-            print("observables (energies / %.3e J, counts absolute): %s" % (escale, ", ".join(parts)))
-    overall = max(overall, obs_worst)
-    ok = overall <= args.tol
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("a")
+    ap.add_argument("b")
+    ap.add_argument("--tol", type=float, default=1e-10)
+    ap.add_argument("--rows", type=int, default=12, help="frames shown in the table (plus the worst)")
+    ap.add_argument("--no-observables", action="store_true", help="compare the per-particle fields only")
+    args = ap.parse_args()
+    try:
+        c = compare(args.a, args.b, not args.no_observables)
+    except Unusable as e:
+        print("FAIL %s" % e)
+        return 2
+    report(c, args.a, args.b, args.rows)
+    ok = c["worst"] <= args.tol
     print("%s max scaled difference %.3e over %d frames (tolerance %.1e)" % (
-        "PASS" if ok else "FAIL", overall, len(common), args.tol))
+        "PASS" if ok else "FAIL", c["worst"], len(c["common"]), args.tol))
     return 0 if ok else 1
 
 
