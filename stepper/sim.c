@@ -117,6 +117,7 @@ oom:
 /* Save the contact history of a list (its first n entries), or put it back keeping the energy
  * reference of the evaluation in between (jd_contact_keep_reference). */
 static void save_history(const jd_contact_list *l, jd_contact_state *state, jd_rolling_state *roll) {
+    if (l->n == 0) return; /* the buffers may not exist yet */
     memcpy(state, l->state, l->n * sizeof *state);
     if (l->roll) memcpy(roll, l->roll, l->n * sizeof *roll);
 }
