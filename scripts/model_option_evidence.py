@@ -18,12 +18,13 @@ import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import chung_ooi  # noqa: E402  (the benchmark's runner and analysis, reused as they are)
+from benchmark import cases  # noqa: E402  (its scene_path is replaced per option value)
 
 SKIPPED_METRICS = {"run_wall_time_s", "force_at_end"}
 
 
 def scenes_with(option, value, work):
-    """A chung_ooi.scene_path replacement that returns each test's scene with model.OPTION set."""
+    """A benchmark.cases.scene_path replacement returning each test's scene with model.OPTION set."""
     def scene_path(test):
         path = os.path.join(work, "scenes", f"test{test}.yaml")
         if not os.path.exists(path):
@@ -58,11 +59,11 @@ def main():
     results = {}
     for value in args.values:
         work = os.path.join(chung_ooi.ROOT, "out", "evidence", args.option, value)
-        chung_ooi.scene_path = scenes_with(args.option, value, work)
+        cases.scene_path = scenes_with(args.option, value, work)
         chung_ooi.run_all(os.path.join(work, "out"), tests, ["jdem"], 2, False)
         records, _ = chung_ooi.analyse_all(os.path.join(work, "out"), tests, ["jdem"], False, [])
         results[value] = deviations(records)
-    print(f"| test | metric | " + " | ".join(f"{v}: rms / max" for v in args.values) + " |")
+    print("| test | metric | " + " | ".join(f"{v}: rms / max" for v in args.values) + " |")
     print("|---|---|" + "---|" * len(args.values))
     for key in sorted(results[args.values[0]]):
         cells = []

@@ -10,6 +10,13 @@ build/liggghts-jdem (docs/liggghts.md) and, beside it, `particles.data` (read_da
 diameter 2R and density, so LIGGGHTS computes the mass as 4 pi/3 R^3 rho exactly like
 jd_sphere_mass) and a copy of the resolved YAML (stored in the trajectory's /parameters).
 Decks are generated, never edited by hand.
+
+--builtin writes the same deck with LIGGGHTS' own contact law instead of ours, for comparison:
+`pair_style gran model hertz tangential history [rolling_friction epsd2]` and every wall as an
+infinite `fix wall/gran ... primitive` (axis-aligned planes -> x/y/zplane, axis-aligned cylinders
+-> x/y/zcylinder; anything else, and moving walls, are refused).  A finite plane becomes the
+infinite plane through it and a cylinder loses its end caps and its side: equivalent only where
+no particle reaches an edge, a rim or the far side.
 """
 import argparse
 import math
@@ -93,7 +100,32 @@ def bounding_box(scene, rmax):
     return [lo[d] - margin for d in range(3)], [hi[d] + margin for d in range(3)]
 
 
-def write_deck(scene, resolved_path, deck_path, traj_path):
+def axis_of(vector):
+    """Index of the coordinate axis a vector lies along, or None."""
+    nonzero = [d for d in range(3) if float(vector[d]) != 0.0]
+    return nonzero[0] if len(nonzero) == 1 else None
+
+
+def primitive_wall(w):
+    """The `primitive` arguments of LIGGGHTS' wall/gran for an axis-aligned plane or cylinder."""
+    if w["type"] == "plane":
+        p1, p2, p3 = ([float(c) for c in p] for p in w["corners"][:3])
+        e1 = [p2[d] - p1[d] for d in range(3)]
+        e2 = [p3[d] - p1[d] for d in range(3)]
+        normal = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+        d = axis_of(normal)
+        if d is None:
+            fail("wall %s: --builtin needs planes normal to x, y or z" % w["name"])
+        return "%splane %s" % ("xyz"[d], num(p1[d]))
+    a, b = ([float(c) for c in p] for p in w["axis"])
+    d = axis_of([b[k] - a[k] for k in range(3)])
+    if d is None:
+        fail("wall %s: --builtin needs cylinders along x, y or z" % w["name"])
+    # primitive_wall_definitions.h: the centre is given in the coordinates (d+1)%3, (d+2)%3
+    return "%scylinder %s %s %s" % ("xyz"[d], num(w["radius"]), num(a[(d + 1) % 3]), num(a[(d + 2) % 3]))
+
+
+def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False):
     deck_dir = os.path.dirname(os.path.abspath(deck_path))
     os.makedirs(deck_dir, exist_ok=True)
     mats = scene["materials"]
@@ -172,9 +204,14 @@ def write_deck(scene, resolved_path, deck_path, traj_path):
     if rolling:
         L.append("fix m5 all property/global coefficientRollingFriction peratomtypepair %d %s\n"
                  % (ntypes, pairs_line(2)))
-    L.append("\npair_style      gran/jiang wall_rule %s damping %s tangential_limit %s mu_r %s rolling %s\n" % (
-        model.get("wall_rule", "hertz"), model.get("damping", "jiang2021"),
-        model.get("tangential_limit", "coulomb"), num(model.get("mu_r", 1.0)), "on" if rolling else "off"))
+    builtin_model = "model hertz tangential history" + (" rolling_friction epsd2" if rolling else "")
+    if builtin:
+        L.append("\n# LIGGGHTS' built-in contact law (--builtin), not jdem's\n")
+        L.append("pair_style      gran %s\n" % builtin_model)
+    else:
+        L.append("\npair_style      gran/jiang wall_rule %s damping %s tangential_limit %s mu_r %s rolling %s\n" % (
+            model.get("wall_rule", "hertz"), model.get("damping", "jiang2021"),
+            model.get("tangential_limit", "coulomb"), num(model.get("mu_r", 1.0)), "on" if rolling else "off"))
     L.append("pair_coeff      * *\n")
     L.append("neighbor        %s bin\n" % num(0.2 * rmax))
     L.append("neigh_modify    delay 0\n")
@@ -184,7 +221,12 @@ def write_deck(scene, resolved_path, deck_path, traj_path):
         v = w.get("velocity", [0, 0, 0])
         vel = "" if all(float(c) == 0.0 for c in v) else " velocity %s" % vec(v)
         fid = "w_" + "".join(c if c.isalnum() or c == "_" else "_" for c in str(w["name"]))
-        if w["type"] == "plane":
+        if builtin:
+            if vel:
+                fail("wall %s: --builtin supports fixed walls only" % w["name"])
+            L.append("fix %s all wall/gran %s primitive type %d %s\n" % (
+                fid, builtin_model, tid[w["material"]], primitive_wall(w)))
+        elif w["type"] == "plane":
             L.append("fix %s all wall/jiang plane corners %s type %d%s\n" % (
                 fid, " ".join(vec(p) for p in w["corners"]), tid[w["material"]], vel))
         elif w["type"] == "cylinder":
@@ -213,6 +255,8 @@ def main():
     ap.add_argument("resolved", help="output of `build/jdem resolve` (YAML file, or - for stdin)")
     ap.add_argument("-o", "--output", required=True, help="deck to write (e.g. DIR/in.jdem)")
     ap.add_argument("--trajectory", required=True, help="H5MD file the deck's dump writes")
+    ap.add_argument("--builtin", action="store_true",
+                    help="LIGGGHTS' own hertz/history/epsd2 law and primitive walls instead of jdem's styles")
     a = ap.parse_args()
     text = sys.stdin.read() if a.resolved == "-" else open(a.resolved).read()
     scene = yaml.safe_load(text)
@@ -222,7 +266,7 @@ def main():
     if os.path.abspath(a.resolved) != resolved_copy:
         with open(resolved_copy, "w") as f:
             f.write(text)
-    write_deck(scene, resolved_copy, a.output, a.trajectory)
+    write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin)
 
 
 if __name__ == "__main__":
