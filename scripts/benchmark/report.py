@@ -62,7 +62,7 @@ def aggregate_table(records, test, engines):
 
 REPORT_NOTES = {
     1: "Reference: closed-form Hertz (E* = E/(2(1−ν²)), R* = R/2, m* = m/2, v = 20 m/s), computed in "
-       "scripts/chung_ooi.py. Overlap is the total overlap. Contact duration: F_n > 0 from onset to end, "
+       "scripts/benchmark/references.py. Overlap is the total overlap. Contact duration: F_n > 0 from onset to end, "
        "interpolated between steps.",
     2: "Reference: closed-form Hertz against a rigid plane (E* = E/(1−ν²), R* = R), model.wall_rule hertz.",
     3: "References: exact_restitution must return e_out = e_in; jiang2021 must return the spec's "
