@@ -1,6 +1,6 @@
 /*
- * scene_doc.h — internal to the scene reader (scene.c, scene_doc.c): typed, validating access to
- * a libyaml document tree, and the sweep machinery (case names, overrides).
+ * scene_doc.h — internal to the scene reader (stepper/scene*.c): typed, validating access to a
+ * libyaml document tree, and the sweep machinery (case names, overrides).
  *
  * Every reader reports the first problem as "FILE:LINE: key 'a.b.c': what is wrong; valid: ..."
  * into the context's error buffer and returns -1; 0 means success.  Key paths use the same dotted

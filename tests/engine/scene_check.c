@@ -10,9 +10,8 @@
  *
  * Build and run from the repository root:
  *   gcc -std=c11 -O2 -g -Wall -Wextra -Werror -D_POSIX_C_SOURCE=200809L -Ikernel -Iio -Istepper \
- *       $(pkg-config --cflags yaml-0.1) tests/engine/scene_check.c stepper/scene.c \
- *       stepper/scene_doc.c stepper/scene_emit.c -o build/scene_check \
- *       $(pkg-config --libs yaml-0.1) -lm
+ *       $(pkg-config --cflags yaml-0.1) tests/engine/scene_check.c stepper/scene*.c \
+ *       -o build/scene_check $(pkg-config --libs yaml-0.1) -lm
  *   build/scene_check tests/scenes
  * (add -fsanitize=address,undefined -fno-omit-frame-pointer for the sanitizer run)
  */

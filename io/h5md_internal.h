@@ -1,0 +1,56 @@
+/*
+ * h5md_internal.h — internal to the H5MD writer (io/h5md.c, io/h5md_util.c, io/xdmf.c): the
+ * time-dependent groups, the error capture and the small HDF5 helpers, and the XDMF sidecar.
+ */
+#ifndef JDEM_IO_H5MD_INTERNAL_H
+#define JDEM_IO_H5MD_INTERNAL_H
+
+#include <hdf5.h>
+#include <stddef.h>
+
+#include "h5md.h"
+
+/* The time-dependent groups under /particles/all. */
+enum { TD_POSITION, TD_VELOCITY, TD_ANGVEL, TD_FORCE, TD_TORQUE, TD_COUNT };
+
+/* h5md_util.c: error handling */
+typedef struct {
+    H5E_auto2_t fn;
+    void *data;
+    int saved; /* 0 if the caller's handler could not be read (e.g. set with H5Eset_auto1) */
+} quiet_t;
+
+void h5md_quiet_on(quiet_t *q, char *detail);
+void h5md_quiet_off(const quiet_t *q);
+void h5md_set_err(char *err, size_t errlen, const char *fmt, ...);
+void h5md_err(const char *detail, char *err, size_t errlen, const char *fmt, ...);
+void h5md_close_id(hid_t *id);
+
+/* h5md_util.c: small HDF5 helpers; each returns 0 / -1 (or an invalid id) and leaves the HDF5
+ * error stack for h5md_err */
+hid_t h5md_str_type(size_t len);
+int h5md_attr_write(hid_t obj, const char *name, hid_t ftype, hid_t mtype, int rank,
+                    const hsize_t *dims, const void *buf);
+int h5md_attr_str(hid_t obj, const char *name, const char *s);
+int h5md_attr_int(hid_t obj, const char *name, int v);
+int h5md_attr_double(hid_t obj, const char *name, double v);
+hid_t h5md_group_create(hid_t loc, const char *name);
+int h5md_dset_fixed(hid_t loc, const char *name, hid_t ftype, hid_t mtype, size_t n,
+                    const void *buf, const char *unit);
+hid_t h5md_dset_extendible(hid_t loc, const char *name, hid_t ftype, int rank,
+                           const hsize_t *rest, const hsize_t *chunk);
+int h5md_append_row(hid_t d, hsize_t at, int rank, const hsize_t *rest, hid_t mtype,
+                    const void *buf);
+
+/* xdmf.c: what the sidecar needs of a closed writer */
+typedef struct xdmf_info {
+    const char *path; /* final .h5 path */
+    size_t n;
+    hsize_t nframes;
+    const double *times;
+    const int *present;
+} xdmf_info;
+
+int xdmf_write(const xdmf_info *h, char *err, size_t errlen);
+
+#endif

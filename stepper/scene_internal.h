@@ -1,0 +1,74 @@
+/*
+ * scene_internal.h — internal to the scene reader (stepper/scene*.c): the loader state shared by
+ * the section readers, and the readers each file provides.
+ *
+ *   scene.c             scene_load / scene_list_cases / scene_free: cases, header, time, output,
+ *                       gravity, model, the default max_impact_speed; calls the readers below
+ *   scene_materials.c   materials, material references, interactions
+ *   scene_particles.c   explicit particles, the sort by id (duplicate ids), the start-overlap check
+ *   scene_generate.c    the lattice generator
+ *   scene_walls.c       walls and their geometry checks
+ *
+ * Every reader reports the first problem into L->c (see scene_doc.h) and returns -1; 0 means
+ * success.
+ */
+#ifndef JDEM_SCENE_INTERNAL_H
+#define JDEM_SCENE_INTERNAL_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "jdem_kernel.h"
+#include "scene.h"
+#include "scene_doc.h"
+
+#define MAX_PARTICLES 100000000
+
+/* [0, 1]: model.mu_r and a lattice's jitter. */
+static const sd_range UNIT = {0.0, 1.0, 0, 0};
+
+/* Loader state: the scene being filled plus, per particle, where it came from (for messages). */
+typedef struct loader {
+    sd_ctx c;
+    jd_scene *s;
+    const yaml_node_t *root;
+    size_t cap;                 /* allocated particles */
+    const yaml_node_t **pnode;  /* the particle's mapping, or its generator's */
+    int32_t *psrc;              /* >= 0: index in particles; < 0: -(generator index + 1) */
+    unsigned char *by_particle; /* per material: used by a particle */
+    unsigned char *by_wall;     /* per material: used by a wall */
+    int max_impact_given;
+} loader;
+
+static inline double norm3(const double v[3]) { return sqrt(jd_dot(v, v)); }
+
+static inline void sub3(const double a[3], const double b[3], double out[3]) {
+    for (int d = 0; d < 3; d++) out[d] = a[d] - b[d];
+}
+
+/* scene.c: optional integer map.key >= lo (out keeps its default when absent). */
+int scene_opt_int(loader *L, const yaml_node_t *map, const char *path, const char *key,
+                  int64_t lo, int64_t *out);
+
+/* scene_materials.c */
+int scene_read_materials(loader *L);
+/* The required map.material, as an index into the scene's materials. */
+int scene_req_material(loader *L, const yaml_node_t *map, const char *path, int *out);
+/* Last: the defaults of a pair depend on whether particles and walls make it meet. */
+int scene_read_interactions(loader *L);
+
+/* scene_particles.c */
+int scene_read_particles(loader *L);
+/* Append a particle with zero velocities; returns its index or -1. */
+long scene_add_particle(loader *L, const yaml_node_t *node, int32_t src);
+int scene_sort_particles(loader *L);
+int scene_check_overlaps(loader *L);
+
+/* scene_generate.c */
+int scene_read_generators(loader *L);
+
+/* scene_walls.c */
+int scene_read_walls(loader *L);
+
+#endif

@@ -1,0 +1,128 @@
+/*
+ * scene_walls.c — the walls section: planar quadrilaterals and cylinders, with their geometry
+ * checks.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene_internal.h"
+
+/* Relative tolerance of docs/scenes.md: wall geometry, fraction of the wall's size. */
+#define GEOM_TOL 1e-9
+
+static const char *const PLANE_KEYS[] = {"name", "type", "corners", "material", "velocity", NULL};
+static const char *const CYLINDER_KEYS[] = {"name", "type", "axis", "radius", "side", "material",
+                                            "velocity", NULL};
+
+/* Enum spellings, indexed by the kernel's enum values. */
+static const char *const WALL_TYPES[] = {"plane", "cylinder", NULL};
+static const char *const CYLINDER_SIDES[] = {"outside", "inside", NULL};
+_Static_assert(JD_WALL_PLANE == 0 && JD_WALL_CYLINDER == 1, "WALL_TYPES order");
+
+/* Size of a point set: its largest pairwise distance. */
+static double extent(const double (*p)[3], int n) {
+    double size = 0.0;
+    for (int a = 0; a < n; a++)
+        for (int b = a + 1; b < n; b++) {
+            double d[3];
+            sub3(p[b], p[a], d);
+            size = fmax(size, norm3(d));
+        }
+    return size;
+}
+
+/* Planar quadrilateral: P1..P3 not collinear, P4 in their plane, convex and counter-clockwise
+ * about the normal (P2-P1) x (P3-P1), all within GEOM_TOL of the wall's size. */
+static int check_plane(loader *L, const yaml_node_t *w, const char *path, jd_wall *wall) {
+    double (*p)[3] = wall->corners, e1[3], e2[3], n[3], d4[3];
+    char sub[SD_PATH_MAX];
+    sd_join(sub, path, "corners");
+    const yaml_node_t *at = sd_get(&L->c, w, "corners");
+    double size = extent((const double (*)[3])p, 4);
+    sub3(p[1], p[0], e1);
+    sub3(p[2], p[0], e2);
+    jd_cross(e1, e2, n);
+    double area = norm3(n);
+    if (!(area > GEOM_TOL * size * size))
+        return sd_fail(&L->c, at, sub, "the first three corners are collinear; valid: corners "
+                       "of a quadrilateral with a non-zero area");
+    for (int d = 0; d < 3; d++) wall->normal[d] = n[d] / area;
+    sub3(p[3], p[0], d4);
+    double off = jd_dot(d4, wall->normal);
+    if (fabs(off) > GEOM_TOL * size)
+        return sd_fail(&L->c, at, sub, "the fourth corner is %.3g m off the plane of the first "
+                       "three; valid: coplanar corners (within %g of the wall's size)", off,
+                       GEOM_TOL);
+    for (int k = 0; k < 4; k++) {
+        double a[3], b[3], t[3];
+        sub3(p[(k + 1) % 4], p[k], a);
+        sub3(p[(k + 2) % 4], p[(k + 1) % 4], b);
+        jd_cross(a, b, t);
+        if (!(jd_dot(t, wall->normal) > GEOM_TOL * size * size))
+            return sd_fail(&L->c, at, sub, "the corners do not form a convex quadrilateral in "
+                           "counter-clockwise order; valid: corners in order around the edge");
+    }
+    return 0;
+}
+
+static int read_cylinder(loader *L, const yaml_node_t *w, const char *path, jd_wall *wall) {
+    const yaml_node_t *axis = sd_get(&L->c, w, "axis");
+    char sub[SD_PATH_MAX];
+    sd_join(sub, path, "axis");
+    if (!axis) return sd_missing(&L->c, w, path, "axis", "[[x, y, z], [x, y, z]]");
+    if (sd_points(&L->c, axis, sub, 2, &wall->axis[0][0]) ||
+        sd_req_num(&L->c, w, path, "radius", SD_POSITIVE, &wall->radius) ||
+        sd_opt_enum(&L->c, w, path, "side", CYLINDER_SIDES, &wall->inside))
+        return -1;
+    double d[3];
+    sub3(wall->axis[1], wall->axis[0], d);
+    double scale = fmax(wall->radius, fmax(norm3(wall->axis[0]), norm3(wall->axis[1])));
+    if (!(norm3(d) > GEOM_TOL * scale))
+        return sd_fail(&L->c, axis, sub, "the axis has zero length; valid: two distinct end "
+                       "points");
+    return 0;
+}
+
+static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t index) {
+    jd_wall *wall = &L->s->walls[index];
+    char sub[SD_PATH_MAX];
+    if (sd_mapping(&L->c, w, path, "{name, type, material, ...}")) return -1;
+    const yaml_node_t *type = sd_get(&L->c, w, "type"), *name = sd_get(&L->c, w, "name");
+    sd_join(sub, path, "type");
+    if (!type) return sd_missing(&L->c, w, path, "type", "plane, cylinder");
+    if (sd_enum(&L->c, type, sub, WALL_TYPES, &wall->type)) return -1;
+    const int plane = wall->type == JD_WALL_PLANE;
+    if (sd_keys(&L->c, w, path, plane ? PLANE_KEYS : CYLINDER_KEYS)) return -1;
+    sd_join(sub, path, "name");
+    if (!name) return sd_missing(&L->c, w, path, "name", "a unique name");
+    if (sd_str(&L->c, name, sub, wall->name, sizeof wall->name)) return -1;
+    for (size_t k = 0; k < index; k++)
+        if (strcmp(L->s->walls[k].name, wall->name) == 0)
+            return sd_fail(&L->c, name, sub, "duplicate wall name '%s' (also walls.%zu); valid: "
+                           "unique names", wall->name, k);
+    if (scene_req_material(L, w, path, &wall->material) ||
+        sd_opt_vec3(&L->c, w, path, "velocity", wall->velocity))
+        return -1;
+    L->by_wall[wall->material] = 1;
+    if (!plane) return read_cylinder(L, w, path, wall);
+    sd_join(sub, path, "corners");
+    const yaml_node_t *corners = sd_get(&L->c, w, "corners");
+    if (!corners) return sd_missing(&L->c, w, path, "corners", "four points [[x, y, z], ...]");
+    if (sd_points(&L->c, corners, sub, 4, &wall->corners[0][0])) return -1;
+    return check_plane(L, w, path, wall);
+}
+
+int scene_read_walls(loader *L) {
+    const yaml_node_t *list = sd_get(&L->c, L->root, "walls");
+    if (!list) return 0;
+    if (sd_sequence(&L->c, list, "walls", "a list of {name, type, material, ...}")) return -1;
+    L->s->walls = calloc(sd_len(list) ? sd_len(list) : 1, sizeof *L->s->walls);
+    if (!L->s->walls) return sd_fail(&L->c, list, "walls", "out of memory");
+    L->s->n_walls = sd_len(list);
+    for (size_t i = 0; i < sd_len(list); i++) {
+        char path[SD_PATH_MAX];
+        sd_join_index(path, "walls", i);
+        if (read_wall(L, sd_item(&L->c, list, i), path, i)) return -1;
+    }
+    return 0;
+}
