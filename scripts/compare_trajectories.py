@@ -2,7 +2,10 @@
 """compare_trajectories.py — compare two jdem H5MD trajectories (e.g. build/jdem vs
 build/liggghts-jdem) frame by frame.
 
-    scripts/compare_trajectories.py A.h5 B.h5 [--tol 1e-10] [--rows 12]
+    scripts/compare_trajectories.py A.h5 B.h5 [--tol TOL] [--rows 12]
+
+The tolerance is the scene's `output.compare_tolerance` (stored in A's /parameters/scene; the
+default there is 1e-10), unless --tol overrides it.
 
 Particles are matched by id and frames by step (only steps present in both are compared; the
 frames of each file are listed if they differ).  For every common frame the largest difference
@@ -37,16 +40,17 @@ def load(path):
     for k in FIELDS:
         if k in p:
             out["fields"][k] = (p[k]["step"][()], p[k]["value"])
-    g = None
+    scene = {}
     if "parameters" in f and "scene" in f["parameters"]:
         try:
             txt = f["parameters/scene"][()]
             if isinstance(txt, bytes):
                 txt = txt.decode()
-            g = yaml.safe_load(str(txt)).get("gravity")
+            scene = yaml.safe_load(str(txt)) or {}
         except Exception:  # the scene text is optional metadata
-            g = None
-    out["gravity"] = np.array(g if g else [0.0, 0.0, 0.0], dtype=float)
+            scene = {}
+    out["gravity"] = np.array(scene.get("gravity") or [0.0, 0.0, 0.0], dtype=float)
+    out["tolerance"] = (scene.get("output") or {}).get("compare_tolerance")
     try:
         out["creator"] = f["h5md/creator"].attrs["name"]
         if isinstance(out["creator"], bytes):
@@ -180,7 +184,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("a")
     ap.add_argument("b")
-    ap.add_argument("--tol", type=float, default=1e-10)
+    ap.add_argument("--tol", type=float, default=None,
+                    help="tolerance (default: the scene's output.compare_tolerance, else 1e-10)")
     ap.add_argument("--rows", type=int, default=12, help="frames shown in the table (plus the worst)")
     ap.add_argument("--no-observables", action="store_true", help="compare the per-particle fields only")
     args = ap.parse_args()
@@ -190,9 +195,10 @@ def main():
         print("FAIL %s" % e)
         return 2
     report(c, args.a, args.b, args.rows)
-    ok = c["worst"] <= args.tol
+    tol = args.tol if args.tol is not None else (c["A"]["tolerance"] or 1e-10)
+    ok = c["worst"] <= tol
     print("%s max scaled difference %.3e over %d frames (tolerance %.1e)" % (
-        "PASS" if ok else "FAIL", c["worst"], len(c["common"]), args.tol))
+        "PASS" if ok else "FAIL", c["worst"], len(c["common"]), tol))
     return 0 if ok else 1
 
 

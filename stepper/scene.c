@@ -19,7 +19,8 @@ static const char *const TOP_KEYS[] = {"jdem_scene", "name", "case", "descriptio
                                        "output", "gravity", "model", "materials", "interactions",
                                        "particles", "generate", "walls", "sweep", NULL};
 static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_speed", NULL};
-static const char *const OUTPUT_KEYS[] = {"every", "observables_every", NULL};
+static const char *const OUTPUT_KEYS[] = {"every", "observables_every", "compare_tolerance",
+                                          NULL};
 static const char *const MODEL_KEYS[] = {"wall_rule", "damping", "tangential_limit", "mu_r", NULL};
 
 /* Enum spellings, indexed by the kernel's enum values. */
@@ -140,7 +141,10 @@ static int read_output(loader *L) {
     L->s->output_every = 1;
     if (rc || scene_opt_int(L, o, "output", "every", 1, &L->s->output_every)) return -1;
     L->s->observables_every = L->s->output_every;
-    return scene_opt_int(L, o, "output", "observables_every", 1, &L->s->observables_every);
+    if (scene_opt_int(L, o, "output", "observables_every", 1, &L->s->observables_every)) return -1;
+    L->s->compare_tolerance = 1e-10; /* the two engines run the same kernel in the same order */
+    return sd_opt_num(&L->c, o, "output", "compare_tolerance", SD_POSITIVE,
+                      &L->s->compare_tolerance);
 }
 
 static int read_model(loader *L) {

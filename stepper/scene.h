@@ -59,6 +59,8 @@ typedef struct jd_scene {
     /* output */
     int64_t output_every;
     int64_t observables_every;
+    double compare_tolerance; /* largest scaled difference scripts/compare_trajectories.py accepts
+                                 between two engines' runs of this scene [-] */
 
     double gravity[3];        /* [m/s^2] */
 

@@ -121,7 +121,8 @@ static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
            key_int(e, "steps", s->steps) || key_num(e, "max_impact_speed", s->max_impact_speed) ||
            map_end(e) || str(e, "output") || map_start(e, 0) ||
            key_int(e, "every", s->output_every) ||
-           key_int(e, "observables_every", s->observables_every) || map_end(e) ||
+           key_int(e, "observables_every", s->observables_every) ||
+           key_num(e, "compare_tolerance", s->compare_tolerance) || map_end(e) ||
            key_vec(e, "gravity", s->gravity) || str(e, "model") || map_start(e, 0) ||
            key_str(e, "wall_rule", WALL_RULES[s->wall_rule]) ||
            key_str(e, "damping", DAMPING_MAPS[s->damping_map]) ||
