@@ -12,7 +12,7 @@ PY    := /usr/bin/python3
 CC    := gcc
 CXX   := mpicxx
 
-DEB_PACKAGES := gcc g++ make pkg-config libyaml-dev libhdf5-dev libcmocka-dev \
+DEB_PACKAGES := gcc g++ make pkg-config clang libclang-rt-14-dev libyaml-dev libhdf5-dev libcmocka-dev \
                 python3-numpy python3-h5py python3-matplotlib python3-yaml \
                 liggghts libliggghts-dev mpi-default-dev mpi-default-bin
 
@@ -113,5 +113,27 @@ demo: deps
 	$(MAKE) chung-ooi
 	@echo "report: out/chung_ooi/report.md"
 
+# Performance benchmark (reference_runs/bench/README.md): settled beds, 3 engines, medians of 3.
+#   make bench [BENCH_SIZES=5k,20k,80k] [BENCH_REPEATS=3]     report: out/bench/report.md
+.PHONY: bench
+bench: all
+	$(PY) scripts/bench.py $(if $(BENCH_SIZES),--sizes $(BENCH_SIZES)) $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
+
 clean:
 	rm -rf build out
+
+# ---------------------------------------------------------------------------------------------
+# Fuzzing the scene reader with libFuzzer (clang): `make fuzz [FUZZ_SECONDS=600]`.  The seed
+# corpus tests/fuzz/corpus/ is read only; inputs that grow coverage collect in build/fuzz/corpus
+# (fold the useful ones back with `build/fuzz_scene -merge=1 tests/fuzz/corpus build/fuzz/corpus`)
+# and a crashing input is written to build/fuzz/ (the run then fails).
+FUZZ_SECONDS ?= 60
+.PHONY: fuzz
+build/fuzz_scene: tests/fuzz/fuzz_scene.c $(SCENE_SRC) $(HEADERS)
+	@mkdir -p build
+	clang $(CFLAGS) -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
+	    tests/fuzz/fuzz_scene.c $(SCENE_SRC) -o $@ $(PKG_LIBS)
+fuzz: build/fuzz_scene
+	@mkdir -p build/fuzz/corpus
+	build/fuzz_scene -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 \
+	    -dict=tests/fuzz/scene.dict -artifact_prefix=build/fuzz/ build/fuzz/corpus tests/fuzz/corpus

@@ -10,16 +10,13 @@
 
 #include "atom.h"
 #include "error.h"
-#include "fix.h"
-#include "fix_gravity.h"
 #include "force.h"
 #include "modify.h"
 #include "output.h"
 #include "update.h"
 
-#include "fix_wall_jiang.h"
 #include "h5md.h"
-#include "jdem_kernel.h"
+#include "jdem_observables.h"
 #include "pair_gran_jiang.h"
 
 using namespace LAMMPS_NS;
@@ -88,18 +85,8 @@ void DumpH5mdJdem::write() {
   double **x = atom->x, **v = atom->v, **omega = atom->omega, **f = atom->f, **torque = atom->torque;
   const double *radius = atom->radius, *rmass = atom->rmass;
 
-  /* pack my atoms and the local parts of the observables */
+  /* pack my atoms */
   std::vector<double> mine;
-  double obs[3] = {0.0, 0.0, 0.0}; /* kinetic, rotational, gravitational */
-  double g[3] = {0.0, 0.0, 0.0};
-  for (int k = 0; k < modify->nfix; k++) {
-    FixGravity *fg = dynamic_cast<FixGravity *>(modify->fix[k]);
-    if (fg) {
-      double gk[3];
-      fg->get_gravity(gk);
-      for (int d = 0; d < 3; d++) g[d] += gk[d];
-    }
-  }
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit)) continue;
     double row[NCOL];
@@ -115,33 +102,13 @@ void DumpH5mdJdem::write() {
       row[COL_T + d] = torque[i][d];
     }
     mine.insert(mine.end(), row, row + NCOL);
-    const double m = rmass[i];
-    obs[0] += 0.5 * m * jd_dot(v[i], v[i]);
-    obs[1] += 0.5 * jd_sphere_inertia(m, radius[i]) * jd_dot(omega[i], omega[i]);
-    obs[2] -= m * jd_dot(g, x[i]);
   }
 
-  /* contact observables from our pair style and walls */
+  /* the observables, summed on rank 0 */
   PairGranJiang *pair = dynamic_cast<PairGranJiang *>(force->pair);
-  double cobs[7] = {0, 0, 0, 0, 0, 0, 0}; /* elastic, damp, fric, wall_work, contacts, wall_contacts */
-  if (pair) {
-    cobs[0] += pair->e_elastic_now;
-    cobs[1] += pair->e_damp_cum;
-    cobs[2] += pair->e_fric_cum;
-    cobs[4] += pair->contacts_now;
-    for (int k = 0; k < modify->nfix; k++) {
-      FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
-      if (!w) continue;
-      cobs[0] += w->e_elastic_now;
-      cobs[1] += w->e_damp_cum;
-      cobs[2] += w->e_fric_cum;
-      cobs[3] += w->work_cum;
-      cobs[5] += w->contacts_now;
-    }
-  }
-  double all_obs[3], all_cobs[7];
-  MPI_Reduce(obs, all_obs, 3, MPI_DOUBLE, MPI_SUM, 0, world);
-  MPI_Reduce(cobs, all_cobs, 7, MPI_DOUBLE, MPI_SUM, 0, world);
+  double obs[JDO_N], all_obs[JDO_N];
+  jdem_local_observables(lmp, groupbit, obs);
+  MPI_Reduce(obs, all_obs, JDO_N, MPI_DOUBLE, MPI_SUM, 0, world);
 
   /* gather the rows on rank 0 */
   const int nme_d = (int)mine.size();
@@ -229,15 +196,15 @@ void DumpH5mdJdem::write() {
       if (jd_h5md_write_frame(h5, &fr, err, sizeof err) != 0) failed = 1;
     }
     struct { const char *name; double value; bool on; } o[] = {
-        {"kinetic_energy", all_obs[0], true},
-        {"rotational_energy", all_obs[1], true},
-        {"elastic_energy", all_cobs[0], pair != NULL},
-        {"gravitational_energy", all_obs[2], true},
-        {"damping_dissipation", all_cobs[1], pair != NULL && pair->energy},
-        {"friction_dissipation", all_cobs[2], pair != NULL && pair->energy},
-        {"wall_work", all_cobs[3], pair != NULL},
-        {"contacts", all_cobs[4], pair != NULL},
-        {"wall_contacts", all_cobs[5], pair != NULL},
+        {"kinetic_energy", all_obs[JDO_KINETIC], true},
+        {"rotational_energy", all_obs[JDO_ROTATIONAL], true},
+        {"elastic_energy", all_obs[JDO_ELASTIC], pair != NULL},
+        {"gravitational_energy", all_obs[JDO_GRAVITATIONAL], true},
+        {"damping_dissipation", all_obs[JDO_DAMPING], pair != NULL && pair->energy},
+        {"friction_dissipation", all_obs[JDO_FRICTION], pair != NULL && pair->energy},
+        {"wall_work", all_obs[JDO_WALL_WORK], pair != NULL},
+        {"contacts", all_obs[JDO_CONTACTS], pair != NULL},
+        {"wall_contacts", all_obs[JDO_WALL_CONTACTS], pair != NULL},
     };
     for (size_t k = 0; !failed && k < sizeof o / sizeof o[0]; k++)
       if (o[k].on && jd_h5md_write_observable(h5, o[k].name, (int64_t)step, time, o[k].value, err, sizeof err) != 0)

@@ -33,6 +33,7 @@ class DumpH5mdJdem : public Dump {
   DumpH5mdJdem(class LAMMPS *, int, char **);
   virtual ~DumpH5mdJdem();
   virtual void write();
+  const std::string &file_name() const { return path; } /* FILE.h5 (FILE.h5.part while open) */
 
  protected:
   virtual void init_style();

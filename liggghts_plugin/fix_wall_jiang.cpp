@@ -2,6 +2,7 @@
  * law jd_contact(). */
 #include "fix_wall_jiang.h"
 
+#include <cmath>
 #include <cstring>
 #include <string>
 
@@ -13,6 +14,7 @@
 
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
+#include "jdem_watchdog.h"
 #include "pair_gran_jiang.h"
 
 using namespace LAMMPS_NS;
@@ -20,7 +22,7 @@ using namespace FixConst;
 
 FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), e_damp_cum(0.0), e_fric_cum(0.0), work_cum(0.0),
-      e_elastic_now(0.0), contacts_now(0.0), shape(-1), wtype(0), slen(0), hist(NULL),
+      e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY), shape(-1), wtype(0), slen(0), hist(NULL),
       nmax_hist(0), pair(NULL) {
   const char *usage =
       "Illegal fix wall/jiang command: fix ID group wall/jiang plane corners x1 y1 z1 x2 y2 z2 "
@@ -141,6 +143,8 @@ void FixWallJiang::loop(bool commit) {
   const double dt = update->dt;
   const int rule = pair->wall_rule;
   double e_damp = 0.0, e_fric = 0.0, e_el = 0.0, ncontacts = 0.0, work = 0.0;
+  const int *tag = atom->tag;
+  overlap_trip = JdOverlapTrip();
 
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit)) continue;
@@ -153,6 +157,8 @@ void FixWallJiang::loop(bool commit) {
         for (int k = 0; k < slen; k++) h[k] = 0.0;
       continue;
     }
+    if (jd_overlap_excessive(g.delta, R, INFINITY, overlap_limit))
+      overlap_trip.note(g.delta, R, tag[i], 0, id);
     const double m = rmass[i];
     g.k_n = jd_kn_wall(rule, pair->youngs(type[i]), pair->poisson(type[i]), R);
     g.m_eff = m;

@@ -21,6 +21,7 @@
 #include "fix.h"
 
 #include "jdem_geometry.h"
+#include "jdem_overlap.h"
 
 namespace LAMMPS_NS {
 
@@ -43,6 +44,10 @@ class FixWallJiang : public Fix {
   /* Observables of this rank: cumulative dissipation and wall work [J]; at the last force
    * evaluation the elastic energy [J] and the number of wall contacts carrying force. */
   double e_damp_cum, e_fric_cum, work_cum, e_elastic_now, contacts_now;
+
+  /* As PairGranJiang's: set by fix jdem/watchdog; INFINITY (the default): never. */
+  double overlap_limit;
+  JdOverlapTrip overlap_trip;
 
  private:
   template <unsigned F> void loop(bool commit);

@@ -2,6 +2,7 @@
  * LIGGGHTS around jd_geom_spheres() and jd_contact(). */
 #include "pair_gran_jiang.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -10,6 +11,7 @@
 #include "comm.h"
 #include "dump.h"
 #include "error.h"
+#include "fix.h"
 #include "fix_property_global.h"
 #include "force.h"
 #include "modify.h"
@@ -21,6 +23,7 @@
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
 #include "jdem_geometry.h"
+#include "jdem_watchdog.h"
 
 using namespace LAMMPS_NS;
 
@@ -33,7 +36,8 @@ static_assert(sizeof(jd_rolling_state) == JD_ROLLING_STATE_LEN * sizeof(double),
 PairGranJiang::PairGranJiang(LAMMPS *lmp)
     : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
       xi_limit(JD_XI_COULOMB), mu_r(1.0), rolling(false), energy(false), e_damp_cum(0.0),
-      e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), features_(0), ntypes_(0) {}
+      e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
+      features_(0), ntypes_(0) {}
 
 /* ---------------------------------------------------------------------------------------- */
 
@@ -133,10 +137,13 @@ void PairGranJiang::init_granular() {
       if (c.mu > 0.0) any_fric = true;
     }
 
-  /* Energies only when a dump h5md/jdem records the observables. */
+  /* Energies only when a dump h5md/jdem records the observables or fix jdem/watchdog checks
+   * their balance. */
   energy = false;
   for (int k = 0; k < output->ndump; k++)
     if (std::strcmp(output->dump[k]->style, "h5md/jdem") == 0) energy = true;
+  for (int k = 0; k < modify->nfix; k++)
+    if (std::strcmp(modify->fix[k]->style, "jdem/watchdog") == 0) energy = true;
 
   features_ = 0u;
   if (any_damp) features_ |= JD_F_DAMPING;
@@ -178,6 +185,8 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
   const bool apply = computeflag_ != 0;
 
   double e_damp = 0.0, e_fric = 0.0, e_el = 0.0, ncontacts = 0.0;
+  const int *tag = atom->tag;
+  overlap_trip = JdOverlapTrip();
 
   for (int ii = 0; ii < inum; ii++) {
     const int i = ilist[ii];
@@ -201,6 +210,8 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
         continue;
       }
       const double Rj = radius[j], mj = rmass[j];
+      if (jd_overlap_excessive(g.delta, Ri, Rj, overlap_limit))
+        overlap_trip.note(g.delta, std::fmin(Ri, Rj), tag[i], tag[j], NULL);
       g.k_n = jd_kn_pair(kpi, jd_hertz_prefactor(E_[type[j]], nu_[type[j]], Rj));
       g.m_eff = mi * mj / (mi + mj);
       if (F & JD_F_ROLLING) {

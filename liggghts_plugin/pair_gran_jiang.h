@@ -20,6 +20,7 @@
 #include "pair_gran.h"
 
 #include "jdem_kernel.h"
+#include "jdem_overlap.h"
 
 namespace LAMMPS_NS {
 
@@ -52,6 +53,11 @@ class PairGranJiang : public PairGran {
    * count every pair once): cumulative dissipation [J], and at the last force evaluation the
    * elastic energy [J] and the number of contacts carrying force. */
   double e_damp_cum, e_fric_cum, e_elastic_now, contacts_now;
+
+  /* Set by fix jdem/watchdog: overlaps beyond overlap_limit x the smaller radius are noted in
+   * overlap_trip (reset at every force evaluation).  INFINITY (the default): never. */
+  double overlap_limit;
+  JdOverlapTrip overlap_trip;
 
  protected:
   virtual void compute_force(int eflag, int vflag, int addflag);

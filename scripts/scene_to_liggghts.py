@@ -125,6 +125,18 @@ def primitive_wall(w):
     return "%scylinder %s %s %s" % ("xyz"[d], num(w["radius"]), num(a[(d + 1) % 3]), num(a[(d + 2) % 3]))
 
 
+def watchdog_lines(scene, builtin):
+    """`fix jdem/watchdog` with the scene's limits (docs/scenes.md "Watchdog"), energy checked at
+    the observable samples as build/jdem does.  It needs gran/jiang: none with --builtin."""
+    wd = scene.get("watchdog") or {}
+    if builtin or not wd.get("enabled", True):
+        return []
+    out = scene.get("output") or {}
+    every = int(out.get("observables_every", out.get("every", 1)))
+    return ["fix watchdog all jdem/watchdog %d overlap %s energy %s\n" % (
+        every, num(wd.get("max_overlap_fraction", 0.5)), num(wd.get("max_energy_jump", 0.05)))]
+
+
 def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False):
     deck_dir = os.path.dirname(os.path.abspath(deck_path))
     os.makedirs(deck_dir, exist_ok=True)
@@ -240,6 +252,7 @@ def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False):
     if gm > 0.0:
         L.append("fix grav all gravity %s vector %s\n" % (num(gm), vec(g)))
     L.append("fix integr all nve/sphere\n")
+    L.extend(watchdog_lines(scene, builtin))
     L.append("\ntimestep        %s\n" % num(dt))
     L.append("thermo          %d\n" % max(1, steps // 10))
     L.append("dump d all h5md/jdem %d %s scene %s case %s scene_yaml %s\n" % (

@@ -4,6 +4,7 @@
  * jd_contact() compiles away every law the scene does not use (DESIGN.md: "leave out what a
  * scene does not need").  Order as LIGGGHTS: pair forces in list order, wall forces, gravity.
  */
+#include <math.h>
 #include <string.h>
 
 #include "geometry.h"
@@ -35,6 +36,8 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F) {
             jd_contact_separate(st, rs);
             continue;
         }
+        if (jd_overlap_excessive(g.delta, s->radius[i], s->radius[j], s->max_overlap))
+            sim_watchdog_overlap(s, i, j, g.delta, fmin(s->radius[i], s->radius[j]));
         jd_kinematics k;
         load_kinematics(s, i, &k);
         const double *vb = s->v + 3 * (size_t)j, *wb = s->omega + 3 * (size_t)j;
@@ -70,6 +73,8 @@ static JD_ALWAYS_INLINE void wall_loop(jd_sim *s, const unsigned F) {
             jd_contact_separate(st, rs);
             continue;
         }
+        if (jd_overlap_excessive(g.delta, s->radius[i], INFINITY, s->max_overlap))
+            sim_watchdog_overlap(s, i, -1 - L->j[c], g.delta, s->radius[i]);
         jd_kinematics k;
         load_kinematics(s, i, &k);
         for (int d = 0; d < 3; d++) {
@@ -103,6 +108,7 @@ static JD_ALWAYS_INLINE void contact_loops(jd_sim *s, const unsigned F) {
         break;
 
 void sim_compute_forces(jd_sim *s) {
+    s->overlap_trip.fraction = 0.0; /* the watchdog looks at this evaluation only */
     memset(s->f, 0, 3 * s->n * sizeof *s->f);
     memset(s->torque, 0, 3 * s->n * sizeof *s->torque);
     _Static_assert(JD_F_DAMPING == 1 && JD_F_FRICTION == 2 && JD_F_ROLLING == 4 && JD_F_MU_R == 8,

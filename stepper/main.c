@@ -2,11 +2,13 @@
  * main.c — the `jdem` command line (docs/scenes.md).
  *
  * Exit status: 0 success, 2 usage or input error (bad option, bad scene, unsafe time step),
- * 1 runtime failure (cannot write the output, simulation diverged, out of memory).  A failed run
- * never leaves a file under the final output name: the writer works on OUT.part and renames it
- * only at a successful close.
+ * 1 runtime failure (cannot write the output, simulation diverged, watchdog, out of memory),
+ * 128 + N when stopped by signal N (SIGINT 130, SIGTERM 143).  A failed or stopped run never
+ * leaves a file under the final output name: the writer works on OUT.part and renames it only
+ * at a successful close; a stopped run closes OUT.part properly, so it stays readable.
  */
 #include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -54,7 +56,15 @@ static const char usage_text[] =
     "                           particle-wall pair each step (O(N^2)) instead of the Verlet\n"
     "                           list; results must agree with the default path\n"
     "\n"
-    "exit status: 0 success, 1 runtime failure, 2 usage or input error.\n";
+    "watchdog (run, scene key watchdog:): a non-finite state, an overlap beyond\n"
+    "max_overlap_fraction of the smaller radius, or a jump of the total energy beyond\n"
+    "max_energy_jump between observable samples stops the run (exit status 1).\n"
+    "\n"
+    "signals (run): SIGINT or SIGTERM stops the run at the next step (a second one at once);\n"
+    "the frame of that step is written and the trajectory closed, as OUT.h5.part.\n"
+    "\n"
+    "exit status: 0 success, 1 runtime failure or watchdog, 2 usage or input error,\n"
+    "128 + N stopped by signal N (130 SIGINT, 143 SIGTERM).\n";
 
 typedef struct cli {
     const char *command, *scene, *case_name, *output;
@@ -183,6 +193,40 @@ static int check_time_step(const jd_scene *sc, const cli *c) {
     return 0;
 }
 
+/* Set by SIGINT/SIGTERM, read by the run loop (jd_sim.stop): the handler does no I/O. */
+static volatile sig_atomic_t stop_signal;
+
+static void on_stop_signal(int sig) { stop_signal = sig; }
+
+/* SA_RESETHAND: a second signal takes the default action, for a run that does not get to its
+ * next step.  SA_RESTART: HDF5's writes are not cut short by the first one. */
+static void catch_stop_signals(void) {
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND | SA_RESTART;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+/* The message of a run that did not complete; returns the exit status.  The file was closed
+ * with ok = 0: readable, and kept as OUT.part, never under the name of a complete run. */
+static int report_unfinished(int rc, const jd_sim *sim, const char *err, const char *out) {
+    if (rc == JD_RUN_STOPPED) {
+        fprintf(stderr, "jdem: %s at step %lld; the trajectory up to step %lld is kept, closed, "
+                "as %s.part\n", stop_signal == SIGINT ? "interrupted (SIGINT)" : "terminated "
+                "(SIGTERM)", (long long)sim->step, (long long)sim->frame_step, out);
+        return 128 + stop_signal;
+    }
+    if (rc == JD_RUN_TRIPPED)
+        fprintf(stderr, "jdem: %s; the trajectory up to step %lld is kept, closed, as %s.part "
+                "(the run failed)\n", err, (long long)sim->frame_step, out);
+    else
+        fprintf(stderr, "jdem: %s; the partial trajectory is in %s.part\n", err, out);
+    return EXIT_RUNTIME;
+}
+
 static int cmd_run(const cli *c) {
     jd_scene sc;
     int rc = load(c, &sc);
@@ -211,10 +255,14 @@ static int cmd_run(const cli *c) {
     const jd_h5md_particles parts = {.n = sc.n_particles, .id = sc.id, .species = sim.species,
                                      .radius = sim.radius, .mass = sim.mass};
     if (!(h = jd_h5md_create(out, &meta, &parts, err, sizeof err))) goto fail;
-    if (sim_run(&sim, h, !c->quiet, err, sizeof err) != 0) {
+    sim.stop = &stop_signal;
+    catch_stop_signals();
+    const int run_rc = sim_run(&sim, h, !c->quiet, err, sizeof err);
+    if (run_rc != 0) {
         char err2[256];
-        jd_h5md_close(h, 0, err2, sizeof err2);
-        fprintf(stderr, "jdem: %s; the partial trajectory is in %s.part\n", err, out);
+        if (jd_h5md_close(h, 0, err2, sizeof err2) != 0)
+            fprintf(stderr, "jdem: closing %s.part failed: %s\n", out, err2);
+        rc = report_unfinished(run_rc, &sim, err, out);
         goto done;
     }
     if (jd_h5md_close(h, 1, err, sizeof err) != 0) goto fail;

@@ -45,6 +45,15 @@ typedef struct jd_wall {
     int inside;               /* 0: obstacle (contact on the outer surface), 1: container */
 } jd_wall;
 
+/* Run-time watchdog (docs/scenes.md "Watchdog"): limits that stop a run that goes wrong. */
+typedef struct jd_watchdog_limits {
+    int enabled;                 /* 0: no checks beyond the writer's refusal of non-finite frames */
+    double max_overlap_fraction; /* overlap / the smaller radius of the pair (the particle's
+                                    radius against a wall) [-] */
+    double max_energy_jump;      /* |change of the total energy| between two observable samples
+                                    relative to the energy in play (kernel/jdem_watchdog.h) [-] */
+} jd_watchdog_limits;
+
 typedef struct jd_scene {
     char path[1024];          /* the scene file */
     char name[JD_NAME_MAX];   /* scene name */
@@ -63,6 +72,8 @@ typedef struct jd_scene {
                                  between two engines' runs of this scene [-] */
 
     double gravity[3];        /* [m/s^2] */
+
+    jd_watchdog_limits watchdog;
 
     /* model options (kernel enums) */
     int wall_rule;            /* jd_wall_rule */

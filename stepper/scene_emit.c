@@ -114,6 +114,13 @@ static const char *const WALL_RULES[] = {"hertz", "jiang2021"};
 static const char *const DAMPING_MAPS[] = {"jiang2021", "exact_restitution"};
 static const char *const XI_LIMITS[] = {"coulomb", "unconstrained"};
 
+static int emit_watchdog(yaml_emitter_t *e, const jd_watchdog_limits *w) {
+    return str(e, "watchdog") || map_start(e, 0) || str(e, "enabled") ||
+           scalar(e, w->enabled ? "true" : "false", YAML_PLAIN_SCALAR_STYLE) ||
+           key_num(e, "max_overlap_fraction", w->max_overlap_fraction) ||
+           key_num(e, "max_energy_jump", w->max_energy_jump) || map_end(e);
+}
+
 static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
     return key_int(e, "jdem_scene", 1) || key_str(e, "name", s->name) ||
            key_str(e, "case", s->case_name) || key_str(e, "description", s->description) ||
@@ -127,7 +134,7 @@ static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
            key_str(e, "wall_rule", WALL_RULES[s->wall_rule]) ||
            key_str(e, "damping", DAMPING_MAPS[s->damping_map]) ||
            key_str(e, "tangential_limit", XI_LIMITS[s->xi_limit]) || key_num(e, "mu_r", s->mu_r) ||
-           map_end(e);
+           map_end(e) || emit_watchdog(e, &s->watchdog);
 }
 
 static int emit_material(yaml_emitter_t *e, const jd_material *m) {

@@ -183,7 +183,9 @@ int sim_init(jd_sim *s, const jd_scene *scene, int allpairs, char *err, size_t e
     s->n = scene->n_particles;
     s->dt = scene->dt;
     s->allpairs = allpairs;
+    s->frame_step = -1;
     memcpy(s->g, scene->gravity, sizeof s->g);
+    s->max_overlap = scene->watchdog.enabled ? scene->watchdog.max_overlap_fraction : INFINITY;
     if (setup(s, err, errlen) == 0) return 0;
     sim_free(s);
     return -1;
@@ -224,21 +226,30 @@ static int write_frame(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     return h ? jd_h5md_write_frame(h, &fr, err, errlen) : 0;
 }
 
-static int write_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
-    if (!h) return 0;
+/* One observable sample: written when there is output, and always seen by the watchdog. */
+static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     jd_observables o;
     double val[JD_N_OBSERVABLES];
     sim_observables(s, &o);
     sim_observables_values(&o, val);
-    for (int k = 0; k < JD_N_OBSERVABLES; k++)
+    for (int k = 0; h && k < JD_N_OBSERVABLES; k++)
         if (jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->dt,
                                      val[k], err, errlen) != 0)
-            return -1;
-    return 0;
+            return JD_RUN_ERROR;
+    return sim_watchdog_energy(s, &o, err, errlen);
 }
 
 static int due(int64_t step, int64_t every, int64_t last) {
     return step == 0 || step == last || (every > 0 && step % every == 0);
+}
+
+/* A run stopped early (watchdog, signal) ends its trajectory at the step reached, so that the
+ * file shows the state that stopped it; write_frame refuses a non-finite state (NaN frames would
+ * only break the readers), and the stop message stays in err. */
+static void write_stop_frame(jd_sim *s, jd_h5md *h) {
+    char ignored[256];
+    if (s->frame_step != s->step && write_frame(s, h, ignored, sizeof ignored) == 0)
+        s->frame_step = s->step;
 }
 
 int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) {
@@ -248,13 +259,24 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
     progress_start(&p, show_progress, last, s->n);
     int rc = 0;
     for (;;) {
-        if (due(s->step, sc->output_every, last) && (rc = write_frame(s, h, err, errlen)) != 0) break;
-        if (due(s->step, sc->observables_every, last) && (rc = write_observables(s, h, err, errlen)) != 0)
+        if ((rc = sim_watchdog_step(s, err, errlen)) != 0) break;
+        if (due(s->step, sc->output_every, last)) {
+            if ((rc = write_frame(s, h, err, errlen)) != 0) break;
+            s->frame_step = s->step;
+        }
+        if (due(s->step, sc->observables_every, last) &&
+            (rc = sample_observables(s, h, err, errlen)) != 0)
             break;
         if (s->step >= last) break;
+        if (s->stop && *s->stop) {
+            snprintf(err, errlen, "stopped at step %lld", (long long)s->step);
+            rc = JD_RUN_STOPPED;
+            break;
+        }
         if ((rc = sim_step(s, err, errlen)) != 0) break;
         progress_update(&p, s->step, (double)s->step * s->dt);
     }
     progress_finish(&p);
+    if (rc == JD_RUN_TRIPPED || rc == JD_RUN_STOPPED) write_stop_frame(s, h);
     return rc;
 }

@@ -10,6 +10,7 @@
  *   integrate.c    one velocity-Verlet step exactly as LIGGGHTS fix nve/sphere
  *   observables.c  energies and contact counts
  *   guard.c        the time-step guard
+ *   watchdog.c     the run-time watchdog: non-finite state, excessive overlap, energy jumps
  *   progress.c     the progress line on stderr
  *
  * Data layout.  Particle vectors (x, v, omega, f, torque) are arrays of 3n doubles, x0 y0 z0 x1
@@ -22,11 +23,13 @@
 #ifndef JDEM_SIM_H
 #define JDEM_SIM_H
 
+#include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
 
 #include "jdem_geometry.h"
 #include "jdem_kernel.h"
+#include "jdem_watchdog.h"
 #include "scene.h"
 
 /* A list of contact candidates (i, j) sorted by (i, j), with the history of each contact stored
@@ -50,11 +53,18 @@ typedef struct jd_sim_wall {
     double disp[3];    /* translation since the last neighbour build [m] */
 } jd_sim_wall;
 
+/* The largest overlap beyond the watchdog's limit in one force evaluation (fraction 0: none). */
+typedef struct jd_overlap_trip {
+    double fraction;   /* overlap / the smaller radius [-] */
+    int32_t i, j;      /* particle indices; j < 0: wall -j - 1 */
+} jd_overlap_trip;
+
 typedef struct jd_sim {
     const jd_scene *scene;
     size_t n;          /* particles */
     double dt;         /* [s] */
     int64_t step;      /* steps done */
+    int64_t frame_step; /* step of the last frame written by sim_run, -1 before the first */
     unsigned features; /* JD_F_* bits of the force loops, fixed for the run */
 
     /* particle state, 3n each */
@@ -86,7 +96,24 @@ typedef struct jd_sim {
     /* energy bookkeeping */
     double e_damp_dropped, e_fric_dropped; /* accumulators of contacts dropped from the lists */
     double wall_work;  /* work done on the particles by the walls [J] */
+
+    /* run-time watchdog (watchdog.c) */
+    double max_overlap;         /* the scene's max_overlap_fraction; INFINITY with the watchdog
+                                   off, so that the force loops test it without a branch on it */
+    jd_overlap_trip overlap_trip; /* of the last force evaluation */
+    int nonfinite;              /* the last step left a non-finite x (it then stopped before
+                                   the neighbour search), v or omega (a non-finite force or
+                                   torque shows up in v or omega) */
+    int has_energy_ref;         /* energy_ref holds the previous observable sample */
+    jd_energy_terms energy_ref;
+    int64_t energy_ref_step;
+
+    /* set by the caller (e.g. a signal handler) to stop the run at the next step; NULL: never */
+    const volatile sig_atomic_t *stop;
 } jd_sim;
+
+/* Results of sim_run besides 0. */
+enum { JD_RUN_ERROR = -1, JD_RUN_TRIPPED = -2, JD_RUN_STOPPED = -3 };
 
 /* sim.c */
 /* Set up from a loaded scene (kept by pointer; it must outlive the sim) and compute the forces
@@ -96,7 +123,10 @@ void sim_free(jd_sim *s);
 
 struct jd_h5md;
 /* Run scene->steps steps writing frames and observables to h (which may be NULL: no output).
- * show_progress: print the progress line on stderr.  Returns 0, or -1 with a reason in err. */
+ * show_progress: print the progress line on stderr.  Returns 0; JD_RUN_ERROR with a reason in
+ * err; JD_RUN_TRIPPED when the watchdog stopped the run (its message in err); JD_RUN_STOPPED when
+ * *s->stop was set.  On the last two the frame of the step reached is written (unless its state
+ * is not finite), so the trajectory ends where the run stopped. */
 int sim_run(jd_sim *s, struct jd_h5md *h, int show_progress, char *err, size_t errlen);
 
 /* neighbour.c */
@@ -137,6 +167,14 @@ typedef struct jd_guard {
 #define JD_GUARD_RAYLEIGH_FRACTION 0.2
 #define JD_GUARD_STEPS_PER_CONTACT 50.0
 void sim_guard(const jd_scene *scene, jd_guard *g);
+
+/* watchdog.c.  The force loops call sim_watchdog_overlap() (out of line: the rare case) for a
+ * contact with jd_overlap_excessive(); the run loop calls the checks below, which return 0 or
+ * JD_RUN_TRIPPED with "watchdog: step N: QUANTITY VALUE for particle(s) IDS exceeds LIMIT ..."
+ * in msg. */
+void sim_watchdog_overlap(jd_sim *s, int32_t i, int32_t j, double delta, double rmin);
+int sim_watchdog_step(const jd_sim *s, char *msg, size_t len);       /* every step */
+int sim_watchdog_energy(jd_sim *s, const jd_observables *o, char *msg, size_t len); /* samples */
 
 /* progress.c */
 typedef struct jd_progress {

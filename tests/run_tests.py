@@ -15,7 +15,8 @@ import time
 
 PY = "/usr/bin/python3"
 
-ENGINE_TESTS = ["neighbour", "free_flight", "hertz_impact", "energy_balance", "guard"]
+ENGINE_TESTS = ["neighbour", "free_flight", "hertz_impact", "energy_balance", "guard", "watchdog",
+                "signals"]
 SANITIZED = {"JDEM": "build/san/jdem"}
 
 # name, command, output style, extra environment.  Sanitizer builds run the same checks.
@@ -30,6 +31,10 @@ SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines",
            for t in ENGINE_TESTS]
 # The two engines on the same scenes (bitwise or 1e-10), and LIGGGHTS on 1 vs 2 MPI ranks.
 SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {})]
+# The watchdog in LIGGGHTS (fix jdem/watchdog): the same trips as the stepper's.
+SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "lines", {})]
+# The pour (576 spheres, walls, a cylinder): round-off horizons and settled statistics.
+SUITES += [("pour", [PY, "tests/liggghts/check_pour.py"], "lines", {})]
 # The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
 # `make demo` runs the full sweeps.
 CHUNG_OOI = "out/test/chung_ooi"

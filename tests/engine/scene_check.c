@@ -159,6 +159,9 @@ static const char *diff_scenes(const jd_scene *a, const jd_scene *b) {
     SAME(damping_map);
     SAME(xi_limit);
     SAME(mu_r);
+    SAME(watchdog.enabled);
+    SAME(watchdog.max_overlap_fraction);
+    SAME(watchdog.max_energy_jump);
     SAME(n_materials);
     SAME(n_particles);
     SAME(n_walls);

@@ -6,5 +6,6 @@ int main(void) {
     failed += run_kernel_tests();
     failed += run_geometry_tests();
     failed += run_h5md_tests();
+    failed += run_watchdog_tests();
     return failed;
 }

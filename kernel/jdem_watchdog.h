@@ -1,0 +1,54 @@
+/*
+ * jdem_watchdog.h — the limits of the run-time watchdog, shared by both engines (the stepper's
+ * stepper/watchdog.c and LIGGGHTS' `fix jdem/watchdog`), so that both stop a run on exactly the
+ * same condition.  Pure C11, static inline: no I/O, no allocation, no globals.
+ */
+#ifndef JDEM_KERNEL_WATCHDOG_H
+#define JDEM_KERNEL_WATCHDOG_H
+
+#include <math.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Overlap delta [m] of spheres Ra, Rb [m] (Rb = INFINITY for a wall) beyond frac of the smaller
+ * radius.  A limit of INFINITY never trips (the engines use it for "watchdog off", so that the
+ * force loops need no branch on it); a NaN delta does not trip here (the non-finite check
+ * reports it with the right quantity). */
+static inline int jd_overlap_excessive(double delta, double Ra, double Rb, double frac) {
+    return delta > frac * fmin(Ra, Rb);
+}
+
+/* The terms of the energy balance of docs/scenes.md [J]. */
+typedef struct jd_energy_terms {
+    double kinetic, rotational, elastic, gravitational, damping, friction, wall_work;
+} jd_energy_terms;
+
+/* KE + RE + elastic + gravitational + dissipated - wall work: constant in an exact run. */
+static inline double jd_energy_total(const jd_energy_terms *e) {
+    return e->kinetic + e->rotational + e->elastic + e->gravitational + e->damping + e->friction -
+           e->wall_work;
+}
+
+/* The energy in play: the terms that do not depend on where the origin of height is.  The
+ * gravitational energy enters only through its round-off (1e-12 of it), so that a run with a
+ * distant origin and nothing moving yet cannot trip on the last bits of -sum m g.x. */
+static inline double jd_energy_scale(const jd_energy_terms *e) {
+    return e->kinetic + e->rotational + e->elastic + e->damping + e->friction +
+           fabs(e->wall_work) + 1e-12 * fabs(e->gravitational);
+}
+
+/* Relative jump of the total energy from sample a to sample b [-]: |E_b - E_a| over the larger
+ * energy in play of the two.  0 when nothing changed (also when nothing is in play); INFINITY
+ * when energy appears from nothing; NaN when a term is not finite. */
+static inline double jd_energy_jump(const jd_energy_terms *a, const jd_energy_terms *b) {
+    const double d = fabs(jd_energy_total(b) - jd_energy_total(a));
+    const double scale = fmax(jd_energy_scale(a), jd_energy_scale(b));
+    return d == 0.0 ? 0.0 : d / scale;
+}
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* JDEM_KERNEL_WATCHDOG_H */

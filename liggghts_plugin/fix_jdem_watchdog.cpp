@@ -1,0 +1,182 @@
+/* fix_jdem_watchdog.cpp — see fix_jdem_watchdog.h.  Each check finds this rank's worst case,
+ * then one MINLOC/MAXLOC reduction picks the global one and its owner broadcasts the details,
+ * so that every rank builds the same message for error->all. */
+#include "fix_jdem_watchdog.h"
+
+#include <mpi.h>
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+
+#include "atom.h"
+#include "comm.h"
+#include "error.h"
+#include "force.h"
+#include "modify.h"
+#include "output.h"
+#include "update.h"
+
+#include "dump_h5md_jdem.h"
+#include "fix_wall_jiang.h"
+#include "jdem_observables.h"
+#include "pair_gran_jiang.h"
+
+using namespace LAMMPS_NS;
+
+FixJdemWatchdog::FixJdemWatchdog(LAMMPS *lmp, int narg, char **arg)
+    : Fix(lmp, narg, arg), energy_every(1), max_overlap(0.5), max_energy_jump(0.05),
+      has_ref(false), ref(), ref_step(0) {
+  if (narg < 4) error->all(FLERR, "Illegal fix jdem/watchdog command: fix ID group jdem/watchdog N [overlap F] [energy J]");
+  energy_every = force->inumeric(FLERR, arg[3]);
+  if (energy_every < 1) error->all(FLERR, "fix jdem/watchdog: N must be >= 1");
+  for (int i = 4; i < narg; i += 2) {
+    if (i + 1 >= narg) error->all(FLERR, "fix jdem/watchdog: keyword without a value");
+    const double value = force->numeric(FLERR, arg[i + 1]);
+    if (!(value > 0.0)) error->all(FLERR, "fix jdem/watchdog: limits must be > 0");
+    if (std::strcmp(arg[i], "overlap") == 0) max_overlap = value;
+    else if (std::strcmp(arg[i], "energy") == 0) max_energy_jump = value;
+    else error->all(FLERR, "fix jdem/watchdog: unknown keyword (valid: overlap, energy)");
+  }
+  nevery = 1; /* the cheap checks run every step; the energy check every energy_every */
+}
+
+int FixJdemWatchdog::setmask() { return FixConst::END_OF_STEP; }
+
+/* Hand the overlap limit to the force loops, which note what exceeds it as they go. */
+void FixJdemWatchdog::init() {
+  PairGranJiang *pair = dynamic_cast<PairGranJiang *>(force->pair);
+  if (!pair) error->all(FLERR, "fix jdem/watchdog requires pair_style gran/jiang");
+  pair->overlap_limit = max_overlap;
+  for (int k = 0; k < modify->nfix; k++) {
+    FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
+    if (w) w->overlap_limit = max_overlap;
+  }
+}
+
+void FixJdemWatchdog::setup(int) { check(); }
+
+void FixJdemWatchdog::end_of_step() { check(); }
+
+/* The stepper's order: the state, the overlaps, then the energy at its samples. */
+void FixJdemWatchdog::check() {
+  std::string msg;
+  if (nonfinite(msg)) trip(msg, false);
+  if (overlap(msg)) trip(msg, true);
+  const bigint step = update->ntimestep;
+  if ((step % energy_every == 0 || step == update->laststep) && energy(msg)) trip(msg, true);
+}
+
+static std::string format(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static std::string format(const char *fmt, ...) {
+  char buf[1024];
+  va_list ap;
+  va_start(ap, fmt);
+  std::vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  return buf;
+}
+
+/* Forces first (a non-finite force is the cause of the velocity it produces), then the
+ * smallest id: the key quantity * 2^31 + id orders both in one MINLOC. */
+bool FixJdemWatchdog::nonfinite(std::string &msg) {
+  static const char *const names[] = {"force", "torque", "position", "velocity", "angular velocity"};
+  double **q[] = {atom->f, atom->torque, atom->x, atom->v, atom->omega};
+  const double id_range = 2147483648.0;
+  struct { double key; int rank; } mine = {INFINITY, comm->me}, all;
+  double value = 0.0;
+  for (int k = 0; k < 5 && mine.key == INFINITY; k++)
+    for (int i = 0; i < atom->nlocal; i++)
+      for (int d = 0; d < 3; d++)
+        if ((atom->mask[i] & groupbit) && !std::isfinite(q[k][i][d]) &&
+            k * id_range + atom->tag[i] < mine.key) {
+          mine.key = k * id_range + atom->tag[i];
+          value = q[k][i][d];
+        }
+  MPI_Allreduce(&mine, &all, 1, MPI_DOUBLE_INT, MPI_MINLOC, world);
+  if (all.key == INFINITY) return false;
+  MPI_Bcast(&value, 1, MPI_DOUBLE, all.rank, world);
+  const int k = (int)(all.key / id_range);
+  msg = format("jdem: watchdog: step " BIGINT_FORMAT ": %s %g for particle(s) %.0f is not finite",
+               update->ntimestep, names[k], value, all.key - k * id_range);
+  return true;
+}
+
+bool FixJdemWatchdog::overlap(std::string &msg) {
+  JdOverlapTrip worst = dynamic_cast<PairGranJiang *>(force->pair)->overlap_trip;
+  for (int k = 0; k < modify->nfix; k++) {
+    FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
+    if (w && w->overlap_trip.fraction > worst.fraction) worst = w->overlap_trip;
+  }
+  struct { double fraction; int rank; } mine = {worst.fraction, comm->me}, all;
+  MPI_Allreduce(&mine, &all, 1, MPI_DOUBLE_INT, MPI_MAXLOC, world);
+  if (!(all.fraction > 0.0)) return false;
+  int tags[2] = {worst.tag_a < worst.tag_b || !worst.tag_b ? worst.tag_a : worst.tag_b,
+                 worst.tag_a < worst.tag_b || !worst.tag_b ? worst.tag_b : worst.tag_a};
+  char wall[128] = "";
+  if (worst.wall) std::snprintf(wall, sizeof wall, "%s", worst.wall);
+  MPI_Bcast(tags, 2, MPI_INT, all.rank, world);
+  MPI_Bcast(wall, sizeof wall, MPI_CHAR, all.rank, world);
+  const std::string with = tags[1] ? format(", %d", tags[1]) : format(" against wall '%s'", wall);
+  msg = format("jdem: watchdog: step " BIGINT_FORMAT ": overlap fraction %.6g for particle(s) %d%s "
+               "exceeds %g", update->ntimestep, all.fraction, tags[0], with.c_str(), max_overlap);
+  return true;
+}
+
+/* Id of the atom with the largest kinetic energy: where a spurious energy gain usually sits. */
+int FixJdemWatchdog::most_energetic() {
+  struct { double e; int rank; } mine = {-1.0, comm->me}, all;
+  int tag = 0;
+  for (int i = 0; i < atom->nlocal; i++) {
+    const double e = atom->rmass[i] * jd_dot(atom->v[i], atom->v[i]);
+    if ((atom->mask[i] & groupbit) && e > mine.e) {
+      mine.e = e;
+      tag = atom->tag[i];
+    }
+  }
+  MPI_Allreduce(&mine, &all, 1, MPI_DOUBLE_INT, MPI_MAXLOC, world);
+  MPI_Bcast(&tag, 1, MPI_INT, all.rank, world);
+  return tag;
+}
+
+bool FixJdemWatchdog::energy(std::string &msg) {
+  double local[JDO_N], sum[JDO_N];
+  jdem_local_observables(lmp, groupbit, local);
+  MPI_Allreduce(local, sum, JDO_N, MPI_DOUBLE, MPI_SUM, world);
+  jd_energy_terms now;
+  now.kinetic = sum[JDO_KINETIC];
+  now.rotational = sum[JDO_ROTATIONAL];
+  now.elastic = sum[JDO_ELASTIC];
+  now.gravitational = sum[JDO_GRAVITATIONAL];
+  now.damping = sum[JDO_DAMPING];
+  now.friction = sum[JDO_FRICTION];
+  now.wall_work = sum[JDO_WALL_WORK];
+  const double jump = has_ref ? jd_energy_jump(&ref, &now) : 0.0;
+  if (!(jump <= max_energy_jump)) { /* NaN trips too */
+    const int id = most_energetic();
+    msg = format("jdem: watchdog: step " BIGINT_FORMAT ": energy jump %.6g for particle(s) %d exceeds "
+                 "%g (total energy %.9g J at step " BIGINT_FORMAT ", %.9g J now; the particle named "
+                 "has the largest kinetic energy)", update->ntimestep, jump, id, max_energy_jump,
+                 jd_energy_total(&ref), ref_step, jd_energy_total(&now));
+    return true;
+  }
+  ref = now;
+  ref_step = update->ntimestep;
+  has_ref = true;
+  return false;
+}
+
+/* Write the frame of this step (the dumps' collective write), name the file each h5md/jdem dump
+ * keeps, and stop through LIGGGHTS' error path (the dumps keep FILE.part). */
+void FixJdemWatchdog::trip(const std::string &msg, bool write_frame) {
+  if (write_frame) output->write_dump(update->ntimestep);
+  std::string full = msg;
+  for (int k = 0; k < output->ndump; k++) {
+    DumpH5mdJdem *d = dynamic_cast<DumpH5mdJdem *>(output->dump[k]);
+    if (d)
+      full += format("; the trajectory up to step " BIGINT_FORMAT " is kept, closed, as %s.part "
+                     "(the run failed)", update->ntimestep, d->file_name().c_str());
+  }
+  error->all(FLERR, full.c_str());
+}

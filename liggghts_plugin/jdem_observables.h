@@ -1,0 +1,21 @@
+/* jdem_observables.h — this rank's part of the /observables of docs/scenes.md, from the atoms,
+ * fix gravity, pair_style gran/jiang and every fix wall/jiang: summed over ranks they are the
+ * totals.  One computation for the two users, dump h5md/jdem (which writes them) and fix
+ * jdem/watchdog (which checks the energy balance with kernel/jdem_watchdog.h). */
+#ifndef JDEM_OBSERVABLES_H
+#define JDEM_OBSERVABLES_H
+
+namespace LAMMPS_NS {
+class LAMMPS;
+
+/* Indices into the array filled by jdem_local_observables(). */
+enum { JDO_KINETIC = 0, JDO_ROTATIONAL, JDO_GRAVITATIONAL, JDO_ELASTIC, JDO_DAMPING,
+       JDO_FRICTION, JDO_WALL_WORK, JDO_CONTACTS, JDO_WALL_CONTACTS, JDO_N };
+
+/* Sums over this rank's atoms of `groupbit` and its contacts (pairs with a ghost partner count
+ * 1/2, see PairGranJiang).  The contact terms stay 0 without pair_style gran/jiang. */
+void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]);
+
+}  // namespace LAMMPS_NS
+
+#endif

@@ -1,0 +1,99 @@
+#!/usr/bin/python3
+"""check_watchdog.py — the run-time watchdog in LIGGGHTS (fix jdem/watchdog) against build/jdem's.
+
+    tests/liggghts/check_watchdog.py [--keep]
+
+For each case of tests/engine/scenes/watchdog_blowup.yaml (an overlap trip, an energy-jump
+trip) both engines must stop at the same step with the same message "jdem: watchdog: step N:
+QUANTITY VALUE for particle(s) IDS exceeds LIMIT" (LIGGGHTS through error->all, on 1 and on 2
+MPI ranks), exit non-zero, and leave a readable OUT.part (nothing under OUT) whose last frame is
+that step with finite values.  A resolved impact (Chung & Ooi test 1) must run to the end in
+LIGGGHTS with the watchdog in its deck.  Prints one PASS/FAIL line per check; exit 1 on failure.
+"""
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import h5py
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+PY = sys.executable
+JDEM = os.path.join(ROOT, "build", "jdem")
+SCENE = os.path.join(ROOT, "tests", "engine", "scenes", "watchdog_blowup.yaml")
+TRIP = re.compile(r"jdem: watchdog: step (\d+): [^;]*")
+
+failed = 0
+
+
+def check(name, ok, detail=""):
+    global failed
+    print(("PASS %s" % name) if ok else ("FAIL %s: %s" % (name, detail)), flush=True)
+    failed += 0 if ok else 1
+    return ok
+
+
+def check_part(name, out, step):
+    """OUT.part readable, OUT absent, last frame at `step`, every value finite."""
+    check(name + "_no_final_file", not os.path.exists(out), "a file under the final name")
+    try:
+        with h5py.File(out + ".part", "r") as f:
+            steps = f["particles/all/position/step"][()]
+            finite = all(np.isfinite(f["particles/all/%s/value" % k][()]).all()
+                         for k in ("position", "velocity", "angular_velocity", "force", "torque"))
+    except OSError as e:
+        return check(name + "_part_readable", False, str(e))
+    check(name + "_last_frame", len(steps) > 0 and steps[-1] == step, "frame steps %s, trip at %d" % (steps, step))
+    check(name + "_finite", finite, "non-finite values in the trajectory")
+
+
+def liggghts(tmp, case, np_):
+    out = os.path.join(tmp, "%s_np%d.h5" % (case, np_))
+    r = subprocess.run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), SCENE, "--case", case,
+                        "-o", out, "--np", str(np_)], capture_output=True, text=True)
+    with open(os.path.join(tmp, "%s_np%d.deck" % (case, np_), "log.lammps"), errors="replace") as f:
+        log = f.read()
+    return r.returncode, log, out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--keep", action="store_true", help="keep the runs (printed directory)")
+    a = ap.parse_args()
+    tmp = tempfile.mkdtemp(prefix="jdem_watchdog_")
+    for case, ranks in (("overlap", (1, 2)), ("energy", (1,))):
+        out = os.path.join(tmp, case + ".jdem.h5")
+        r = subprocess.run([JDEM, "run", SCENE, "--case", case, "--force", "--quiet", "-o", out],
+                           capture_output=True, text=True)
+        m = TRIP.search(r.stderr)
+        if not check("jdem_%s_trips" % case, r.returncode == 1 and m, "exit %d: %r" % (r.returncode, r.stderr)):
+            continue
+        for n in ranks:
+            name = "liggghts_%s_np%d" % (case, n)
+            rc, log, lout = liggghts(tmp, case, n)
+            lm = TRIP.search(log)
+            check(name + "_fails", rc != 0, "exit status 0")
+            if check(name + "_same_message", lm is not None and lm.group(0) == m.group(0),
+                     "jdem: %r, LIGGGHTS: %r" % (m.group(0), lm.group(0) if lm else log[-1500:])):
+                check(name + "_names_part", lout + ".part" in log, "the message does not name %s.part" % lout)
+                check_part(name, lout, int(lm.group(1)))
+    out = os.path.join(tmp, "impact.h5")
+    r = subprocess.run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"),
+                        os.path.join(ROOT, "tests", "engine", "scenes", "chung_ooi_1.yaml"), "-o", out],
+                       capture_output=True, text=True)
+    check("liggghts_resolved_impact_does_not_trip", r.returncode == 0 and os.path.exists(out),
+          "exit %d: %s" % (r.returncode, r.stderr[-1500:]))
+    if a.keep:
+        print("runs kept in %s" % tmp)
+    else:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
