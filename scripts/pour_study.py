@@ -21,11 +21,7 @@ run-to-run spread of the settled statistics).  Run times go to OUT/runs.json (me
 `run --engines ... --seeds ...` can add runs).  `analyze` writes OUT/summary.json, OUT/report.md
 and the plots.
 
-Deck box: scene_to_liggghts.py sizes the LIGGGHTS box for free fall over the whole run (1.8 m
-for 0.6 s), which makes LIGGGHTS stop with "Too many neighbor bins".  The particles are
-enclosed by the walls here, so the deck's box is replaced by the box the generator writes for a
-run of zero duration (the walls' extent plus 4 radii).  See tight_box().  lig2x adds a
-`processors` line (set_processors()); otherwise the decks are the generator's.  2-rank runs
+Decks: the generator's, except that lig2x adds a `processors` line (set_processors()).  2-rank runs
 use Open MPI's mpi_yield_when_idle (the results do not depend on it).  The environment variables
 JDEM and LIGGGHTS_JDEM select the engines (default build/jdem, build/liggghts-jdem).
 """
@@ -45,8 +41,6 @@ import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
-import scene_to_liggghts  # noqa: E402  (bounding_box: the deck's box rule)
 
 JDEM = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))   # as tests/engine
 LIG = os.environ.get("LIGGGHTS_JDEM", os.path.join(ROOT, "build", "liggghts-jdem"))
@@ -98,22 +92,6 @@ def run_jdem(scene, out):
     return timed([JDEM, "run", scene, "-o", out, "--quiet"])
 
 
-def tight_box(deck_dir):
-    """Replace the box of DECK_DIR/particles.data by the generator's box for a zero-length run."""
-    scene = yaml.safe_load(open(os.path.join(deck_dir, "resolved.yaml")))
-    scene["time"]["steps"] = 0
-    rmax = max(float(p["radius"]) for p in scene["particles"])
-    lo, hi = scene_to_liggghts.bounding_box(scene, rmax)
-    path = os.path.join(deck_dir, "particles.data")
-    lines = open(path).read().split("\n")
-    for n, line in enumerate(lines[:12]):
-        for d, ax in enumerate("xyz"):
-            if line.endswith(" %slo %shi" % (ax, ax)):
-                lines[n] = "%s %s %slo %shi" % (repr(lo[d]), repr(hi[d]), ax, ax)
-    with open(path, "w") as f:
-        f.write("\n".join(lines))
-
-
 def set_processors(deck_dir, grid):
     """Insert `processors GRID` before read_data in DECK_DIR/in.jdem."""
     path = os.path.join(deck_dir, "in.jdem")
@@ -135,7 +113,6 @@ def run_liggghts(scene, out, np_=1, builtin=False, grid=None):
         f.write(check([JDEM, "resolve", scene]))
     check([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), resolved, "-o",
            os.path.join(deck_dir, "in.jdem"), "--trajectory", out] + (["--builtin"] if builtin else []))
-    tight_box(deck_dir)
     if grid:
         set_processors(deck_dir, grid)
     cmd = [LIG, "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"]
@@ -460,9 +437,7 @@ RUNS_TEXT = """
   (`processors 2 1 1`), through the pile and the bar for the whole run. builtin: 1 rank,
   LIGGGHTS' own `gran model hertz tangential history rolling_friction epsd2` and primitive walls
   (scene_to_liggghts.py --builtin). seedN: jdem with lattice seed N instead of 7.
-* Decks: the generator's, except the box (scene_to_liggghts.py sizes it for 0.6 s of free fall,
-  3.9 m wide, and LIGGGHTS stops with "Too many neighbor bins"; replaced by the walls' extent
-  plus 4 radii) and lig2x's `processors` line.
+* Decks: the generator's, except lig2x's `processors` line.
 * Times: wall and CPU (user + system of all processes, both ranks for lig2/lig2x), with the
   1-minute load average when the run started: the machine was shared (load 3–6 on 2 cores), so
   wall times are upper bounds; CPU times compare better. 2-rank runs use

@@ -89,14 +89,15 @@ def bounding_box(scene, rmax):
             grow(p, r)
             grow([p[d] + v[d] * T for d in range(3)], r)
     # room for the particles to move: ballistic reach over the run, at least 4 radii, and at
-    # most 100 x the initial extent (LIGGGHTS bins the whole box; a particle leaving a
-    # boundary-f box is lost, which liggghts_run.py reports through the atom count)
+    # most the initial extent of particles and walls (LIGGGHTS bins the whole box, and a box
+    # sized for a long free fall has too many neighbour bins; a particle leaving a boundary-f
+    # box is lost, which liggghts_run.py reports through the atom count)
     vmax = max([math.sqrt(sum(float(c) ** 2 for c in p.get("velocity", [0, 0, 0])))
                 for p in scene.get("particles") or []] + [0.0])
     gabs = math.sqrt(sum(c * c for c in g))
     extent = max(hi[d] - lo[d] for d in range(3))
     reach = vmax * T + 0.5 * gabs * T * T
-    margin = max(4.0 * rmax, min(1.05 * reach + 2.0 * rmax, 100.0 * extent))
+    margin = max(4.0 * rmax, min(1.05 * reach + 2.0 * rmax, extent))
     return [lo[d] - margin for d in range(3)], [hi[d] + margin for d in range(3)]
 
 
