@@ -1,0 +1,638 @@
+#!/usr/bin/python3
+"""bench.py — the performance benchmark of issue 6 (`make bench`).
+
+    scripts/bench.py [--sizes 5k,20k] [--variants all] [--engines jdem,liggghts-jdem,liggghts]
+                     [--repeats 3] [--ranks-size 20k] [--out out/bench] [--fresh] [--report-only]
+
+Dense beds of spheres settled under gravity in an open box (reference_runs/bench/README.md):
+monodisperse R = 1 mm or bidisperse 1 mm / 2 mm (half and half by number), soft (E = 1e7 Pa) or
+stiff (E = 7e10 Pa), with or without rolling resistance; nu = 0.3, rho = 2500, e = 0.5, mu = 0.5.
+
+1. Beds (once per size and dispersity, reused by every variant, engine and repeat; kept in
+   OUT/beds/, regenerated only when missing): build/jdem settles a jittered lattice of soft
+   spheres (reference_runs/bench/settle.yaml.in).  build/jdem refuses scenes whose spheres
+   overlap by more than 1e-6 R at the start, so the settled bed is then relaxed until every
+   contact overlaps by exactly 5e-10 m (damped Gauss-Newton least squares, CGLS, numpy only):
+   the settled contact network with nearly zero forces, which gravity loads again in the timed
+   run.  Soft and stiff variants start from the same bed (settling at the stiff time step would
+   take ~1e6 steps).
+2. Scenes: reference_runs/bench/bench.yaml.in + the bed as explicit particles at rest; dt is the
+   stepper's largest safe dt (its guard at max_impact_speed 1 m/s), rounded down; frames only
+   at step 0 and the last step.
+3. Timings, each repeated --repeats times (median reported):
+   * jdem: a run of S steps minus a run of 1 step (set-up, parsing, the two frames cancel);
+   * liggghts-jdem and stock liggghts: LIGGGHTS' "Loop time of ..." (the run loop only).  The
+     decks come from scene_to_liggghts.py (stock: --builtin, dump removed).
+   Also the CPU time of the loop (GNU time's user+sys of the S-step run minus that of a 1-step
+   run, for every engine on 1 rank): steadier than wall time when other jobs share the machine.
+   The LIGGGHTS decks get `processors * * 1` (the box is twice the bed's height: a z split
+   would leave one rank empty); 2 MPI ranks are timed at --ranks-size.
+   Peak resident memory is GNU time's maximum RSS (for MPI runs: of the largest process).
+   Average contacts per particle = 2 x particle-particle contacts / N at the last step (jdem and
+   liggghts-jdem: the trajectory's /observables/contacts; stock: compute contact/atom).
+4. A callgrind profile of a 200-step jdem run (if valgrind is installed; OUT/profile.json).
+5. OUT/summary.json, OUT/runs.jsonl (every single timing), OUT/report.md with plots.
+
+Timing results are appended to OUT/runs.jsonl and reused (a run already measured is not run
+again) unless --fresh; so an interrupted bench continues where it stopped.
+"""
+import argparse
+import json
+import math
+import os
+import re
+import shutil
+import statistics
+import string
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+TEMPLATES = os.path.join(ROOT, "reference_runs", "bench")
+JDEM = os.path.join(ROOT, "build", "jdem")
+LIGGGHTS_JDEM = os.path.join(ROOT, "build", "liggghts-jdem")
+LIGGGHTS = "/usr/bin/liggghts"
+GNU_TIME = "/usr/bin/time"
+
+E_SOFT, E_STIFF = 1.0e7, 7.0e10
+R_SMALL, R_LARGE = 1.0e-3, 2.0e-3
+LAYERS = 20                       # lattice layers before settling
+TOUCH = 5e-7                      # contact overlap of the bench beds, fraction of the smallest radius
+ETA_ROLL = 0.1                    # rolling-friction coefficient of the "roll" variants
+SIZES = {"5k": 5000, "20k": 20000, "80k": 80000, "320k": 320000, "1M": 1000000}
+STEPS = {"5k": 2000, "20k": 500, "80k": 200, "320k": 100, "1M": 50}
+SETTLE_TIME = {"mono": 0.12, "bi": 0.15}
+VARIANTS = [(stiff, disp, roll) for stiff in ("soft", "stiff") for disp in ("mono", "bi")
+            for roll in ("", "_roll")]
+VARIANT_NAMES = ["%s_%s%s" % v for v in VARIANTS]
+ENGINES = ("jdem", "liggghts-jdem", "liggghts")
+
+
+def log(msg):
+    sys.stderr.write("[bench %s] %s\n" % (time.strftime("%H:%M:%S"), msg))
+    sys.stderr.flush()
+
+
+def num(x):
+    return repr(float(x))
+
+
+# ---------------------------------------------------------------------------------------------
+# Geometry of a bed
+
+def bed_geometry(size, disp):
+    n = SIZES[size]
+    rmax = R_LARGE if disp == "bi" else R_SMALL
+    spacing = 2.05 * rmax
+    k = max(2, int(round(math.sqrt(n / LAYERS))))
+    side = k * spacing
+    height = 2.0 * LAYERS * spacing
+    return dict(n=k * k * LAYERS, k=k, spacing=spacing, side=side, height=height, rmax=rmax)
+
+
+def walls_yaml(side, height):
+    L, H = num(side), num(height)
+    rows = [("floor", "[[0, 0, 0], [%s, 0, 0], [%s, %s, 0], [0, %s, 0]]" % (L, L, L, L)),
+            ("x_low", "[[0, 0, 0], [0, %s, 0], [0, %s, %s], [0, 0, %s]]" % (L, L, H, H)),
+            ("x_high", "[[%s, 0, 0], [%s, 0, %s], [%s, %s, %s], [%s, %s, 0]]" % (L, L, H, L, L, H, L, L)),
+            ("y_low", "[[0, 0, 0], [0, 0, %s], [%s, 0, %s], [%s, 0, 0]]" % (H, L, H, L)),
+            ("y_high", "[[0, %s, 0], [%s, %s, 0], [%s, %s, %s], [0, %s, %s]]" % (L, L, L, L, L, H, L, H))]
+    return "\n".join("  - {name: %s, type: plane, corners: %s, material: wall}" % r for r in rows)
+
+
+def fill(template, **kw):
+    with open(os.path.join(TEMPLATES, template)) as f:
+        return string.Template(f.read()).substitute(**{k: str(v) for k, v in kw.items()})
+
+
+def safe_dt(scene_path):
+    """The stepper's largest safe dt for this scene (from its guard message), rounded down to
+    two significant digits."""
+    r = subprocess.run([JDEM, "run", scene_path, "-o", "/dev/null/x.h5"], capture_output=True, text=True)
+    m = re.search(r"largest safe dt = ([0-9.eE+-]+)", r.stderr)
+    if not m:
+        raise RuntimeError("no safe dt in the stepper's message:\n" + r.stderr)
+    v = float(m.group(1))
+    e = math.floor(math.log10(v)) - 1
+    return math.floor(v / 10.0 ** e) * 10.0 ** e
+
+
+def round_sig(v):
+    return float("%.2g" % v)
+
+
+# ---------------------------------------------------------------------------------------------
+# Beds
+
+def h5_last_frame(path):
+    import h5py
+    with h5py.File(path, "r") as f:
+        p = f["particles/all"]
+        return dict(id=p["id"][...].astype(np.int64), radius=p["radius"][...].astype(float),
+                    x=p["position/value"][-1].astype(float),
+                    contacts=float(f["observables/contacts/value"][-1]),
+                    wall_contacts=float(f["observables/wall_contacts/value"][-1]),
+                    kinetic_energy=float(f["observables/kinetic_energy/value"][-1]))
+
+
+def find_contacts(x, r, side):
+    """Overlapping pairs (i < j) with unit normals from i to j and overlaps; wall contacts of the
+    open box (floor and four sides) with the wall normal pointing into the box."""
+    n = len(r)
+    h = 2.0 * r.max()
+    c = np.floor(x / h).astype(np.int64)
+    c -= c.min(axis=0)
+    nc = c.max(axis=0) + 3
+    key = (c[:, 2] * nc[1] + c[:, 1]) * nc[0] + c[:, 0]
+    order = np.argsort(key, kind="stable")
+    skey = key[order]
+    I, J = [], []
+    for dz in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            for dx in (-1, 0, 1):
+                nk = key + (dz * nc[1] + dy) * nc[0] + dx
+                lo = np.searchsorted(skey, nk, "left")
+                hi = np.searchsorted(skey, nk, "right")
+                cnt = hi - lo
+                ii = np.repeat(np.arange(n), cnt)
+                start = np.repeat(lo - np.concatenate(([0], np.cumsum(cnt)[:-1])), cnt)
+                jj = order[np.arange(cnt.sum()) + start]
+                keep = ii < jj
+                I.append(ii[keep])
+                J.append(jj[keep])
+    I, J = np.concatenate(I), np.concatenate(J)
+    d = x[J] - x[I]
+    dist = np.sqrt((d * d).sum(axis=1))
+    ov = r[I] + r[J] - dist
+    m = ov > 0
+    I, J, dist, ov, d = I[m], J[m], dist[m], ov[m], d[m]
+    nrm = d / dist[:, None]
+    WI, WN, WO = [], [], []
+    for axis, pos, sgn in ((2, 0.0, 1.0), (0, 0.0, 1.0), (0, side, -1.0), (1, 0.0, 1.0), (1, side, -1.0)):
+        gap = sgn * (x[:, axis] - pos)
+        ovw = r - gap
+        m = ovw > 0
+        idx = np.nonzero(m)[0]
+        nv = np.zeros((len(idx), 3))
+        nv[:, axis] = sgn
+        WI.append(idx)
+        WN.append(nv)
+        WO.append(ovw[m])
+    return I, J, nrm, ov, np.concatenate(WI), np.concatenate(WN), np.concatenate(WO)
+
+
+def cgls(A, AT, b, shape, tol, maxit, damp):
+    """Damped least squares: minimise |A u - b|^2 + damp^2 |u|^2 (CGLS).  The damping keeps
+    near-singular directions (rattlers, nearly collinear contacts) from blowing up."""
+    u = np.zeros(shape)
+    res = b.copy()
+    s = AT(res)
+    p = s.copy()
+    gamma = (s * s).sum()
+    s0 = np.sqrt(gamma)
+    it = 0
+    for it in range(maxit):
+        q = A(p)
+        delta = (q * q).sum() + damp * damp * (p * p).sum()
+        if delta == 0.0:
+            break
+        alpha = gamma / delta
+        u += alpha * p
+        res -= alpha * q
+        s = AT(res) - damp * damp * u
+        g2 = (s * s).sum()
+        if np.sqrt(g2) < tol * s0:
+            break
+        p = s + (g2 / gamma) * p
+        gamma = g2
+    return u, it + 1
+
+
+def relax_to_touching(x, r, side, target, tol=1e-10, maxit=5000, passes=80, damp=1e-3):
+    """Move the particles of a settled bed so that every contact overlaps by exactly `target`
+    (Gauss-Newton: linearised constraints n_ij . (u_j - u_i) = ov_ij - target for the pairs in
+    contact and n_w . u_i = ov_w - target for the wall contacts, solved by least squares; the
+    normals and overlaps are re-evaluated at the moved positions each pass).  Pairs and wall
+    contacts that the displacement creates are added to the constraints.  Stops when every
+    overlap is within [0.5, 1.5] target."""
+    n = len(r)
+    I, J, _, _, WI, WN, _ = find_contacts(x, r, side)
+    _, _, _, ov0, _, _, WO0 = find_contacts(x, r, side)
+    xc = x.copy()
+    it_total, worst, npass = 0, float("inf"), 0
+    for npass in range(passes):
+        d = xc[J] - xc[I]
+        dist = np.sqrt((d * d).sum(axis=1))
+        nrm = d / dist[:, None]
+        ov = r[I] + r[J] - dist
+        ax = np.argmax(np.abs(WN), axis=1)
+        sg = WN[np.arange(len(WI)), ax]
+        wo = r[WI] - sg * (xc[WI, ax] - np.where(sg > 0, 0.0, side))
+        b = np.concatenate((ov - target, wo - target))
+
+        def A(u):
+            return np.concatenate((((u[J] - u[I]) * nrm).sum(axis=1), (u[WI] * WN).sum(axis=1)))
+
+        def AT(v):
+            vp, vw = v[:len(I)], v[len(I):]
+            g = np.zeros((n, 3))
+            for k in range(3):
+                g[:, k] = (np.bincount(J, vp * nrm[:, k], n) - np.bincount(I, vp * nrm[:, k], n)
+                           + np.bincount(WI, vw * WN[:, k], n))
+            return g
+
+        # Levenberg-Marquardt: heavy damping while the errors are large (near-singular
+        # directions would blow up), light damping near the solution (or the soft modes of a
+        # wide bed converge too slowly)
+        err = np.abs(b).max()
+        lm = damp if err > 1e-6 else damp * 1e-2 if err > 1e-8 else damp * 1e-4
+        u, it = cgls(A, AT, b, (n, 3), tol, maxit, lm)
+        it_total += it
+        xc = xc + u
+        I2, J2, _, ov2, WI2, WN2, WO2 = find_contacts(xc, r, side)
+        # every current overlap, including the constrained ones' errors
+        d = xc[J] - xc[I]
+        ovc = r[I] + r[J] - np.sqrt((d * d).sum(axis=1))
+        worst = max(ov2.max() if len(ov2) else 0.0, WO2.max() if len(WO2) else 0.0)
+        lowest = min(ovc.min() if len(ovc) else target, 1.0)
+        log("relax pass %d: %d + %d constraints, %d iterations, overlaps in [%.3g, %.3g] m"
+            % (npass, len(I), len(WI), it, lowest, worst))
+        if worst <= 1.8 * target and lowest >= -20.0 * target:  # jdem accepts <= 2 target; gaps < 10 nm are harmless
+            break
+        have = set(zip(I.tolist(), J.tolist()))
+        add = [(i, j) for i, j, o in zip(I2.tolist(), J2.tolist(), ov2.tolist())
+               if o > 1.5 * target and (i, j) not in have]
+        if add:
+            ai, aj = np.array(add).T
+            I, J = np.concatenate((I, ai)), np.concatenate((J, aj))
+        haveW = set(zip(WI.tolist(), map(tuple, WN.tolist())))
+        for k, nv, o in zip(WI2.tolist(), map(tuple, WN2.tolist()), WO2.tolist()):
+            if o > 1.5 * target and (k, nv) not in haveW:
+                WI = np.append(WI, k)
+                WN = np.vstack((WN, np.array(nv)[None, :]))
+    info = dict(pairs=int(len(I)), wall_contacts=int(len(WI)), cgls_iterations=it_total, passes=npass + 1,
+                max_overlap_settled=float(max(ov0.max(), WO0.max())), max_overlap_after=float(worst),
+                max_displacement=float(np.abs(xc - x).max()))
+    return xc, info
+
+
+def make_bed(out, size, disp):
+    """OUT/beds/SIZE_DISP.npz (ids, radii, positions): the settled bed, relaxed so that every
+    contact overlaps by TOUCH x the smallest radius (build/jdem refuses scenes whose particles
+    overlap by more than 1e-6 of the smaller radius at the start).  Returns its path."""
+    beds = os.path.join(out, "beds")
+    os.makedirs(beds, exist_ok=True)
+    base = os.path.join(beds, "%s_%s" % (size, disp))
+    path = base + ".npz"
+    if os.path.exists(path):
+        return path
+    g = bed_geometry(size, disp)
+    radius_line = ("radii: {values: [%s, %s], fractions: [0.5, 0.5]}" % (num(R_SMALL), num(R_LARGE))
+                   if disp == "bi" else "radius: %s" % num(R_SMALL))
+    kw = dict(name="bed_%s_%s" % (size, disp), dispersity=disp, n=g["n"], radius_line=radius_line,
+              half=num(0.5 * g["spacing"]), spacing=num(g["spacing"]), k=g["k"], layers=LAYERS,
+              walls=walls_yaml(g["side"], g["height"]), settle_time=SETTLE_TIME[disp])
+    scene = base + "_settle.yaml"
+    with open(scene, "w") as f:
+        f.write(fill("settle.yaml.in", dt=1.0, settle_steps=1, **kw))
+    dt = safe_dt(scene)
+    steps = int(math.ceil(SETTLE_TIME[disp] / dt))
+    with open(scene, "w") as f:
+        f.write(fill("settle.yaml.in", dt=num(dt), settle_steps=steps, **kw))
+    traj = base + "_settle.jdem.h5"
+    if not os.path.exists(traj):
+        log("settling %s %s: %d spheres, %d steps of %g s" % (size, disp, g["n"], steps, dt))
+        t0 = time.time()
+        r = subprocess.run([JDEM, "run", scene, "-o", traj, "--quiet"], capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError("settling failed:\n" + r.stderr)
+        log("settled in %.0f s" % (time.time() - t0))
+    fr = h5_last_frame(traj)
+    info = dict(size=size, dispersity=disp, n=g["n"], side=g["side"], height=g["height"],
+                settle_dt=dt, settle_steps=steps,
+                settled_contacts_per_particle=2.0 * fr["contacts"] / g["n"],
+                settled_kinetic_energy=fr["kinetic_energy"])
+    x2, st = relax_to_touching(fr["x"], fr["radius"], g["side"], TOUCH * fr["radius"].min())
+    info["relaxed"] = st
+    log("bed %s %s: settled %.2f contacts/particle, KE %.3g J; relaxed to touching: %s"
+        % (size, disp, info["settled_contacts_per_particle"], fr["kinetic_energy"], json.dumps(st)))
+    np.savez(path, id=fr["id"], radius=fr["radius"], x=x2, info=json.dumps(info))
+    return path
+
+
+# ---------------------------------------------------------------------------------------------
+# Scenes
+
+def scene_path(out, size, variant):
+    return os.path.join(out, "scenes", "%s_%s.yaml" % (size, variant))
+
+
+def make_scene(out, size, variant, bed_path, steps):
+    stiff, disp, roll = variant.split("_")[0], variant.split("_")[1], variant.endswith("_roll")
+    path = scene_path(out, size, variant)
+    bed = np.load(bed_path)
+    info = json.loads(str(bed["info"]))
+    g = bed_geometry(size, disp)
+    kw = dict(name="bench_%s_%s" % (size, variant), variant=variant, n=len(bed["id"]),
+              E=num(E_STIFF if stiff == "stiff" else E_SOFT), eta=num(ETA_ROLL if roll else 0.0),
+              walls=walls_yaml(info["side"], g["height"]))
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    head = fill("bench.yaml.in", dt=1.0, steps=1, **kw)
+    lines = ["  - {id: %d, material: grain, radius: %s, position: [%s, %s, %s]}\n"
+             % (i, num(r), num(p[0]), num(p[1]), num(p[2]))
+             for i, r, p in zip(bed["id"], bed["radius"], bed["x"])]
+    with open(path, "w") as f:
+        f.write(head + "".join(lines))
+    dt = safe_dt(path)
+    with open(path, "w") as f:
+        f.write(fill("bench.yaml.in", dt=num(dt), steps=steps, **kw) + "".join(lines))
+    return path, dt
+
+
+def make_decks(out, size, variant, scene, steps):
+    """Resolved scene and the two LIGGGHTS decks (ours and stock) in OUT/decks/SIZE_VARIANT/."""
+    d = os.path.join(out, "decks", "%s_%s" % (size, variant))
+    os.makedirs(d, exist_ok=True)
+    resolved = os.path.join(d, "resolved.yaml")
+    r = subprocess.run([JDEM, "resolve", scene], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(r.stderr)
+    with open(resolved, "w") as f:
+        f.write(r.stdout)
+    decks = {}
+    for engine, extra in (("liggghts-jdem", []), ("liggghts", ["--builtin"])):
+        dd = os.path.join(d, engine)
+        os.makedirs(dd, exist_ok=True)
+        deck = os.path.join(dd, "in.bench")
+        r = subprocess.run([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), resolved, "-o", deck,
+                            "--trajectory", os.path.join(dd, "out.h5")] + extra, capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError("deck generation failed:\n" + r.stderr)
+        with open(deck) as f:
+            text = f.read()
+        text = re.sub(r"(?m)^thermo\s+\d+\s*$", "thermo          %d" % steps, text)
+        # the box reaches twice the bed's height (the walls' extent): never split it along z,
+        # or one rank would own every particle
+        text = re.sub(r"(?m)^(boundary .*)$", r"\1\nprocessors      * * 1", text, count=1)
+        if engine == "liggghts":
+            # stock LIGGGHTS has no dump h5md/jdem: count contacts with its own computes instead
+            text = re.sub(r"(?m)^dump .*$\n", "", text)
+            text = text.replace("\nrun ", "\ncompute cc all contact/atom\ncompute csum all reduce sum c_cc\n"
+                                "thermo_style    custom step atoms ke c_csum\nrun ", 1)
+        with open(deck, "w") as f:
+            f.write(text)
+        decks[engine] = deck
+    return decks
+
+
+# ---------------------------------------------------------------------------------------------
+# Timed runs
+
+def timed(cmd, cwd):
+    """Run cmd under GNU time; returns (wall s, cpu s, peak RSS bytes, stdout, stderr, rc)."""
+    tf = os.path.join(cwd, ".time")
+    full = [GNU_TIME, "-o", tf, "-f", "%e %U %S %M"] + cmd
+    r = subprocess.run(full, cwd=cwd, capture_output=True, text=True)
+    try:
+        e, u, s, m = open(tf).read().split()[-4:]
+        wall, cpu, rss = float(e), float(u) + float(s), int(m) * 1024
+    except (OSError, ValueError):
+        wall, cpu, rss = float("nan"), float("nan"), 0
+    return wall, cpu, rss, r.stdout, r.stderr, r.returncode
+
+
+def mpi_prefix(ranks):
+    if ranks <= 1:
+        return []
+    flags = ["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []
+    return [shutil.which("mpirun") or "mpirun"] + flags + ["-np", str(ranks), "--bind-to", "none"]
+
+
+def calibrate_liggghts(deck, engine):
+    """CPU seconds of a 1-step run of the same deck (reading the data file, set-up, one step):
+    subtracted from the S-step run's CPU time it leaves the CPU time of the loop, a measure that
+    other jobs on the machine disturb less than wall time."""
+    d = os.path.dirname(deck)
+    one = os.path.join(d, "in.bench1")
+    with open(deck) as f:
+        text = f.read()
+    with open(one, "w") as f:
+        f.write(re.sub(r"(?m)^run\s+\d+\s*$", "run             1", text))
+    exe = LIGGGHTS_JDEM if engine == "liggghts-jdem" else LIGGGHTS
+    w, c, rss, so, se, rc = timed([exe, "-in", "in.bench1", "-log", "log.calib", "-screen", "none"], d)
+    if rc:
+        raise RuntimeError("%s 1-step calibration failed:\n%s" % (engine, se[-2000:]))
+    return dict(wall_s=w, cpu_s=c, peak_rss=rss)
+
+
+def run_jdem(out, size, variant, scene, steps, n):
+    d = os.path.join(out, "runs", "%s_%s" % (size, variant), "jdem")
+    os.makedirs(d, exist_ok=True)
+    one = os.path.join(d, "one.yaml")
+    with open(scene) as f:
+        text = f.read()
+    text = re.sub(r"(?m)^  steps: \d+", "  steps: 1", text)
+    text = re.sub(r"(?m)^  (every|observables_every): \d+", r"  \1: 1", text)
+    with open(one, "w") as f:
+        f.write(text)
+    w1, c1, _, _, e1, rc1 = timed([JDEM, "run", one, "-o", os.path.join(d, "one.h5"), "--quiet"], d)
+    traj = os.path.join(d, "out.h5")
+    w, c, rss, _, e, rc = timed([JDEM, "run", scene, "-o", traj, "--quiet"], d)
+    if rc or rc1:
+        raise RuntimeError("jdem failed:\n" + e + e1)
+    fr = h5_last_frame(traj)
+    return dict(wall_s=w - w1, cpu_s=c - c1, total_wall_s=w, setup_wall_s=w1, peak_rss=rss,
+                contacts_per_particle=2.0 * fr["contacts"] / n, timing="run(S) - run(1)")
+
+
+LOOP_RE = re.compile(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
+
+
+def run_liggghts(out, size, variant, deck, engine, ranks, steps, n):
+    d = os.path.dirname(deck)
+    exe = LIGGGHTS_JDEM if engine == "liggghts-jdem" else LIGGGHTS
+    cmd = mpi_prefix(ranks) + [exe, "-in", os.path.basename(deck), "-log", "log.%d" % ranks, "-screen", "none"]
+    w, c, rss, so, se, rc = timed(cmd, d)
+    logtext = open(os.path.join(d, "log.%d" % ranks), errors="replace").read()
+    m = LOOP_RE.findall(logtext)
+    if rc or not m:
+        raise RuntimeError("%s failed (exit %d):\n%s\n%s" % (engine, rc, logtext[-3000:], se[-2000:]))
+    loop, procs, nsteps, natoms = m[-1]
+    if int(natoms) != n:
+        raise RuntimeError("%s lost atoms: %s of %d" % (engine, natoms, n))
+    if engine == "liggghts-jdem":
+        fr = h5_last_frame(os.path.join(d, "out.h5"))
+        cpp = 2.0 * fr["contacts"] / n
+    else:  # thermo: step atoms ke c_csum  (contact/atom counts each contact at both atoms)
+        rows = re.findall(r"(?m)^\s*(\d+)\s+(\d+)\s+\S+\s+(\S+)\s*$", logtext)
+        cpp = float(rows[-1][2]) / n if rows else float("nan")
+    tail = logtext[logtext.rfind("Loop time of"):]
+    split = {k.strip().lower(): float(v) for k, v in
+             re.findall(r"(?m)^(Pair|Neigh|Comm|Outpt|Other|Modify)\s+time \(%\) = \S+ \(([0-9.eE+-]+)\)", tail)}
+    return dict(wall_s=float(loop), cpu_s=c, total_wall_s=w, peak_rss=rss, contacts_per_particle=cpp,
+                timing="LIGGGHTS loop time", liggghts_split_percent=split)
+
+
+# ---------------------------------------------------------------------------------------------
+
+def load_runs(path):
+    runs = []
+    if os.path.exists(path):
+        with open(path) as f:
+            for line in f:
+                line = line.strip()
+                if line:
+                    runs.append(json.loads(line))
+    return runs
+
+
+def summarise(runs):
+    groups = {}
+    calib = {}
+    for r in runs:
+        if r["engine"].endswith("/calib"):
+            calib.setdefault((r["size"], r["variant"], r["engine"][:-6], r["steps"]), []).append(r["cpu_s"])
+    runs = [r for r in runs if not r["engine"].endswith("/calib")]
+    for r in runs:
+        groups.setdefault((r["size"], r["variant"], r["engine"], r["ranks"]), []).append(r)
+    rows = []
+    for (size, variant, engine, ranks), rs in sorted(groups.items(), key=lambda kv: (
+            SIZES.get(kv[0][0], 0), VARIANT_NAMES.index(kv[0][1]) if kv[0][1] in VARIANT_NAMES else 99,
+            ENGINES.index(kv[0][2]), kv[0][3])):
+        wall = statistics.median(r["wall_s"] for r in rs)
+        n, steps = rs[0]["n"], rs[0]["steps"]
+        rss = max(r["peak_rss"] for r in rs)
+        cpu = statistics.median(r["cpu_s"] for r in rs)
+        if engine == "jdem":
+            cpu_loop = cpu  # already run(S) - run(1)
+        elif ranks == 1 and (size, variant, engine, steps) in calib:
+            cpu_loop = cpu - statistics.median(calib[(size, variant, engine, steps)])
+        else:
+            cpu_loop = None  # MPI ranks busy-wait: CPU time is not work
+        rows.append(dict(scene="%s_%s" % (size, variant), size=size, variant=variant, engine=engine,
+                         threads=1, ranks=ranks, N=n, steps=steps, dt=rs[0]["dt"], repeats=len(rs),
+                         wall_seconds=wall, wall_seconds_all=[r["wall_s"] for r in rs],
+                         cpu_seconds_loop=cpu_loop,
+                         particle_steps_per_cpu_second=(n * steps / cpu_loop) if cpu_loop and cpu_loop > 0 else None,
+                         particle_steps_per_second=n * steps / wall if wall > 0 else float("nan"),
+                         contacts_per_particle=statistics.median(r["contacts_per_particle"] for r in rs),
+                         peak_rss_bytes=rss, bytes_per_particle=rss * ranks / n, timing=rs[0]["timing"],
+                         liggghts_split_percent=rs[0].get("liggghts_split_percent"),
+                         load_average=statistics.median(r.get("load_average", 0.0) for r in rs)))
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--sizes", default=os.environ.get("BENCH_SIZES", "5k,20k"))
+    ap.add_argument("--variants", default=os.environ.get("BENCH_VARIANTS", "all"))
+    ap.add_argument("--engines", default=os.environ.get("BENCH_ENGINES", ",".join(ENGINES)))
+    ap.add_argument("--repeats", type=int, default=int(os.environ.get("BENCH_REPEATS", "3")))
+    ap.add_argument("--ranks-size", default=os.environ.get("BENCH_RANKS_SIZE", "20k"),
+                    help="size at which the LIGGGHTS engines also run on 2 MPI ranks ('' for none)")
+    ap.add_argument("--steps", default=os.environ.get("BENCH_STEPS", ""),
+                    help="override steps per size, e.g. 5k=1000,20k=300")
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
+    ap.add_argument("--fresh", action="store_true", help="forget earlier timings (beds are kept)")
+    ap.add_argument("--report-only", action="store_true")
+    ap.add_argument("--no-profile", action="store_true", help="skip the callgrind profile of jdem")
+    a = ap.parse_args()
+    out = os.path.abspath(a.out)
+    os.makedirs(out, exist_ok=True)
+    runs_path = os.path.join(out, "runs.jsonl")
+    if a.fresh and os.path.exists(runs_path):
+        os.remove(runs_path)
+    steps_of = dict(STEPS)
+    for item in filter(None, a.steps.split(",")):
+        k, v = item.split("=")
+        steps_of[k] = int(v)
+    sizes = [s for s in a.sizes.split(",") if s]
+    for s in sizes:
+        if s not in SIZES:
+            ap.error("unknown size %s (valid: %s)" % (s, ", ".join(SIZES)))
+    variants = VARIANT_NAMES if a.variants == "all" else a.variants.split(",")
+    engines = a.engines.split(",")
+
+    if not a.report_only:
+        done = {}
+        for r in load_runs(runs_path):
+            key = (r["size"], r["variant"], r["engine"], r["ranks"], r["steps"])
+            done[key] = done.get(key, 0) + 1
+        for size in sizes:
+            beds = {disp: make_bed(out, size, disp) for disp in ("mono", "bi")
+                    if any(v.split("_")[1] == disp for v in variants)}
+            steps = steps_of[size]
+            for variant in variants:
+                disp = variant.split("_")[1]
+                scene, dt = make_scene(out, size, variant, beds[disp], steps)
+                n = int(np.load(beds[disp])["id"].shape[0])
+                decks = make_decks(out, size, variant, scene, steps)
+                jobs = []
+                for engine in engines:
+                    jobs.append((engine, 1))
+                    if engine != "jdem" and size == a.ranks_size:
+                        jobs.append((engine, 2))
+                for rep in range(a.repeats):
+                    for engine, ranks in jobs:
+                        key = (size, variant, engine, ranks, steps)
+                        if done.get(key, 0) > rep:
+                            continue
+                        if engine == "jdem":
+                            res = run_jdem(out, size, variant, scene, steps, n)
+                        else:
+                            res = run_liggghts(out, size, variant, decks[engine], engine, ranks, steps, n)
+                        res.update(size=size, variant=variant, engine=engine, ranks=ranks, threads=1,
+                                   n=n, steps=steps, dt=dt, repeat=rep, when=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                                   load_average=os.getloadavg()[0],
+                                   binary_mtime=time.strftime("%Y-%m-%dT%H:%M:%S", time.gmtime(os.path.getmtime(
+                                       JDEM if engine == "jdem" else LIGGGHTS_JDEM if engine == "liggghts-jdem"
+                                       else LIGGGHTS))))
+                        log("%s %s %s np=%d rep %d: %.3f s, %.3g particle-steps/s, %.2f contacts/particle"
+                            % (size, variant, engine, ranks, rep, res["wall_s"], n * steps / res["wall_s"],
+                               res["contacts_per_particle"]))
+                        with open(runs_path, "a") as f:
+                            f.write(json.dumps(res) + "\n")
+                for rep in range(a.repeats):  # CPU-time calibration of the LIGGGHTS engines (1 rank)
+                    for engine in engines:
+                        key = (size, variant, engine + "/calib", 1, steps)
+                        if engine == "jdem" or done.get(key, 0) > rep:
+                            continue
+                        res = calibrate_liggghts(decks[engine], engine)
+                        res.update(size=size, variant=variant, engine=engine + "/calib", ranks=1, n=n,
+                                   steps=steps, dt=dt, repeat=rep, load_average=os.getloadavg()[0])
+                        with open(runs_path, "a") as f:
+                            f.write(json.dumps(res) + "\n")
+    if not a.report_only and not a.no_profile and not os.path.exists(os.path.join(out, "profile.json")):
+        import bench_report
+        sc = scene_path(out, sizes[0], "soft_mono")
+        if os.path.exists(sc):
+            log("profiling jdem (callgrind) on %s" % sc)
+            bench_report.profile_jdem(out, sc, int(np.load(make_bed(out, sizes[0], "mono"))["id"].shape[0]))
+    rows = summarise(load_runs(runs_path))
+    with open(os.path.join(out, "summary.json"), "w") as f:
+        json.dump(dict(generated=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                       machine=machine_info(), runs=rows), f, indent=1)
+    import bench_report
+    bench_report.write_report(out, rows, machine_info())
+    log("wrote %s and %s" % (os.path.join(out, "summary.json"), os.path.join(out, "report.md")))
+    return 0
+
+
+def machine_info():
+    info = {"cpus": os.cpu_count()}
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                info["cpu"] = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return info
+
+
+if __name__ == "__main__":
+    sys.exit(main())
