@@ -323,6 +323,13 @@ static inline int jd_contact(const unsigned features, const jd_pair_coeffs *c,
         if (ddelta <= 0.0) return 0; /* still separating after the end of the collision */
         jd_contact_separate(s, r);   /* a new approach while still overlapping: new contact */
         flags = 0;
+        if (features & JD_F_ENERGY) {
+            /* Its normal spring is already compressed.  That energy was booked as damping at the
+             * end of the collision and is stored again now: take it back from damping, so that
+             * the friction term does not see it. */
+            s->u_prev = jd_normal_energy(g->k_n, g->delta);
+            s->e_damp -= s->u_prev;
+        }
     }
 
     /* Normal law. */
@@ -371,7 +378,7 @@ static inline int jd_contact(const unsigned features, const jd_pair_coeffs *c,
             double fs[3];
             for (int d = 0; d < 3; d++) fs[d] = sliding ? ft[d] : -Kt * s->xi[d];
             u_new += Kt > 0.0 ? 0.5 * jd_dot(fs, fs) / Kt : 0.0;
-            if (!sliding) dash += Ct * jd_dot(vt, vt) * dt;
+            if (!sliding) dash += Ct * jd_dot(vt_law, vt) * dt; /* the dashpot acts on vt_law */
         }
     }
 
@@ -393,14 +400,19 @@ static inline int jd_contact(const unsigned features, const jd_pair_coeffs *c,
          * two ends of a step times its displacement (exactly, up to terms that cancel over a
          * collision), so the contact books the same: work W on the bodies this step, and what it
          * dissipated is -W less the change of its stored energy.  The normal dashpot's share is
-         * the same trapezoid on its own force; the remainder is the sliders' (friction). */
+         * the same trapezoid on its own force; the remainder is the sliders' (friction), or the
+         * dashpot's too when there are no sliders. */
         double w = jd_dot(s->f_prev, vrel) + jd_dot(f, vrel);
         if (features & JD_F_ROLLING) w += jd_dot(r->m_prev, wrel) + jd_dot(m_roll, wrel);
         const double fd = Cn * ddelta;
         dash += 0.5 * (s->fd_prev + fd) * ddelta * dt;
         const double diss = -0.5 * w * dt - (u_new - s->u_prev);
-        s->e_damp += dash;
-        s->e_fric += diss - dash;
+        if (features & (JD_F_FRICTION | JD_F_ROLLING)) {
+            s->e_damp += dash;
+            s->e_fric += diss - dash;
+        } else {
+            s->e_damp += diss; /* no sliders: all of it is the dashpot's (to O(dt^2)) */
+        }
         s->fd_prev = fd;
         s->u_prev = u_new;
         for (int d = 0; d < 3; d++) s->f_prev[d] = f[d];
@@ -435,6 +447,15 @@ static inline void jd_contact_keep_reference(jd_contact_state *s, const jd_conta
     s->u_prev = evaluated->u_prev;
     if (r && r_evaluated)
         for (int d = 0; d < 3; d++) r->m_prev[d] = r_evaluated->m_prev[d];
+}
+
+/* Work done on a particle by a translating wall during a step [J]: the trapezoidal rule of
+ * jd_contact's bookkeeping on the wall's force, F_on_particle = -f, with the force on the wall
+ * at the start (f_prev, read from the contact state before the evaluation) and at the end (f)
+ * of the step, and the wall velocity v_wall. */
+static inline double jd_wall_work(const double f_prev[3], const double f[3],
+                                  const double v_wall[3], double dt) {
+    return -0.5 * (jd_dot(f_prev, v_wall) + jd_dot(f, v_wall)) * dt;
 }
 
 /* Energy stored in a contact (normal spring + tangential and rolling springs) at its last

@@ -175,7 +175,9 @@ void FixWallJiang::loop(bool commit) {
     jd_rolling_state *rsp = (F & JD_F_ROLLING) ? &rs : NULL;
     jd_load_history(h, st, rsp);
     jd_contact_result out;
+    const double f_prev[3] = {st.f_prev[0], st.f_prev[1], st.f_prev[2]};
     const int carries = jd_contact(F, &pair->coeffs(type[i], wtype), &g, &k, dt, &st, rsp, &out);
+    work += jd_wall_work(f_prev, out.f, vel, dt); /* also over the step a contact ends */
     if (F & JD_F_ENERGY) {
       e_damp += st.e_damp;
       e_fric += st.e_fric;
@@ -189,12 +191,11 @@ void FixWallJiang::loop(bool commit) {
       f[i][d] -= out.f[d];
       torque[i][d] += out.ta[d];
     }
-    work -= jd_dot(out.f, vel); /* power delivered to the particle, F_on_particle . v_wall */
   }
   if (commit) {
     e_damp_cum += e_damp;
     e_fric_cum += e_fric;
-    work_cum += work * dt;
+    work_cum += work;
   }
   e_elastic_now = e_el;
   contacts_now = ncontacts;

@@ -83,16 +83,17 @@ static JD_ALWAYS_INLINE void wall_loop(jd_sim *s, const unsigned F) {
         }
         const jd_pair_coeffs *co = &s->coeffs[(size_t)s->species[i] * nm + (size_t)w->material];
         jd_contact_result out;
-        if (!jd_contact(F, co, &g, &k, s->dt, st, rs, &out)) continue;
+        const double f_prev[3] = {st->f_prev[0], st->f_prev[1], st->f_prev[2]};
+        const int carries = jd_contact(F, co, &g, &k, s->dt, st, rs, &out);
+        work += jd_wall_work(f_prev, out.f, w->v, s->dt); /* also over the step a contact ends */
+        if (!carries) continue;
         double *fa = s->f + 3 * (size_t)i, *ta = s->torque + 3 * (size_t)i;
         for (int d = 0; d < 3; d++) {
             fa[d] -= out.f[d];
             ta[d] += out.ta[d];
         }
-        /* power the wall delivers to the particle: F_on_particle . v_wall */
-        work -= jd_dot(out.f, w->v);
     }
-    s->wall_work += work * s->dt;
+    s->wall_work += work;
 }
 
 static JD_ALWAYS_INLINE void contact_loops(jd_sim *s, const unsigned F) {

@@ -242,13 +242,17 @@ static int cmd_run(const cli *c) {
     if (c->output)
         snprintf(out, sizeof out, "%s", c->output);
     else if (snprintf(out, sizeof out, "out/%s/%s.jdem.h5", sc.name, sc.case_name) >= (int)sizeof out)
-        goto done;
+        goto fail;
     if (make_parent_dirs(out, err, sizeof err) != 0) goto fail;
     if (sim_init(&sim, &sc, getenv("JDEM_NEIGHBOUR") && !strcmp(getenv("JDEM_NEIGHBOUR"), "allpairs"),
                  err, sizeof err) != 0)
         goto fail;
     sim_ok = 1;
     yaml = scene_yaml_string(&sc);
+    if (!yaml) {
+        snprintf(err, sizeof err, "out of memory writing the resolved scene");
+        goto fail;
+    }
     const jd_h5md_meta meta = {.creator = "jdem", .creator_version = JDEM_VERSION,
                                .scene_name = sc.name, .case_name = sc.case_name,
                                .scene_yaml = yaml, .dt = sc.dt};

@@ -215,10 +215,19 @@ static void luding_end_of_collision(void **state) {
     assert_true(s.xi[0] == 0.0 && s.u_prev == 0.0 && ((int)s.flags & JD_S_ENDED));
     assert_rel(s.e_damp - damp_before, stored - 0.5 * f1 * 1.0 * dt, 1e-12);
     assert_int_equal(jd_contact(F, &c, &g, &fast, dt, &s, NULL, &out), 0);
-    /* approaching again while still overlapping starts a new contact */
+    /* approaching again while still overlapping starts a new contact, whose already compressed
+     * spring is stored energy again (taken back from damping), never negative friction */
     fast.vb[2] = -1.0;
+    fast.vb[0] = 0.0;
+    const double damp_ended = s.e_damp, fric_ended = s.e_fric;
     assert_int_equal(jd_contact(F, &c, &g, &fast, dt, &s, NULL, &out), 1);
     assert_true(out.fn > 0.0);
+    /* (the restart step itself may book at most the work of one step, F_n |v_n| dt) */
+    assert_true(fabs(s.e_fric - fric_ended) <= out.fn * 1.0 * dt);
+    /* its stored energy comes back out of damping, plus at most one step of dashpot work */
+    const double restored = damp_ended - jd_normal_energy(k, d);
+    const double dashpot_step = 2.0 * c.gamma * sqrt(m * k * sqrt(d)) * 1.0 * 1.0 * dt;
+    assert_true(s.e_damp >= restored && s.e_damp <= restored + dashpot_step);
 }
 
 int run_kernel_tests(void) {
