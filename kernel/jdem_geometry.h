@@ -150,6 +150,30 @@ static inline int jd_geom_cylinder(const jd_cylinder *c, const double x[3], doub
     return 1;
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* The material fields of a contact (docs/model.md §1-2)                                       */
+/* ------------------------------------------------------------------------------------------ */
+
+/* Sphere–sphere: k_n from the two per-particle Hertz prefactors kp_a, kp_b [N/m^1.5] (eq. 5),
+ * effective mass from m_a, m_b [kg], and — only with JD_F_ROLLING in features, the one law that
+ * uses it — effective moment of inertia from I_a, I_b [kg m^2]. */
+static inline void jd_geom_pair_material(const unsigned features, jd_contact_geom *g, double kp_a,
+                                         double kp_b, double m_a, double m_b, double I_a,
+                                         double I_b) {
+    g->k_n = jd_kn_pair(kp_a, kp_b);
+    g->m_eff = m_a * m_b / (m_a + m_b);
+    g->i_eff = (features & JD_F_ROLLING) ? I_a * I_b / (I_a + I_b) : 0.0;
+}
+
+/* Sphere–wall: the wall is rigid and immovable, so k_n is the wall rule's prefactor k_wall
+ * (jd_kn_wall) [N/m^1.5] and the effective mass and inertia are the particle's m, I. */
+static inline void jd_geom_wall_material(const unsigned features, jd_contact_geom *g,
+                                         double k_wall, double m, double I) {
+    g->k_n = k_wall;
+    g->m_eff = m;
+    g->i_eff = (features & JD_F_ROLLING) ? I : 0.0;
+}
+
 #ifdef __cplusplus
 }
 #endif

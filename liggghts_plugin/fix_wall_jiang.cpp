@@ -160,9 +160,8 @@ void FixWallJiang::loop(bool commit) {
     if (jd_overlap_excessive(g.delta, R, INFINITY, overlap_limit))
       overlap_trip.note(g.delta, R, tag[i], 0, id);
     const double m = rmass[i];
-    g.k_n = jd_kn_wall(rule, pair->youngs(type[i]), pair->poisson(type[i]), R);
-    g.m_eff = m;
-    g.i_eff = (F & JD_F_ROLLING) ? jd_sphere_inertia(m, R) : 0.0;
+    jd_geom_wall_material(F, &g, jd_kn_wall(rule, pair->youngs(type[i]), pair->poisson(type[i]), R),
+                          m, jd_sphere_inertia(m, R));
     jd_kinematics k;
     for (int d = 0; d < 3; d++) {
       k.va[d] = v[i][d];

@@ -212,14 +212,8 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
       const double Rj = radius[j], mj = rmass[j];
       if (jd_overlap_excessive(g.delta, Ri, Rj, overlap_limit))
         overlap_trip.note(g.delta, std::fmin(Ri, Rj), tag[i], tag[j], NULL);
-      g.k_n = jd_kn_pair(kpi, jd_hertz_prefactor(E_[type[j]], nu_[type[j]], Rj));
-      g.m_eff = mi * mj / (mi + mj);
-      if (F & JD_F_ROLLING) {
-        const double Ii = jd_sphere_inertia(mi, Ri), Ij = jd_sphere_inertia(mj, Rj);
-        g.i_eff = Ii * Ij / (Ii + Ij);
-      } else {
-        g.i_eff = 0.0;
-      }
+      jd_geom_pair_material(F, &g, kpi, jd_hertz_prefactor(E_[type[j]], nu_[type[j]], Rj), mi, mj,
+                            jd_sphere_inertia(mi, Ri), jd_sphere_inertia(mj, Rj));
       jd_kinematics k;
       for (int d = 0; d < 3; d++) {
         k.va[d] = v[i][d];

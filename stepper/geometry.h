@@ -17,15 +17,8 @@ static inline int sim_pair_geom(const jd_sim *s, const unsigned features, int32_
                                 jd_contact_geom *g) {
     if (!jd_geom_spheres(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j, s->radius[j], g))
         return 0;
-    g->k_n = jd_kn_pair(s->kp[i], s->kp[j]);
-    const double ma = s->mass[i], mb = s->mass[j];
-    g->m_eff = ma * mb / (ma + mb);
-    if (features & JD_F_ROLLING) {
-        const double Ia = s->inertia[i], Ib = s->inertia[j];
-        g->i_eff = Ia * Ib / (Ia + Ib);
-    } else {
-        g->i_eff = 0.0;
-    }
+    jd_geom_pair_material(features, g, s->kp[i], s->kp[j], s->mass[i], s->mass[j], s->inertia[i],
+                          s->inertia[j]);
     return 1;
 }
 
@@ -38,9 +31,7 @@ static inline int sim_wall_geom(const jd_sim *s, int32_t i, const jd_sim_wall *w
     const int touch = w->type == JD_WALL_PLANE ? jd_geom_plane(&w->plane, x, R, g)
                                                : jd_geom_cylinder(&w->cyl, x, R, g);
     if (!touch) return 0;
-    g->k_n = s->kw[i];
-    g->m_eff = s->mass[i];
-    g->i_eff = s->inertia[i];
+    jd_geom_wall_material(JD_F_ROLLING, g, s->kw[i], s->mass[i], s->inertia[i]);
     return 1;
 }
 
