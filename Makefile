@@ -23,6 +23,10 @@ PKG_LIBS   := $(shell pkg-config --libs yaml-0.1 hdf5 2>/dev/null) -lm
 CFLAGS   := -std=c11 -O2 -g -ffp-contract=off $(WARN) -D_POSIX_C_SOURCE=200809L -DJDEM_VERSION=\"$(VERSION)\" \
             -Ikernel -Iio -Istepper $(PKG_CFLAGS)
 SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+# OpenMP threads in the standalone engine's force and integration loops (stepper/ only: the
+# kernel and the H5MD writer stay free of it, and clang's fuzz build needs no OpenMP runtime).
+# Threads: `jdem run --threads N` or OMP_NUM_THREADS (docs/scenes.md, "Threads").
+OMPFLAGS := -fopenmp
 
 KERNEL_SRC  := $(wildcard kernel/*.c)
 IO_SRC      := $(wildcard io/*.c)
@@ -53,16 +57,22 @@ deps:
 build/obj/%.o: %.c $(HEADERS)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -c $< -o $@
+build/obj/stepper/%.o: stepper/%.c $(HEADERS)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(OMPFLAGS) -c $< -o $@
 
 build/san/%.o: %.c $(HEADERS)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(SANFLAGS) -c $< -o $@
+build/san/stepper/%.o: stepper/%.c $(HEADERS)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(OMPFLAGS) $(SANFLAGS) -c $< -o $@
 
 build/jdem: $(patsubst %.c,build/obj/%.o,$(KERNEL_SRC) $(IO_SRC) $(STEPPER_SRC))
-	$(CC) $(CFLAGS) $^ -o $@ $(PKG_LIBS)
+	$(CC) $(CFLAGS) $(OMPFLAGS) $^ -o $@ $(PKG_LIBS)
 
 build/san/jdem: $(patsubst %.c,build/san/%.o,$(KERNEL_SRC) $(IO_SRC) $(STEPPER_SRC))
-	$(CC) $(CFLAGS) $(SANFLAGS) $^ -o $@ $(PKG_LIBS)
+	$(CC) $(CFLAGS) $(OMPFLAGS) $(SANFLAGS) $^ -o $@ $(PKG_LIBS)
 
 # ---------------------------------------------------------------------------------------------
 # LIGGGHTS plugin: Debian's libliggghts + our styles; the kernel and the H5MD writer are the same

@@ -39,13 +39,17 @@ enum {
 /* Sphere–sphere                                                                               */
 /* ------------------------------------------------------------------------------------------ */
 
-/* Sphere a (centre xa [m], radius Ra [m]) against sphere b (xb, Rb).  Contact when
- * rsq < (Ra + Rb)^2, rsq = |xb - xa|^2 (LIGGGHTS' test), with delta > 0 and r > 0.  Fills
- * n = (xb - xa)/r (as (xb - xa) * (1/r)), delta = Ra + Rb - r,
- * ra = (Ra - delta/2) n (= x_C - xa), rb = ra - (xb - xa) (= x_C - xb),
- * r_roll = Ra Rb/(Ra + Rb) [m], and returns 1; returns 0 without contact. */
-static inline int jd_geom_spheres(const double xa[3], double Ra, const double xb[3], double Rb,
-                                  jd_contact_geom *g) {
+/* Rolling radius of two spheres R_a R_b/(R_a + R_b) [m]. */
+static inline double jd_rolling_radius(double Ra, double Rb) { return Ra * Rb / (Ra + Rb); }
+
+/* Sphere a (centre xa [m], radius Ra [m]) against sphere b (xb, Rb), the geometric fields
+ * without r_roll (an engine that keeps r_roll per pair fills it from jd_rolling_radius).
+ * Contact when rsq < (Ra + Rb)^2, rsq = |xb - xa|^2 (LIGGGHTS' test), with delta > 0 and r > 0.
+ * Fills n = (xb - xa)/r (as (xb - xa) * (1/r)), delta = Ra + Rb - r,
+ * ra = (Ra - delta/2) n (= x_C - xa), rb = ra - (xb - xa) (= x_C - xb), and returns 1; returns
+ * 0 without contact. */
+static inline int jd_geom_spheres_contact(const double xa[3], double Ra, const double xb[3],
+                                          double Rb, jd_contact_geom *g) {
     const double dx[3] = {xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]};
     const double rsq = jd_dot(dx, dx);
     const double radsum = Ra + Rb;
@@ -61,7 +65,14 @@ static inline int jd_geom_spheres(const double xa[3], double Ra, const double xb
         g->rb[k] = g->ra[k] - dx[k];
     }
     g->delta = delta;
-    g->r_roll = Ra * Rb / radsum;
+    return 1;
+}
+
+/* jd_geom_spheres_contact plus r_roll = jd_rolling_radius(Ra, Rb) [m]. */
+static inline int jd_geom_spheres(const double xa[3], double Ra, const double xb[3], double Rb,
+                                  jd_contact_geom *g) {
+    if (!jd_geom_spheres_contact(xa, Ra, xb, Rb, g)) return 0;
+    g->r_roll = jd_rolling_radius(Ra, Rb);
     return 1;
 }
 

@@ -36,6 +36,15 @@
 extern "C" {
 #endif
 
+/* How jd_contact is declared.  An engine whose force loops are specialised per feature set
+ * defines JD_CONTACT_INLINE as `static inline __attribute__((always_inline))` before including
+ * this header, so that each loop gets its own copy of the law with the unused laws compiled
+ * away (compilers otherwise keep one out-of-line copy, with the features as a run-time value,
+ * for a function this large called from many loops).  Same arithmetic either way. */
+#ifndef JD_CONTACT_INLINE
+#define JD_CONTACT_INLINE static inline
+#endif
+
 /* ------------------------------------------------------------------------------------------ */
 /* Feature flags: which laws a force loop evaluates.  A scene pays only for what it uses.      */
 /* ------------------------------------------------------------------------------------------ */
@@ -300,7 +309,7 @@ static inline int jd_capped_spring(double stored[3], const double rate[3], doubl
  * Returns 1 while the contact carries force, 0 once it has ended (Luding's rule: the total
  * normal force reached zero while unloading; it stays ended until the bodies separate or start
  * approaching again, which begins a new contact). */
-static inline int jd_contact(const unsigned features, const jd_pair_coeffs *c,
+JD_CONTACT_INLINE int jd_contact(const unsigned features, const jd_pair_coeffs *c,
                              const jd_contact_geom *g, const jd_kinematics *k, double dt,
                              jd_contact_state *s, jd_rolling_state *r, jd_contact_result *out) {
     /* Relative velocity at the contact point, eq. (6). */

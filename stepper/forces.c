@@ -3,53 +3,91 @@
  * body is instantiated once per combination with the bits as a literal constant, so that
  * jd_contact() compiles away every law the scene does not use (DESIGN.md: "leave out what a
  * scene does not need").  Order as LIGGGHTS: pair forces in list order, wall forces, gravity.
+ *
+ * Threads (sim.h, "Threads"): each list is cut into one contiguous chunk per thread (the same
+ * cut for a given list length and thread count); thread 0 adds into f and torque, thread t > 0
+ * into buffer t - 1, which the reduction adds to f and torque per particle in thread order and
+ * zeroes for the next evaluation.  With one thread this is exactly the serial loop.
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
-
-#include "geometry.h"
-#include "sim.h"
+#include <time.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #if defined(__GNUC__)
 #define JD_ALWAYS_INLINE inline __attribute__((always_inline))
 #else
 #define JD_ALWAYS_INLINE inline
 #endif
+/* one copy of the law per specialised loop (kernel/jdem_kernel.h, JD_CONTACT_INLINE) */
+#define JD_CONTACT_INLINE static JD_ALWAYS_INLINE
 
-static JD_ALWAYS_INLINE void load_kinematics(const jd_sim *s, int32_t i, jd_kinematics *k) {
-    const double *v = s->v + 3 * (size_t)i, *w = s->omega + 3 * (size_t)i;
-    for (int d = 0; d < 3; d++) {
-        k->va[d] = v[d];
-        k->wa[d] = w[d];
-    }
+#include "geometry.h"
+#include "sim.h"
+
+double sim_clock(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F) {
+int sim_forces_init(jd_sim *s) {
+    const size_t nb = (size_t)(s->threads - 1) * 6 * s->n;
+    s->tbuf = nb ? calloc(nb, sizeof *s->tbuf) : NULL;
+    s->trips = calloc((size_t)s->threads, sizeof *s->trips);
+    return (nb && !s->tbuf) || !s->trips ? -1 : 0;
+}
+
+/* Where thread `tid` adds its forces and torques. */
+typedef struct acc {
+    double *f, *t;
+} acc;
+
+static acc acc_of(const jd_sim *s, int tid) {
+    if (tid == 0) return (acc){s->f, s->torque};
+    double *b = s->tbuf + (size_t)(tid - 1) * 6 * s->n;
+    return (acc){b, b + 3 * s->n};
+}
+
+/* [lo, hi) of thread tid's chunk of n items. */
+static void chunk(size_t n, int tid, int nt, size_t *lo, size_t *hi) {
+    *lo = n * (size_t)tid / (size_t)nt;
+    *hi = n * (size_t)(tid + 1) / (size_t)nt;
+}
+
+static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
+                                       jd_overlap_trip *trip) {
     const jd_contact_list *L = &s->pairs;
     const size_t nm = s->n_materials;
-    for (size_t c = 0; c < L->n; c++) {
+    const double *x_v = s->v, *x_w = s->omega;
+    for (size_t c = c0; c < c1; c++) {
         const int32_t i = L->i[c], j = L->j[c];
         jd_contact_state *st = &L->state[c];
         jd_rolling_state *rs = (F & JD_F_ROLLING) ? &L->roll[c] : NULL;
         jd_contact_geom g;
-        if (!sim_pair_geom(s, F, i, j, &g)) {
+        if (!sim_pair_geom(s, F, c, i, j, &g)) {
             jd_contact_separate(st, rs);
             continue;
         }
         if (jd_overlap_excessive(g.delta, s->radius[i], s->radius[j], s->max_overlap))
-            sim_watchdog_overlap(s, i, j, g.delta, fmin(s->radius[i], s->radius[j]));
+            sim_watchdog_overlap(trip, i, j, g.delta, fmin(s->radius[i], s->radius[j]));
         jd_kinematics k;
-        load_kinematics(s, i, &k);
-        const double *vb = s->v + 3 * (size_t)j, *wb = s->omega + 3 * (size_t)j;
+        const double *va = x_v + 3 * (size_t)i, *wa = x_w + 3 * (size_t)i;
+        const double *vb = x_v + 3 * (size_t)j, *wb = x_w + 3 * (size_t)j;
         for (int d = 0; d < 3; d++) {
+            k.va[d] = va[d];
+            k.wa[d] = wa[d];
             k.vb[d] = vb[d];
             k.wb[d] = wb[d];
         }
         const jd_pair_coeffs *co = &s->coeffs[(size_t)s->species[i] * nm + (size_t)s->species[j]];
         jd_contact_result out;
         if (!jd_contact(F, co, &g, &k, s->dt, st, rs, &out)) continue;
-        double *fa = s->f + 3 * (size_t)i, *fb = s->f + 3 * (size_t)j;
-        double *ta = s->torque + 3 * (size_t)i, *tb = s->torque + 3 * (size_t)j;
+        double *fa = a.f + 3 * (size_t)i, *fb = a.f + 3 * (size_t)j;
+        double *ta = a.t + 3 * (size_t)i, *tb = a.t + 3 * (size_t)j;
         for (int d = 0; d < 3; d++) {
             fa[d] -= out.f[d];
             fb[d] += out.f[d];
@@ -59,11 +97,13 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F) {
     }
 }
 
-static JD_ALWAYS_INLINE void wall_loop(jd_sim *s, const unsigned F) {
+/* Returns the work the walls did on the particles of the chunk. */
+static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
+                                         jd_overlap_trip *trip) {
     const jd_contact_list *L = &s->wall_pairs;
     const size_t nm = s->n_materials;
     double work = 0.0;
-    for (size_t c = 0; c < L->n; c++) {
+    for (size_t c = c0; c < c1; c++) {
         const int32_t i = L->i[c];
         const jd_sim_wall *w = &s->walls[L->j[c]];
         jd_contact_state *st = &L->state[c];
@@ -74,10 +114,11 @@ static JD_ALWAYS_INLINE void wall_loop(jd_sim *s, const unsigned F) {
             continue;
         }
         if (jd_overlap_excessive(g.delta, s->radius[i], INFINITY, s->max_overlap))
-            sim_watchdog_overlap(s, i, -1 - L->j[c], g.delta, s->radius[i]);
+            sim_watchdog_overlap(trip, i, -1 - L->j[c], g.delta, s->radius[i]);
         jd_kinematics k;
-        load_kinematics(s, i, &k);
         for (int d = 0; d < 3; d++) {
+            k.va[d] = s->v[3 * (size_t)i + d];
+            k.wa[d] = s->omega[3 * (size_t)i + d];
             k.vb[d] = w->v[d];
             k.wb[d] = 0.0;
         }
@@ -87,31 +128,40 @@ static JD_ALWAYS_INLINE void wall_loop(jd_sim *s, const unsigned F) {
         const int carries = jd_contact(F, co, &g, &k, s->dt, st, rs, &out);
         work += jd_wall_work(f_prev, out.f, w->v, s->dt); /* also over the step a contact ends */
         if (!carries) continue;
-        double *fa = s->f + 3 * (size_t)i, *ta = s->torque + 3 * (size_t)i;
+        double *fa = a.f + 3 * (size_t)i, *ta = a.t + 3 * (size_t)i;
         for (int d = 0; d < 3; d++) {
             fa[d] -= out.f[d];
             ta[d] += out.ta[d];
         }
     }
-    s->wall_work += work;
+    return work;
 }
 
-static JD_ALWAYS_INLINE void contact_loops(jd_sim *s, const unsigned F) {
-    pair_loop(s, F);
-    wall_loop(s, F);
+/* This thread's share of the contact loops; returns its wall work. */
+static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int tid, int nt,
+                                             double *t_pairs_end) {
+    const acc a = acc_of(s, tid);
+    jd_overlap_trip *trip = &s->trips[tid];
+    size_t lo, hi;
+    chunk(s->pairs.n, tid, nt, &lo, &hi);
+    pair_loop(s, F, lo, hi, a, trip);
+    if (nt > 1) {
+#pragma omp barrier
+    }
+    if (tid == 0) *t_pairs_end = sim_clock();
+    chunk(s->wall_pairs.n, tid, nt, &lo, &hi);
+    return wall_loop(s, F, lo, hi, a, trip);
 }
 
 /* One instantiation per combination of the four optional laws; JD_F_ENERGY is always on (the
  * observables need it).  The switch maps the run-time bits to a literal constant. */
-#define JD_FORCE_CASE(bits)                        \
-    case (bits):                                   \
-        contact_loops(s, (bits) | JD_F_ENERGY);    \
+#define JD_FORCE_CASE(bits)                                                     \
+    case (bits):                                                                \
+        work = contact_loops(s, (bits) | JD_F_ENERGY, tid, nt, &t_pairs_end);   \
         break;
 
-void sim_compute_forces(jd_sim *s) {
-    s->overlap_trip.fraction = 0.0; /* the watchdog looks at this evaluation only */
-    memset(s->f, 0, 3 * s->n * sizeof *s->f);
-    memset(s->torque, 0, 3 * s->n * sizeof *s->torque);
+static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
+    double work = 0.0, t_pairs_end = 0.0;
     _Static_assert(JD_F_DAMPING == 1 && JD_F_FRICTION == 2 && JD_F_ROLLING == 4 && JD_F_MU_R == 8,
                    "the dispatch below enumerates the four optional laws as bits 0-3");
     switch (s->features & 15u) {
@@ -120,11 +170,64 @@ void sim_compute_forces(jd_sim *s) {
         JD_FORCE_CASE(8) JD_FORCE_CASE(9) JD_FORCE_CASE(10) JD_FORCE_CASE(11)
         JD_FORCE_CASE(12) JD_FORCE_CASE(13) JD_FORCE_CASE(14) JD_FORCE_CASE(15)
     }
+    if (tid == 0) *t_pairs_end_out = t_pairs_end;
+    return work;
+}
+
+/* f += the other threads' buffers (zeroing them) and gravity, for particles [lo, hi). */
+static void reduce(jd_sim *s, size_t lo, size_t hi) {
+    const size_t n = s->n;
     const double *g = s->g;
-    if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0) {
-        for (size_t i = 0; i < s->n; i++) {
+    const int gravity = g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0;
+    for (int t = 1; t < s->threads; t++) {
+        double *bf = s->tbuf + (size_t)(t - 1) * 6 * n, *bt = bf + 3 * n;
+        for (size_t k = 3 * lo; k < 3 * hi; k++) {
+            s->f[k] += bf[k];
+            s->torque[k] += bt[k];
+            bf[k] = bt[k] = 0.0;
+        }
+    }
+    if (gravity)
+        for (size_t i = lo; i < hi; i++) {
             const double m = s->mass[i];
             for (int d = 0; d < 3; d++) s->f[3 * i + d] += m * g[d];
         }
+}
+
+void sim_compute_forces(jd_sim *s) {
+    const int nt = s->threads;
+    double work[nt > 0 ? nt : 1];
+    double t_pairs_end = 0.0, t_walls_end = 0.0;
+    const double t0 = sim_clock();
+#pragma omp parallel num_threads(nt) if (nt > 1)
+    {
+#ifdef _OPENMP
+        const int tid = omp_get_thread_num();
+#else
+        const int tid = 0;
+#endif
+        size_t lo, hi;
+        chunk(s->n, tid, nt, &lo, &hi);
+        memset(s->f + 3 * lo, 0, 3 * (hi - lo) * sizeof *s->f);
+        memset(s->torque + 3 * lo, 0, 3 * (hi - lo) * sizeof *s->torque);
+        s->trips[tid].fraction = 0.0;
+        if (nt > 1) {
+#pragma omp barrier
+        }
+        work[tid] = dispatch(s, tid, nt, &t_pairs_end);
+        if (nt > 1) {
+#pragma omp barrier
+        }
+        if (tid == 0) t_walls_end = sim_clock();
+        reduce(s, lo, hi);
     }
+    /* the worst overlap of this evaluation (the first thread's on a tie, as in serial order) */
+    s->overlap_trip.fraction = 0.0;
+    for (int t = 0; t < nt; t++) {
+        if (s->trips[t].fraction > s->overlap_trip.fraction) s->overlap_trip = s->trips[t];
+        s->wall_work += work[t];
+    }
+    const double t1 = sim_clock();
+    s->timing.pairs += (t_pairs_end - t0) + (t1 - t_walls_end);
+    s->timing.walls += t_walls_end - t_pairs_end;
 }

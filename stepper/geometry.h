@@ -1,8 +1,8 @@
 /*
  * geometry.h — contact geometry of one candidate for the force loops and the observables (so
  * both see the same contacts).  The shapes are the kernel's (kernel/jdem_geometry.h, shared with
- * the LIGGGHTS plugin); this adds the material fields from the per-particle constants.  a is the
- * particle with the lower index (or the particle of a wall contact); n points from a to b.
+ * the LIGGGHTS plugin); this adds the material fields.  a is the particle with the lower index
+ * (or the particle of a wall contact); n points from a to b.
  */
 #ifndef JDEM_GEOMETRY_H
 #define JDEM_GEOMETRY_H
@@ -10,15 +10,39 @@
 #include "jdem_geometry.h"
 #include "sim.h"
 
-/* Sphere–sphere: returns 1 and fills g when the spheres overlap (rsq < radsum^2).  i_eff is
- * only needed by the rolling law, so it is computed only with JD_F_ROLLING in features (a
- * compile-time constant at the call sites). */
-static inline int sim_pair_geom(const jd_sim *s, const unsigned features, int32_t i, int32_t j,
-                                jd_contact_geom *g) {
-    if (!jd_geom_spheres(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j, s->radius[j], g))
+/* The constants of pair (i, j) as jd_geom_pair_material and jd_geom_spheres compute them; the
+ * neighbour build stores them with the list entry.  pcr may be NULL (no rolling). */
+static inline void sim_pair_constants(const jd_sim *s, int32_t i, int32_t j, jd_pair_const *pc,
+                                      jd_pair_const_roll *pcr) {
+    jd_contact_geom g;
+    jd_geom_pair_material(pcr ? JD_F_ROLLING : 0u, &g, s->kp[i], s->kp[j], s->mass[i], s->mass[j],
+                          s->inertia[i], s->inertia[j]);
+    pc->k_n = g.k_n;
+    pc->m_eff = g.m_eff;
+    if (pcr) {
+        pcr->i_eff = g.i_eff;
+        pcr->r_roll = jd_rolling_radius(s->radius[i], s->radius[j]);
+    }
+}
+
+/* Sphere–sphere for entry c of the pair list: returns 1 and fills g when the spheres overlap
+ * (rsq < radsum^2).  The material fields come from the entry's stored constants; i_eff and
+ * r_roll are only read by the rolling law, so they are filled only with JD_F_ROLLING in
+ * features (a compile-time constant at the call sites). */
+static inline int sim_pair_geom(const jd_sim *s, const unsigned features, size_t c, int32_t i,
+                                int32_t j, jd_contact_geom *g) {
+    if (!jd_geom_spheres_contact(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
+                                 s->radius[j], g))
         return 0;
-    jd_geom_pair_material(features, g, s->kp[i], s->kp[j], s->mass[i], s->mass[j], s->inertia[i],
-                          s->inertia[j]);
+    const jd_pair_const *pc = &s->pairs.pc[c];
+    g->k_n = pc->k_n;
+    g->m_eff = pc->m_eff;
+    if (features & JD_F_ROLLING) {
+        g->i_eff = s->pairs.pcr[c].i_eff;
+        g->r_roll = s->pairs.pcr[c].r_roll;
+    } else {
+        g->i_eff = g->r_roll = 0.0;
+    }
     return 1;
 }
 

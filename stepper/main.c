@@ -46,6 +46,19 @@ static const char usage_text[] =
     "                           when the run completes, so OUT.h5 is never a truncated file\n"
     "  --force                  run even if the time step is unsafe (run)\n"
     "  --quiet                  no summary and no progress line on stderr (run)\n"
+    "  --threads N              OpenMP threads of the force and integration loops (run;\n"
+    "                           default: OMP_NUM_THREADS if set, else 1).  A run is\n"
+    "                           reproducible bit for bit for a given N; different N differ\n"
+    "                           by round-off (the order in which contact forces are summed)\n"
+    "  --timing                 print where the time loop's wall time went (neighbour\n"
+    "                           search, pair forces, wall forces, integration, output) on\n"
+    "                           stderr at the end of the run, also with --quiet (run)\n"
+    "  --no-sort                keep the scene's particle order instead of renumbering the\n"
+    "                           particles in cell order at each neighbour build (run; a\n"
+    "                           reference for the sorted path, results agree to round-off)\n"
+    "  --all-laws               evaluate every contact law even where the scene's\n"
+    "                           coefficients switch it off (run; the general force loop, a\n"
+    "                           reference for the scene-specialised ones: same trajectory)\n"
     "\n"
     "time-step guard (run): dt must not exceed 20 % of the Rayleigh time step of the smallest\n"
     "sphere, nor 1/50 of the shortest Hertz contact time at time.max_impact_speed; otherwise\n"
@@ -68,8 +81,16 @@ static const char usage_text[] =
 
 typedef struct cli {
     const char *command, *scene, *case_name, *output;
-    int force, quiet;
+    int force, quiet, timing, no_sort, all_laws, threads;
 } cli;
+
+/* A positive thread count from s (option or environment), or 0. */
+static int thread_count(const char *s) {
+    char *end;
+    errno = 0;
+    const long v = s ? strtol(s, &end, 10) : 0;
+    return s && *s && !*end && errno == 0 && v >= 1 && v <= 1024 ? (int)v : 0;
+}
 
 static int usage_error(const char *msg, const char *arg) {
     fprintf(stderr, "jdem: %s%s%s\n", msg, arg ? ": " : "", arg ? arg : "");
@@ -93,6 +114,16 @@ static int parse(int argc, char **argv, cli *c) {
             c->force = 1;
         } else if (!strcmp(a, "--quiet")) {
             c->quiet = 1;
+        } else if (!strcmp(a, "--timing")) {
+            c->timing = 1;
+        } else if (!strcmp(a, "--no-sort")) {
+            c->no_sort = 1;
+        } else if (!strcmp(a, "--all-laws")) {
+            c->all_laws = 1;
+        } else if (!strcmp(a, "--threads")) {
+            if (!has_value) return usage_error("--threads needs a value", NULL);
+            if (!(c->threads = thread_count(argv[++k])))
+                return usage_error("--threads needs a whole number from 1 to 1024", argv[k]);
         } else if (a[0] == '-' && a[1] != '\0') {
             return usage_error("unknown option", a);
         } else if (!c->command) {
@@ -107,8 +138,15 @@ static int parse(int argc, char **argv, cli *c) {
     if (strcmp(c->command, "cases") && strcmp(c->command, "run") && strcmp(c->command, "resolve"))
         return usage_error("unknown command", c->command);
     if (!c->scene) return usage_error("missing SCENE", NULL);
-    if (strcmp(c->command, "run") && (c->output || c->force || c->quiet))
-        return usage_error("-o, --force and --quiet apply to 'run' only", NULL);
+    if (strcmp(c->command, "run") &&
+        (c->output || c->force || c->quiet || c->timing || c->no_sort || c->all_laws || c->threads))
+        return usage_error("-o, --force, --quiet, --threads, --timing, --no-sort and --all-laws "
+                           "apply to 'run' only", NULL);
+    if (!c->threads && getenv("OMP_NUM_THREADS")) {
+        if (!(c->threads = thread_count(getenv("OMP_NUM_THREADS"))))
+            return usage_error("OMP_NUM_THREADS must be a whole number from 1 to 1024",
+                               getenv("OMP_NUM_THREADS"));
+    }
     if (!strcmp(c->command, "cases") && c->case_name)
         return usage_error("--case does not apply to 'cases'", NULL);
     return 0;
@@ -227,6 +265,26 @@ static int report_unfinished(int rc, const jd_sim *sim, const char *err, const c
     return EXIT_RUNTIME;
 }
 
+/* One line per part of the time loop, and a machine-readable summary line (scripts/bench.py). */
+static void print_timing(const jd_sim *s) {
+    const jd_timing *t = &s->timing;
+    const double total = t->neighbour + t->pairs + t->walls + t->integration + t->output;
+    const struct {
+        const char *name;
+        double v;
+    } part[] = {{"neighbour search", t->neighbour}, {"pair forces", t->pairs},
+                {"wall forces", t->walls}, {"integration", t->integration}, {"output", t->output}};
+    fprintf(stderr, "jdem: timing of %lld steps, %zu particles, %d thread(s), %lld neighbour builds:\n",
+            (long long)s->step, s->n, s->threads, (long long)s->n_builds);
+    for (size_t k = 0; k < sizeof part / sizeof *part; k++)
+        fprintf(stderr, "jdem:   %-17s %10.4f s  %5.1f %%\n", part[k].name, part[k].v,
+                total > 0.0 ? 100.0 * part[k].v / total : 0.0);
+    fprintf(stderr, "jdem-timing: neighbour=%.6f pairs=%.6f walls=%.6f integration=%.6f output=%.6f "
+            "steps=%lld builds=%lld threads=%d pair_entries=%zu wall_entries=%zu\n",
+            t->neighbour, t->pairs, t->walls, t->integration, t->output, (long long)s->step,
+            (long long)s->n_builds, s->threads, s->pairs.n, s->wall_pairs.n);
+}
+
 static int cmd_run(const cli *c) {
     jd_scene sc;
     int rc = load(c, &sc);
@@ -237,6 +295,7 @@ static int cmd_run(const cli *c) {
     int sim_ok = 0;
     jd_h5md *h = NULL;
     char *yaml = NULL;
+    double *mass = NULL;
     if ((rc = check_time_step(&sc, c)) != 0) goto done;
     rc = EXIT_RUNTIME;
     if (c->output)
@@ -244,9 +303,10 @@ static int cmd_run(const cli *c) {
     else if (snprintf(out, sizeof out, "out/%s/%s.jdem.h5", sc.name, sc.case_name) >= (int)sizeof out)
         goto fail;
     if (make_parent_dirs(out, err, sizeof err) != 0) goto fail;
-    if (sim_init(&sim, &sc, getenv("JDEM_NEIGHBOUR") && !strcmp(getenv("JDEM_NEIGHBOUR"), "allpairs"),
-                 err, sizeof err) != 0)
-        goto fail;
+    const jd_sim_options opt = {
+        .allpairs = getenv("JDEM_NEIGHBOUR") && !strcmp(getenv("JDEM_NEIGHBOUR"), "allpairs"),
+        .no_sort = c->no_sort, .all_laws = c->all_laws, .threads = c->threads ? c->threads : 1};
+    if (sim_init(&sim, &sc, &opt, err, sizeof err) != 0) goto fail;
     sim_ok = 1;
     yaml = scene_yaml_string(&sc);
     if (!yaml) {
@@ -256,12 +316,22 @@ static int cmd_run(const cli *c) {
     const jd_h5md_meta meta = {.creator = "jdem", .creator_version = JDEM_VERSION,
                                .scene_name = sc.name, .case_name = sc.case_name,
                                .scene_yaml = yaml, .dt = sc.dt};
-    const jd_h5md_particles parts = {.n = sc.n_particles, .id = sc.id, .species = sim.species,
-                                     .radius = sim.radius, .mass = sim.mass};
-    if (!(h = jd_h5md_create(out, &meta, &parts, err, sizeof err))) goto fail;
+    /* the particles' constants in scene order (the engine may have renumbered them) */
+    if (!(mass = malloc((sc.n_particles ? sc.n_particles : 1) * sizeof *mass))) {
+        snprintf(err, sizeof err, "out of memory");
+        goto fail;
+    }
+    sim_scalars_in_scene_order(&sim, sim.mass, mass);
+    const jd_h5md_particles parts = {.n = sc.n_particles, .id = sc.id, .species = sc.material,
+                                     .radius = sc.radius, .mass = mass};
+    h = jd_h5md_create(out, &meta, &parts, err, sizeof err);
+    free(mass);
+    mass = NULL;
+    if (!h) goto fail;
     sim.stop = &stop_signal;
     catch_stop_signals();
     const int run_rc = sim_run(&sim, h, !c->quiet, err, sizeof err);
+    if (c->timing) print_timing(&sim);
     if (run_rc != 0) {
         char err2[256];
         if (jd_h5md_close(h, 0, err2, sizeof err2) != 0)
@@ -279,6 +349,7 @@ fail:
     fprintf(stderr, "jdem: %s\n", err[0] ? err : "output path too long");
 done:
     free(yaml);
+    free(mass);
     if (sim_ok) sim_free(&sim);
     scene_free(&sc);
     return rc;

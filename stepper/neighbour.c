@@ -17,27 +17,40 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry.h"
 #include "sim.h"
 
-static int list_reserve(jd_contact_list *l, size_t need, int rolling) {
-    if (need <= l->cap) return 0;
+/* The buffers of a list swap roles between the pair and the wall list (sim_neighbour_build,
+ * sim_reorder), so a list may lack the arrays of its new kind even with enough capacity; every
+ * array a list has is kept at its capacity. */
+int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
+    const int rolling = (kind & JD_LIST_ROLLING) != 0, pairs = (kind & JD_LIST_PAIRS) != 0;
+    const int complete = (!rolling || l->roll) && (!pairs || l->pc) && (!(pairs && rolling) || l->pcr);
+    if (need <= l->cap && complete) return 0;
     size_t cap = l->cap ? l->cap : 256;
     while (cap < need) cap += cap / 2;
+    const int grow = cap != l->cap;
     int32_t *i = realloc(l->i, cap * sizeof *i);
     if (i) l->i = i;
     int32_t *j = realloc(l->j, cap * sizeof *j);
     if (j) l->j = j;
     jd_contact_state *st = realloc(l->state, cap * sizeof *st);
     if (st) l->state = st;
-    jd_rolling_state *r = rolling ? realloc(l->roll, cap * sizeof *r) : NULL;
+    const int want_r = rolling || (grow && l->roll), want_pc = pairs || (grow && l->pc),
+              want_pcr = (pairs && rolling) || (grow && l->pcr);
+    jd_rolling_state *r = want_r ? realloc(l->roll, cap * sizeof *r) : l->roll;
     if (r) l->roll = r;
-    if (!i || !j || !st || (rolling && !r)) return -1;
+    jd_pair_const *pc = want_pc ? realloc(l->pc, cap * sizeof *pc) : l->pc;
+    if (pc) l->pc = pc;
+    jd_pair_const_roll *pcr = want_pcr ? realloc(l->pcr, cap * sizeof *pcr) : l->pcr;
+    if (pcr) l->pcr = pcr;
+    if (!i || !j || !st || (want_r && !r) || (want_pc && !pc) || (want_pcr && !pcr)) return -1;
     l->cap = cap;
     return 0;
 }
 
-static int list_push(jd_contact_list *l, int32_t i, int32_t j, int rolling) {
-    if (l->n == l->cap && list_reserve(l, l->n + 1, rolling) != 0) return -1;
+static int list_push(jd_contact_list *l, int32_t i, int32_t j, unsigned kind) {
+    if ((l->n == l->cap || l->n == 0) && sim_list_reserve(l, l->n + 1, kind) != 0) return -1;
     l->i[l->n] = i;
     l->j[l->n] = j;
     l->n++;
@@ -49,6 +62,8 @@ void sim_contact_list_free(jd_contact_list *l) {
     free(l->j);
     free(l->state);
     free(l->roll);
+    free(l->pc);
+    free(l->pcr);
     memset(l, 0, sizeof *l);
 }
 
@@ -108,8 +123,12 @@ static int wall_candidate(const jd_sim_wall *w, const double *x, double R, doubl
     return cy->inside ? d > cy->rc - R - skin : d < cy->rc + R + skin;
 }
 
+static unsigned list_kind(const jd_sim *s, unsigned pairs) {
+    return ((s->features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) | pairs;
+}
+
 static int build_wall_list(jd_sim *s, jd_contact_list *l) {
-    const int rolling = (s->features & JD_F_ROLLING) != 0;
+    const unsigned rolling = list_kind(s, 0u);
     for (size_t i = 0; i < s->n; i++)
         for (size_t w = 0; w < s->n_walls; w++)
             if ((s->allpairs || wall_candidate(&s->walls[w], s->x + 3 * i, s->radius[i], s->skin)) &&
@@ -153,17 +172,20 @@ static int bin_particles(jd_sim *s, double h, const double lo[3], const int nc[3
     return 0;
 }
 
-static int build_pair_list_cells(jd_sim *s, jd_contact_list *l, char *err, size_t errlen) {
-    if (s->n < 2) return 0;
-    const int rolling = (s->features & JD_F_ROLLING) != 0;
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+/* The cell grid over the particles' bounding box: cell edge h >= the largest interaction
+ * range, grown if the box would need more than about 8 cells per particle (sparse or scattered
+ * systems).  Fails on a non-finite position. */
+static int cell_grid(const jd_sim *s, double *h_out, double lo[3], int nc[3], char *err,
+                     size_t errlen) {
+    double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     double rmax = 0.0;
+    for (int d = 0; d < 3; d++) lo[d] = INFINITY;
     for (size_t i = 0; i < s->n; i++) {
         for (int d = 0; d < 3; d++) {
             const double xd = s->x[3 * i + d];
             if (!isfinite(xd)) {
                 snprintf(err, errlen, "particle %lld has a non-finite position at step %lld",
-                         (long long)s->scene->id[i], (long long)s->step);
+                         sim_particle_id(s, i), (long long)s->step);
                 return -1;
             }
             lo[d] = fmin(lo[d], xd);
@@ -171,15 +193,36 @@ static int build_pair_list_cells(jd_sim *s, jd_contact_list *l, char *err, size_
         }
         rmax = fmax(rmax, s->radius[i]);
     }
-    /* cell edge >= the largest interaction range, grown if the box would need more than
-     * about 8 cells per particle (sparse or scattered systems) */
     double h = 2.0 * rmax + s->skin;
     const double max_cells = 8.0 * (double)s->n + 64.0;
     double cells = 1.0;
     for (int d = 0; d < 3; d++) cells *= floor((hi[d] - lo[d]) / h) + 1.0;
     if (cells > max_cells) h *= cbrt(cells / max_cells) * 1.01;
-    int nc[3];
     for (int d = 0; d < 3; d++) nc[d] = (int)floor((hi[d] - lo[d]) / h) + 1;
+    *h_out = h;
+    return 0;
+}
+
+/* Renumber the particles in cell order (z, then y, then x; within a cell by index), so that
+ * neighbours lie close in memory. */
+static int sort_into_cells(jd_sim *s, char *err, size_t errlen) {
+    double h, lo[3];
+    int nc[3];
+    if (cell_grid(s, &h, lo, nc, err, errlen) != 0) return -1;
+    if (bin_particles(s, h, lo, nc) != 0) {
+        snprintf(err, errlen, "out of memory sorting %zu particles", s->n);
+        return -1;
+    }
+    /* cell_items is the new order (new index -> old index) */
+    return sim_reorder(s, s->cell_items, err, errlen);
+}
+
+static int build_pair_list_cells(jd_sim *s, jd_contact_list *l, char *err, size_t errlen) {
+    if (s->n < 2) return 0;
+    const unsigned kind = list_kind(s, JD_LIST_PAIRS);
+    double h, lo[3];
+    int nc[3];
+    if (cell_grid(s, &h, lo, nc, err, errlen) != 0) return -1;
     if (bin_particles(s, h, lo, nc) != 0) goto oom;
 
     for (size_t i = 0; i < s->n; i++) {
@@ -204,8 +247,7 @@ static int build_pair_list_cells(jd_sim *s, jd_contact_list *l, char *err, size_
                         const double *xj = s->x + 3 * (size_t)j;
                         const double d[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
                         const double range = ri + s->radius[j] + s->skin;
-                        if (jd_dot(d, d) < range * range &&
-                            list_push(l, (int32_t)i, j, rolling) != 0)
+                        if (jd_dot(d, d) < range * range && list_push(l, (int32_t)i, j, kind) != 0)
                             goto oom;
                     }
                 }
@@ -220,15 +262,24 @@ oom:
 }
 
 static int build_pair_list_all(jd_sim *s, jd_contact_list *l) {
-    const int rolling = (s->features & JD_F_ROLLING) != 0;
+    const unsigned kind = list_kind(s, JD_LIST_PAIRS);
     for (size_t i = 0; i < s->n; i++)
         for (size_t j = i + 1; j < s->n; j++)
-            if (list_push(l, (int32_t)i, (int32_t)j, rolling) != 0) return -1;
+            if (list_push(l, (int32_t)i, (int32_t)j, kind) != 0) return -1;
     return 0;
+}
+
+/* The per-pair constants of every entry (the list is rebuilt after each renumbering, so they
+ * are never carried over). */
+static void fill_pair_constants(const jd_sim *s, jd_contact_list *l) {
+    for (size_t c = 0; c < l->n; c++)
+        sim_pair_constants(s, l->i[c], l->j[c], &l->pc[c], l->pcr ? &l->pcr[c] : NULL);
 }
 
 /* Build a new list into `spare`, carry the history over, swap. */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
+    if (!s->allpairs && !s->opt.no_sort && s->n > 1 && sort_into_cells(s, err, errlen) != 0)
+        return -1;
     jd_contact_list *nw = &s->spare;
     nw->n = 0;
     if (s->allpairs) {
@@ -239,6 +290,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
     } else if (build_pair_list_cells(s, nw, err, errlen) != 0) {
         return -1;
     }
+    fill_pair_constants(s, nw);
     carry_over(s, &s->pairs, nw);
     jd_contact_list t = s->pairs;
     s->pairs = *nw;
@@ -265,11 +317,14 @@ int sim_neighbour_stale(const jd_sim *s) {
     const double lim = 0.25 * s->skin * s->skin; /* (skin/2)^2 */
     for (size_t w = 0; w < s->n_walls; w++)
         if (jd_dot(s->walls[w].disp, s->walls[w].disp) > lim) return 1;
-    for (size_t i = 0; i < s->n; i++) {
-        const double d[3] = {s->x[3 * i] - s->x_build[3 * i], s->x[3 * i + 1] - s->x_build[3 * i + 1],
-                             s->x[3 * i + 2] - s->x_build[3 * i + 2]};
+    const long n = (long)s->n;
+    const double *x = s->x, *x0 = s->x_build;
+    int stale = 0;
+#pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1) reduction(| : stale)
+    for (long i = 0; i < n; i++) {
+        const double d[3] = {x[3 * i] - x0[3 * i], x[3 * i + 1] - x0[3 * i + 1], x[3 * i + 2] - x0[3 * i + 2]};
         /* !(<=) so that a NaN position forces a rebuild, which reports it */
-        if (!(jd_dot(d, d) <= lim)) return 1;
+        stale |= !(jd_dot(d, d) <= lim);
     }
-    return 0;
+    return stale;
 }

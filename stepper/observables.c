@@ -46,15 +46,17 @@ void sim_observables(const jd_sim *s, jd_observables *o) {
         jd_contact_geom g;
         const jd_contact_state *st = &s->pairs.state[c];
         o->elastic_energy += jd_contact_elastic_energy(st);
-        if (sim_pair_geom(s, 0u, s->pairs.i[c], s->pairs.j[c], &g) && carries_force(st))
+        const int32_t i = s->pairs.i[c], j = s->pairs.j[c];
+        if (carries_force(st) &&
+            jd_geom_spheres_contact(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
+                                    s->radius[j], &g))
             o->contacts += 1.0;
     }
     for (size_t c = 0; c < s->wall_pairs.n; c++) {
         jd_contact_geom g;
         const jd_contact_state *st = &s->wall_pairs.state[c];
         o->elastic_energy += jd_contact_elastic_energy(st);
-        if (sim_wall_geom(s, s->wall_pairs.i[c], &s->walls[s->wall_pairs.j[c]], &g) &&
-            carries_force(st))
+        if (carries_force(st) && sim_wall_geom(s, s->wall_pairs.i[c], &s->walls[s->wall_pairs.j[c]], &g))
             o->wall_contacts += 1.0;
     }
     o->damping_dissipation = s->e_damp_dropped;

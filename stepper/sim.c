@@ -46,7 +46,7 @@ static unsigned scene_features(const jd_sim *s) {
     const size_t nm = sc->n_materials;
     unsigned char *used = calloc(nm ? nm : 1, 1), *wall_used = calloc(nm ? nm : 1, 1);
     unsigned f = JD_F_ENERGY;
-    if (!used || !wall_used) { /* cannot narrow it down: evaluate every law */
+    if (!used || !wall_used || s->opt.all_laws) { /* the general loop: evaluate every law */
         f |= JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R;
     } else {
         for (size_t i = 0; i < sc->n_particles; i++) used[sc->material[i]] = 1;
@@ -79,7 +79,8 @@ static int init_particles(jd_sim *s, char *err, size_t errlen) {
     for (size_t k = 0; k < sizeof per / sizeof *per; k++)
         if (!(*per[k] = calloc(n1, sizeof(double)))) goto oom;
     if (!(s->species = calloc(n1, sizeof *s->species)) || !(s->cell_of = calloc(n1, sizeof(int32_t))) ||
-        !(s->cell_items = calloc(n1, sizeof(int32_t))))
+        !(s->cell_items = calloc(n1, sizeof(int32_t))) || !(s->orig = calloc(n1, sizeof *s->orig)) ||
+        !(s->scratch = calloc(3 * n1, sizeof *s->scratch)))
         goto oom;
     memcpy(s->x, sc->position, 3 * n * sizeof(double));
     memcpy(s->v, sc->velocity, 3 * n * sizeof(double));
@@ -94,6 +95,7 @@ static int init_particles(jd_sim *s, char *err, size_t errlen) {
             return -1;
         }
         const double r = sc->radius[i];
+        s->orig[i] = (int32_t)i;
         s->species[i] = sc->material[i];
         s->radius[i] = r;
         s->mass[i] = jd_sphere_mass(r, m->density);
@@ -172,21 +174,31 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
         return -1;
     }
     s->features = scene_features(s);
+    if (sim_forces_init(s) != 0) {
+        snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads);
+        return -1;
+    }
     if (sim_walls_init(s, err, errlen) != 0) return -1;
     if (sim_neighbour_build(s, err, errlen) != 0) return -1;
     return setup_forces(s, err, errlen);
 }
 
-int sim_init(jd_sim *s, const jd_scene *scene, int allpairs, char *err, size_t errlen) {
+int sim_init(jd_sim *s, const jd_scene *scene, const jd_sim_options *opt, char *err,
+             size_t errlen) {
     memset(s, 0, sizeof *s);
     s->scene = scene;
     s->n = scene->n_particles;
     s->dt = scene->dt;
-    s->allpairs = allpairs;
+    if (opt) s->opt = *opt;
+    s->allpairs = s->opt.allpairs;
+    s->threads = s->opt.threads > 1 ? s->opt.threads : 1;
     s->frame_step = -1;
     memcpy(s->g, scene->gravity, sizeof s->g);
     s->max_overlap = scene->watchdog.enabled ? scene->watchdog.max_overlap_fraction : INFINITY;
-    if (setup(s, err, errlen) == 0) return 0;
+    if (setup(s, err, errlen) == 0) {
+        memset(&s->timing, 0, sizeof s->timing); /* the time loop's parts only */
+        return 0;
+    }
     sim_free(s);
     return -1;
 }
@@ -196,6 +208,10 @@ void sim_free(jd_sim *s) {
                         s->mass, s->inertia, s->kp,   s->kw, s->dtfm,   s->dtirot};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++) free(arrays[k]);
     free(s->species);
+    free(s->orig);
+    free(s->scratch);
+    free(s->tbuf);
+    free(s->trips);
     free(s->coeffs);
     free(s->walls);
     free(s->cell_of);
@@ -211,19 +227,24 @@ static int check_finite(const jd_sim *s, char *err, size_t errlen) {
     for (size_t k = 0; k < 3 * s->n; k++) {
         if (!isfinite(s->x[k]) || !isfinite(s->v[k]) || !isfinite(s->omega[k])) {
             snprintf(err, errlen, "particle %lld has a non-finite state at step %lld (diverged)",
-                     (long long)s->scene->id[k / 3], (long long)s->step);
+                     sim_particle_id(s, k / 3), (long long)s->step);
             return -1;
         }
     }
     return 0;
 }
 
+/* Frames are in scene order: the vectors are put into it for the write and back after. */
 static int write_frame(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     if (check_finite(s, err, errlen) != 0) return -1;
+    if (!h) return 0;
+    sim_vectors_to_scene_order(s);
     const jd_h5md_frame fr = {.step = s->step, .time = (double)s->step * s->dt, .position = s->x,
                               .velocity = s->v, .angular_velocity = s->omega, .force = s->f,
                               .torque = s->torque};
-    return h ? jd_h5md_write_frame(h, &fr, err, errlen) : 0;
+    const int rc = jd_h5md_write_frame(h, &fr, err, errlen);
+    sim_vectors_to_sim_order(s);
+    return rc;
 }
 
 /* One observable sample: written when there is output, and always seen by the watchdog. */
@@ -260,6 +281,7 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
     int rc = 0;
     for (;;) {
         if ((rc = sim_watchdog_step(s, err, errlen)) != 0) break;
+        const double t0 = sim_clock();
         if (due(s->step, sc->output_every, last)) {
             if ((rc = write_frame(s, h, err, errlen)) != 0) break;
             s->frame_step = s->step;
@@ -267,6 +289,7 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
         if (due(s->step, sc->observables_every, last) &&
             (rc = sample_observables(s, h, err, errlen)) != 0)
             break;
+        s->timing.output += sim_clock() - t0;
         if (s->step >= last) break;
         if (s->stop && *s->stop) {
             snprintf(err, errlen, "stopped at step %lld", (long long)s->step);

@@ -4,6 +4,7 @@
  * One file per mechanism (REBOUND style):
  *   sim.c          set-up from a resolved scene, the run loop with output, tear-down
  *   neighbour.c    cell list -> half Verlet list with skin, wall candidates, history carry-over
+ *   reorder.c      spatial sorting of the particles at rebuilds, and the permute hook
  *   walls.c        wall set-up and rigid translation
  *   geometry.h     contact geometry (kernel/jdem_geometry.h) plus material fields (inline)
  *   forces.c       force loops, specialised at compile time for the scene's feature set
@@ -18,7 +19,21 @@
  * three components of one particle share a cache line (a contact reads all three at once); and
  * the H5MD writer takes exactly this layout, so frames are written without a copy.  Per-particle
  * constants are separate arrays (structure of arrays) so that each loop streams only what it
- * uses.  All indices are the scene's order (sorted by id); pairs are always i < j.
+ * uses.  Pairs are always i < j.
+ *
+ * Particle order.  At every neighbour rebuild the particles are renumbered in the order of
+ * their neighbour cells (reorder.c), so that the particles of one cell, and the neighbours a
+ * contact loop visits, lie close in memory.  orig[i] is the scene index (position in the scene,
+ * sorted by id) of the particle now at index i; everything the engine shows (frames, watchdog
+ * messages) is translated back to scene order.  Other per-particle data that outlives a rebuild
+ * (bonds) registers a permute hook and remaps through it.
+ *
+ * Threads (OpenMP).  The force loops split the contact lists into one contiguous chunk per
+ * thread; thread 0 adds into f and torque, thread t > 0 into its own zeroed buffer, and the
+ * buffers are added to f and torque after the loops (per particle, in thread order).  No two
+ * threads write the same memory, no atomics; for a given thread count the sums are always taken
+ * in the same order, so a run is reproducible bit for bit, and runs with different thread
+ * counts differ only by the round-off of that order.  Integration loops are split by particle.
  */
 #ifndef JDEM_SIM_H
 #define JDEM_SIM_H
@@ -32,6 +47,41 @@
 #include "jdem_watchdog.h"
 #include "scene.h"
 
+/* Material constants of a particle pair, computed once when the pair enters the neighbour list
+ * (jd_geom_pair_material gives the same bits every step, so storing them changes nothing). */
+typedef struct jd_pair_const {
+    double k_n;       /* Hertz prefactor of the pair (eq. 5) [N/m^1.5] */
+    double m_eff;     /* effective mass [kg] */
+} jd_pair_const;
+
+/* The rolling law's constants of a pair (scenes with rolling resistance only). */
+typedef struct jd_pair_const_roll {
+    double i_eff;     /* effective moment of inertia [kg m^2] */
+    double r_roll;    /* rolling radius R_a R_b/(R_a + R_b) [m] */
+} jd_pair_const_roll;
+
+/* Called after the particles were renumbered: the particle that had index k now has index
+ * new_of_old[k] (k < n). */
+typedef void (*jd_permute_hook)(void *ctx, const int32_t *new_of_old, size_t n);
+
+/* Run options that are not part of the scene (command line). */
+typedef struct jd_sim_options {
+    int allpairs;     /* debugging reference: every pair, never rebuilt, no sorting */
+    int no_sort;      /* keep the scene's particle order (reference for the sorted path) */
+    int all_laws;     /* evaluate every law even where its coefficient makes it vanish (the
+                         general loop; reference for the feature-specialised ones) */
+    int threads;      /* OpenMP threads of the force and integration loops; <= 0: 1 */
+} jd_sim_options;
+
+/* Wall-clock seconds spent in each part of the time loop (CLOCK_MONOTONIC). */
+typedef struct jd_timing {
+    double neighbour;   /* rebuild check and rebuilds, including the reordering */
+    double pairs;       /* particle-pair force loop, zeroing and the reduction of the buffers */
+    double walls;       /* particle-wall force loop */
+    double integration; /* half kicks, drift, non-finite probes, wall motion */
+    double output;      /* frames, observables and the energy watchdog */
+} jd_timing;
+
 /* A list of contact candidates (i, j) sorted by (i, j), with the history of each contact stored
  * alongside.  For particle pairs j is a particle index (> i); for wall candidates a wall index.
  * Buffers grow geometrically and are reused across rebuilds (no allocation per contact). */
@@ -40,6 +90,8 @@ typedef struct jd_contact_list {
     int32_t *i, *j;
     jd_contact_state *state;
     jd_rolling_state *roll; /* NULL unless the scene has rolling resistance */
+    jd_pair_const *pc;      /* particle pairs only (walls: NULL): per-pair constants */
+    jd_pair_const_roll *pcr; /* particle pairs of scenes with rolling resistance, else NULL */
 } jd_contact_list;
 
 /* A wall as the engine moves it: the kernel's shape (translated in place) plus what the engine
@@ -70,6 +122,8 @@ typedef struct jd_sim {
     /* particle state, 3n each */
     double *x, *v, *omega, *f, *torque;
     /* per-particle constants */
+    int32_t *orig;     /* scene index of the particle at each index (see "Particle order") */
+    int sorted;        /* 1 once the particles have been renumbered (orig is not the identity) */
     int32_t *species;
     double *radius, *mass, *inertia;
     double *kp;        /* Hertz prefactor jd_hertz_prefactor(E, nu, R) */
@@ -84,8 +138,18 @@ typedef struct jd_sim {
     size_t n_walls;
     jd_sim_wall *walls;
 
+    jd_sim_options opt;
+    int threads;       /* threads actually used (opt.threads clamped to >= 1) */
+    double *tbuf;      /* (threads - 1) x 6n: force and torque buffers of threads 1.. (zero
+                          between force evaluations) */
+    jd_overlap_trip *trips; /* one per thread, merged into overlap_trip */
+    double *scratch;   /* 3n doubles: reordering and frames in scene order */
+    jd_permute_hook permute_hook; /* NULL, or called after each renumbering */
+    void *permute_ctx;
+    jd_timing timing;
+
     /* neighbour search */
-    int allpairs;      /* debugging reference: every pair, never rebuilt (JDEM_NEIGHBOUR=allpairs) */
+    int allpairs;      /* opt.allpairs */
     double skin;       /* [m] */
     double *x_build;   /* positions at the last build, 3n */
     jd_contact_list pairs, wall_pairs, spare;
@@ -118,7 +182,8 @@ enum { JD_RUN_ERROR = -1, JD_RUN_TRIPPED = -2, JD_RUN_STOPPED = -3 };
 /* sim.c */
 /* Set up from a loaded scene (kept by pointer; it must outlive the sim) and compute the forces
  * of step 0 (LIGGGHTS `setup`).  Returns 0, or -1 with a reason in err. */
-int sim_init(jd_sim *s, const jd_scene *scene, int allpairs, char *err, size_t errlen);
+int sim_init(jd_sim *s, const jd_scene *scene, const jd_sim_options *opt, char *err,
+             size_t errlen);
 void sim_free(jd_sim *s);
 
 struct jd_h5md;
@@ -132,7 +197,25 @@ int sim_run(jd_sim *s, struct jd_h5md *h, int show_progress, char *err, size_t e
 /* neighbour.c */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
 int sim_neighbour_stale(const jd_sim *s); /* 1 when a rebuild is due */
+/* Capacity for `need` entries of a list of this kind (JD_LIST_* bits).  Returns 0 or -1. */
+enum { JD_LIST_ROLLING = 1, JD_LIST_PAIRS = 2 };
+int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind);
 void sim_contact_list_free(jd_contact_list *l);
+
+/* reorder.c */
+/* Renumber the particles into the order old_of_new (new index k holds old particle
+ * old_of_new[k]): the per-particle arrays, the contact lists (re-keyed and re-sorted, with the
+ * history of a pair whose ends swap turned around), orig, and the permute hook.  Returns 0 or
+ * -1 (out of memory; nothing changed). */
+int sim_reorder(jd_sim *s, const int32_t *old_of_new, char *err, size_t errlen);
+/* Put x, v, omega, f and torque into scene order (for a frame), and back. */
+void sim_vectors_to_scene_order(jd_sim *s);
+void sim_vectors_to_sim_order(jd_sim *s);
+/* A per-particle array in scene order: out[orig[i]] = a[i]. */
+void sim_scalars_in_scene_order(const jd_sim *s, const double *a, double *out);
+void sim_ints_in_scene_order(const jd_sim *s, const int32_t *a, int32_t *out);
+/* Scene id of the particle at index i. */
+long long sim_particle_id(const jd_sim *s, size_t i);
 
 /* walls.c */
 int sim_walls_init(jd_sim *s, char *err, size_t errlen);
@@ -140,6 +223,10 @@ void sim_walls_move(jd_sim *s);
 
 /* forces.c: zero f and torque, then pair forces, wall forces, gravity. */
 void sim_compute_forces(jd_sim *s);
+/* The force loops' buffers for s->threads threads (sim_init). */
+int sim_forces_init(jd_sim *s);
+/* Monotonic wall clock [s]. */
+double sim_clock(void);
 
 /* integrate.c: one full step.  Returns 0, or -1 with a reason in err. */
 int sim_step(jd_sim *s, char *err, size_t errlen);
@@ -172,7 +259,7 @@ void sim_guard(const jd_scene *scene, jd_guard *g);
  * contact with jd_overlap_excessive(); the run loop calls the checks below, which return 0 or
  * JD_RUN_TRIPPED with "watchdog: step N: QUANTITY VALUE for particle(s) IDS exceeds LIMIT ..."
  * in msg. */
-void sim_watchdog_overlap(jd_sim *s, int32_t i, int32_t j, double delta, double rmin);
+void sim_watchdog_overlap(jd_overlap_trip *t, int32_t i, int32_t j, double delta, double rmin);
 int sim_watchdog_step(const jd_sim *s, char *msg, size_t len);       /* every step */
 int sim_watchdog_energy(jd_sim *s, const jd_observables *o, char *msg, size_t len); /* samples */
 

@@ -13,14 +13,14 @@
 
 #include "sim.h"
 
-/* Keep the worst offender of this force evaluation (sim_compute_forces resets it). */
-void sim_watchdog_overlap(jd_sim *s, int32_t i, int32_t j, double delta, double rmin) {
+/* Keep the worst offender of this force evaluation in t, the trip of the calling thread
+ * (sim_compute_forces resets them and keeps the worst). */
+void sim_watchdog_overlap(jd_overlap_trip *t, int32_t i, int32_t j, double delta, double rmin) {
     const double fraction = delta / rmin;
-    if (fraction > s->overlap_trip.fraction)
-        s->overlap_trip = (jd_overlap_trip){.fraction = fraction, .i = i, .j = j};
+    if (fraction > t->fraction) *t = (jd_overlap_trip){.fraction = fraction, .i = i, .j = j};
 }
 
-static long long id_of(const jd_sim *s, size_t i) { return (long long)s->scene->id[i]; }
+static long long id_of(const jd_sim *s, size_t i) { return sim_particle_id(s, i); }
 
 static int overlap_message(const jd_sim *s, char *msg, size_t len) {
     const jd_overlap_trip *t = &s->overlap_trip;
