@@ -126,7 +126,8 @@ static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0,
         jd_contact_result out;
         const double f_prev[3] = {st->f_prev[0], st->f_prev[1], st->f_prev[2]};
         const int carries = jd_contact(F, co, &g, &k, s->dt, st, rs, &out);
-        work += jd_wall_work(f_prev, out.f, w->v, s->dt); /* also over the step a contact ends */
+        if (F & JD_F_ENERGY) /* also over the step a contact ends */
+            work += jd_wall_work(f_prev, out.f, w->v, s->dt);
         if (!carries) continue;
         double *fa = a.f + 3 * (size_t)i, *ta = a.t + 3 * (size_t)i;
         for (int d = 0; d < 3; d++) {
@@ -153,22 +154,26 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
     return wall_loop(s, F, lo, hi, a, trip);
 }
 
-/* One instantiation per combination of the four optional laws; JD_F_ENERGY is always on (the
- * observables need it).  The switch maps the run-time bits to a literal constant. */
+/* One instantiation per combination of the four optional laws and the energy bookkeeping
+ * (output.energy).  The switch maps the run-time bits to a literal constant. */
 #define JD_FORCE_CASE(bits)                                                     \
     case (bits):                                                                \
-        work = contact_loops(s, (bits) | JD_F_ENERGY, tid, nt, &t_pairs_end);   \
+        work = contact_loops(s, (bits), tid, nt, &t_pairs_end);                 \
         break;
+#define JD_FORCE_CASES(e)                                                                     \
+    JD_FORCE_CASE((e) | 0) JD_FORCE_CASE((e) | 1) JD_FORCE_CASE((e) | 2) JD_FORCE_CASE((e) | 3)     \
+    JD_FORCE_CASE((e) | 4) JD_FORCE_CASE((e) | 5) JD_FORCE_CASE((e) | 6) JD_FORCE_CASE((e) | 7)     \
+    JD_FORCE_CASE((e) | 8) JD_FORCE_CASE((e) | 9) JD_FORCE_CASE((e) | 10) JD_FORCE_CASE((e) | 11)   \
+    JD_FORCE_CASE((e) | 12) JD_FORCE_CASE((e) | 13) JD_FORCE_CASE((e) | 14) JD_FORCE_CASE((e) | 15)
 
 static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
     double work = 0.0, t_pairs_end = 0.0;
-    _Static_assert(JD_F_DAMPING == 1 && JD_F_FRICTION == 2 && JD_F_ROLLING == 4 && JD_F_MU_R == 8,
-                   "the dispatch below enumerates the four optional laws as bits 0-3");
-    switch (s->features & 15u) {
-        JD_FORCE_CASE(0) JD_FORCE_CASE(1) JD_FORCE_CASE(2) JD_FORCE_CASE(3)
-        JD_FORCE_CASE(4) JD_FORCE_CASE(5) JD_FORCE_CASE(6) JD_FORCE_CASE(7)
-        JD_FORCE_CASE(8) JD_FORCE_CASE(9) JD_FORCE_CASE(10) JD_FORCE_CASE(11)
-        JD_FORCE_CASE(12) JD_FORCE_CASE(13) JD_FORCE_CASE(14) JD_FORCE_CASE(15)
+    _Static_assert(JD_F_DAMPING == 1 && JD_F_FRICTION == 2 && JD_F_ROLLING == 4 && JD_F_MU_R == 8 &&
+                       JD_F_ENERGY == 16,
+                   "the dispatch below enumerates the four optional laws as bits 0-3, energy as 4");
+    switch (s->features & 31u) {
+        JD_FORCE_CASES(0)
+        JD_FORCE_CASES(16)
     }
     if (tid == 0) *t_pairs_end_out = t_pairs_end;
     return work;

@@ -8,11 +8,24 @@
 #include "sim.h"
 
 /* v += (0.5 dt/m) f; omega += (0.5 dt/0.4)/(r r m) torque.  dtfm and dtirot are precomputed per
- * particle with exactly LIGGGHTS' expressions, so the products are bit-identical.  Returns 1
- * when some new v or omega is not finite: 0 * inf and 0 * NaN are NaN, so the probe sum is 0 or
- * NaN (-O2 without -ffast-math keeps the multiply), and the watchdog's non-finite check costs
- * no branch per element. */
-static int half_kick(jd_sim *s) {
+ * particle with exactly LIGGGHTS' expressions, so the products are bit-identical. */
+static void half_kick(jd_sim *s) {
+    const long n = (long)s->n;
+    double *v = s->v, *w = s->omega;
+    const double *f = s->f, *t = s->torque, *dtfm = s->dtfm, *dtirot = s->dtirot;
+#pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1)
+    for (long i = 0; i < n; i++) {
+        for (int d = 0; d < 3; d++) {
+            v[3 * i + d] += dtfm[i] * f[3 * i + d];
+            w[3 * i + d] += dtirot[i] * t[3 * i + d];
+        }
+    }
+}
+
+/* The same half kick, returning 1 when some new v or omega is not finite: 0 * inf and 0 * NaN
+ * are NaN, so the probe sum is 0 or NaN (-O2 without -ffast-math keeps the multiply), and the
+ * watchdog's non-finite check costs no branch per element and no second pass. */
+static int final_kick(jd_sim *s) {
     const long n = (long)s->n;
     double *v = s->v, *w = s->omega;
     const double *f = s->f, *t = s->torque, *dtfm = s->dtfm, *dtirot = s->dtirot;
@@ -61,7 +74,7 @@ int sim_step(jd_sim *s, char *err, size_t errlen) {
     const double t2 = sim_clock();
     sim_compute_forces(s);
     const double t3 = sim_clock();
-    s->nonfinite = half_kick(s); /* final_integrate */
+    s->nonfinite = final_kick(s); /* final_integrate */
     s->step++;
     const double t4 = sim_clock();
     s->timing.integration += (t1 - t0) + (t4 - t3);

@@ -21,7 +21,7 @@ static const char *const TOP_KEYS[] = {"jdem_scene", "name", "case", "descriptio
                                        NULL};
 static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_speed", NULL};
 static const char *const OUTPUT_KEYS[] = {"every", "observables_every", "compare_tolerance",
-                                          NULL};
+                                          "energy", NULL};
 static const char *const MODEL_KEYS[] = {"wall_rule", "damping", "tangential_limit", "mu_r", NULL};
 static const char *const WATCHDOG_KEYS[] = {"enabled", "max_overlap_fraction", "max_energy_jump",
                                             NULL};
@@ -147,8 +147,10 @@ static int read_output(loader *L) {
     L->s->observables_every = L->s->output_every;
     if (scene_opt_int(L, o, "output", "observables_every", 1, &L->s->observables_every)) return -1;
     L->s->compare_tolerance = 1e-10; /* the two engines run the same kernel in the same order */
-    return sd_opt_num(&L->c, o, "output", "compare_tolerance", SD_POSITIVE,
-                      &L->s->compare_tolerance);
+    if (sd_opt_num(&L->c, o, "output", "compare_tolerance", SD_POSITIVE, &L->s->compare_tolerance))
+        return -1;
+    L->s->energy = 1;
+    return sd_opt_enum(&L->c, o, "output", "energy", BOOLEANS, &L->s->energy);
 }
 
 static int read_model(loader *L) {

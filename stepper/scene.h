@@ -70,6 +70,8 @@ typedef struct jd_scene {
     int64_t observables_every;
     double compare_tolerance; /* largest scaled difference scripts/compare_trajectories.py accepts
                                  between two engines' runs of this scene [-] */
+    int energy;               /* 1: energy bookkeeping and the energy observables (default); 0:
+                                 neither (the force loops skip JD_F_ENERGY; no energy watchdog) */
 
     double gravity[3];        /* [m/s^2] */
 

@@ -129,7 +129,8 @@ static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
            map_end(e) || str(e, "output") || map_start(e, 0) ||
            key_int(e, "every", s->output_every) ||
            key_int(e, "observables_every", s->observables_every) ||
-           key_num(e, "compare_tolerance", s->compare_tolerance) || map_end(e) ||
+           key_num(e, "compare_tolerance", s->compare_tolerance) || str(e, "energy") ||
+           scalar(e, s->energy ? "true" : "false", YAML_PLAIN_SCALAR_STYLE) || map_end(e) ||
            key_vec(e, "gravity", s->gravity) || str(e, "model") || map_start(e, 0) ||
            key_str(e, "wall_rule", WALL_RULES[s->wall_rule]) ||
            key_str(e, "damping", DAMPING_MAPS[s->damping_map]) ||

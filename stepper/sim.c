@@ -45,7 +45,7 @@ static unsigned scene_features(const jd_sim *s) {
     const jd_scene *sc = s->scene;
     const size_t nm = sc->n_materials;
     unsigned char *used = calloc(nm ? nm : 1, 1), *wall_used = calloc(nm ? nm : 1, 1);
-    unsigned f = JD_F_ENERGY;
+    unsigned f = sc->energy ? JD_F_ENERGY : 0u;
     if (!used || !wall_used || s->opt.all_laws) { /* the general loop: evaluate every law */
         f |= JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R;
     } else {
@@ -254,7 +254,8 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     sim_observables(s, &o);
     sim_observables_values(&o, val);
     for (int k = 0; h && k < JD_N_OBSERVABLES; k++)
-        if (jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->dt,
+        if ((s->scene->energy || !jd_observable_is_energy[k]) &&
+            jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->dt,
                                      val[k], err, errlen) != 0)
             return JD_RUN_ERROR;
     return sim_watchdog_energy(s, &o, err, errlen);

@@ -239,6 +239,8 @@ typedef struct jd_observables {
 } jd_observables;
 #define JD_N_OBSERVABLES 9
 extern const char *const jd_observable_names[JD_N_OBSERVABLES];
+/* 1 for the observables that need the energy bookkeeping (not written with output.energy off) */
+extern const int jd_observable_is_energy[JD_N_OBSERVABLES];
 void sim_observables(const jd_sim *s, jd_observables *o);
 void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES]);
 

@@ -84,7 +84,7 @@ static size_t most_energetic(const jd_sim *s) {
 }
 
 int sim_watchdog_energy(jd_sim *s, const jd_observables *o, char *msg, size_t len) {
-    if (!s->scene->watchdog.enabled) return 0;
+    if (!s->scene->watchdog.enabled || !s->scene->energy) return 0; /* no energies to check */
     jd_energy_terms now;
     energy_terms(o, &now);
     const double limit = s->scene->watchdog.max_energy_jump;
