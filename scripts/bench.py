@@ -429,8 +429,20 @@ def calibrate_liggghts(deck, engine):
     return dict(wall_s=w, cpu_s=c, peak_rss=rss)
 
 
-def run_jdem(out, size, variant, scene, steps, n):
-    d = os.path.join(out, "runs", "%s_%s" % (size, variant), "jdem")
+TIMING_RE = re.compile(r"jdem-timing: (.*)")
+
+
+def jdem_split(stderr):
+    """The time loop's parts from `jdem run --timing` (seconds, and the counts it prints)."""
+    m = TIMING_RE.findall(stderr)
+    if not m:
+        return None
+    return {k: float(v) for k, v in (kv.split("=") for kv in m[-1].split())}
+
+
+def run_jdem(out, size, variant, scene, steps, n, threads=1, extra=(), tag=""):
+    """Time `jdem run SCENE --threads T [extra]` as run(S) - run(1); returns the record."""
+    d = os.path.join(out, "runs", "%s_%s" % (size, variant), "jdem%s_t%d" % (tag, threads))
     os.makedirs(d, exist_ok=True)
     one = os.path.join(d, "one.yaml")
     with open(scene) as f:
@@ -439,14 +451,16 @@ def run_jdem(out, size, variant, scene, steps, n):
     text = re.sub(r"(?m)^  (every|observables_every): \d+", r"  \1: 1", text)
     with open(one, "w") as f:
         f.write(text)
-    w1, c1, _, _, e1, rc1 = timed([JDEM, "run", one, "-o", os.path.join(d, "one.h5"), "--quiet"], d)
+    opts = ["--quiet", "--timing", "--threads", str(threads)] + list(extra)
+    w1, c1, _, _, e1, rc1 = timed([JDEM, "run", one, "-o", os.path.join(d, "one.h5")] + opts, d)
     traj = os.path.join(d, "out.h5")
-    w, c, rss, _, e, rc = timed([JDEM, "run", scene, "-o", traj, "--quiet"], d)
+    w, c, rss, _, e, rc = timed([JDEM, "run", scene, "-o", traj] + opts, d)
     if rc or rc1:
         raise RuntimeError("jdem failed:\n" + e + e1)
     fr = h5_last_frame(traj)
     return dict(wall_s=w - w1, cpu_s=c - c1, total_wall_s=w, setup_wall_s=w1, peak_rss=rss,
-                contacts_per_particle=2.0 * fr["contacts"] / n, timing="run(S) - run(1)")
+                contacts_per_particle=2.0 * fr["contacts"] / n, timing="run(S) - run(1)",
+                jdem_split=jdem_split(e), trajectory=traj)
 
 
 LOOP_RE = re.compile(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
@@ -477,6 +491,55 @@ def run_liggghts(out, size, variant, deck, engine, ranks, steps, n):
                 timing="LIGGGHTS loop time", liggghts_split_percent=split)
 
 
+def same_final_state(a, b):
+    """1 when two trajectories end in bit-identical positions, velocities and spins."""
+    import h5py
+    with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
+        return all(np.array_equal(fa["particles/all/%s/value" % k][-1], fb["particles/all/%s/value" % k][-1])
+                   for k in ("position", "velocity", "angular_velocity"))
+
+
+def feature_check(out, size, steps, repeats):
+    """The scene-specialisation check of issue 6: the soft monodisperse bed without damping and
+    rolling resistance (restitution 1, rolling friction 0), run by the loop specialised for it
+    and by the general loop (--all-laws: every law evaluated, with zero coefficients).  Speed
+    ratio (medians of `repeats` run(S) - run(1) timings, 1 thread) and whether the trajectories
+    are identical bit for bit.  Writes OUT/feature_check.json (kept: delete it to re-measure)."""
+    path = os.path.join(out, "feature_check.json")
+    if os.path.exists(path):
+        return
+    src = scene_path(out, size, "soft_mono")
+    with open(src) as f:
+        text = f.read()
+    plain = re.sub(r"restitution: 0\.5", "restitution: 1.0", text)
+    if plain.count("restitution: 1.0") != 2:
+        raise RuntimeError("feature check: cannot switch off the damping in " + src)
+    scene = scene_path(out, size, "soft_mono_plain")
+    with open(scene, "w") as f:
+        f.write(plain)
+    n = int(np.load(make_bed(out, size, "mono"))["id"].shape[0])
+    res = {}
+    for tag, extra in (("specialised", []), ("general", ["--all-laws"])):
+        runs = [run_jdem(out, size, "soft_mono_plain", scene, steps, n, extra=extra, tag="_" + tag)
+                for _ in range(repeats)]
+        res[tag] = dict(wall_s=[r["wall_s"] for r in runs], cpu_s=[r["cpu_s"] for r in runs],
+                        wall_s_median=statistics.median(r["wall_s"] for r in runs),
+                        cpu_s_median=statistics.median(r["cpu_s"] for r in runs),
+                        trajectory=runs[-1]["trajectory"])
+        log("feature check %s: %.3f s" % (tag, res[tag]["wall_s_median"]))
+    fc = dict(scene=os.path.relpath(scene, out), size=size, N=n, steps=steps, repeats=repeats,
+              description="soft_mono with restitution 1 and rolling friction 0: the loop specialised for "
+                          "friction only against the general loop (--all-laws) evaluating damping, rolling "
+                          "and mu_R with zero coefficients",
+              specialised=res["specialised"], general=res["general"],
+              speed_ratio_wall=res["general"]["wall_s_median"] / res["specialised"]["wall_s_median"],
+              speed_ratio_cpu=res["general"]["cpu_s_median"] / res["specialised"]["cpu_s_median"],
+              identical_trajectory=bool(same_final_state(res["specialised"]["trajectory"],
+                                                         res["general"]["trajectory"])))
+    with open(path, "w") as f:
+        json.dump(fc, f, indent=1)
+
+
 # ---------------------------------------------------------------------------------------------
 
 def load_runs(path):
@@ -498,29 +561,34 @@ def summarise(runs):
             calib.setdefault((r["size"], r["variant"], r["engine"][:-6], r["steps"]), []).append(r["cpu_s"])
     runs = [r for r in runs if not r["engine"].endswith("/calib")]
     for r in runs:
-        groups.setdefault((r["size"], r["variant"], r["engine"], r["ranks"]), []).append(r)
+        groups.setdefault((r["size"], r["variant"], r["engine"], r["ranks"], r.get("threads", 1)), []).append(r)
     rows = []
-    for (size, variant, engine, ranks), rs in sorted(groups.items(), key=lambda kv: (
+    for (size, variant, engine, ranks, threads), rs in sorted(groups.items(), key=lambda kv: (
             SIZES.get(kv[0][0], 0), VARIANT_NAMES.index(kv[0][1]) if kv[0][1] in VARIANT_NAMES else 99,
-            ENGINES.index(kv[0][2]), kv[0][3])):
+            ENGINES.index(kv[0][2]), kv[0][3], kv[0][4])):
         wall = statistics.median(r["wall_s"] for r in rs)
         n, steps = rs[0]["n"], rs[0]["steps"]
         rss = max(r["peak_rss"] for r in rs)
         cpu = statistics.median(r["cpu_s"] for r in rs)
         if engine == "jdem":
-            cpu_loop = cpu  # already run(S) - run(1)
+            cpu_loop = cpu if threads == 1 else None  # already run(S) - run(1); threads add up CPU
         elif ranks == 1 and (size, variant, engine, steps) in calib:
             cpu_loop = cpu - statistics.median(calib[(size, variant, engine, steps)])
         else:
             cpu_loop = None  # MPI ranks busy-wait: CPU time is not work
+        cpp = statistics.median(r["contacts_per_particle"] for r in rs)
+        splits = [r["jdem_split"] for r in rs if r.get("jdem_split")]
+        split = ({k: statistics.median(s[k] for s in splits) for k in splits[0]} if splits else None)
         rows.append(dict(scene="%s_%s" % (size, variant), size=size, variant=variant, engine=engine,
-                         threads=1, ranks=ranks, N=n, steps=steps, dt=rs[0]["dt"], repeats=len(rs),
+                         threads=threads, ranks=ranks, N=n, steps=steps, dt=rs[0]["dt"], repeats=len(rs),
                          wall_seconds=wall, wall_seconds_all=[r["wall_s"] for r in rs],
                          cpu_seconds_loop=cpu_loop,
                          particle_steps_per_cpu_second=(n * steps / cpu_loop) if cpu_loop and cpu_loop > 0 else None,
                          particle_steps_per_second=n * steps / wall if wall > 0 else float("nan"),
-                         contacts_per_particle=statistics.median(r["contacts_per_particle"] for r in rs),
-                         peak_rss_bytes=rss, bytes_per_particle=rss * ranks / n, timing=rs[0]["timing"],
+                         contacts_per_particle=cpp,
+                         peak_rss_bytes=rss, bytes_per_particle=rss * ranks / n,
+                         memory_budget_bytes=300.0 * n + 100.0 * 0.5 * cpp * n,
+                         timing=rs[0]["timing"], jdem_split_seconds=split,
                          liggghts_split_percent=rs[0].get("liggghts_split_percent"),
                          load_average=statistics.median(r.get("load_average", 0.0) for r in rs)))
     return rows
@@ -538,6 +606,8 @@ def main():
                     help="override steps per size, e.g. 5k=1000,20k=300")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
     ap.add_argument("--fresh", action="store_true", help="forget earlier timings (beds are kept)")
+    ap.add_argument("--threads", default=os.environ.get("BENCH_THREADS", "1,2"),
+                    help="OpenMP thread counts of the jdem runs (default 1,2)")
     ap.add_argument("--report-only", action="store_true")
     ap.add_argument("--no-profile", action="store_true", help="skip the callgrind profile of jdem")
     a = ap.parse_args()
@@ -556,11 +626,12 @@ def main():
             ap.error("unknown size %s (valid: %s)" % (s, ", ".join(SIZES)))
     variants = VARIANT_NAMES if a.variants == "all" else a.variants.split(",")
     engines = a.engines.split(",")
+    threads = [int(t) for t in a.threads.split(",") if t]
 
     if not a.report_only:
         done = {}
         for r in load_runs(runs_path):
-            key = (r["size"], r["variant"], r["engine"], r["ranks"], r["steps"])
+            key = (r["size"], r["variant"], r["engine"], r["ranks"], r.get("threads", 1), r["steps"])
             done[key] = done.get(key, 0) + 1
         for size in sizes:
             beds = {disp: make_bed(out, size, disp) for disp in ("mono", "bi")
@@ -573,32 +644,35 @@ def main():
                 decks = make_decks(out, size, variant, scene, steps)
                 jobs = []
                 for engine in engines:
-                    jobs.append((engine, 1))
-                    if engine != "jdem" and size == a.ranks_size:
-                        jobs.append((engine, 2))
+                    if engine == "jdem":
+                        jobs += [(engine, 1, t) for t in threads]
+                        continue
+                    jobs.append((engine, 1, 1))
+                    if size == a.ranks_size:
+                        jobs.append((engine, 2, 1))
                 for rep in range(a.repeats):
-                    for engine, ranks in jobs:
-                        key = (size, variant, engine, ranks, steps)
+                    for engine, ranks, nt in jobs:
+                        key = (size, variant, engine, ranks, nt, steps)
                         if done.get(key, 0) > rep:
                             continue
                         if engine == "jdem":
-                            res = run_jdem(out, size, variant, scene, steps, n)
+                            res = run_jdem(out, size, variant, scene, steps, n, threads=nt)
                         else:
                             res = run_liggghts(out, size, variant, decks[engine], engine, ranks, steps, n)
-                        res.update(size=size, variant=variant, engine=engine, ranks=ranks, threads=1,
+                        res.update(size=size, variant=variant, engine=engine, ranks=ranks, threads=nt,
                                    n=n, steps=steps, dt=dt, repeat=rep, when=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                                    load_average=os.getloadavg()[0],
                                    binary_mtime=time.strftime("%Y-%m-%dT%H:%M:%S", time.gmtime(os.path.getmtime(
                                        JDEM if engine == "jdem" else LIGGGHTS_JDEM if engine == "liggghts-jdem"
                                        else LIGGGHTS))))
-                        log("%s %s %s np=%d rep %d: %.3f s, %.3g particle-steps/s, %.2f contacts/particle"
-                            % (size, variant, engine, ranks, rep, res["wall_s"], n * steps / res["wall_s"],
+                        log("%s %s %s np=%d threads=%d rep %d: %.3f s, %.3g particle-steps/s, %.2f contacts/particle"
+                            % (size, variant, engine, ranks, nt, rep, res["wall_s"], n * steps / res["wall_s"],
                                res["contacts_per_particle"]))
                         with open(runs_path, "a") as f:
                             f.write(json.dumps(res) + "\n")
                 for rep in range(a.repeats):  # CPU-time calibration of the LIGGGHTS engines (1 rank)
                     for engine in engines:
-                        key = (size, variant, engine + "/calib", 1, steps)
+                        key = (size, variant, engine + "/calib", 1, 1, steps)
                         if engine == "jdem" or done.get(key, 0) > rep:
                             continue
                         res = calibrate_liggghts(decks[engine], engine)
@@ -606,6 +680,8 @@ def main():
                                    steps=steps, dt=dt, repeat=rep, load_average=os.getloadavg()[0])
                         with open(runs_path, "a") as f:
                             f.write(json.dumps(res) + "\n")
+    if not a.report_only and "jdem" in engines and "soft_mono" in variants:
+        feature_check(out, sizes[0], steps_of[sizes[0]], a.repeats)
     if not a.report_only and not a.no_profile and not os.path.exists(os.path.join(out, "profile.json")):
         import bench_report
         sc = scene_path(out, sizes[0], "soft_mono")
@@ -613,11 +689,13 @@ def main():
             log("profiling jdem (callgrind) on %s" % sc)
             bench_report.profile_jdem(out, sc, int(np.load(make_bed(out, sizes[0], "mono"))["id"].shape[0]))
     rows = summarise(load_runs(runs_path))
+    fc_path = os.path.join(out, "feature_check.json")
+    fc = json.load(open(fc_path)) if os.path.exists(fc_path) else None
     with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump(dict(generated=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-                       machine=machine_info(), runs=rows), f, indent=1)
+                       machine=machine_info(), runs=rows, feature_check=fc), f, indent=1)
     import bench_report
-    bench_report.write_report(out, rows, machine_info())
+    bench_report.write_report(out, rows, machine_info(), fc)
     log("wrote %s and %s" % (os.path.join(out, "summary.json"), os.path.join(out, "report.md")))
     return 0
 

@@ -4,7 +4,8 @@ import os
 import re
 import subprocess
 
-ENGINE_LABEL = {"jdem": "jdem", "liggghts-jdem": "liggghts-jdem (gran/jiang)", "liggghts": "stock liggghts (hertz/history)"}
+ENGINE_LABEL = {"jdem": "jdem", "jdem/2t": "jdem, 2 threads", "liggghts-jdem": "liggghts-jdem (gran/jiang)",
+                "liggghts": "stock liggghts (hertz/history)"}
 SIZE_ORDER = ["5k", "20k", "80k", "320k", "1M"]
 
 
@@ -13,7 +14,13 @@ def fmt(v, spec=".3g"):
 
 
 def index(rows):
-    return {(r["size"], r["variant"], r["engine"], r["ranks"]): r for r in rows}
+    """(size, variant, engine, ranks) -> row of one thread; jdem's 2-thread rows under engine
+    "jdem/2t" (and so on for other thread counts)."""
+    ix = {}
+    for r in rows:
+        t = r.get("threads", 1)
+        ix[(r["size"], r["variant"], r["engine"] if t == 1 else "%s/%dt" % (r["engine"], t), r["ranks"])] = r
+    return ix
 
 
 def plots(out, rows, variants, sizes):
@@ -24,11 +31,11 @@ def plots(out, rows, variants, sizes):
     files = []
     fig, axes = plt.subplots(2, 4, figsize=(16, 7.5), sharey=True)
     for ax, v in zip(axes.flat, variants):
-        for e, mk in (("jdem", "o-"), ("liggghts-jdem", "s--"), ("liggghts", "^:")):
+        for e, mk in (("jdem", "o-"), ("jdem/2t", "o-."), ("liggghts-jdem", "s--"), ("liggghts", "^:")):
             pts = [(ix[(s, v, e, 1)]["N"], ix[(s, v, e, 1)]["particle_steps_per_second"])
                    for s in sizes if (s, v, e, 1) in ix]
             if pts:
-                ax.plot(*zip(*pts), mk, label=ENGINE_LABEL[e])
+                ax.plot(*zip(*pts), mk, label=ENGINE_LABEL.get(e, e))
         ax.set_xscale("log")
         ax.set_title(v)
         ax.set_xlabel("N")
@@ -54,7 +61,16 @@ def plots(out, rows, variants, sizes):
     ax.axhline(1.0, color="k", lw=0.8)
     ax.set_xscale("log")
     ax.set_xlabel("N")
-    ax.set_ylabel("speed ratio jdem / stock LIGGGHTS (1 rank)")
+    for v in variants:
+        pts = []
+        for s in sizes:
+            a, b = ix.get((s, v, "jdem/2t", 1)), ix.get((s, v, "liggghts", 1))
+            if a and b:
+                pts.append((a["N"], a["particle_steps_per_second"] / b["particle_steps_per_second"]))
+        if pts:
+            ax.plot(*zip(*pts), "x--", label=v + " (jdem 2 threads)")
+    ax.axhline(3.0, color="g", lw=0.8, ls=":")
+    ax.set_ylabel("speed ratio jdem / stock LIGGGHTS (1 rank; dashed: jdem 2 threads)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
@@ -71,8 +87,8 @@ def profile_section(out):
         return []
     pr = json.load(open(path))
     L = ["## Where jdem's time goes (callgrind)\n\n",
-         "`valgrind --tool=callgrind` on `%s` (%d particles, %d steps; instruction counts, "
-         "inclusive, as a share of the time loop `sim_step`; set-up excluded). %s\n\n"
+         "`valgrind --tool=callgrind --toggle-collect=sim_step` on `%s` (%d particles, %d steps, 1 thread; "
+         "instruction counts of the time loop, set-up and output excluded). %s\n\n"
          % (pr["scene"], pr["n"], pr["steps"], pr.get("note", "")),
          "| part | instructions | share of the loop | per particle-step |\n|---|---:|---:|---:|\n"]
     for name, ir in pr["parts"]:
@@ -81,7 +97,49 @@ def profile_section(out):
     return L
 
 
-def write_report(out, rows, machine):
+JDEM_PARTS = (("neighbour", "neighbour search (check + rebuilds, renumbering)"), ("pairs", "pair force loop"),
+              ("walls", "wall force loop"), ("integration", "integration"), ("output", "output"))
+
+
+def split_section(rows, sizes, variants):
+    """Where jdem's time goes (its --timing split of the S-step run, medians)."""
+    jr = [r for r in rows if r["engine"] == "jdem" and r.get("jdem_split_seconds")]
+    if not jr:
+        return []
+    L = ["## Where jdem's time goes (`jdem run --timing`)\n\n",
+         "Wall time of each part of the time loop of the S-step run (median over repeats), as a share of "
+         "the loop and in nanoseconds per particle-step; for stock LIGGGHTS' own split see the table above "
+         "(Pair = force loop, Neigh = neighbour search, Other/Modify = walls and integration).\n\n",
+         "| size | variant | threads | builds | " + " | ".join(p for _, p in JDEM_PARTS) + " |\n",
+         "|---|---|---:|---:|" + "---:|" * len(JDEM_PARTS) + "\n"]
+    for r in sorted(jr, key=lambda r: (SIZE_ORDER.index(r["size"]) if r["size"] in SIZE_ORDER else 99,
+                                       variants.index(r["variant"]) if r["variant"] in variants else 99, r["threads"])):
+        sp = r["jdem_split_seconds"]
+        tot = sum(sp.get(k, 0.0) for k, _ in JDEM_PARTS)
+        ps = r["N"] * r["steps"]
+        cells = ["%.0f %% (%.0f ns)" % (100.0 * sp.get(k, 0.0) / tot if tot else 0.0, 1e9 * sp.get(k, 0.0) / ps)
+                 for k, _ in JDEM_PARTS]
+        L.append("| %s | %s | %d | %d | %s |\n" % (r["size"], r["variant"], r["threads"], int(sp.get("builds", 0)),
+                                                   " | ".join(cells)))
+    L.append("\n")
+    return L
+
+
+def feature_section(fc):
+    if not fc:
+        return []
+    return ["## Scene-specialised force loops\n\n",
+            "%s (`%s`, N = %d, %d steps, medians of %d run(S) - run(1) timings, 1 thread).\n\n"
+            % (fc["description"], fc["scene"], fc["N"], fc["steps"], fc["repeats"]),
+            "| loop | wall [s] | CPU [s] |\n|---|---:|---:|\n",
+            "| specialised (friction only) | %.3f | %.3f |\n" % (fc["specialised"]["wall_s_median"], fc["specialised"]["cpu_s_median"]),
+            "| general (`--all-laws`) | %.3f | %.3f |\n\n" % (fc["general"]["wall_s_median"], fc["general"]["cpu_s_median"]),
+            "Speed ratio general / specialised: **%.2f** (wall), **%.2f** (CPU); target >= 1.3. "
+            "Final positions, velocities and spins bit-identical: **%s**.\n\n"
+            % (fc["speed_ratio_wall"], fc["speed_ratio_cpu"], "yes" if fc["identical_trajectory"] else "NO")]
+
+
+def write_report(out, rows, machine, feature_check=None):
     ix = index(rows)
     sizes = [s for s in SIZE_ORDER if any(r["size"] == s for r in rows)]
     variants = []
@@ -113,20 +171,23 @@ def write_report(out, rows, machine):
              "input (all three engines the same way). Less disturbed by other jobs than wall time; use this column "
              "for the engine comparison when the load average is above the number of cores.")):
         L.append("## %s\n\n%s\n\n" % (title, note))
-        L.append("| size | variant | N | steps | dt [s] | contacts/particle (jdem / stock) | jdem | liggghts-jdem | liggghts | "
-                 "jdem / liggghts | liggghts-jdem / liggghts |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n")
+        L.append("| size | variant | N | steps | dt [s] | contacts/particle (jdem / stock) | jdem | jdem 2 threads | "
+                 "liggghts-jdem | liggghts | jdem / liggghts | jdem 2 threads / 1 | liggghts-jdem / liggghts |\n"
+                 "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n")
         for s in sizes:
             for v in variants:
                 a, b, c = ix.get((s, v, "jdem", 1)), ix.get((s, v, "liggghts-jdem", 1)), ix.get((s, v, "liggghts", 1))
+                a2 = ix.get((s, v, "jdem/2t", 1))
                 base = a or b or c
                 if not base:
                     continue
                 tp = lambda r: r[key] / 1e6 if r and r.get(key) else None
                 ratio = lambda x, y: x[key] / y[key] if x and y and x.get(key) and y.get(key) else None
-                L.append("| %s | %s | %d | %d | %.2g | %s / %s | %s | %s | %s | %s | %s |\n" % (
+                L.append("| %s | %s | %d | %d | %.2g | %s / %s | %s | %s | %s | %s | %s | %s | %s |\n" % (
                     s, v, base["N"], base["steps"], base["dt"],
                     fmt(a["contacts_per_particle"] if a else None, ".2f"), fmt(c["contacts_per_particle"] if c else None, ".2f"),
-                    fmt(tp(a), ".2f"), fmt(tp(b), ".2f"), fmt(tp(c), ".2f"), fmt(ratio(a, c), ".2f"), fmt(ratio(b, c), ".2f")))
+                    fmt(tp(a), ".2f"), fmt(tp(a2), ".2f"), fmt(tp(b), ".2f"), fmt(tp(c), ".2f"), fmt(ratio(a, c), ".2f"),
+                    fmt(ratio(a2, a), ".2f"), fmt(ratio(b, c), ".2f")))
         L.append("\n")
     for p in pngs:
         L.append("![%s](%s)\n\n" % (os.path.basename(p), os.path.basename(p)))
@@ -141,17 +202,19 @@ def write_report(out, rows, machine):
                     r["size"], r["variant"], r["engine"], one["particle_steps_per_second"] / 1e6,
                     r["particle_steps_per_second"] / 1e6,
                     r["particle_steps_per_second"] / one["particle_steps_per_second"]))
-        L.append("\nFor comparison, jdem is single-threaded (1 rank).\n\n")
+        L.append("\njdem runs on one process; its OpenMP threads are in the throughput tables.\n\n")
     L.append("## Memory (peak resident set, largest process)\n\n| size | variant | jdem [MB] | liggghts-jdem [MB] | liggghts [MB] | "
-             "bytes/particle jdem | liggghts-jdem | liggghts |\n|---|---|---:|---:|---:|---:|---:|---:|\n")
+             "bytes/particle jdem | liggghts-jdem | liggghts | jdem budget [MB] (300 B/particle + 100 B/contact) |\n"
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|\n")
     for s in sizes:
         for v in variants:
             rr = [ix.get((s, v, e, 1)) for e in ("jdem", "liggghts-jdem", "liggghts")]
             if not any(rr):
                 continue
-            L.append("| %s | %s | %s | %s | %s | %s | %s | %s |\n" % (
+            L.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s |\n" % (
                 s, v, *[fmt(r["peak_rss_bytes"] / 1e6 if r else None, ".0f") for r in rr],
-                *[fmt(r["bytes_per_particle"] if r else None, ".0f") for r in rr]))
+                *[fmt(r["bytes_per_particle"] if r else None, ".0f") for r in rr],
+                fmt(rr[0]["memory_budget_bytes"] / 1e6 if rr[0] and rr[0].get("memory_budget_bytes") else None, ".1f")))
     L.append("\nPeak RSS includes the executable and its libraries (LIGGGHTS: ~35–55 MB before any atom), "
              "so bytes/particle is meaningful only at the larger sizes.\n\n")
     L.append("## LIGGGHTS' own time split (median run, % of loop time)\n\n| size | variant | engine | ranks | Pair | Neigh | Comm | Other (fixes: walls, integration, gravity) |\n|---|---|---|---:|---:|---:|---:|---:|\n")
@@ -162,6 +225,8 @@ def write_report(out, rows, machine):
                 r["size"], r["variant"], r["engine"], r["ranks"], fmt(sp.get("pair"), ".0f"), fmt(sp.get("neigh"), ".0f"),
                 fmt(sp.get("comm"), ".0f"), fmt(sp.get("other"), ".0f")))
     L.append("\n")
+    L += split_section(rows, sizes, variants)
+    L += feature_section(feature_check)
     L += profile_section(out)
     L.append("## Files\n\n`summary.json` (one entry per scene, engine and rank count: medians), `runs.jsonl` (every timing), "
              "`scenes/` (the bench scenes), `decks/` (the LIGGGHTS decks and logs), `beds/` (settle runs and beds).\n")
@@ -184,45 +249,39 @@ def profile_jdem(out, scene, n, steps=200):
     open(sc, "w").write(text)
     cg = os.path.join(d, "callgrind.out")
     jdem = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "build", "jdem")
-    subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=" + cg, jdem, "run", sc,
-                    "-o", os.path.join(d, "p.h5"), "--quiet"], capture_output=True)
-    ann = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--tree=calling", cg],
+    # only the time loop (sim_step and what it calls) is collected; 1 thread
+    subprocess.run(["valgrind", "--tool=callgrind", "--toggle-collect=sim_step", "--callgrind-out-file=" + cg,
+                    jdem, "run", sc, "-o", os.path.join(d, "p.h5"), "--quiet", "--threads", "1"], capture_output=True)
+    ann = subprocess.run(["callgrind_annotate", "--inclusive=no", "--threshold=100", cg],
                          capture_output=True, text=True).stdout
-    # "calls" lines of the tree: "  N (x%)  >   file:function (Kx) [...]" under "*  ...:sim_step" etc.
-    def callee_sum(caller, callee):
-        tot, inside = 0, False
-        for line in ann.splitlines():
-            if "*  " in line:
-                inside = line.strip().endswith("]") and (":" + caller + " ") in line
-                continue
-            if inside and ">   " in line and (":" + callee + " ") in line:
-                tot += int(line.split()[0].replace(",", ""))
-        return tot
-
-    def incl(fn):
-        for line in ann.splitlines():
-            if "*  " in line and (":" + fn + " ") in line:
-                return int(line.split()[0].replace(",", ""))
-        return 0
-
-    loop = callee_sum("sim_run", "sim_step")
-    forces = callee_sum("sim_step", "sim_compute_forces")
-    contact = callee_sum("sim_compute_forces", "jd_contact")
-    wallgeom = callee_sum("sim_compute_forces", "sim_wall_geom")
-    memset = sum(callee_sum("sim_compute_forces", f) for f in ("__memset_avx2_unaligned_erms", "memset"))
-    kick = callee_sum("sim_step", "half_kick")
-    stale = callee_sum("sim_step", "sim_neighbour_stale")
-    build = callee_sum("sim_step", "sim_neighbour_build")
-    parts = [("contact law `jd_contact` (pairs and walls; out-of-line, one copy)", contact),
-             ("pair/wall loop outside the law: list walk, geometry, gathers, force scatter, gravity", forces - contact - wallgeom - memset),
-             ("wall geometry `sim_wall_geom`", wallgeom),
-             ("zeroing f and torque", memset),
-             ("integration (2 half kicks + drift in sim_step)", kick + (loop - forces - kick - stale - build)),
-             ("neighbour check `sim_neighbour_stale`", stale),
-             ("neighbour rebuilds `sim_neighbour_build`", build)]
-    json.dump(dict(scene=os.path.relpath(scene, out), n=n, steps=steps, loop=loop, parts=parts,
-                   setup_and_output=incl("cmd_run") - loop,
-                   note="Instruction counts are not time (memory stalls and divisions/square roots cost more per "
-                        "instruction), but the split is a fair guide."),
+    # exclusive counts per "file:function": inlined code is attributed to the file it comes
+    # from, so the contact law (kernel/jdem_kernel.h) and the geometry show up inside the loops
+    rules = (("contact law (kernel/jdem_kernel.h, inlined into the force loops)", ("kernel/jdem_kernel.h",), None),
+             ("contact geometry and per-pair constants (jdem_geometry.h, stepper/geometry.h)",
+              ("jdem_geometry.h", "stepper/geometry.h"), None),
+             ("force loops outside the law: list walk, gathers, force scatter, reduction, gravity",
+              ("stepper/forces.c",), None),
+             ("zeroing f and torque (memset)", ("memset",), None),
+             ("integration (half kicks, drift, non-finite probes)", ("stepper/integrate.c",), None),
+             ("neighbour check and rebuilds (incl. renumbering)", ("stepper/neighbour.c", "stepper/reorder.c"), None))
+    parts = {name: 0 for name, _, _ in rules}
+    other, total = 0, 0
+    for line in ann.splitlines():
+        m = re.match(r"^\s*([0-9,]+)\s+(?:\([^)]*\)\s+)?(\S+)", line)
+        if not m or ":" not in m.group(2):
+            if m and "PROGRAM TOTALS" in line:
+                total = int(m.group(1).replace(",", ""))
+            continue
+        ir, where = int(m.group(1).replace(",", "")), m.group(2)
+        for name, keys, _ in rules:
+            if any(k in where for k in keys):
+                parts[name] += ir
+                break
+        else:
+            other += ir
+    plist = [(name, parts[name]) for name, _, _ in rules] + [("other (libgomp, libc, clock)", other)]
+    json.dump(dict(scene=os.path.relpath(scene, out), n=n, steps=steps, loop=total, parts=plist,
+                   note="Instruction counts (1 thread) are not time (memory stalls and divisions/square roots cost "
+                        "more per instruction), but they are deterministic on a shared machine and the split is a fair guide."),
               open(os.path.join(out, "profile.json"), "w"), indent=1)
     return True

@@ -5,9 +5,11 @@
  * scene does not need").  Order as LIGGGHTS: pair forces in list order, wall forces, gravity.
  *
  * Threads (sim.h, "Threads"): each list is cut into one contiguous chunk per thread (the same
- * cut for a given list length and thread count); thread 0 adds into f and torque, thread t > 0
- * into buffer t - 1, which the reduction adds to f and torque per particle in thread order and
- * zeroes for the next evaluation.  With one thread this is exactly the serial loop.
+ * cut for a given list length and thread count); each thread adds into its own buffer of forces
+ * and torques, and the reduction sets f and torque per particle to the sum of the buffers in
+ * thread order (plus gravity) and zeroes them for the next evaluation: one barrier per
+ * evaluation, no atomics.  With one thread the loops add into f and torque directly: exactly
+ * the serial loop.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -35,7 +37,7 @@ double sim_clock(void) {
 }
 
 int sim_forces_init(jd_sim *s) {
-    const size_t nb = (size_t)(s->threads - 1) * 6 * s->n;
+    const size_t nb = s->threads > 1 ? (size_t)s->threads * 6 * s->n : 0;
     s->tbuf = nb ? calloc(nb, sizeof *s->tbuf) : NULL;
     s->trips = calloc((size_t)s->threads, sizeof *s->trips);
     return (nb && !s->tbuf) || !s->trips ? -1 : 0;
@@ -47,8 +49,8 @@ typedef struct acc {
 } acc;
 
 static acc acc_of(const jd_sim *s, int tid) {
-    if (tid == 0) return (acc){s->f, s->torque};
-    double *b = s->tbuf + (size_t)(tid - 1) * 6 * s->n;
+    if (s->threads == 1) return (acc){s->f, s->torque};
+    double *b = s->tbuf + (size_t)tid * 6 * s->n;
     return (acc){b, b + 3 * s->n};
 }
 
@@ -138,7 +140,8 @@ static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0,
     return work;
 }
 
-/* This thread's share of the contact loops; returns its wall work. */
+/* This thread's share of the contact loops; returns its wall work.  *t_pairs_end: when thread 0
+ * finished its share of the pairs (with threads, the split of the timing is thread 0's). */
 static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int tid, int nt,
                                              double *t_pairs_end) {
     const acc a = acc_of(s, tid);
@@ -146,9 +149,6 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
     size_t lo, hi;
     chunk(s->pairs.n, tid, nt, &lo, &hi);
     pair_loop(s, F, lo, hi, a, trip);
-    if (nt > 1) {
-#pragma omp barrier
-    }
     if (tid == 0) *t_pairs_end = sim_clock();
     chunk(s->wall_pairs.n, tid, nt, &lo, &hi);
     return wall_loop(s, F, lo, hi, a, trip);
@@ -179,16 +179,17 @@ static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
     return work;
 }
 
-/* f += the other threads' buffers (zeroing them) and gravity, for particles [lo, hi). */
+/* With threads: f = the sum of the threads' buffers in thread order (zeroing them), for
+ * particles [lo, hi).  Then gravity. */
 static void reduce(jd_sim *s, size_t lo, size_t hi) {
     const size_t n = s->n;
     const double *g = s->g;
     const int gravity = g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0;
-    for (int t = 1; t < s->threads; t++) {
-        double *bf = s->tbuf + (size_t)(t - 1) * 6 * n, *bt = bf + 3 * n;
+    for (int t = 0; s->threads > 1 && t < s->threads; t++) {
+        double *bf = s->tbuf + (size_t)t * 6 * n, *bt = bf + 3 * n;
         for (size_t k = 3 * lo; k < 3 * hi; k++) {
-            s->f[k] += bf[k];
-            s->torque[k] += bt[k];
+            s->f[k] = t ? s->f[k] + bf[k] : bf[k];
+            s->torque[k] = t ? s->torque[k] + bt[k] : bt[k];
             bf[k] = bt[k] = 0.0;
         }
     }
@@ -213,12 +214,11 @@ void sim_compute_forces(jd_sim *s) {
 #endif
         size_t lo, hi;
         chunk(s->n, tid, nt, &lo, &hi);
-        memset(s->f + 3 * lo, 0, 3 * (hi - lo) * sizeof *s->f);
-        memset(s->torque + 3 * lo, 0, 3 * (hi - lo) * sizeof *s->torque);
-        s->trips[tid].fraction = 0.0;
-        if (nt > 1) {
-#pragma omp barrier
+        if (nt == 1) { /* the loops add into f and torque directly */
+            memset(s->f, 0, 3 * s->n * sizeof *s->f);
+            memset(s->torque, 0, 3 * s->n * sizeof *s->torque);
         }
+        s->trips[tid].fraction = 0.0;
         work[tid] = dispatch(s, tid, nt, &t_pairs_end);
         if (nt > 1) {
 #pragma omp barrier

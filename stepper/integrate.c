@@ -7,25 +7,41 @@
  */
 #include "sim.h"
 
-/* v += (0.5 dt/m) f; omega += (0.5 dt/0.4)/(r r m) torque.  dtfm and dtirot are precomputed per
- * particle with exactly LIGGGHTS' expressions, so the products are bit-identical. */
-static void half_kick(jd_sim *s) {
+/* initial_integrate: v += (0.5 dt/m) f; omega += (0.5 dt/0.4)/(r r m) torque; x += dt v.
+ * dtfm and dtirot are precomputed per particle with exactly LIGGGHTS' expressions, so the
+ * products are bit-identical; each particle's update is independent, so doing the kick and the
+ * drift in one pass gives LIGGGHTS' numbers exactly.  The same pass checks whether some
+ * particle moved more than half the skin since the last neighbour build (*moved; !(<=) so that a
+ * NaN position forces a rebuild, which reports it) and returns 1 when some new x is not finite:
+ * 0 * inf and 0 * NaN are NaN, so the probe sum is 0 or NaN (-O2 without -ffast-math keeps the
+ * multiply), and the watchdog's non-finite check costs no branch per element. */
+static int initial_integrate(jd_sim *s, int *moved) {
     const long n = (long)s->n;
-    double *v = s->v, *w = s->omega;
-    const double *f = s->f, *t = s->torque, *dtfm = s->dtfm, *dtirot = s->dtirot;
-#pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1)
+    double *x = s->x, *v = s->v, *w = s->omega;
+    const double *x0 = s->x_build, *f = s->f, *t = s->torque, *dtfm = s->dtfm, *dtirot = s->dtirot;
+    const double dt = s->dt, lim = 0.25 * s->skin * s->skin; /* (skin/2)^2 */
+    double probe = 0.0;
+    int far = 0;
+#pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1) \
+    reduction(+ : probe) reduction(| : far)
     for (long i = 0; i < n; i++) {
-        for (int d = 0; d < 3; d++) {
-            v[3 * i + d] += dtfm[i] * f[3 * i + d];
-            w[3 * i + d] += dtirot[i] * t[3 * i + d];
+        double d[3];
+        for (int k = 0; k < 3; k++) {
+            v[3 * i + k] += dtfm[i] * f[3 * i + k];
+            w[3 * i + k] += dtirot[i] * t[3 * i + k];
+            x[3 * i + k] += dt * v[3 * i + k];
+            probe += 0.0 * x[3 * i + k];
+            d[k] = x[3 * i + k] - x0[3 * i + k];
         }
+        far |= !(jd_dot(d, d) <= lim);
     }
+    *moved = far && !s->allpairs;
+    return probe != 0.0;
 }
 
-/* The same half kick, returning 1 when some new v or omega is not finite: 0 * inf and 0 * NaN
- * are NaN, so the probe sum is 0 or NaN (-O2 without -ffast-math keeps the multiply), and the
- * watchdog's non-finite check costs no branch per element and no second pass. */
-static int final_kick(jd_sim *s) {
+/* final_integrate: the same half kick, returning 1 when some new v or omega is not finite (the
+ * same probe). */
+static int final_integrate(jd_sim *s) {
     const long n = (long)s->n;
     double *v = s->v, *w = s->omega;
     const double *f = s->f, *t = s->torque, *dtfm = s->dtfm, *dtirot = s->dtirot;
@@ -41,40 +57,23 @@ static int final_kick(jd_sim *s) {
     return probe != 0.0;
 }
 
-/* x += dt v; returns 1 when some new x is not finite (the same probe). */
-static int drift(jd_sim *s) {
-    const long m = 3 * (long)s->n;
-    const double dt = s->dt;
-    double *x = s->x;
-    const double *v = s->v;
-    double probe = 0.0;
-#pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1) reduction(+ : probe)
-    for (long k = 0; k < m; k++) {
-        x[k] += dt * v[k];
-        probe += 0.0 * x[k];
-    }
-    return probe != 0.0;
-}
-
 int sim_step(jd_sim *s, char *err, size_t errlen) {
-    /* initial_integrate: half kick, then drift with the half-step velocity (per particle the
-     * operations are independent, so two loops give LIGGGHTS' numbers exactly) */
     const double t0 = sim_clock();
-    half_kick(s);
+    int moved;
     /* A non-finite position stops the step here, before the neighbour search bins it: the run
      * loop's watchdog reports it (sim_watchdog_step) and the run ends. */
-    if (drift(s)) {
+    if (initial_integrate(s, &moved)) {
         s->nonfinite = 1;
         s->step++;
         return 0;
     }
     sim_walls_move(s); /* fix move/mesh moves the walls in the same phase as the particles */
     const double t1 = sim_clock();
-    if (sim_neighbour_stale(s) && sim_neighbour_build(s, err, errlen) != 0) return -1;
+    if ((moved || sim_neighbour_walls_moved(s)) && sim_neighbour_build(s, err, errlen) != 0) return -1;
     const double t2 = sim_clock();
     sim_compute_forces(s);
     const double t3 = sim_clock();
-    s->nonfinite = final_kick(s); /* final_integrate */
+    s->nonfinite = final_integrate(s);
     s->step++;
     const double t4 = sim_clock();
     s->timing.integration += (t1 - t0) + (t4 - t3);

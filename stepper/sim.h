@@ -29,10 +29,12 @@
  * (bonds) registers a permute hook and remaps through it.
  *
  * Threads (OpenMP).  The force loops split the contact lists into one contiguous chunk per
- * thread; thread 0 adds into f and torque, thread t > 0 into its own zeroed buffer, and the
- * buffers are added to f and torque after the loops (per particle, in thread order).  No two
- * threads write the same memory, no atomics; for a given thread count the sums are always taken
- * in the same order, so a run is reproducible bit for bit, and runs with different thread
+ * thread; each thread adds into its own buffer, and after one barrier the buffers are summed
+ * into f and torque per particle, in thread order.  No two threads write the same memory, no
+ * atomics (a contact adds to two particles that any thread may also touch, so the alternatives
+ * are atomics on every addition, or a colouring of the contacts that costs a sort per rebuild
+ * and still leaves a thread-count-dependent order).  For a given thread count the sums are always
+ * taken in the same order, so a run is reproducible bit for bit, and runs with different thread
  * counts differ only by the round-off of that order.  Integration loops are split by particle.
  */
 #ifndef JDEM_SIM_H
@@ -140,8 +142,8 @@ typedef struct jd_sim {
 
     jd_sim_options opt;
     int threads;       /* threads actually used (opt.threads clamped to >= 1) */
-    double *tbuf;      /* (threads - 1) x 6n: force and torque buffers of threads 1.. (zero
-                          between force evaluations) */
+    double *tbuf;      /* with threads > 1: threads x 6n, each thread's force and torque buffer
+                          (zero between force evaluations); NULL with one thread */
     jd_overlap_trip *trips; /* one per thread, merged into overlap_trip */
     double *scratch;   /* 3n doubles: reordering and frames in scene order */
     jd_permute_hook permute_hook; /* NULL, or called after each renumbering */
@@ -196,7 +198,9 @@ int sim_run(jd_sim *s, struct jd_h5md *h, int show_progress, char *err, size_t e
 
 /* neighbour.c */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
-int sim_neighbour_stale(const jd_sim *s); /* 1 when a rebuild is due */
+/* 1 when some wall moved more than skin/2 since the last build (the particles' part of the
+ * rebuild criterion rides in the drift, integrate.c) */
+int sim_neighbour_walls_moved(const jd_sim *s);
 /* Capacity for `need` entries of a list of this kind (JD_LIST_* bits).  Returns 0 or -1. */
 enum { JD_LIST_ROLLING = 1, JD_LIST_PAIRS = 2 };
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind);
