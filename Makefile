@@ -26,7 +26,10 @@ SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit
 # OpenMP threads in the standalone engine's force and integration loops (stepper/ only: the
 # kernel and the H5MD writer stay free of it, and clang's fuzz build needs no OpenMP runtime).
 # Threads: `jdem run --threads N` or OMP_NUM_THREADS (docs/scenes.md, "Threads").
-OMPFLAGS := -fopenmp
+# -fno-math-errno: sqrt compiles to the instruction alone (no errno branch); the results are
+# the same bits (sqrt is correctly rounded either way), and the stepper never reads errno after
+# a math function.
+OMPFLAGS := -fopenmp -fno-math-errno
 
 KERNEL_SRC  := $(wildcard kernel/*.c)
 IO_SRC      := $(wildcard io/*.c)

@@ -430,15 +430,18 @@ JD_CONTACT_INLINE int jd_contact(const unsigned features, const jd_pair_coeffs *
     }
     s->flags = (double)flags;
 
-    /* Assemble: force on b, torques about each centre (eq. 19), rolling moment on b. */
+    /* Assemble: force on b, torques about each centre (eq. 19), rolling moment on b (without
+     * rolling resistance nothing is added: the engines' torque sums start from +0, so adding a
+     * +0 moment could only have turned a -0 torque into +0, which their sums never see). */
     double fa[3] = {-f[0], -f[1], -f[2]};
     jd_cross(g->ra, fa, out->ta);
     jd_cross(g->rb, f, out->tb);
-    for (int d = 0; d < 3; d++) {
-        out->f[d] = f[d];
-        out->ta[d] -= m_roll[d];
-        out->tb[d] += m_roll[d];
-    }
+    for (int d = 0; d < 3; d++) out->f[d] = f[d];
+    if (features & JD_F_ROLLING)
+        for (int d = 0; d < 3; d++) {
+            out->ta[d] -= m_roll[d];
+            out->tb[d] += m_roll[d];
+        }
     return 1;
 }
 

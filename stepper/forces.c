@@ -65,6 +65,7 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, size_t c0, s
     const jd_contact_list *L = &s->pairs;
     const size_t nm = s->n_materials;
     const double *x_v = s->v, *x_w = s->omega;
+    const jd_pair_coeffs *co1 = nm == 1 ? s->coeffs : NULL; /* one material: no lookup */
     for (size_t c = c0; c < c1; c++) {
         const int32_t i = L->i[c], j = L->j[c];
         jd_contact_state *st = &L->state[c];
@@ -85,7 +86,8 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, size_t c0, s
             k.vb[d] = vb[d];
             k.wb[d] = wb[d];
         }
-        const jd_pair_coeffs *co = &s->coeffs[(size_t)s->species[i] * nm + (size_t)s->species[j]];
+        const jd_pair_coeffs *co =
+            co1 ? co1 : &s->coeffs[(size_t)s->species[i] * nm + (size_t)s->species[j]];
         jd_contact_result out;
         if (!jd_contact(F, co, &g, &k, s->dt, st, rs, &out)) continue;
         double *fa = a.f + 3 * (size_t)i, *fb = a.f + 3 * (size_t)j;
