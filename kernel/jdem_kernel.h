@@ -36,11 +36,12 @@
 extern "C" {
 #endif
 
-/* How jd_contact is declared.  An engine whose force loops are specialised per feature set
- * defines JD_CONTACT_INLINE as `static inline __attribute__((always_inline))` before including
- * this header, so that each loop gets its own copy of the law with the unused laws compiled
- * away (compilers otherwise keep one out-of-line copy, with the features as a run-time value,
- * for a function this large called from many loops).  Same arithmetic either way. */
+/* How jd_contact and its two helpers (jd_rotate_into_plane, jd_capped_spring) are declared.
+ * An engine whose force loops are specialised per feature set defines JD_CONTACT_INLINE as
+ * `static inline __attribute__((always_inline))` before including this header, so that each
+ * loop gets its own copy of the law with the unused laws compiled away (compilers otherwise
+ * keep one out-of-line copy, with the features as a run-time value, for a function this large
+ * called from many loops).  Same arithmetic either way. */
 #ifndef JD_CONTACT_INLINE
 #define JD_CONTACT_INLINE static inline
 #endif
@@ -237,7 +238,7 @@ static inline void jd_contact_separate(jd_contact_state *s, jd_rolling_state *r)
 /* Keep a stored tangential vector in the current tangent plane: remove its normal component and
  * rescale it to its previous length, so that a turning contact frame neither creates nor destroys
  * spring energy (§4.3). */
-static inline void jd_rotate_into_plane(double v[3], const double n[3]) {
+JD_CONTACT_INLINE void jd_rotate_into_plane(double v[3], const double n[3]) {
     const double len2 = jd_dot(v, v);
     if (len2 == 0.0) return;
     const double vn = jd_dot(v, n);
@@ -277,7 +278,7 @@ static inline double jd_normal_energy(double k_n, double delta) {
  * (or moment) on b; the return value is 1 when the cap was active (sliding).  With
  * JD_XI_COULOMB the stored vector is reset to -out/K while sliding (the dashpot is off while
  * sliding, as the seed states), so K |stored| never exceeds the cap. */
-static inline int jd_capped_spring(double stored[3], const double rate[3], double K, double C,
+JD_CONTACT_INLINE int jd_capped_spring(double stored[3], const double rate[3], double K, double C,
                                    double cap, double dt, int xi_limit, double out[3]) {
     stored[0] += rate[0] * dt;
     stored[1] += rate[1] * dt;

@@ -223,6 +223,23 @@ void sim_free(jd_sim *s) {
     memset(s, 0, sizeof *s);
 }
 
+static size_t list_bytes(const jd_contact_list *l) {
+    const size_t entry = 2 * sizeof(int32_t) + sizeof(jd_contact_state) +
+                         (l->roll ? sizeof(jd_rolling_state) : 0) + (l->pc ? sizeof(jd_pair_const) : 0) +
+                         (l->pcr ? sizeof(jd_pair_const_roll) : 0);
+    return l->cap * entry;
+}
+
+size_t sim_memory_bytes(const jd_sim *s) {
+    const size_t per_particle = 6 * 3 * sizeof(double) /* x v omega f torque x_build */ +
+                                3 * sizeof(double) /* scratch */ + 7 * sizeof(double) /* constants */ +
+                                4 * sizeof(int32_t) /* species orig cell_of cell_items */;
+    return s->n * per_particle + (s->tbuf ? (size_t)s->threads * 6 * s->n * sizeof(double) : 0) +
+           s->cell_cap * sizeof(int32_t) + list_bytes(&s->pairs) + list_bytes(&s->wall_pairs) +
+           list_bytes(&s->spare) + s->n_walls * sizeof *s->walls +
+           s->n_materials * s->n_materials * sizeof *s->coeffs;
+}
+
 static int check_finite(const jd_sim *s, char *err, size_t errlen) {
     for (size_t k = 0; k < 3 * s->n; k++) {
         if (!isfinite(s->x[k]) || !isfinite(s->v[k]) || !isfinite(s->omega[k])) {

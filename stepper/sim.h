@@ -196,6 +196,10 @@ struct jd_h5md;
  * is not finite), so the trajectory ends where the run stopped. */
 int sim_run(jd_sim *s, struct jd_h5md *h, int show_progress, char *err, size_t errlen);
 
+/* Bytes the engine holds for the run (particle arrays, contact lists at their capacity, cells,
+ * thread buffers): its memory apart from the scene and the libraries. */
+size_t sim_memory_bytes(const jd_sim *s);
+
 /* neighbour.c */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
 /* 1 when some wall moved more than skin/2 since the last build (the particles' part of the
