@@ -154,8 +154,4 @@ void sim_scalars_in_scene_order(const jd_sim *s, const double *a, double *out) {
     for (size_t i = 0; i < s->n; i++) out[s->orig[i]] = a[i];
 }
 
-void sim_ints_in_scene_order(const jd_sim *s, const int32_t *a, int32_t *out) {
-    for (size_t i = 0; i < s->n; i++) out[s->orig[i]] = a[i];
-}
-
 long long sim_particle_id(const jd_sim *s, size_t i) { return (long long)s->scene->id[s->orig[i]]; }

@@ -221,7 +221,6 @@ void sim_vectors_to_scene_order(jd_sim *s);
 void sim_vectors_to_sim_order(jd_sim *s);
 /* A per-particle array in scene order: out[orig[i]] = a[i]. */
 void sim_scalars_in_scene_order(const jd_sim *s, const double *a, double *out);
-void sim_ints_in_scene_order(const jd_sim *s, const int32_t *a, int32_t *out);
 /* Scene id of the particle at index i. */
 long long sim_particle_id(const jd_sim *s, size_t i);
 
