@@ -15,7 +15,8 @@ import time
 
 PY = "/usr/bin/python3"
 
-ENGINE_TESTS = ["neighbour", "free_flight", "hertz_impact", "energy_balance", "guard", "watchdog",
+ENGINE_TESTS = ["neighbour", "free_flight", "hertz_impact", "energy_balance", "guard",
+                "guard_coordination", "watchdog",
                 "signals"]
 SANITIZED = {"JDEM": "build/san/jdem"}
 
