@@ -184,10 +184,11 @@ static int check_time_step(const jd_scene *sc, const cli *c) {
                 sc->dt, g.rayleigh_bound, g.contact_time);
         if (isfinite(g.contact_time))
             fprintf(stderr, " at %.6g m/s (%.1f steps per contact); Verlet limit at coordination "
-                    "number %g = %.6g s\n", sc->max_impact_speed, g.contact_time / sc->dt,
+                    "number %g = %.6g s", sc->max_impact_speed, g.contact_time / sc->dt,
                     sc->coordination_number, g.coordination_bound);
         else
-            fprintf(stderr, " (no impact to resolve)\n");
+            fprintf(stderr, " (no impact to resolve)");
+        fprintf(stderr, "; largest safe dt = %.9g s\n", g.safe_dt);
     }
     if (!g.violated) return 0;
     char msg[512];

@@ -282,7 +282,8 @@ static int read_scene(loader *L) {
         return sd_fail(&L->c, p ? p : L->root, "particles", "no particles; valid: at least one "
                        "particle in particles or generate");
     }
-    if (scene_read_interactions(L) || scene_sort_particles(L) || scene_check_overlaps(L))
+    if (scene_read_interactions(L) || scene_sort_particles(L) || scene_check_overlaps(L) ||
+        scene_check_wall_overlaps(L))
         return -1;
     return L->max_impact_given ? 0 : default_impact_speed(L);
 }
