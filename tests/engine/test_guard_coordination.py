@@ -91,6 +91,7 @@ exact = exact_limit(2, [(0, 1, (1, 0, 0))], K_pair)
 got = guard_limit([(-0.0101, 0, 0), (0.0101, 0, 0)], [], 1)
 c.check("pair_bound_safe", got <= exact, f"guard {got:.6g} s > exact {exact:.6g} s")
 c.check("pair_bound_tight", got >= 0.7 * exact, f"guard {got:.6g} s < 0.7 x exact {exact:.6g} s")
+print(f"(pair: guard {got:.6g} s, exact {exact:.6g} s, ratio {got / exact:.3f})")
 
 # a sphere on a wall (exact Hertz wall stiffness 4/3 E/(1-nu^2) sqrt(R))
 K_wall = secant_stiffness(MASS, 4.0 / 3.0 * E / (1 - NU * NU) * math.sqrt(R))
@@ -100,6 +101,7 @@ floor = [{"name": "floor", "type": "plane", "material": "wall",
 got = guard_limit([(0, 0, 0)], floor, 1)
 c.check("wall_bound_safe", got <= exact, f"guard {got:.6g} s > exact {exact:.6g} s")
 c.check("wall_bound_tight", got >= 0.7 * exact, f"guard {got:.6g} s < 0.7 x exact {exact:.6g} s")
+print(f"(wall: guard {got:.6g} s, exact {exact:.6g} s, ratio {got / exact:.3f})")
 
 # a close-packed cluster: a centre sphere with its 12 neighbours (cuboctahedron), every touching
 # pair in contact (12 centre-shell and 24 shell-shell contacts)
