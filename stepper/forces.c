@@ -120,6 +120,7 @@ void sim_compute_forces(jd_sim *s) {
         JD_FORCE_CASE(8) JD_FORCE_CASE(9) JD_FORCE_CASE(10) JD_FORCE_CASE(11)
         JD_FORCE_CASE(12) JD_FORCE_CASE(13) JD_FORCE_CASE(14) JD_FORCE_CASE(15)
     }
+    if (s->bonds) sim_bonds_forces(s); /* in parallel with the contacts (bonds.c) */
     const double *g = s->g;
     if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0) {
         for (size_t i = 0; i < s->n; i++) {

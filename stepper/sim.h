@@ -10,6 +10,7 @@
  *   integrate.c    one velocity-Verlet step exactly as LIGGGHTS fix nve/sphere
  *   observables.c  energies and contact counts
  *   guard.c        the time-step guard
+ *   bonds.c        parallel bonds: list, rules, bond loop, events, observables (bonds.h)
  *   watchdog.c     the run-time watchdog: non-finite state, excessive overlap, energy jumps
  *   progress.c     the progress line on stderr
  *
@@ -27,6 +28,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bonds.h"
 #include "jdem_geometry.h"
 #include "jdem_kernel.h"
 #include "jdem_watchdog.h"
@@ -93,6 +95,8 @@ typedef struct jd_sim {
     int32_t *cell_of, *cell_items, *cell_start;
     size_t cell_cap;   /* capacity of cell_start */
 
+    jd_bonds *bonds;   /* parallel bonds (bonds.h); NULL when the scene has no bond types */
+
     /* energy bookkeeping */
     double e_damp_dropped, e_fric_dropped; /* accumulators of contacts dropped from the lists */
     double wall_work;  /* work done on the particles by the walls [J] */
@@ -149,6 +153,7 @@ typedef struct jd_observables {
     double kinetic_energy, rotational_energy, elastic_energy, gravitational_energy;
     double damping_dissipation, friction_dissipation, wall_work;
     double contacts, wall_contacts;
+    jd_bond_observables bond;  /* scenes with bond types only (s->bonds) */
 } jd_observables;
 #define JD_N_OBSERVABLES 9
 extern const char *const jd_observable_names[JD_N_OBSERVABLES];
@@ -160,7 +165,8 @@ typedef struct jd_guard {
     double rayleigh_bound;   /* 0.2 x the smallest Rayleigh step [s]; INFINITY without particles */
     double contact_time;     /* shortest Hertz contact time at max_impact_speed [s]; INFINITY if none */
     double contact_bound;    /* contact_time / JD_GUARD_STEPS_PER_CONTACT [s] */
-    double safe_dt;          /* min of the two bounds [s] */
+    double bond_bound;       /* sim_bonds_guard [s]; INFINITY without bonds */
+    double safe_dt;          /* min of the bounds [s] */
     const char *violated;    /* description of the tightest violated bound, or NULL when safe */
     double violated_value;   /* its value [s] */
 } jd_guard;
