@@ -184,7 +184,7 @@ static void record_break(jd_sim *s, size_t k, const jd_bond_geom *g, const jd_bo
                          int64_t step) {
     jd_bonds *b = s->bonds;
     b->n_broken[out->mode]++;
-    if (b->in_setup ||
+    if (s->in_setup ||
         grow((void **)&b->events, &b->events_cap, b->n_events + 1, sizeof *b->events))
         return;
     jd_h5md_bond_break *e = &b->events[b->n_events++];
@@ -264,13 +264,13 @@ static void compact(jd_bonds *b) {
 void sim_bonds_forces(jd_sim *s) {
     jd_bonds *b = s->bonds;
     const jd_scene *sc = s->scene;
-    const int64_t step = s->step + (b->in_setup ? 0 : 1); /* the step whose forces these are */
-    while (!b->in_setup && b->next_rule < sc->n_bond_rules &&
+    const int64_t step = s->step + (s->in_setup ? 0 : 1); /* the step whose forces these are */
+    while (!s->in_setup && b->next_rule < sc->n_bond_rules &&
            sc->bond_rules[b->next_rule].step <= step)
         apply_rule(s, &sc->bond_rules[b->next_rule++], step);
     const size_t broke = (b->features & JD_B_DAMPING) ? bond_loop(s, JD_B_ENERGY | JD_B_DAMPING, step)
                                                       : bond_loop(s, JD_B_ENERGY, step);
-    if (broke && !b->in_setup) compact(b);
+    if (broke && !s->in_setup) compact(b);
 }
 
 jd_bond_state *sim_bonds_save(const jd_sim *s) {

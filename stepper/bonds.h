@@ -34,7 +34,6 @@ typedef struct jd_bonds {
     jd_bond_state *state;
     size_t next_rule;          /* first scene rule not yet applied */
     unsigned char *ever;       /* per particle: 1 once it has been bonded (fragment count) */
-    int in_setup;              /* step-0 force evaluation: no rules, no events kept */
     /* output not yet written */
     jd_h5md_bond *formed;      /* bonds formed since the last sim_bonds_output */
     size_t n_formed, formed_cap;

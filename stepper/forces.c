@@ -128,4 +128,5 @@ void sim_compute_forces(jd_sim *s) {
             for (int d = 0; d < 3; d++) s->f[3 * i + d] += m * g[d];
         }
     }
+    if (s->loads) sim_loads_apply(s); /* last, as LIGGGHTS' post-force fixes (loads.c) */
 }

@@ -155,13 +155,11 @@ static int setup_forces(jd_sim *s, char *err, size_t errlen) {
     if (ok && s->bonds) ok = (bonds = sim_bonds_save(s)) != NULL;
     if (ok) {
         for (int k = 0; k < 2; k++) save_history(lists[k], state[k], roll[k]);
-        if (s->bonds) s->bonds->in_setup = 1;
+        s->in_setup = 1;
         sim_compute_forces(s);
+        s->in_setup = 0;
         for (int k = 0; k < 2; k++) restore_history(lists[k], state[k], roll[k]);
-        if (s->bonds) {
-            s->bonds->in_setup = 0;
-            sim_bonds_restore(s, bonds);
-        }
+        if (s->bonds) sim_bonds_restore(s, bonds);
     } else {
         snprintf(err, errlen, "out of memory");
     }
@@ -180,7 +178,7 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
     }
     s->features = scene_features(s);
     if (sim_walls_init(s, err, errlen) != 0) return -1;
-    if (sim_bonds_init(s, err, errlen) != 0) return -1;
+    if (sim_bonds_init(s, err, errlen) != 0 || sim_loads_init(s, err, errlen) != 0) return -1;
     if (sim_neighbour_build(s, err, errlen) != 0) return -1;
     return setup_forces(s, err, errlen);
 }
@@ -213,6 +211,7 @@ void sim_free(jd_sim *s) {
     sim_contact_list_free(&s->wall_pairs);
     sim_contact_list_free(&s->spare);
     sim_bonds_free(s);
+    sim_loads_free(s);
     memset(s, 0, sizeof *s);
 }
 
