@@ -30,6 +30,7 @@ const char *jd_guard_bound_name(int bound) {
     case JD_GUARD_RAYLEIGH: return "20 % of the Rayleigh time step";
     case JD_GUARD_CONTACT_TIME: return "1/50 of the shortest Hertz contact time";
     case JD_GUARD_COORDINATION: return "the Verlet stability limit at coordination number";
+    case JD_GUARD_BOND: return "1/20 of the fastest bond period";
     default: return "";
     }
 }
@@ -67,6 +68,7 @@ static void tighten(jd_guard_result *r, double dt, double bound, int which) {
 void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
     *out = (jd_guard_result){.rayleigh_bound = INFINITY, .contact_time = INFINITY,
                              .contact_bound = INFINITY, .coordination_bound = INFINITY,
+                             .bond_bound = INFINITY,
                              .safe_dt = INFINITY, .binding = JD_GUARD_SAFE,
                              .violated = JD_GUARD_SAFE};
     const double v = in->max_impact_speed;
@@ -105,6 +107,9 @@ void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
     tighten(out, in->dt, out->rayleigh_bound, JD_GUARD_RAYLEIGH);
     tighten(out, in->dt, out->contact_bound, JD_GUARD_CONTACT_TIME);
     tighten(out, in->dt, out->coordination_bound, JD_GUARD_COORDINATION);
+    if (in->bond_omega2 > 0.0)
+        out->bond_bound = 2.0 * JD_PI / sqrt(in->bond_omega2) / JD_GUARD_STEPS_PER_BOND_PERIOD;
+    tighten(out, in->dt, out->bond_bound, JD_GUARD_BOND);
 }
 
 /* "BOUND (V s)", with the coordination number where it is that bound. */

@@ -12,7 +12,10 @@
  *                 (accuracy of the force curve; erratum 18);
  *   coordination  stability of velocity Verlet, omega_max dt <= 2, with omega_max bounded for a
  *                 particle with C contacts (Otsubo, O'Sullivan & Shire 2017: the critical step
- *                 depends on m, K_max and the maximum coordination number; see docs/model.md).
+ *                 depends on m, K_max and the maximum coordination number; see docs/model.md);
+ *   bond          with parallel bonds, the fastest bond mode spans JD_GUARD_STEPS_PER_BOND_PERIOD
+ *                 steps (the engine sums jd_bond_omega2_bound, kernel/jdem_bond.h, over the bonds
+ *                 of each particle: a Gershgorin bound; docs/model.md §9).
  */
 #ifndef JDEM_KERNEL_GUARD_H
 #define JDEM_KERNEL_GUARD_H
@@ -25,6 +28,7 @@ extern "C" {
 
 #define JD_GUARD_RAYLEIGH_FRACTION 0.2
 #define JD_GUARD_STEPS_PER_CONTACT 50.0
+#define JD_GUARD_STEPS_PER_BOND_PERIOD 20.0
 /* Default expected (maximum) coordination number: the kissing number of equal spheres. */
 #define JD_GUARD_DEFAULT_COORDINATION 12.0
 
@@ -45,6 +49,8 @@ typedef struct jd_guard_input {
     double max_impact_speed; /* fastest relative impact to resolve [m/s]; 0: nothing moves */
     double coordination;     /* expected maximum contacts of one particle [-], >= 1 */
     double damping_ratio;    /* largest viscous damping ratio gamma of any pair [-], >= 0 */
+    double bond_omega2;      /* largest over the particles of the sum of jd_bond_omega2_bound
+                                over its bonds [rad^2/s^2]; 0 without bonds */
     double dt;               /* the time step to judge [s] */
 } jd_guard_input;
 
@@ -52,7 +58,8 @@ typedef enum {
     JD_GUARD_SAFE = 0,
     JD_GUARD_RAYLEIGH = 1,
     JD_GUARD_CONTACT_TIME = 2,
-    JD_GUARD_COORDINATION = 3
+    JD_GUARD_COORDINATION = 3,
+    JD_GUARD_BOND = 4
 } jd_guard_bound;
 
 typedef struct jd_guard_result {
@@ -66,7 +73,9 @@ typedef struct jd_guard_result {
                                   [rad/s]; 0 when nothing moves */
     double coordination_bound; /* 2/omega_max, reduced for damping [s]; INFINITY when nothing
                                   moves */
-    double safe_dt;            /* the smallest of the three bounds [s] */
+    double bond_bound;         /* 2 pi / sqrt(bond_omega2) / JD_GUARD_STEPS_PER_BOND_PERIOD [s];
+                                  INFINITY without bonds */
+    double safe_dt;            /* the smallest of the four bounds [s] */
     int binding;               /* jd_guard_bound: the smallest bound (SAFE only if all are
                                   infinite) */
     int violated;              /* jd_guard_bound: the smallest bound dt exceeds, or SAFE */
@@ -77,7 +86,8 @@ typedef struct jd_guard_result {
 void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out);
 
 /* "20 % of the Rayleigh time step", "1/50 of the shortest Hertz contact time", "the Verlet
- * stability limit at coordination number C" (without C), "" for SAFE. */
+ * stability limit at coordination number C" (without C), "1/20 of the fastest bond period",
+ * "" for SAFE. */
 const char *jd_guard_bound_name(int bound);
 
 /* The engines' shared texts, written into buf (len bytes; no I/O):

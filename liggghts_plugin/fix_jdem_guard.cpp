@@ -82,6 +82,7 @@ void FixJdemGuard::init() {
   in.max_impact_speed = vmax;
   in.coordination = coordination;
   in.damping_ratio = zeta;
+  in.bond_omega2 = 0.0; // bonds are not consulted here (yet): no bond bound in LIGGGHTS
   in.dt = update->dt;
   jd_guard_result r;
   jd_guard_assess(&in, &r);

@@ -2,7 +2,7 @@
  * guard.c — is the scene's time step safe?  The bounds are the kernel's (kernel/jdem_guard.h,
  * shared with LIGGGHTS' `fix jdem/guard`); this file only gathers what they need from the scene:
  * the smallest radius of each species, the walls, the impact speed, the expected coordination
- * number and the strongest damping of any pair of materials.
+ * number, the strongest damping of any pair of materials and the bonds' frequencies.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -38,7 +38,8 @@ int sim_guard(const jd_scene *sc, jd_guard_input *in, jd_guard_species **species
                            .has_walls = sc->n_walls > 0, .wall_rule = sc->wall_rule,
                            .max_impact_speed = sc->max_impact_speed,
                            .coordination = sc->coordination_number,
-                           .damping_ratio = damping_ratio(sc, sp), .dt = sc->dt};
+                           .damping_ratio = damping_ratio(sc, sp),
+                           .bond_omega2 = sim_bonds_omega2(sc), .dt = sc->dt};
     jd_guard_assess(in, r);
     *species = sp;
     return 0;

@@ -49,8 +49,9 @@ static const char usage_text[] =
     "\n"
     "time-step guard (run): dt must not exceed 20 % of the Rayleigh time step of the smallest\n"
     "sphere, nor 1/50 of the shortest Hertz contact time at time.max_impact_speed, nor the\n"
-    "Verlet stability limit of a sphere with time.coordination_number contacts; otherwise\n"
-    "the run is refused (exit status 2) unless --force is given.\n"
+    "Verlet stability limit of a sphere with time.coordination_number contacts, nor (with\n"
+    "bonds) 1/20 of the period of the fastest bond mode; otherwise the run is refused (exit\n"
+    "status 2) unless --force is given.\n"
     "\n"
     "environment:\n"
     "  JDEM_NEIGHBOUR=allpairs  debugging aid: evaluate every particle pair and every\n"
@@ -188,6 +189,8 @@ static int check_time_step(const jd_scene *sc, const cli *c) {
                     sc->coordination_number, g.coordination_bound);
         else
             fprintf(stderr, " (no impact to resolve)");
+        if (isfinite(g.bond_bound))
+            fprintf(stderr, "; 1/20 of the fastest bond period = %.6g s", g.bond_bound);
         fprintf(stderr, "; largest safe dt = %.9g s\n", g.safe_dt);
     }
     if (!g.violated) return 0;

@@ -47,6 +47,10 @@ SUITES += [
                              STABILITY_CASES, "--factors", "10", "--engines", "jdem",
                              "--jdem", "build/san/jdem"], "lines", {}),
 ]
+# Parallel bonds: the checks of `make bonds`, shortened, in the stepper and its sanitized build.
+SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--out", "out/test/bonds"], "lines", {}),
+           ("bonds-sanitized", [PY, "scripts/bond_checks.py", "--quick", "--out",
+                                "out/test/bonds-san"], "lines", SANITIZED)]
 # The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
 # `make demo` runs the full sweeps.
 CHUNG_OOI = "out/test/chung_ooi"

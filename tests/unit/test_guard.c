@@ -65,11 +65,31 @@ static void coordination_and_damping_scale_the_verlet_limit(void **state) {
     assert_rel(damped.coordination_bound, four.coordination_bound * 0.5, 1e-12);
 }
 
+/* Two glass spheres (as above) joined by a bond whose fastest mode is 1 MHz: the bond bound is
+ * 1/20 of its period, 5e-8 s, tighter than the contact bound (8.07e-7 s), and it is named. */
+static void a_stiff_bond_binds(void **state) {
+    (void)state;
+    jd_guard_species sp;
+    jd_guard_input in = glass_pair(&sp, 1e-7);
+    const double omega = 2.0 * JD_PI * 1e6;
+    in.bond_omega2 = omega * omega;
+    jd_guard_result r;
+    jd_guard_assess(&in, &r);
+    assert_rel(r.bond_bound, 1e-6 / 20.0, 1e-14);
+    assert_int_equal(r.binding, JD_GUARD_BOND);
+    assert_int_equal(r.violated, JD_GUARD_BOND);
+    char msg[512];
+    jd_guard_refusal(&in, &r, "Use --force to run anyway.", msg, sizeof msg);
+    assert_string_equal(msg, "time step 1e-07 s is unsafe: it exceeds 1/20 of the fastest bond "
+                             "period (5e-08 s); largest safe dt = 5e-08 s. Use --force to run anyway.");
+}
+
 int run_guard_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(bounds_match_published_values),
         cmocka_unit_test(the_tightest_broken_bound_is_named),
         cmocka_unit_test(coordination_and_damping_scale_the_verlet_limit),
+        cmocka_unit_test(a_stiff_bond_binds),
     };
     return cmocka_run_group_tests_name("guard", tests, NULL, NULL);
 }
