@@ -182,12 +182,10 @@ static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
 }
 
 /* With threads: f = the sum of the threads' buffers in thread order (zeroing them), for
- * particles [lo, hi).  Then gravity. */
+ * particles [lo, hi). */
 static void reduce(jd_sim *s, size_t lo, size_t hi) {
     const size_t n = s->n;
-    const double *g = s->g;
-    const int gravity = g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0;
-    for (int t = 0; s->threads > 1 && t < s->threads; t++) {
+    for (int t = 0; t < s->threads; t++) {
         double *bf = s->tbuf + (size_t)t * 6 * n, *bt = bf + 3 * n;
         for (size_t k = 3 * lo; k < 3 * hi; k++) {
             s->f[k] = t ? s->f[k] + bf[k] : bf[k];
@@ -195,11 +193,17 @@ static void reduce(jd_sim *s, size_t lo, size_t hi) {
             bf[k] = bt[k] = 0.0;
         }
     }
-    if (gravity)
-        for (size_t i = lo; i < hi; i++) {
-            const double m = s->mass[i];
-            for (int d = 0; d < 3; d++) s->f[3 * i + d] += m * g[d];
-        }
+}
+
+static void gravity(jd_sim *s) {
+    const double *g = s->g;
+    if (g[0] == 0.0 && g[1] == 0.0 && g[2] == 0.0) return;
+    const long n = (long)s->n;
+    double *f = s->f;
+    const double *mass = s->mass;
+#pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1)
+    for (long i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) f[3 * i + d] += mass[i] * g[d];
 }
 
 void sim_compute_forces(jd_sim *s) {
@@ -214,8 +218,6 @@ void sim_compute_forces(jd_sim *s) {
 #else
         const int tid = 0;
 #endif
-        size_t lo, hi;
-        chunk(s->n, tid, nt, &lo, &hi);
         if (nt == 1) { /* the loops add into f and torque directly */
             memset(s->f, 0, 3 * s->n * sizeof *s->f);
             memset(s->torque, 0, 3 * s->n * sizeof *s->torque);
@@ -224,9 +226,11 @@ void sim_compute_forces(jd_sim *s) {
         work[tid] = dispatch(s, tid, nt, &t_pairs_end);
         if (nt > 1) {
 #pragma omp barrier
+            size_t lo, hi;
+            chunk(s->n, tid, nt, &lo, &hi);
+            reduce(s, lo, hi);
         }
         if (tid == 0) t_walls_end = sim_clock();
-        reduce(s, lo, hi);
     }
     /* the worst overlap of this evaluation (the first thread's on a tie, as in serial order) */
     s->overlap_trip.fraction = 0.0;
@@ -234,6 +238,11 @@ void sim_compute_forces(jd_sim *s) {
         if (s->trips[t].fraction > s->overlap_trip.fraction) s->overlap_trip = s->trips[t];
         s->wall_work += work[t];
     }
+    /* then in LIGGGHTS' order: bonds (in parallel with the contacts, bonds.c), gravity, and the
+     * post-force loads (loads.c) */
+    if (s->bonds) sim_bonds_forces(s);
+    gravity(s);
+    if (s->loads) sim_loads_apply(s);
     const double t1 = sim_clock();
     s->timing.pairs += (t_pairs_end - t0) + (t1 - t_walls_end);
     s->timing.walls += t_walls_end - t_pairs_end;

@@ -124,7 +124,8 @@ int sim_reorder(jd_sim *s, const int32_t *old_of_new, char *err, size_t errlen) 
     gather_ints(s->species, old_of_new, n, iscratch);
     gather_ints(s->orig, old_of_new, n, iscratch);
     s->sorted = 1;
-    if (s->permute_hook) s->permute_hook(s->permute_ctx, new_of_old, n);
+    sim_bonds_permute(s->bonds, new_of_old, n);
+    sim_loads_permute(s->loads, new_of_old);
     free(new_of_old);
     return 0;
 oom:
@@ -152,6 +153,14 @@ void sim_vectors_to_sim_order(jd_sim *s) {
 
 void sim_scalars_in_scene_order(const jd_sim *s, const double *a, double *out) {
     for (size_t i = 0; i < s->n; i++) out[s->orig[i]] = a[i];
+}
+
+void sim_positions_in_scene_order(const jd_sim *s, double *x, int32_t *where) {
+    for (size_t i = 0; i < s->n; i++) {
+        const size_t p = (size_t)s->orig[i];
+        for (int d = 0; d < 3; d++) x[3 * p + d] = s->x[3 * i + d];
+        where[p] = (int32_t)i;
+    }
 }
 
 long long sim_particle_id(const jd_sim *s, size_t i) { return (long long)s->scene->id[s->orig[i]]; }

@@ -4,13 +4,15 @@
  * One file per mechanism (REBOUND style):
  *   sim.c          set-up from a resolved scene, the run loop with output, tear-down
  *   neighbour.c    cell list -> half Verlet list with skin, wall candidates, history carry-over
- *   reorder.c      spatial sorting of the particles at rebuilds, and the permute hook
+ *   reorder.c      spatial sorting of the particles at rebuilds (remapping what holds indices)
  *   walls.c        wall set-up and rigid translation
  *   geometry.h     contact geometry (kernel/jdem_geometry.h) plus material fields (inline)
  *   forces.c       force loops, specialised at compile time for the scene's feature set
  *   integrate.c    one velocity-Verlet step exactly as LIGGGHTS fix nve/sphere
  *   observables.c  energies and contact counts
  *   guard.c        the time-step guard
+ *   bonds.c        parallel bonds: list, rules, bond loop, events, observables (bonds.h)
+ *   loads.c        held particles and constant external forces, with their work
  *   watchdog.c     the run-time watchdog: non-finite state, excessive overlap, energy jumps
  *   progress.c     the progress line on stderr
  *
@@ -25,8 +27,9 @@
  * their neighbour cells (reorder.c), so that the particles of one cell, and the neighbours a
  * contact loop visits, lie close in memory.  orig[i] is the scene index (position in the scene,
  * sorted by id) of the particle now at index i; everything the engine shows (frames, watchdog
- * messages) is translated back to scene order.  Other per-particle data that outlives a rebuild
- * (bonds) registers a permute hook and remaps through it.
+ * messages) is translated back to scene order.  Every other holder of particle indices that
+ * outlives a rebuild (bonds, loads) is remapped by sim_reorder through its permute function
+ * (sim_bonds_permute, sim_loads_permute), and reads scene data through orig.
  *
  * Threads (OpenMP).  The force loops split the contact lists into one contiguous chunk per
  * thread; each thread adds into its own buffer, and after one barrier the buffers are summed
@@ -44,7 +47,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bonds.h"
 #include "jdem_geometry.h"
+#include "jdem_guard.h"
 #include "jdem_kernel.h"
 #include "jdem_watchdog.h"
 #include "scene.h"
@@ -61,10 +66,6 @@ typedef struct jd_pair_const_roll {
     double i_eff;     /* effective moment of inertia [kg m^2] */
     double r_roll;    /* rolling radius R_a R_b/(R_a + R_b) [m] */
 } jd_pair_const_roll;
-
-/* Called after the particles were renumbered: the particle that had index k now has index
- * new_of_old[k] (k < n). */
-typedef void (*jd_permute_hook)(void *ctx, const int32_t *new_of_old, size_t n);
 
 /* Run options that are not part of the scene (command line). */
 typedef struct jd_sim_options {
@@ -146,8 +147,6 @@ typedef struct jd_sim {
                           (zero between force evaluations); NULL with one thread */
     jd_overlap_trip *trips; /* one per thread, merged into overlap_trip */
     double *scratch;   /* 3n doubles: reordering and frames in scene order */
-    jd_permute_hook permute_hook; /* NULL, or called after each renumbering */
-    void *permute_ctx;
     jd_timing timing;
 
     /* neighbour search */
@@ -158,6 +157,10 @@ typedef struct jd_sim {
     int64_t n_builds;
     int32_t *cell_of, *cell_items, *cell_start;
     size_t cell_cap;   /* capacity of cell_start */
+
+    jd_bonds *bonds;   /* parallel bonds (bonds.h); NULL when the scene has no bond types */
+    struct jd_loads *loads; /* held particles and external forces (loads.c); NULL if none */
+    int in_setup;      /* the step-0 force evaluation (LIGGGHTS `setup`) is running */
 
     /* energy bookkeeping */
     double e_damp_dropped, e_fric_dropped; /* accumulators of contacts dropped from the lists */
@@ -213,7 +216,7 @@ void sim_contact_list_free(jd_contact_list *l);
 /* reorder.c */
 /* Renumber the particles into the order old_of_new (new index k holds old particle
  * old_of_new[k]): the per-particle arrays, the contact lists (re-keyed and re-sorted, with the
- * history of a pair whose ends swap turned around), orig, and the permute hook.  Returns 0 or
+ * history of a pair whose ends swap turned around), orig, the bonds and the loads.  Returns 0 or
  * -1 (out of memory; nothing changed). */
 int sim_reorder(jd_sim *s, const int32_t *old_of_new, char *err, size_t errlen);
 /* Put x, v, omega, f and torque into scene order (for a frame), and back. */
@@ -221,6 +224,8 @@ void sim_vectors_to_scene_order(jd_sim *s);
 void sim_vectors_to_sim_order(jd_sim *s);
 /* A per-particle array in scene order: out[orig[i]] = a[i]. */
 void sim_scalars_in_scene_order(const jd_sim *s, const double *a, double *out);
+/* Positions in scene order (x, 3n) and where[p]: the engine index of scene particle p. */
+void sim_positions_in_scene_order(const jd_sim *s, double *x, int32_t *where);
 /* Scene id of the particle at index i. */
 long long sim_particle_id(const jd_sim *s, size_t i);
 
@@ -235,6 +240,14 @@ int sim_forces_init(jd_sim *s);
 /* Monotonic wall clock [s]. */
 double sim_clock(void);
 
+/* loads.c: set up (0 or -1 with err), free, and apply after every other force (forces.c). */
+typedef struct jd_loads jd_loads;
+int sim_loads_init(jd_sim *s, char *err, size_t errlen);
+void sim_loads_free(jd_sim *s);
+void sim_loads_apply(jd_sim *s);
+/* Remap the loaded particles after a re-sort (reorder.c): particle k is now new_index[k]. */
+void sim_loads_permute(jd_loads *l, const int32_t *new_index);
+
 /* integrate.c: one full step.  Returns 0, or -1 with a reason in err. */
 int sim_step(jd_sim *s, char *err, size_t errlen);
 
@@ -243,6 +256,7 @@ typedef struct jd_observables {
     double kinetic_energy, rotational_energy, elastic_energy, gravitational_energy;
     double damping_dissipation, friction_dissipation, wall_work;
     double contacts, wall_contacts;
+    jd_bond_observables bond;  /* scenes with bond types only (s->bonds) */
 } jd_observables;
 #define JD_N_OBSERVABLES 9
 extern const char *const jd_observable_names[JD_N_OBSERVABLES];
@@ -251,18 +265,11 @@ extern const int jd_observable_is_energy[JD_N_OBSERVABLES];
 void sim_observables(const jd_sim *s, jd_observables *o);
 void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES]);
 
-/* guard.c: time-step bounds of a scene. */
-typedef struct jd_guard {
-    double rayleigh_bound;   /* 0.2 x the smallest Rayleigh step [s]; INFINITY without particles */
-    double contact_time;     /* shortest Hertz contact time at max_impact_speed [s]; INFINITY if none */
-    double contact_bound;    /* contact_time / JD_GUARD_STEPS_PER_CONTACT [s] */
-    double safe_dt;          /* min of the two bounds [s] */
-    const char *violated;    /* description of the tightest violated bound, or NULL when safe */
-    double violated_value;   /* its value [s] */
-} jd_guard;
-#define JD_GUARD_RAYLEIGH_FRACTION 0.2
-#define JD_GUARD_STEPS_PER_CONTACT 50.0
-void sim_guard(const jd_scene *scene, jd_guard *g);
+/* guard.c: the kernel's time-step guard (kernel/jdem_guard.h) applied to a scene.  Fills *in
+ * (its species array is malloc'ed into *species: free it) and *r; returns 0, or -1 when out of
+ * memory. */
+int sim_guard(const jd_scene *scene, jd_guard_input *in, jd_guard_species **species,
+              jd_guard_result *r);
 
 /* watchdog.c.  The force loops call sim_watchdog_overlap() (out of line: the rare case) for a
  * contact with jd_overlap_excessive(); the run loop calls the checks below, which return 0 or
