@@ -15,7 +15,11 @@ a cylinder, damping, friction, rolling resistance, ~50 neighbour rebuilds).
   evaluates those laws with zero coefficients, which add exact zeros, so the trajectories are
   identical bit for bit;
 * energy bookkeeping off (output.energy: false) against on: it never feeds back into the
-  forces, so the trajectories are identical bit for bit, and the energy observables are absent.
+  forces, so the trajectories are identical bit for bit, and the energy observables are absent;
+* bonds through the renumbering: the bonded 4x4x4 block of scripts/bond_checks.py dropped onto a
+  tilted plate (bonds break progressively), sorted against --no-sort: the bonds are remapped at
+  every renumbering, so the same bonds break at the same steps and the trajectories agree to
+  round-off.
 
 Run:  /usr/bin/python3 tests/engine/test_fastpaths.py        (JDEM=path/to/jdem to override)
 """
@@ -23,8 +27,16 @@ import os
 import re
 import tempfile
 
-from engine_common import Checks, load, np, scene, JDEM
 import subprocess
+import sys
+
+import h5py
+import yaml
+
+from engine_common import Checks, load, np, scene, JDEM, ROOT
+
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import bond_checks  # noqa: E402  (the bonded-block scene)
 
 VECTORS = ("position", "velocity", "angular_velocity")
 POS_TOL, VEL_TOL = 1e-12, 1e-10  # relative to the largest |value| of the frame
@@ -37,7 +49,9 @@ def run_file(path, *args, env=None):
     if p.returncode != 0:
         raise RuntimeError(f"jdem run {path} {' '.join(args)} failed: {p.stderr.strip()}")
     m = re.search(r"jdem-timing: .*builds=(\d+) threads=(\d+)", p.stderr)
-    return load(out), int(m.group(1)), int(m.group(2))
+    t = load(out)
+    t["path"] = out
+    return t, int(m.group(1)), int(m.group(2))
 
 
 def variant(text, name):
@@ -104,4 +118,31 @@ ne, _, _ = run_file(no_energy)
 c.check("energy_off_same_trajectory", identical(ne, srt), "energy bookkeeping changed the trajectory")
 c.check("energy_off_no_energy_observables", "elastic_energy" not in ne["obs"] and "kinetic_energy" in ne["obs"],
         f"observables {sorted(ne['obs'])}")
+# The block's generator numbers its spheres in lattice order, which is already cell order; the
+# resolved scene with the ids shuffled (bonds renamed alike) makes the renumbering non-trivial.
+gen = variant(yaml.safe_dump(bond_checks.block_scene(True), sort_keys=False), "block_drop_gen")
+resolved = yaml.safe_load(subprocess.run([JDEM, "resolve", gen], capture_output=True, text=True,
+                                         check=True).stdout)
+ids = [p["id"] for p in resolved["particles"]]
+rename = dict(zip(ids, np.random.default_rng(3).permutation(ids).tolist()))
+for p in resolved["particles"]:
+    p["id"] = rename[p["id"]]
+for b in resolved["bonds"]:
+    b["ids"] = sorted(rename[i] for i in b["ids"])
+block = variant(yaml.safe_dump(resolved, sort_keys=False), "block_drop")
+
+
+def breaks(path):
+    with h5py.File(path, "r") as f:
+        g = f.get("connectivity/broken_bonds")
+        return [] if g is None else sorted(map(tuple, np.column_stack((g["step"][()], g["ids"][()])).tolist()))
+
+
+bt_ref, _, _ = run_file(block, "--no-sort")
+bt_srt, _, _ = run_file(block)
+c.check("bonds_sorting_changes_summation_order", not identical(bt_ref, bt_srt),
+        "sorted and unsorted block runs are identical: was anything renumbered?")
+roundoff_equal(c, "bonds_sorted_vs_unsorted", bt_srt, bt_ref)
+ba, bb = breaks(bt_ref["path"]), breaks(bt_srt["path"])
+c.check("bonds_sorted_same_breaks", len(ba) > 0 and ba == bb, f"{len(ba)} and {len(bb)} breaks, equal: {ba == bb}")
 c.exit()
