@@ -608,6 +608,10 @@ def main():
     ap.add_argument("--fresh", action="store_true", help="forget earlier timings (beds are kept)")
     ap.add_argument("--threads", default=os.environ.get("BENCH_THREADS", "1,2"),
                     help="OpenMP thread counts of the jdem runs (default 1,2)")
+    ap.add_argument("--threads-variants", default=os.environ.get("BENCH_THREADS_VARIANTS", "soft_mono"),
+                    help="variants whose jdem runs use every --threads count ('all' for every variant); "
+                         "the others run on 1 thread (default soft_mono: the beds issue 6 sets the "
+                         "thread target on; keeps make bench short)")
     ap.add_argument("--report-only", action="store_true")
     ap.add_argument("--no-profile", action="store_true", help="skip the callgrind profile of jdem")
     a = ap.parse_args()
@@ -645,7 +649,8 @@ def main():
                 jobs = []
                 for engine in engines:
                     if engine == "jdem":
-                        jobs += [(engine, 1, t) for t in threads]
+                        many = a.threads_variants == "all" or variant in a.threads_variants.split(",")
+                        jobs += [(engine, 1, t) for t in (threads if many else [1])]
                         continue
                     jobs.append((engine, 1, 1))
                     if size == a.ranks_size:
