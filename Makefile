@@ -27,7 +27,7 @@ SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit
 KERNEL_SRC  := $(wildcard kernel/*.c)
 IO_SRC      := $(wildcard io/*.c)
 STEPPER_SRC := $(wildcard stepper/*.c)
-SCENE_SRC   := $(wildcard stepper/scene*.c)
+SCENE_SRC   := $(wildcard stepper/scene*.c) stepper/guard.c kernel/jdem_kernel.c  # guard: dt: auto
 PLUGIN_SRC  := $(wildcard liggghts_plugin/*.cpp)
 UNIT_SRC    := $(wildcard tests/unit/*.c)
 HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)

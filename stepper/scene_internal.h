@@ -39,6 +39,7 @@ typedef struct loader {
     unsigned char *by_particle; /* per material: used by a particle */
     unsigned char *by_wall;     /* per material: used by a wall */
     int max_impact_given;
+    const yaml_node_t *time;    /* the time mapping: steps from end_time wait for an auto dt */
 } loader;
 
 static inline double norm3(const double v[3]) { return sqrt(jd_dot(v, v)); }

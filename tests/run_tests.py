@@ -15,7 +15,7 @@ import time
 
 PY = "/usr/bin/python3"
 
-ENGINE_TESTS = ["neighbour", "free_flight", "hertz_impact", "energy_balance", "guard", "watchdog",
+ENGINE_TESTS = ["neighbour", "free_flight", "hertz_impact", "energy_balance", "guard", "dt_auto", "watchdog",
                 "signals"]
 SANITIZED = {"JDEM": "build/san/jdem"}
 
