@@ -6,6 +6,7 @@
 #   make test       unit tests (also under ASan+UBSan), engine tests, Chung–Ooi checks, cross-engine
 #   make demo       build and run the eight Chung–Ooi tests; report in out/chung_ooi/report.md
 #   make chung-ooi  the Chung–Ooi runs and report only (no dependency check)
+#   make accuracy   error against run time, three engines; report in out/accuracy/report.md
 
 SHELL := /bin/bash
 PY    := /usr/bin/python3
@@ -118,6 +119,13 @@ demo: deps
 .PHONY: bench
 bench: all
 	$(PY) scripts/bench.py $(if $(BENCH_SIZES),--sizes $(BENCH_SIZES)) $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
+
+# Error against run time (issue 6): Chung–Ooi tests 1, 3, 4 and a settling bed, dt swept over
+# factors of the time-step guard's dt, in jdem, liggghts-jdem and LIGGGHTS hertz/history; timings
+# medians of ACCURACY_REPEATS (default 3).  ~11 min on 2 busy cores.  Report: out/accuracy/report.md
+.PHONY: accuracy
+accuracy: all
+	$(PY) scripts/accuracy.py run $(if $(ACCURACY_REPEATS),--repeats $(ACCURACY_REPEATS))
 
 clean:
 	rm -rf build out
