@@ -3,6 +3,7 @@
 
     scripts/accuracy.py run     [--out out/accuracy] [--items a,b] [--engines jdem,...] [--repeats 3]
     scripts/accuracy.py analyse [--out out/accuracy]
+    scripts/accuracy.py check   [--out out/accuracy]   PASS/FAIL: orders and engine agreement
 
 For each item (Chung–Ooi Tests 1, 3 and 4, chosen cases, and the settling of a small bed,
 reference_runs/accuracy/bed.yaml) and each engine, the time step is swept over factors of the
@@ -225,9 +226,48 @@ def run_all(out, items, engines, repeats):
     return runs
 
 
+# Checks of `check` (the reduced study of `make test`): the observed order of Test 1 in each
+# engine against the theory of velocity Verlet, second order for a force that is smooth
+# enough (elastic Hertz: F ~ delta^1.5, continuously differentiable at the onset), and the two
+# engines of the Jiang kernel against each other (the same kernel in the same order).
+EXPECTED_ORDER = {"test1_glass": (2.0, 0.3)}
+ENGINE_AGREEMENT = 1e-9
+
+
+def check_summary(out):
+    """PASS/FAIL lines from OUT/summary.json; returns the number of failures."""
+    with open(os.path.join(out, "summary.json")) as f:
+        items = json.load(f)["items"]
+    failures, checked = 0, 0
+
+    def report(ok, name, detail):
+        nonlocal failures, checked
+        checked += 1
+        failures += not ok
+        print("%s accuracy/%s: %s" % ("PASS" if ok else "FAIL", name, detail))
+
+    for item, (order, tol) in EXPECTED_ORDER.items():
+        for engine, res in items.get(item, {}).get("engines", {}).items():
+            for metric, got in (res.get("order_by_metric") or {}).items():
+                report(got is not None and abs(got - order) <= tol, "%s/%s/%s/order" % (item, engine, metric),
+                       "observed order %s, expected %g +- %g" % (got, order, tol))
+    for item, it in items.items():
+        eng = it["engines"]
+        if "jdem" not in eng or "liggghts-jdem" not in eng:
+            continue
+        for a, b in zip(eng["jdem"]["rows"] or [], eng["liggghts-jdem"]["rows"] or []):
+            worst = max(abs(a["metrics"][m]["value"] - b["metrics"][m]["value"]) / abs(a["metrics"][m]["value"])
+                        for m in a["metrics"]) if a.get("metrics") and b.get("metrics") else math.inf
+            report(worst <= ENGINE_AGREEMENT, "%s/f%g/jdem-vs-liggghts-jdem" % (item, a["factor"]),
+                   "largest relative difference of the metrics %.3g (limit %g)" % (worst, ENGINE_AGREEMENT))
+    if not checked:
+        report(False, "summary", "nothing to check in %s" % out)
+    return failures
+
+
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("command", choices=("run", "analyse"))
+    ap.add_argument("command", choices=("run", "analyse", "check"))
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "accuracy"))
     ap.add_argument("--items", default=",".join(ITEMS))
     ap.add_argument("--engines", default=",".join(ENGINES))
@@ -243,6 +283,8 @@ def main(argv):
     if a.repeats < 1:
         ap.error("--repeats must be >= 1")
     runs_path = os.path.join(out, "runs.json")
+    if a.command == "check":
+        return 1 if check_summary(out) else 0
     if a.command == "run":
         if os.path.isdir(out):
             shutil.rmtree(out)

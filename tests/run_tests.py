@@ -44,6 +44,15 @@ SUITES += [
      "lines", {}),
 ]
 
+# The work-precision study reduced to Test 1 in the two engines of the Jiang kernel (`make
+# accuracy` runs all of it): observed order against velocity Verlet's 2, engines against each other.
+ACCURACY = "out/test/accuracy"
+SUITES += [
+    ("accuracy", ["sh", "-c", f"{PY} scripts/accuracy.py run --items test1_glass --engines jdem,liggghts-jdem "
+                  f"--repeats 1 --out {ACCURACY} && {PY} scripts/accuracy.py check --out {ACCURACY}"],
+     "lines", {}),
+]
+
 CMOCKA_OK = re.compile(r"^\[\s+OK\s+\] (\S+)")
 CMOCKA_FAIL = re.compile(r"^\[\s+FAILED\s+\] (\S+)$")
 
