@@ -286,8 +286,10 @@ def main(argv):
     if a.command == "check":
         return 1 if check_summary(out) else 0
     if a.command == "run":
+        if os.path.isdir(out) and os.listdir(out) and not os.path.exists(runs_path):
+            ap.error("%s exists and holds no runs.json: not a study to replace" % out)
         if os.path.isdir(out):
-            shutil.rmtree(out)
+            shutil.rmtree(out)  # a fresh study: no trajectory of an earlier one may be analysed
         os.makedirs(out)
         t0 = time.monotonic()
         runs = run_all(out, items, engines, a.repeats)
