@@ -40,7 +40,7 @@ def item_rows(info, engine, seeds_floor=None):
     ref = runs.get("reference")
     if not ref or ref["status"] != "ok":
         return None, "reference run failed: %s" % (ref or {}).get("message", "missing")[-300:]
-    test = int(info["scene"].split("test")[1][0]) if info["kind"] == "impact" else None
+    test = info["test"]
     startup = median(runs["startup"]["wall"]) if runs.get("startup", {}).get("wall") else None
     if info["kind"] == "impact":
         ref_vals = impact_values(path_of(ref), test, info["case"], engine)
@@ -197,7 +197,7 @@ def plot_item(out, item, info, results):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    metrics = BED_METRICS if info["kind"] == "bed" else IMPACT_METRICS[int(info["scene"].split("test")[1][0])]
+    metrics = BED_METRICS if info["kind"] == "bed" else IMPACT_METRICS[info["test"]]
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.6))
     for engine, res in results.items():
         rows = [r for r in (res["rows"] or []) if r["status"] == "ok" and r["error"] > 0]
