@@ -112,6 +112,10 @@ def bed_floor_section(it):
                  "of the packing fraction %.2e, of the coordination %.2e.\n"
                  % (ffac(min(it["factors"])), len(fl["seeds"]["packing_fraction"]["values"]),
                     fl["seeds"]["packing_fraction"]["relative_std"], fl["seeds"]["coordination"]["relative_std"]))
+        if "ke_history" in fl["seeds"]:
+            L.append("The kinetic-energy histories of the other realisations differ from this one's by "
+                     "ke_history = %.2e on average: the dt-induced differences above are of the kind two "
+                     "realisations of the same bed show.\n" % fl["seeds"]["ke_history"]["mean"])
     return "".join(L)
 
 
