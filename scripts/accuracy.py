@@ -16,7 +16,8 @@ guard's safe dt of that case (stepper/guard.c: min(20 % Rayleigh, t_c/50)):
 Every run of an item starts from the same physical state and lasts the same physical time; only
 dt (and the output interval in steps) changes.  Engines:
     jdem            build/jdem run ... --force (factors above 1 exceed the guard)
-    liggghts-jdem   build/liggghts-jdem, pair_style gran/jiang (deck: scene_to_liggghts.py)
+    liggghts-jdem   build/liggghts-jdem, pair_style gran/jiang (deck: scene_to_liggghts.py --force:
+                    its fix jdem/guard lets the factors above 1 run)
     liggghts        LIGGGHTS' own hertz/history law (deck: scene_to_liggghts.py --builtin), run by
                     build/liggghts-jdem for its trajectory writer; against its own reference
 Each sweep run is timed --repeats times (median wall and CPU time of the whole process; runs are
@@ -154,7 +155,7 @@ def engine_command(engine, scene_file, traj):
         return [JDEM, "run", scene_file, "-o", traj, "--quiet", "--force"], None
     deck_dir = os.path.join(os.path.dirname(traj), "deck")
     check([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), scene_file, "-o",
-           os.path.join(deck_dir, "in.jdem"), "--trajectory", traj]
+           os.path.join(deck_dir, "in.jdem"), "--trajectory", traj, "--force"]
           + (["--builtin"] if engine == "liggghts" else []))
     return [LIGGGHTS, "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"], deck_dir
 
