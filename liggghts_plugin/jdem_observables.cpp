@@ -6,6 +6,11 @@
 #include "force.h"
 #include "lammps.h"
 #include "modify.h"
+#include "output.h"
+#include "dump.h"
+#include "fix.h"
+
+#include <cstring>
 
 #include "fix_wall_jiang.h"
 #include "jdem_kernel.h"
@@ -53,6 +58,14 @@ void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]) {
     out[JDO_WALL_WORK] += w->work_cum;
     out[JDO_WALL_CONTACTS] += w->contacts_now;
   }
+}
+
+bool jdem_wants_energy(LAMMPS *lmp) {
+  for (int k = 0; k < lmp->output->ndump; k++)
+    if (std::strcmp(lmp->output->dump[k]->style, "h5md/jdem") == 0) return true;
+  for (int k = 0; k < lmp->modify->nfix; k++)
+    if (std::strcmp(lmp->modify->fix[k]->style, "jdem/watchdog") == 0) return true;
+  return false;
 }
 
 }  // namespace LAMMPS_NS

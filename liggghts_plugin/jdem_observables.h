@@ -16,6 +16,10 @@ enum { JDO_KINETIC = 0, JDO_ROTATIONAL, JDO_GRAVITATIONAL, JDO_ELASTIC, JDO_DAMP
  * 1/2, see PairGranJiang).  The contact terms stay 0 without pair_style gran/jiang. */
 void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]);
 
+/* True when some consumer of the energies is defined (a dump h5md/jdem, which writes them, or a
+ * fix jdem/watchdog, which checks their balance): the force loops then book them. */
+bool jdem_wants_energy(LAMMPS *lmp);
+
 }  // namespace LAMMPS_NS
 
 #endif

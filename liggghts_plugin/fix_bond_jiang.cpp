@@ -1,0 +1,458 @@
+/* fix_bond_jiang.cpp — see fix_bond_jiang.h.  Glue only: bookkeeping of LIGGGHTS around
+ * jd_bond() (kernel/jdem_bond.h). */
+#include "fix_bond_jiang.h"
+
+#include <mpi.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "force.h"
+#include "memory.h"
+#include "neigh_list.h"
+#include "pair.h"
+#include "update.h"
+
+#include "jdem_observables.h"
+
+using namespace LAMMPS_NS;
+using namespace FixConst;
+
+
+static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double),
+              "jd_bond_state must be JD_BOND_STATE_LEN doubles");
+
+FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
+    : Fix(lmp, narg, arg), e_elastic_now(0.0), e_damp_cum(0.0), e_broken_cum(0.0), max_bonds(12),
+      create_step(-1), create_tol(0.0), file_read(false), nmax_b(0), nbond(NULL), partner(NULL),
+      bstate(NULL), nmax_ghost(0), fghost(NULL) {
+  const char *usage =
+      "Illegal fix bond/jiang command: fix ID group bond/jiang kn KN kt KT sigma_c S tau_c T "
+      "lambda L [damping GAMMA] [bending I|J_literal] [max_bonds N] [file FILE] "
+      "[create_at STEP [tolerance X]]";
+  std::memset(&params, 0, sizeof params);
+  params.bending = JD_BOND_BEND_I;
+  bool seen[5] = {false, false, false, false, false};
+  for (int iarg = 3; iarg < narg; iarg += 2) {
+    if (iarg + 1 >= narg) error->all(FLERR, usage);
+    const std::string k = arg[iarg], val = arg[iarg + 1];
+    if (k == "kn") params.kn = force->numeric(FLERR, arg[iarg + 1]), seen[0] = true;
+    else if (k == "kt") params.kt = force->numeric(FLERR, arg[iarg + 1]), seen[1] = true;
+    else if (k == "sigma_c") params.sigma_c = val == "inf" ? INFINITY : force->numeric(FLERR, arg[iarg + 1]), seen[2] = true;
+    else if (k == "tau_c") params.tau_c = val == "inf" ? INFINITY : force->numeric(FLERR, arg[iarg + 1]), seen[3] = true;
+    else if (k == "lambda") params.lambda = force->numeric(FLERR, arg[iarg + 1]), seen[4] = true;
+    else if (k == "damping") params.gamma = force->numeric(FLERR, arg[iarg + 1]);
+    else if (k == "bending") {
+      if (val == "I") params.bending = JD_BOND_BEND_I;
+      else if (val == "J_literal") params.bending = JD_BOND_BEND_J_LITERAL;
+      else error->all(FLERR, "fix bond/jiang: bending must be I or J_literal");
+    } else if (k == "max_bonds") max_bonds = force->inumeric(FLERR, arg[iarg + 1]);
+    else if (k == "file") bond_file = val;
+    else if (k == "create_at") create_step = (bigint)force->inumeric(FLERR, arg[iarg + 1]);
+    else if (k == "tolerance") create_tol = force->numeric(FLERR, arg[iarg + 1]);
+    else error->all(FLERR, ("fix bond/jiang: unknown keyword '" + k + "'; " + usage).c_str());
+  }
+  for (int s = 0; s < 5; s++)
+    if (!seen[s]) error->all(FLERR, (std::string("fix bond/jiang: kn, kt, sigma_c, tau_c and lambda are required; ") + usage).c_str());
+  if (!(params.kn > 0.0) || !(params.kt > 0.0))
+    error->all(FLERR, "fix bond/jiang: kn and kt must be > 0 [N/m^3]");
+  if (!(params.sigma_c > 0.0) || !(params.tau_c > 0.0))
+    error->all(FLERR, "fix bond/jiang: sigma_c and tau_c must be > 0 [Pa] (inf: unbreakable)");
+  if (!(params.lambda > 0.0)) error->all(FLERR, "fix bond/jiang: lambda must be > 0");
+  if (!(params.gamma >= 0.0)) error->all(FLERR, "fix bond/jiang: damping must be >= 0");
+  /* Comm::exchange leaves room for about 1000 doubles beyond an atom's own: stay well inside */
+  if (max_bonds < 1 || 1 + max_bonds * (1 + JD_BOND_STATE_LEN) > 500)
+    error->all(FLERR, "fix bond/jiang: max_bonds must be between 1 and 26");
+  if (create_step < -1) error->all(FLERR, "fix bond/jiang: create_at must be a step >= 0");
+  if (!(create_tol >= 0.0)) error->all(FLERR, "fix bond/jiang: tolerance must be >= 0");
+  if (!atom->tag_enable || atom->map_style == 0)
+    error->all(FLERR, "fix bond/jiang needs atom IDs and `atom_modify map array` (or hash)");
+  if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
+    error->all(FLERR, "fix bond/jiang requires atom_style granular (sphere)");
+
+  features = (params.gamma > 0.0 ? (unsigned)JD_B_DAMPING : 0u);
+  nbroken[0] = nbroken[1] = 0.0;
+  scalar_flag = vector_flag = 1;
+  size_vector = 3;
+  global_freq = 1;
+  extscalar = extvector = 0;
+  create_attribute = 1;
+  comm_reverse = 6;
+  grow_arrays(atom->nmax);
+  atom->add_callback(0);
+}
+
+FixBondJiang::~FixBondJiang() {
+  atom->delete_callback(id, 0);
+  memory->destroy(nbond);
+  memory->destroy(partner);
+  memory->destroy(bstate);
+  memory->destroy(fghost);
+}
+
+int FixBondJiang::setmask() { return POST_FORCE; }
+
+void FixBondJiang::init() {
+  if (force->newton_pair)
+    error->all(FLERR, "fix bond/jiang requires `newton off` (as LIGGGHTS' granular pair styles)");
+  features = (params.gamma > 0.0 ? (unsigned)JD_B_DAMPING : 0u) | (jdem_wants_energy(lmp) ? (unsigned)JD_B_ENERGY : 0u);
+  if (create_step >= 0 && !force->pair)
+    error->all(FLERR, "fix bond/jiang create_at needs a pair style (its neighbour list finds touching atoms)");
+}
+
+/* Explicit bonds are formed at the first set-up; the set-up evaluation does not advance the
+ * bond states (as gran/jiang's contact history). */
+void FixBondJiang::setup(int vflag) {
+  if (!file_read && !bond_file.empty()) read_bond_file(bond_file.c_str());
+  file_read = true;
+  compute(false);
+}
+
+void FixBondJiang::post_force(int vflag) {
+  if (update->ntimestep == create_step) create_touching();
+  compute(true);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Forming bonds.                                                                              */
+
+/* Store a bond on local atom i (the lower id); false when i already holds max_bonds bonds. */
+bool FixBondJiang::add_bond(int i, int partner_tag) {
+  for (int k = 0; k < nbond[i]; k++)
+    if (partner[i][k] == partner_tag) return true; /* already bonded */
+  if (nbond[i] >= max_bonds) return false;
+  const int k = nbond[i]++;
+  partner[i][k] = partner_tag;
+  jd_bond_state fresh;
+  jd_bond_form(&fresh);
+  std::memcpy(state(i, k), &fresh, sizeof fresh);
+  return true;
+}
+
+static void too_many(Error *error, int tag, int max_bonds) {
+  char msg[256];
+  std::snprintf(msg, sizeof msg, "fix bond/jiang: atom %d would have more than %d bonds (raise max_bonds)",
+                tag, max_bonds);
+  error->one(FLERR, msg);
+}
+
+/* Rank 0 reads the file and broadcasts the pairs; the rank owning the lower id stores each. */
+void FixBondJiang::read_bond_file(const char *path) {
+  std::vector<int> pairs;
+  int nbad = 0;
+  char msg[512] = "";
+  if (comm->me == 0) {
+    std::ifstream in(path);
+    if (!in) {
+      std::snprintf(msg, sizeof msg, "fix bond/jiang: cannot read bond file %s", path);
+      nbad = 1;
+    }
+    std::string line;
+    for (int lineno = 1; !nbad && std::getline(in, line); lineno++) {
+      const size_t hash = line.find('#');
+      if (hash != std::string::npos) line.erase(hash);
+      std::istringstream ls(line);
+      long a, b;
+      std::string rest;
+      if (!(ls >> a)) continue; /* blank or comment line */
+      if (!(ls >> b) || (ls >> rest) || a < 1 || b < 1 || a == b || a > atom->map_tag_max ||
+          b > atom->map_tag_max) {
+        std::snprintf(msg, sizeof msg,
+                      "fix bond/jiang: %s line %d: expected two different atom ids between 1 and %d",
+                      path, lineno, atom->map_tag_max);
+        nbad = 1;
+        break;
+      }
+      pairs.push_back((int)std::min(a, b));
+      pairs.push_back((int)std::max(a, b));
+    }
+  }
+  MPI_Bcast(&nbad, 1, MPI_INT, 0, world);
+  if (nbad) {
+    MPI_Bcast(msg, sizeof msg, MPI_CHAR, 0, world);
+    error->all(FLERR, msg);
+  }
+  int n = (int)pairs.size();
+  MPI_Bcast(&n, 1, MPI_INT, 0, world);
+  pairs.resize(n);
+  if (n) MPI_Bcast(pairs.data(), n, MPI_INT, 0, world);
+
+  /* every id must exist somewhere (each atom is owned by exactly one rank) */
+  int found_mine = 0;
+  for (int p = 0; p < n; p += 2) {
+    const int ia = atom->map(pairs[p]), ib = atom->map(pairs[p + 1]);
+    if (ia >= 0 && ia < atom->nlocal) found_mine++;
+    if (ib >= 0 && ib < atom->nlocal) found_mine++;
+    if (ia >= 0 && ia < atom->nlocal && !add_bond(ia, pairs[p + 1])) too_many(error, pairs[p], max_bonds);
+  }
+  int found = 0;
+  MPI_Allreduce(&found_mine, &found, 1, MPI_INT, MPI_SUM, world);
+  if (found != n) {
+    std::snprintf(msg, sizeof msg, "fix bond/jiang: %s names atom ids that do not exist", path);
+    error->all(FLERR, msg);
+  }
+}
+
+/* Bond every touching pair of the group, with the same test as the contact (jd_geom_spheres:
+ * distance < R_a + R_b), widened by the tolerance.  The pair style's neighbour list holds each
+ * local pair once and each local-ghost pair on both ranks; the owner of the lower id stores it. */
+void FixBondJiang::create_touching() {
+  NeighList *list = force->pair->list;
+  if (!list) error->all(FLERR, "fix bond/jiang create_at: the pair style has no neighbour list");
+  double **x = atom->x;
+  const double *radius = atom->radius;
+  const int *tag = atom->tag, *mask = atom->mask;
+  const int nlocal = atom->nlocal;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    if (!(mask[i] & groupbit)) continue;
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = list->firstneigh[i][jj] & NEIGHMASK;
+      if (!(mask[j] & groupbit)) continue;
+      const double dx = x[j][0] - x[i][0], dy = x[j][1] - x[i][1], dz = x[j][2] - x[i][2];
+      const double reach = (radius[i] + radius[j]) * (1.0 + create_tol);
+      if (dx * dx + dy * dy + dz * dz >= reach * reach && create_tol == 0.0) continue;
+      if (create_tol > 0.0 && dx * dx + dy * dy + dz * dz > reach * reach) continue;
+      const int lo = tag[i] < tag[j] ? i : j, hi = lo == i ? j : i;
+      if (lo >= nlocal) continue; /* the other rank stores it */
+      if (!add_bond(lo, tag[hi])) too_many(error, tag[lo], max_bonds);
+    }
+  }
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Evaluating the bonds.                                                                       */
+
+void FixBondJiang::compute(bool commit) {
+  switch (features) {
+    case 0u: loop<0u>(commit); break;
+    case JD_B_DAMPING: loop<JD_B_DAMPING>(commit); break;
+    case JD_B_ENERGY: loop<JD_B_ENERGY>(commit); break;
+    default: loop<JD_B_DAMPING | JD_B_ENERGY>(commit); break;
+  }
+}
+
+/* Every bond stored on a local atom, in storage order.  commit false (the set-up evaluation):
+ * forces only, the states keep all but their energy reference (jd_bond_keep_reference). */
+template <unsigned F>
+void FixBondJiang::loop(bool commit) {
+  double **x = atom->x, **v = atom->v, **f = atom->f;
+  double **omega = atom->omega, **torque = atom->torque;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  const int *tag = atom->tag;
+  const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
+  const double dt = update->dt;
+  const double cut = std::fmax(comm->cutghost[0], std::fmax(comm->cutghost[1], comm->cutghost[2]));
+  const bigint step = update->ntimestep;
+  const double time = update->atime + (double)(step - update->atimestep) * dt;
+
+  if (nall > nmax_ghost) {
+    nmax_ghost = atom->nmax;
+    memory->destroy(fghost);
+    memory->create(fghost, nmax_ghost, 6, "bond/jiang:fghost");
+  }
+  for (int i = nlocal; i < nall; i++)
+    for (int d = 0; d < 6; d++) fghost[i][d] = 0.0;
+
+  double e_el = 0.0, e_damp = 0.0, e_broken = 0.0;
+  for (int i = 0; i < nlocal; i++) {
+    for (int k = 0; k < nbond[i];) {
+      int j = atom->map(partner[i][k]);
+      if (j < 0) {
+        char msg[256];
+        std::snprintf(msg, sizeof msg, "fix bond/jiang: step " BIGINT_FORMAT ": the partner %d of atom %d "
+                      "is neither on this rank nor a ghost (a bond longer than the ghost cutoff %g m?)",
+                      step, partner[i][k], tag[i], cut);
+        error->one(FLERR, msg);
+      }
+      j = domain->closest_image(i, j);
+      jd_bond_geom g = jd_bond_geom(); /* zeroed: m_eff, i_eff are read only with damping */
+      if (!jd_bond_geom_spheres(x[i], radius[i], x[j], radius[j], &g)) {
+        char msg[160];
+        std::snprintf(msg, sizeof msg, "fix bond/jiang: step " BIGINT_FORMAT ": bonded atoms %d and %d "
+                      "are at the same position", step, tag[i], partner[i][k]);
+        error->one(FLERR, msg);
+      }
+      if (!(radius[i] + radius[j] - g.delta < cut)) {
+        char msg[320];
+        std::snprintf(msg, sizeof msg, "fix bond/jiang: step " BIGINT_FORMAT ": bond %d-%d is %g m long, "
+                      "not within the ghost cutoff %g m that keeps partners visible on every rank; "
+                      "raise it with `communicate single vel yes cutoff X`", step, tag[i], partner[i][k],
+                      radius[i] + radius[j] - g.delta, cut);
+        error->one(FLERR, msg);
+      }
+      g.sec = jd_bond_section_of(params.lambda, radius[i], radius[j]);
+      if (F & JD_B_DAMPING) {
+        const double Ii = jd_sphere_inertia(rmass[i], radius[i]), Ij = jd_sphere_inertia(rmass[j], radius[j]);
+        g.m_eff = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
+        g.i_eff = Ii * Ij / (Ii + Ij);
+      }
+      jd_kinematics kin;
+      for (int d = 0; d < 3; d++) {
+        kin.va[d] = v[i][d];
+        kin.wa[d] = omega[i][d];
+        kin.vb[d] = v[j][d];
+        kin.wb[d] = omega[j][d];
+      }
+      jd_bond_state st;
+      std::memcpy(&st, state(i, k), sizeof st);
+      jd_bond_result out;
+      const int mode = jd_bond(F, &params, &g, &kin, dt, &st, &out);
+      if (mode != JD_BOND_INTACT && commit) {
+        Event ev;
+        ev.step = step;
+        ev.time = time;
+        ev.tag_a = tag[i];
+        ev.tag_b = partner[i][k];
+        ev.mode = mode;
+        for (int d = 0; d < 3; d++) {
+          ev.x[d] = x[i][d] + g.ra[d];
+          ev.n[d] = g.n[d];
+        }
+        ev.r = out;
+        events.push_back(ev);
+        nbroken[mode == JD_BOND_BROKE_TENSION ? 0 : 1] += 1.0;
+        e_damp += st.e_damp;
+        e_broken += st.e_break;
+        /* remove the slot, keeping the others in order (the force summation order) */
+        for (int m = k + 1; m < nbond[i]; m++) {
+          partner[i][m - 1] = partner[i][m];
+          std::memcpy(state(i, m - 1), state(i, m), sizeof st);
+        }
+        nbond[i]--;
+        continue;
+      }
+      if (commit) {
+        e_damp += st.e_damp; /* harvested every step, as gran/jiang does */
+        st.e_damp = 0.0;
+        std::memcpy(state(i, k), &st, sizeof st);
+      } else {
+        jd_bond_state kept;
+        std::memcpy(&kept, state(i, k), sizeof kept);
+        jd_bond_keep_reference(&kept, &st);
+        std::memcpy(state(i, k), &kept, sizeof kept);
+      }
+      k++;
+      if (mode != JD_BOND_INTACT) continue; /* set-up evaluation of a bond that would fail */
+      if (F & JD_B_ENERGY) e_el += st.u_prev;
+      for (int d = 0; d < 3; d++) {
+        f[i][d] -= out.f[d];
+        torque[i][d] += out.ta[d];
+      }
+      double *fj = j < nlocal ? f[j] : fghost[j], *tj = j < nlocal ? torque[j] : fghost[j] + 3;
+      for (int d = 0; d < 3; d++) {
+        fj[d] += out.f[d];
+        tj[d] += out.tb[d];
+      }
+    }
+  }
+  if (comm->nprocs > 1 || domain->xperiodic || domain->yperiodic || domain->zperiodic)
+    comm->reverse_comm_fix(this);
+  e_elastic_now = e_el;
+  if (commit) {
+    e_damp_cum += e_damp;
+    e_broken_cum += e_broken;
+  }
+}
+
+/* Comm::reverse_comm_fix takes the return value as the datums per atom (comm_reverse). */
+int FixBondJiang::pack_reverse_comm(int n, int first, double *buf) {
+  int m = 0;
+  for (int i = first; i < first + n; i++)
+    for (int d = 0; d < 6; d++) buf[m++] = fghost[i][d];
+  return 6;
+}
+
+void FixBondJiang::unpack_reverse_comm(int n, int *list, double *buf) {
+  double **f = atom->f, **torque = atom->torque;
+  int m = 0;
+  for (int i = 0; i < n; i++) {
+    const int j = list[i];
+    for (int d = 0; d < 3; d++) f[j][d] += buf[m++];
+    for (int d = 0; d < 3; d++) torque[j][d] += buf[m++];
+  }
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* What the dump and the observables read.                                                     */
+
+std::vector<FixBondJiang::Event> FixBondJiang::take_events() {
+  std::vector<Event> out;
+  out.swap(events);
+  return out;
+}
+
+void FixBondJiang::local_bonds(std::vector<int> &pairs) const {
+  for (int i = 0; i < atom->nlocal; i++)
+    for (int k = 0; k < nbond[i]; k++) {
+      pairs.push_back(atom->tag[i]);
+      pairs.push_back(partner[i][k]);
+    }
+}
+
+int FixBondJiang::local_count() const {
+  int n = 0;
+  for (int i = 0; i < atom->nlocal; i++) n += nbond[i];
+  return n;
+}
+
+double FixBondJiang::compute_scalar() { return compute_vector(0); }
+
+double FixBondJiang::compute_vector(int n) {
+  const double mine = n == 0 ? (double)local_count() : nbroken[n - 1];
+  double all = 0.0;
+  MPI_Allreduce(&mine, &all, 1, MPI_DOUBLE, MPI_SUM, world);
+  return all;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Per-atom bonds that migrate with their atom.                                                */
+
+void FixBondJiang::grow_arrays(int nmax) {
+  memory->grow(nbond, nmax, "bond/jiang:nbond");
+  memory->grow(partner, nmax, max_bonds, "bond/jiang:partner");
+  memory->grow(bstate, nmax, max_bonds * JD_BOND_STATE_LEN, "bond/jiang:state");
+  for (int i = nmax_b; i < nmax; i++) nbond[i] = 0;
+  nmax_b = nmax;
+}
+
+void FixBondJiang::copy_arrays(int i, int j, int delflag) {
+  nbond[j] = nbond[i];
+  for (int k = 0; k < nbond[i]; k++) partner[j][k] = partner[i][k];
+  std::memcpy(bstate[j], bstate[i], (size_t)nbond[i] * JD_BOND_STATE_LEN * sizeof(double));
+}
+
+void FixBondJiang::set_arrays(int i) { nbond[i] = 0; }
+
+/* nbond, then per bond the partner id and the state (ids are exact in a double) */
+int FixBondJiang::pack_exchange(int i, double *buf) {
+  int m = 0;
+  buf[m++] = nbond[i];
+  for (int k = 0; k < nbond[i]; k++) {
+    buf[m++] = partner[i][k];
+    for (int s = 0; s < JD_BOND_STATE_LEN; s++) buf[m++] = bstate[i][k * JD_BOND_STATE_LEN + s];
+  }
+  return m;
+}
+
+int FixBondJiang::unpack_exchange(int nlocal, double *buf) {
+  int m = 0;
+  nbond[nlocal] = (int)buf[m++];
+  for (int k = 0; k < nbond[nlocal]; k++) {
+    partner[nlocal][k] = (int)buf[m++];
+    for (int s = 0; s < JD_BOND_STATE_LEN; s++) bstate[nlocal][k * JD_BOND_STATE_LEN + s] = buf[m++];
+  }
+  return m;
+}
+
+double FixBondJiang::memory_usage() {
+  return (double)nmax_b * (sizeof(int) + max_bonds * (sizeof(int) + JD_BOND_STATE_LEN * sizeof(double))) +
+         (double)nmax_ghost * 6 * sizeof(double);
+}

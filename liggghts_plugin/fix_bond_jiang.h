@@ -1,0 +1,114 @@
+/* fix_bond_jiang.h — `fix bond/jiang`: Potyondy–Cundall parallel bonds (kernel/jdem_bond.h) in
+ * LIGGGHTS, acting in parallel with pair_style gran/jiang's contacts.
+ *
+ *   fix ID group bond/jiang kn KN kt KT sigma_c S tau_c T lambda L [damping GAMMA]
+ *                           [bending I|J_literal] [max_bonds N] [file FILE]
+ *                           [create_at STEP [tolerance X]]
+ *
+ *   kn, kt     normal and shear stiffness per unit area                     [N/m^3]
+ *   sigma_c    tensile strength, tau_c shear strength (inf: never)          [Pa]
+ *   lambda     bond-radius multiplier: R_bond = lambda min(R_a, R_b)        [-]
+ *   damping    damping ratio of the bond's dashpots (default 0: none)       [-]
+ *   bending    second moment of the bending stiffness (default I; docs/model.md)
+ *   max_bonds  bonds one atom can store (default 12, the FCC coordination)
+ *   file FILE  explicit bonds: lines "ID_A ID_B" ('#' starts a comment), formed at set-up
+ *   create_at  at this step, bond every pair of touching atoms of the group, |x_b - x_a| <=
+ *              (R_a + R_b)(1 + X) (default X = 0)
+ *
+ * Bookkeeping (docs/liggghts.md, "Bonds"):
+ *   - a bond is stored once, on the atom with the lower id, as the partner's id and the kernel
+ *     state; it moves with that atom between ranks (pack/unpack_exchange) and does not depend on
+ *     neighbour lists, so it survives rebuilds and any stretch;
+ *   - the rank owning the lower-id atom evaluates it; it finds the partner through atom->map, a
+ *     ghost when the partner lives on another rank, and sends the partner's force and torque back
+ *     with a reverse communication (LIGGGHTS runs granular pairs with newton off: no other
+ *     reverse communication of forces takes place);
+ *   - a partner must be within the ghost cutoff: a longer bond stops the run with a message that
+ *     names it (`communicate single vel yes cutoff X` raises the cutoff);
+ *   - a bond that fails is removed on the spot and recorded as an event (dump h5md/jdem writes
+ *     them); the pair then interacts through gran/jiang alone.
+ * Thermo: f_ID is the number of intact bonds, f_ID[1], f_ID[2], f_ID[3] the intact bonds and the
+ * bonds broken in tension and in shear so far. */
+#ifndef JDEM_FIX_BOND_JIANG_H
+#define JDEM_FIX_BOND_JIANG_H
+
+#include <string>
+#include <vector>
+
+#include "fix.h"
+
+#include "jdem_bond.h"
+
+namespace LAMMPS_NS {
+
+class FixBondJiang : public Fix {
+ public:
+  FixBondJiang(class LAMMPS *, int, char **);
+  ~FixBondJiang();
+  int setmask();
+  void init();
+  void setup(int);
+  void post_force(int);
+
+  void grow_arrays(int);
+  void copy_arrays(int, int, int);
+  void set_arrays(int);
+  int pack_exchange(int, double *);
+  int unpack_exchange(int, double *);
+  int pack_reverse_comm(int, int, double *);
+  void unpack_reverse_comm(int, int *, double *);
+  double memory_usage();
+  /* thermo output: f_ID = intact bonds, f_ID[1..3] = intact, broken in tension, in shear */
+  double compute_scalar();
+  double compute_vector(int);
+
+  /* One broken bond. */
+  struct Event {
+    bigint step;
+    double time;      /* [s] */
+    int tag_a, tag_b; /* tag_a < tag_b */
+    int mode;         /* jd_bond_mode */
+    double x[3];      /* the bond's point x_C [m] */
+    double n[3];      /* unit vector a -> b */
+    jd_bond_result r; /* forces, moments and stresses that broke it */
+  };
+  /* This rank's events since the last take_events(); dump h5md/jdem collects them. */
+  std::vector<Event> take_events();
+
+  /* This rank's intact bonds as (lower id, higher id) pairs. */
+  void local_bonds(std::vector<int> &pairs) const;
+  int local_count() const;
+
+  /* Observables of this rank: elastic energy stored in the bonds at the last force evaluation,
+   * and the cumulative energy dissipated by bond damping and released by broken bonds [J]. */
+  double e_elastic_now, e_damp_cum, e_broken_cum;
+
+ private:
+  void compute(bool commit);
+  template <unsigned F> void loop(bool commit);
+  void read_bond_file(const char *path);
+  void create_touching();
+  bool add_bond(int i, int partner_tag);
+  double *state(int i, int k) { return &bstate[i][k * JD_BOND_STATE_LEN]; }
+
+  jd_bond_params params;
+  unsigned features; /* JD_B_* of the run */
+  int max_bonds;
+  std::string bond_file;
+  bigint create_step;
+  double create_tol;
+  bool file_read;
+
+  int nmax_b;
+  int *nbond;     /* bonds stored on each atom */
+  int **partner;  /* their partners' ids */
+  double **bstate; /* their kernel states, JD_BOND_STATE_LEN doubles each */
+  int nmax_ghost;
+  double **fghost; /* force and torque on ghost partners, sent home by reverse communication */
+  std::vector<Event> events;
+  double nbroken[2]; /* this rank's bonds broken in tension, in shear (cumulative) */
+};
+
+}  // namespace LAMMPS_NS
+
+#endif
