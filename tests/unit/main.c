@@ -7,5 +7,6 @@ int main(void) {
     failed += run_geometry_tests();
     failed += run_h5md_tests();
     failed += run_watchdog_tests();
+    failed += run_bond_tests();
     return failed;
 }
