@@ -15,7 +15,10 @@
 #include "domain.h"
 #include "error.h"
 #include "force.h"
+#include "group.h"
 #include "memory.h"
+#include "modify.h"
+#include "neighbor.h"
 #include "neigh_list.h"
 #include "pair.h"
 #include "update.h"
@@ -31,18 +34,35 @@ static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double),
 
 FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), e_elastic_now(0.0), e_damp_cum(0.0), e_broken_cum(0.0), max_bonds(12),
-      create_step(-1), create_tol(0.0), file_read(false), nmax_b(0), nbond(NULL), partner(NULL),
+      file_read(false), nmax_b(0), nbond(NULL), partner(NULL),
       bstate(NULL), nmax_ghost(0), fghost(NULL) {
   const char *usage =
       "Illegal fix bond/jiang command: fix ID group bond/jiang kn KN kt KT sigma_c S tau_c T "
       "lambda L [damping GAMMA] [bending I|J_literal] [max_bonds N] [file FILE] "
-      "[create_at STEP [tolerance X]]";
+      "[rule K step S group GROUP max_gap X] ...";
   std::memset(&params, 0, sizeof params);
   params.bending = JD_BOND_BEND_I;
   bool seen[5] = {false, false, false, false, false};
   for (int iarg = 3; iarg < narg; iarg += 2) {
     if (iarg + 1 >= narg) error->all(FLERR, usage);
     const std::string k = arg[iarg], val = arg[iarg + 1];
+    if (k == "rule") {
+      if (iarg + 8 > narg || std::strcmp(arg[iarg + 2], "step") != 0 ||
+          std::strcmp(arg[iarg + 4], "group") != 0 || std::strcmp(arg[iarg + 6], "max_gap") != 0)
+        error->all(FLERR, "fix bond/jiang: rule K step S group GROUP max_gap X");
+      Rule r;
+      r.index = force->inumeric(FLERR, arg[iarg + 1]);
+      r.step = (bigint)force->inumeric(FLERR, arg[iarg + 3]);
+      const int igroup = group->find(arg[iarg + 5]);
+      if (igroup < 0) error->all(FLERR, (std::string("fix bond/jiang: rule: no group '") + arg[iarg + 5] + "'").c_str());
+      r.groupbit = group->bitmask[igroup];
+      r.max_gap = force->numeric(FLERR, arg[iarg + 7]);
+      if (r.index < 0 || r.step < 0 || !(r.max_gap >= 0.0))
+        error->all(FLERR, "fix bond/jiang: rule needs K >= 0, step S >= 0 and max_gap X >= 0");
+      rules.push_back(r);
+      iarg += 6;
+      continue;
+    }
     if (k == "kn") params.kn = force->numeric(FLERR, arg[iarg + 1]), seen[0] = true;
     else if (k == "kt") params.kt = force->numeric(FLERR, arg[iarg + 1]), seen[1] = true;
     else if (k == "sigma_c") params.sigma_c = val == "inf" ? INFINITY : force->numeric(FLERR, arg[iarg + 1]), seen[2] = true;
@@ -55,8 +75,6 @@ FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
       else error->all(FLERR, "fix bond/jiang: bending must be I or J_literal");
     } else if (k == "max_bonds") max_bonds = force->inumeric(FLERR, arg[iarg + 1]);
     else if (k == "file") bond_file = val;
-    else if (k == "create_at") create_step = (bigint)force->inumeric(FLERR, arg[iarg + 1]);
-    else if (k == "tolerance") create_tol = force->numeric(FLERR, arg[iarg + 1]);
     else error->all(FLERR, ("fix bond/jiang: unknown keyword '" + k + "'; " + usage).c_str());
   }
   for (int s = 0; s < 5; s++)
@@ -70,8 +88,6 @@ FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
   /* Comm::exchange leaves room for about 1000 doubles beyond an atom's own: stay well inside */
   if (max_bonds < 1 || 1 + max_bonds * (1 + JD_BOND_STATE_LEN) > 500)
     error->all(FLERR, "fix bond/jiang: max_bonds must be between 1 and 26");
-  if (create_step < -1) error->all(FLERR, "fix bond/jiang: create_at must be a step >= 0");
-  if (!(create_tol >= 0.0)) error->all(FLERR, "fix bond/jiang: tolerance must be >= 0");
   if (!atom->tag_enable || atom->map_style == 0)
     error->all(FLERR, "fix bond/jiang needs atom IDs and `atom_modify map array` (or hash)");
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
@@ -103,8 +119,19 @@ void FixBondJiang::init() {
   if (force->newton_pair)
     error->all(FLERR, "fix bond/jiang requires `newton off` (as LIGGGHTS' granular pair styles)");
   features = (params.gamma > 0.0 ? (unsigned)JD_B_DAMPING : 0u) | (jdem_wants_energy(lmp) ? (unsigned)JD_B_ENERGY : 0u);
-  if (create_step >= 0 && !force->pair)
-    error->all(FLERR, "fix bond/jiang create_at needs a pair style (its neighbour list finds touching atoms)");
+  if (!rules.empty() && (!force->pair || !force->pair->list))
+    error->all(FLERR, "fix bond/jiang: rules need a pair style (its neighbour list gives the candidates)");
+  double rmax = 0.0, rmax_all = 0.0;
+  for (int i = 0; i < atom->nlocal; i++) rmax = std::fmax(rmax, atom->radius[i]);
+  MPI_Allreduce(&rmax, &rmax_all, 1, MPI_DOUBLE, MPI_MAX, world);
+  for (size_t r = 0; r < rules.size(); r++)
+    if (rules[r].max_gap * rmax_all > neighbor->skin) {
+      char msg[256];
+      std::snprintf(msg, sizeof msg, "fix bond/jiang: rule %d: max_gap x the largest radius (%g m) exceeds the "
+                    "neighbour skin %g m, so candidate pairs could be missed; raise the skin",
+                    rules[r].index, rules[r].max_gap * rmax_all, neighbor->skin);
+      error->all(FLERR, msg);
+    }
 }
 
 /* Explicit bonds are formed at the first set-up; the set-up evaluation does not advance the
@@ -112,24 +139,43 @@ void FixBondJiang::init() {
 void FixBondJiang::setup(int vflag) {
   if (!file_read && !bond_file.empty()) read_bond_file(bond_file.c_str());
   file_read = true;
+  for (size_t r = 0; r < rules.size(); r++)
+    if (rules[r].step == update->ntimestep) form_by_rule(rules[r]);
   compute(false);
 }
 
 void FixBondJiang::post_force(int vflag) {
-  if (update->ntimestep == create_step) create_touching();
+  for (size_t r = 0; r < rules.size(); r++)
+    if (rules[r].step == update->ntimestep) form_by_rule(rules[r]);
   compute(true);
 }
 
 /* ---------------------------------------------------------------------------------------- */
 /* Forming bonds.                                                                              */
 
-/* Store a bond on local atom i (the lower id); false when i already holds max_bonds bonds. */
-bool FixBondJiang::add_bond(int i, int partner_tag) {
+bool FixBondJiang::bonded(int i, int tag_b) const {
   for (int k = 0; k < nbond[i]; k++)
-    if (partner[i][k] == partner_tag) return true; /* already bonded */
+    if (partner[i][k] == tag_b) return true;
+  return false;
+}
+
+/* A pair holds at most one bond, of any type (docs/scenes.md). */
+bool FixBondJiang::bonded_anywhere(int i, int tag_b) const {
+  for (int k = 0; k < modify->nfix; k++) {
+    const FixBondJiang *b = dynamic_cast<const FixBondJiang *>(modify->fix[k]);
+    if (b && b->bonded(i, tag_b)) return true;
+  }
+  return false;
+}
+
+/* Store a new bond on local atom i (the lower id) and record it; false when i already holds
+ * max_bonds bonds of this type. */
+bool FixBondJiang::add_bond(int i, int partner_tag, int rule) {
   if (nbond[i] >= max_bonds) return false;
   const int k = nbond[i]++;
   partner[i][k] = partner_tag;
+  Formed fr = {update->ntimestep, rule, atom->tag[i], partner_tag};
+  formed.push_back(fr);
   jd_bond_state fresh;
   jd_bond_form(&fresh);
   std::memcpy(state(i, k), &fresh, sizeof fresh);
@@ -190,7 +236,14 @@ void FixBondJiang::read_bond_file(const char *path) {
     const int ia = atom->map(pairs[p]), ib = atom->map(pairs[p + 1]);
     if (ia >= 0 && ia < atom->nlocal) found_mine++;
     if (ib >= 0 && ib < atom->nlocal) found_mine++;
-    if (ia >= 0 && ia < atom->nlocal && !add_bond(ia, pairs[p + 1])) too_many(error, pairs[p], max_bonds);
+    if (ia >= 0 && ia < atom->nlocal) {
+      if (bonded_anywhere(ia, pairs[p + 1])) {
+        std::snprintf(msg, sizeof msg, "fix bond/jiang: %s: atoms %d and %d are bonded twice", path,
+                      pairs[p], pairs[p + 1]);
+        error->one(FLERR, msg);
+      }
+      if (!add_bond(ia, pairs[p + 1], -1)) too_many(error, pairs[p], max_bonds);
+    }
   }
   int found = 0;
   MPI_Allreduce(&found_mine, &found, 1, MPI_INT, MPI_SUM, world);
@@ -200,29 +253,28 @@ void FixBondJiang::read_bond_file(const char *path) {
   }
 }
 
-/* Bond every touching pair of the group, with the same test as the contact (jd_geom_spheres:
- * distance < R_a + R_b), widened by the tolerance.  The pair style's neighbour list holds each
- * local pair once and each local-ghost pair on both ranks; the owner of the lower id stores it. */
-void FixBondJiang::create_touching() {
+/* The rule's pair test (docs/scenes.md): both atoms in the group, not bonded yet, surface gap
+ * |x_b - x_a| - R_a - R_b <= max_gap min(R_a, R_b).  The pair style's neighbour list holds each
+ * local pair once and each local-ghost pair on both ranks; the owner of the lower id forms it. */
+void FixBondJiang::form_by_rule(const Rule &r) {
   NeighList *list = force->pair->list;
-  if (!list) error->all(FLERR, "fix bond/jiang create_at: the pair style has no neighbour list");
   double **x = atom->x;
   const double *radius = atom->radius;
   const int *tag = atom->tag, *mask = atom->mask;
   const int nlocal = atom->nlocal;
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
-    if (!(mask[i] & groupbit)) continue;
+    if (!(mask[i] & r.groupbit)) continue;
     for (int jj = 0; jj < list->numneigh[i]; jj++) {
       const int j = list->firstneigh[i][jj] & NEIGHMASK;
-      if (!(mask[j] & groupbit)) continue;
-      const double dx = x[j][0] - x[i][0], dy = x[j][1] - x[i][1], dz = x[j][2] - x[i][2];
-      const double reach = (radius[i] + radius[j]) * (1.0 + create_tol);
-      if (dx * dx + dy * dy + dz * dz >= reach * reach && create_tol == 0.0) continue;
-      if (create_tol > 0.0 && dx * dx + dy * dy + dz * dz > reach * reach) continue;
+      if (!(mask[j] & r.groupbit)) continue;
       const int lo = tag[i] < tag[j] ? i : j, hi = lo == i ? j : i;
-      if (lo >= nlocal) continue; /* the other rank stores it */
-      if (!add_bond(lo, tag[hi])) too_many(error, tag[lo], max_bonds);
+      if (lo >= nlocal) continue; /* the other rank forms it */
+      const double d[3] = {x[hi][0] - x[lo][0], x[hi][1] - x[lo][1], x[hi][2] - x[lo][2]};
+      const double gap = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - radius[lo] - radius[hi];
+      if (!(gap <= r.max_gap * std::fmin(radius[lo], radius[hi]))) continue;
+      if (bonded_anywhere(lo, tag[hi])) continue;
+      if (!add_bond(lo, tag[hi], r.index)) too_many(error, tag[lo], max_bonds);
     }
   }
 }
@@ -386,6 +438,12 @@ void FixBondJiang::unpack_reverse_comm(int n, int *list, double *buf) {
 std::vector<FixBondJiang::Event> FixBondJiang::take_events() {
   std::vector<Event> out;
   out.swap(events);
+  return out;
+}
+
+std::vector<FixBondJiang::Formed> FixBondJiang::take_formed() {
+  std::vector<Formed> out;
+  out.swap(formed);
   return out;
 }
 

@@ -3,17 +3,23 @@
  *
  *   fix ID group bond/jiang kn KN kt KT sigma_c S tau_c T lambda L [damping GAMMA]
  *                           [bending I|J_literal] [max_bonds N] [file FILE]
- *                           [create_at STEP [tolerance X]]
+ *                           [rule K step S group GROUP max_gap X] ...
  *
+ * One fix is one bond type of the scene (docs/scenes.md "Bonds"); the n-th fix bond/jiang of
+ * the input is bond type n - 1 in the trajectory's /connectivity/bond_type.
  *   kn, kt     normal and shear stiffness per unit area                     [N/m^3]
  *   sigma_c    tensile strength, tau_c shear strength (inf: never)          [Pa]
  *   lambda     bond-radius multiplier: R_bond = lambda min(R_a, R_b)        [-]
  *   damping    damping ratio of the bond's dashpots (default 0: none)       [-]
  *   bending    second moment of the bending stiffness (default I; docs/model.md)
  *   max_bonds  bonds one atom can store (default 12, the FCC coordination)
- *   file FILE  explicit bonds: lines "ID_A ID_B" ('#' starts a comment), formed at set-up
- *   create_at  at this step, bond every pair of touching atoms of the group, |x_b - x_a| <=
- *              (R_a + R_b)(1 + X) (default X = 0)
+ *   file FILE  explicit bonds: lines "ID_A ID_B" ('#' starts a comment), formed at the first
+ *              set-up with zero force, wherever the two atoms are
+ *   rule       at step S (before the step's bond forces), bond every pair of atoms of GROUP not
+ *              yet bonded (by any fix bond/jiang) with |x_b - x_a| - R_a - R_b <= X min(R_a, R_b);
+ *              K orders the rules of all bond fixes in /connectivity (the scene's rule index).
+ *              The candidates come from the pair style's neighbour list: X max(R) must not
+ *              exceed the neighbour skin.
  *
  * Bookkeeping (docs/liggghts.md, "Bonds"):
  *   - a bond is stored once, on the atom with the lower id, as the partner's id and the kernel
@@ -72,8 +78,18 @@ class FixBondJiang : public Fix {
     double n[3];      /* unit vector a -> b */
     jd_bond_result r; /* forces, moments and stresses that broke it */
   };
-  /* This rank's events since the last take_events(); dump h5md/jdem collects them. */
+  /* A bond formed: rule -1 for the explicit ones (docs/scenes.md orders /connectivity/bonds
+   * by step, rule, ids). */
+  struct Formed {
+    bigint step;
+    int rule;
+    int tag_a, tag_b; /* tag_a < tag_b */
+  };
+  /* This rank's records since the last call; dump h5md/jdem collects them. */
   std::vector<Event> take_events();
+  std::vector<Formed> take_formed();
+  /* True when local atom i (the lower id) holds an intact bond with the atom of id tag_b. */
+  bool bonded(int i, int tag_b) const;
 
   /* This rank's intact bonds as (lower id, higher id) pairs. */
   void local_bonds(std::vector<int> &pairs) const;
@@ -87,16 +103,22 @@ class FixBondJiang : public Fix {
   void compute(bool commit);
   template <unsigned F> void loop(bool commit);
   void read_bond_file(const char *path);
-  void create_touching();
-  bool add_bond(int i, int partner_tag);
+  struct Rule {
+    int index;
+    bigint step;
+    int groupbit;
+    double max_gap;
+  };
+  void form_by_rule(const Rule &r);
+  bool bonded_anywhere(int i, int tag_b) const;
+  bool add_bond(int i, int partner_tag, int rule);
   double *state(int i, int k) { return &bstate[i][k * JD_BOND_STATE_LEN]; }
 
   jd_bond_params params;
   unsigned features; /* JD_B_* of the run */
   int max_bonds;
   std::string bond_file;
-  bigint create_step;
-  double create_tol;
+  std::vector<Rule> rules;
   bool file_read;
 
   int nmax_b;
@@ -106,6 +128,7 @@ class FixBondJiang : public Fix {
   int nmax_ghost;
   double **fghost; /* force and torque on ghost partners, sent home by reverse communication */
   std::vector<Event> events;
+  std::vector<Formed> formed;
   double nbroken[2]; /* this rank's bonds broken in tension, in shear (cumulative) */
 };
 
