@@ -8,5 +8,6 @@ int main(void) {
     failed += run_h5md_tests();
     failed += run_watchdog_tests();
     failed += run_bond_tests();
+    failed += run_h5md_bonds_tests();
     return failed;
 }

@@ -26,5 +26,6 @@ int run_geometry_tests(void);
 int run_h5md_tests(void);
 int run_watchdog_tests(void);
 int run_bond_tests(void);
+int run_h5md_bonds_tests(void);
 
 #endif
