@@ -19,6 +19,8 @@
 #include "memory.h"
 #include "modify.h"
 #include "neighbor.h"
+#include "output.h"
+#include "dump.h"
 #include "neigh_list.h"
 #include "pair.h"
 #include "update.h"
@@ -34,7 +36,7 @@ static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double),
 
 FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), e_elastic_now(0.0), e_damp_cum(0.0), e_broken_cum(0.0), max_bonds(12),
-      file_read(false), nmax_b(0), nbond(NULL), partner(NULL),
+      file_read(false), record(true), nmax_b(0), nbond(NULL), partner(NULL),
       bstate(NULL), nmax_ghost(0), fghost(NULL) {
   const char *usage =
       "Illegal fix bond/jiang command: fix ID group bond/jiang kn KN kt KT sigma_c S tau_c T "
@@ -119,6 +121,10 @@ void FixBondJiang::init() {
   if (force->newton_pair)
     error->all(FLERR, "fix bond/jiang requires `newton off` (as LIGGGHTS' granular pair styles)");
   features = (params.gamma > 0.0 ? (unsigned)JD_B_DAMPING : 0u) | (jdem_wants_energy(lmp) ? (unsigned)JD_B_ENERGY : 0u);
+  /* records only for a dump h5md/jdem that collects them */
+  record = false;
+  for (int k = 0; k < output->ndump; k++)
+    if (std::strcmp(output->dump[k]->style, "h5md/jdem") == 0) record = true;
   if (!rules.empty() && (!force->pair || !force->pair->list))
     error->all(FLERR, "fix bond/jiang: rules need a pair style (its neighbour list gives the candidates)");
   double rmax = 0.0, rmax_all = 0.0;
@@ -175,7 +181,7 @@ bool FixBondJiang::add_bond(int i, int partner_tag, int rule) {
   const int k = nbond[i]++;
   partner[i][k] = partner_tag;
   Formed fr = {update->ntimestep, rule, atom->tag[i], partner_tag};
-  formed.push_back(fr);
+  if (record) formed.push_back(fr);
   jd_bond_state fresh;
   jd_bond_form(&fresh);
   std::memcpy(state(i, k), &fresh, sizeof fresh);
@@ -369,7 +375,7 @@ void FixBondJiang::loop(bool commit) {
           ev.n[d] = g.n[d];
         }
         ev.r = out;
-        events.push_back(ev);
+        if (record) events.push_back(ev);
         nbroken[mode == JD_BOND_BROKE_TENSION ? 0 : 1] += 1.0;
         e_damp += st.e_damp;
         e_broken += st.e_break;

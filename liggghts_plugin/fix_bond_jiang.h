@@ -120,6 +120,7 @@ class FixBondJiang : public Fix {
   std::string bond_file;
   std::vector<Rule> rules;
   bool file_read;
+  bool record; /* keep formed/broken records: a dump h5md/jdem collects them */
 
   int nmax_b;
   int *nbond;     /* bonds stored on each atom */

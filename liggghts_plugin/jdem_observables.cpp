@@ -12,6 +12,7 @@
 
 #include <cstring>
 
+#include "fix_bond_jiang.h"
 #include "fix_wall_jiang.h"
 #include "jdem_kernel.h"
 #include "pair_gran_jiang.h"
@@ -42,6 +43,13 @@ void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]) {
     out[JDO_KINETIC] += 0.5 * m * jd_dot(v[i], v[i]);
     out[JDO_ROTATIONAL] += 0.5 * jd_sphere_inertia(m, atom->radius[i]) * jd_dot(omega[i], omega[i]);
     out[JDO_GRAVITATIONAL] -= m * jd_dot(g, x[i]);
+  }
+  for (int k = 0; k < lmp->modify->nfix; k++) {
+    FixBondJiang *b = dynamic_cast<FixBondJiang *>(lmp->modify->fix[k]);
+    if (!b) continue;
+    out[JDO_BOND_ELASTIC] += b->e_elastic_now;
+    out[JDO_BOND_DAMPING] += b->e_damp_cum;
+    out[JDO_BOND_BREAKAGE] += b->e_broken_cum;
   }
   PairGranJiang *pair = dynamic_cast<PairGranJiang *>(lmp->force->pair);
   if (!pair) return;
