@@ -125,7 +125,7 @@ void FixBondJiang::init() {
   record = false;
   for (int k = 0; k < output->ndump; k++)
     if (std::strcmp(output->dump[k]->style, "h5md/jdem") == 0) record = true;
-  if (!rules.empty() && (!force->pair || !force->pair->list))
+  if (!rules.empty() && !force->pair)
     error->all(FLERR, "fix bond/jiang: rules need a pair style (its neighbour list gives the candidates)");
   double rmax = 0.0, rmax_all = 0.0;
   for (int i = 0; i < atom->nlocal; i++) rmax = std::fmax(rmax, atom->radius[i]);
@@ -264,6 +264,7 @@ void FixBondJiang::read_bond_file(const char *path) {
  * local pair once and each local-ghost pair on both ranks; the owner of the lower id forms it. */
 void FixBondJiang::form_by_rule(const Rule &r) {
   NeighList *list = force->pair->list;
+  if (!list) error->all(FLERR, "fix bond/jiang: rules need a pair style with a neighbour list (gran/jiang)");
   double **x = atom->x;
   const double *radius = atom->radius;
   const int *tag = atom->tag, *mask = atom->mask;
