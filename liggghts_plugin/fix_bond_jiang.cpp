@@ -115,7 +115,47 @@ FixBondJiang::~FixBondJiang() {
   memory->destroy(fghost);
 }
 
-int FixBondJiang::setmask() { return POST_FORCE; }
+int FixBondJiang::setmask() { return PRE_NEIGHBOR | POST_FORCE; }
+
+/* At every neighbour rebuild, after the ghosts were acquired: each bond shorter than the ghost
+ * cutoff has its partner as a ghost until the next rebuild.  Collective, so that every rank
+ * stops with the same message (and the dumps keep their files). */
+void FixBondJiang::check_reach() {
+  double **x = atom->x;
+  const double cut = std::fmin(comm->cutghost[0], std::fmin(comm->cutghost[1], comm->cutghost[2]));
+  struct { double ratio; int rank; } mine = {0.0, comm->me}, worst;
+  int tags[2] = {0, 0};
+  double len = 0.0;
+  for (int i = 0; i < atom->nlocal; i++)
+    for (int k = 0; k < nbond[i]; k++) {
+      int j = atom->map(partner[i][k]);
+      double L = INFINITY; /* no image of the partner here: beyond any cutoff */
+      if (j >= 0) {
+        j = domain->closest_image(i, j);
+        const double d[3] = {x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
+        L = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      }
+      if (L / cut > mine.ratio) {
+        mine.ratio = L / cut;
+        tags[0] = atom->tag[i];
+        tags[1] = partner[i][k];
+        len = L;
+      }
+    }
+  MPI_Allreduce(&mine, &worst, 1, MPI_DOUBLE_INT, MPI_MAXLOC, world);
+  if (worst.ratio < 1.0) return;
+  MPI_Bcast(tags, 2, MPI_INT, worst.rank, world);
+  MPI_Bcast(&len, 1, MPI_DOUBLE, worst.rank, world);
+  char msg[400];
+  std::snprintf(msg, sizeof msg, "fix bond/jiang: step " BIGINT_FORMAT ": bond %d-%d is %.9g m long, not within "
+                "the ghost cutoff %g m that keeps bonded partners visible on every rank; raise it with "
+                "`communicate single vel yes cutoff X`", update->ntimestep, tags[0], tags[1], len, cut);
+  error->all(FLERR, msg);
+}
+
+void FixBondJiang::setup_pre_neighbor() { check_reach(); }
+
+void FixBondJiang::pre_neighbor() { check_reach(); }
 
 void FixBondJiang::init() {
   if (force->newton_pair)
@@ -308,7 +348,6 @@ void FixBondJiang::loop(bool commit) {
   const int *tag = atom->tag;
   const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
   const double dt = update->dt;
-  const double cut = std::fmax(comm->cutghost[0], std::fmax(comm->cutghost[1], comm->cutghost[2]));
   const bigint step = update->ntimestep;
   const double time = update->atime + (double)(step - update->atimestep) * dt;
 
@@ -327,8 +366,7 @@ void FixBondJiang::loop(bool commit) {
       if (j < 0) {
         char msg[256];
         std::snprintf(msg, sizeof msg, "fix bond/jiang: step " BIGINT_FORMAT ": the partner %d of atom %d "
-                      "is neither on this rank nor a ghost (a bond longer than the ghost cutoff %g m?)",
-                      step, partner[i][k], tag[i], cut);
+                      "is neither on this rank nor a ghost", step, partner[i][k], tag[i]);
         error->one(FLERR, msg);
       }
       j = domain->closest_image(i, j);
@@ -337,14 +375,6 @@ void FixBondJiang::loop(bool commit) {
         char msg[160];
         std::snprintf(msg, sizeof msg, "fix bond/jiang: step " BIGINT_FORMAT ": bonded atoms %d and %d "
                       "are at the same position", step, tag[i], partner[i][k]);
-        error->one(FLERR, msg);
-      }
-      if (!(radius[i] + radius[j] - g.delta < cut)) {
-        char msg[320];
-        std::snprintf(msg, sizeof msg, "fix bond/jiang: step " BIGINT_FORMAT ": bond %d-%d is %g m long, "
-                      "not within the ghost cutoff %g m that keeps partners visible on every rank; "
-                      "raise it with `communicate single vel yes cutoff X`", step, tag[i], partner[i][k],
-                      radius[i] + radius[j] - g.delta, cut);
         error->one(FLERR, msg);
       }
       g.sec = jd_bond_section_of(params.lambda, radius[i], radius[j]);

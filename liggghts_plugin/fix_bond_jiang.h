@@ -29,8 +29,9 @@
  *     ghost when the partner lives on another rank, and sends the partner's force and torque back
  *     with a reverse communication (LIGGGHTS runs granular pairs with newton off: no other
  *     reverse communication of forces takes place);
- *   - a partner must be within the ghost cutoff: a longer bond stops the run with a message that
- *     names it (`communicate single vel yes cutoff X` raises the cutoff);
+ *   - a partner must be within the ghost cutoff at every neighbour rebuild (then it stays a ghost
+ *     until the next one): a longer bond stops the run on every rank with a message that names
+ *     it (`communicate single vel yes cutoff X` raises the cutoff);
  *   - a bond that fails is removed on the spot and recorded as an event (dump h5md/jdem writes
  *     them); the pair then interacts through gran/jiang alone.
  * Thermo: f_ID is the number of intact bonds, f_ID[1], f_ID[2], f_ID[3] the intact bonds and the
@@ -54,6 +55,8 @@ class FixBondJiang : public Fix {
   int setmask();
   void init();
   void setup(int);
+  void setup_pre_neighbor();
+  void pre_neighbor();
   void post_force(int);
 
   void grow_arrays(int);
@@ -101,6 +104,7 @@ class FixBondJiang : public Fix {
 
  private:
   void compute(bool commit);
+  void check_reach();
   template <unsigned F> void loop(bool commit);
   void read_bond_file(const char *path);
   struct Rule {
