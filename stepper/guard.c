@@ -4,6 +4,7 @@
  *   (b) the shortest Hertz contact (any species pair, any species against a wall, at the
  *       smallest radii and the scene's max_impact_speed) must span at least 50 steps
  *       (erratum 18: 3-4 steps per contact, the seed's rule of thumb, is far too coarse).
+ *   (c) with bonds, the fastest bond mode must span at least 20 steps (sim_bonds_guard, bonds.c).
  * The contact time scales like R (m ~ R^3, k ~ R^0.5, t ~ (m/k)^0.4), so the smallest radii
  * give the shortest contact.
  */
@@ -24,7 +25,8 @@ static void tighten(jd_guard *g, double bound, const char *what) {
 }
 
 void sim_guard(const jd_scene *sc, jd_guard *g) {
-    *g = (jd_guard){.rayleigh_bound = INFINITY, .contact_time = INFINITY, .contact_bound = INFINITY};
+    *g = (jd_guard){.rayleigh_bound = INFINITY, .contact_time = INFINITY, .contact_bound = INFINITY,
+                    .bond_bound = INFINITY};
     species_info *sp = calloc(sc->n_materials ? sc->n_materials : 1, sizeof *sp);
     if (!sp) { /* cannot assess: report as unsafe rather than silently safe */
         g->safe_dt = 0.0;
@@ -62,8 +64,10 @@ void sim_guard(const jd_scene *sc, jd_guard *g) {
     }
     free(sp);
     g->contact_bound = g->contact_time / JD_GUARD_STEPS_PER_CONTACT;
-    g->safe_dt = fmin(g->rayleigh_bound, g->contact_bound);
+    g->bond_bound = sim_bonds_guard(sc);
+    g->safe_dt = fmin(fmin(g->rayleigh_bound, g->contact_bound), g->bond_bound);
     if (sc->dt > g->rayleigh_bound) tighten(g, g->rayleigh_bound, "20 % of the Rayleigh time step");
     if (sc->dt > g->contact_bound)
         tighten(g, g->contact_bound, "1/50 of the shortest Hertz contact time");
+    if (sc->dt > g->bond_bound) tighten(g, g->bond_bound, "1/20 of the fastest bond period");
 }

@@ -48,8 +48,9 @@ static const char usage_text[] =
     "  --quiet                  no summary and no progress line on stderr (run)\n"
     "\n"
     "time-step guard (run): dt must not exceed 20 % of the Rayleigh time step of the smallest\n"
-    "sphere, nor 1/50 of the shortest Hertz contact time at time.max_impact_speed; otherwise\n"
-    "the run is refused (exit status 2) unless --force is given.\n"
+    "sphere, nor 1/50 of the shortest Hertz contact time at time.max_impact_speed, nor (with\n"
+    "bonds) 1/20 of the period of the fastest bond mode; otherwise the run is refused (exit\n"
+    "status 2) unless --force is given.\n"
     "\n"
     "environment:\n"
     "  JDEM_NEIGHBOUR=allpairs  debugging aid: evaluate every particle pair and every\n"
@@ -179,6 +180,9 @@ static int check_time_step(const jd_scene *sc, const cli *c) {
                     g.contact_time / sc->dt);
         else
             fprintf(stderr, " (no impact to resolve)\n");
+        if (isfinite(g.bond_bound))
+            fprintf(stderr, "jdem: bond bound (1/20 of the fastest bond period) = %.6g s\n",
+                    g.bond_bound);
     }
     if (!g.violated) return 0;
     if (!c->force) {

@@ -371,6 +371,8 @@ void scene_free(jd_scene *scene) {
     free(scene->position);
     free(scene->velocity);
     free(scene->angular_velocity);
+    free(scene->fixed);
+    free(scene->force);
     free(scene->walls);
     free(scene->bond_types);
     free(scene->bond_ids);

@@ -111,6 +111,10 @@ typedef struct jd_scene {
     double *position;         /* 3n [m] */
     double *velocity;         /* 3n [m/s] */
     double *angular_velocity; /* 3n [rad/s] */
+    unsigned char *fixed;     /* n: 1 = force and torque held at zero (moves at its initial
+                                 velocity and spin, like LIGGGHTS fix freeze) */
+    double *force;            /* 3n: constant external force [N] (LIGGGHTS fix addforce) */
+    int has_loads;            /* some particle is fixed or has an external force */
 
     size_t n_walls;
     jd_wall *walls;

@@ -172,7 +172,11 @@ static int emit_particles(yaml_emitter_t *e, const jd_scene *s) {
             key_str(e, "material", s->materials[s->material[i]].name) ||
             key_num(e, "radius", s->radius[i]) || key_vec(e, "position", &s->position[3 * i]) ||
             key_vec(e, "velocity", &s->velocity[3 * i]) ||
-            key_vec(e, "angular_velocity", &s->angular_velocity[3 * i]) || map_end(e))
+            key_vec(e, "angular_velocity", &s->angular_velocity[3 * i]) ||
+            (s->fixed[i] && (str(e, "fixed") || scalar(e, "true", YAML_PLAIN_SCALAR_STYLE))) ||
+            ((s->force[3 * i] != 0.0 || s->force[3 * i + 1] != 0.0 || s->force[3 * i + 2] != 0.0) &&
+             key_vec(e, "force", &s->force[3 * i])) ||
+            map_end(e))
             return 1;
     return seq_end(e);
 }

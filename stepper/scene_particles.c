@@ -11,7 +11,8 @@
 #define OVERLAP_TOL 1e-6
 
 static const char *const PARTICLE_KEYS[] = {"id", "material", "radius", "position", "velocity",
-                                            "angular_velocity", NULL};
+                                            "angular_velocity", "fixed", "force", NULL};
+static const char *const BOOLEANS[] = {"false", "true", NULL};
 
 /* ---------------------------------------------------------------------------------------- */
 /* Particles                                                                                 */
@@ -33,6 +34,8 @@ static int grow_particles(loader *L, size_t need) {
     GROW(s->position, 3);
     GROW(s->velocity, 3);
     GROW(s->angular_velocity, 3);
+    GROW(s->fixed, 1);
+    GROW(s->force, 3);
     GROW(L->pnode, 1);
     GROW(L->psrc, 1);
 #undef GROW
@@ -50,6 +53,8 @@ long scene_add_particle(loader *L, const yaml_node_t *node, int32_t src) {
     size_t i = s->n_particles++;
     memset(&s->velocity[3 * i], 0, 3 * sizeof(double));
     memset(&s->angular_velocity[3 * i], 0, 3 * sizeof(double));
+    memset(&s->force[3 * i], 0, 3 * sizeof(double));
+    s->fixed[i] = 0;
     L->pnode[i] = node;
     L->psrc[i] = src;
     return (long)i;
@@ -81,8 +86,14 @@ static int read_particle(loader *L, const yaml_node_t *p, size_t index) {
         sd_req_num(&L->c, p, path, "radius", SD_POSITIVE, &s->radius[i]) ||
         sd_req_vec3(&L->c, p, path, "position", &s->position[3 * i]) ||
         sd_opt_vec3(&L->c, p, path, "velocity", &s->velocity[3 * i]) ||
-        sd_opt_vec3(&L->c, p, path, "angular_velocity", &s->angular_velocity[3 * i]))
+        sd_opt_vec3(&L->c, p, path, "angular_velocity", &s->angular_velocity[3 * i]) ||
+        sd_opt_vec3(&L->c, p, path, "force", &s->force[3 * i]))
         return -1;
+    int fixed = 0;
+    if (sd_opt_enum(&L->c, p, path, "fixed", BOOLEANS, &fixed)) return -1;
+    s->fixed[i] = (unsigned char)fixed;
+    s->has_loads |= fixed || s->force[3 * i] != 0.0 || s->force[3 * i + 1] != 0.0 ||
+                    s->force[3 * i + 2] != 0.0;
     s->material[i] = mat;
     return 0;
 }
@@ -137,6 +148,8 @@ static int permute(loader *L, const id_index *perm) {
     PERMUTE(s->position, 3);
     PERMUTE(s->velocity, 3);
     PERMUTE(s->angular_velocity, 3);
+    PERMUTE(s->fixed, 1);
+    PERMUTE(s->force, 3);
     PERMUTE(L->pnode, 1);
     PERMUTE(L->psrc, 1);
 #undef PERMUTE

@@ -151,10 +151,15 @@ static int setup_forces(jd_sim *s, char *err, size_t errlen) {
         roll[k] = malloc((lists[k]->n + 1) * sizeof *roll[k]);
         ok = ok && state[k] && roll[k];
     }
+    jd_bond_state *bonds = NULL;
+    if (ok && s->bonds) ok = (bonds = sim_bonds_save(s)) != NULL;
     if (ok) {
         for (int k = 0; k < 2; k++) save_history(lists[k], state[k], roll[k]);
+        s->in_setup = 1;
         sim_compute_forces(s);
+        s->in_setup = 0;
         for (int k = 0; k < 2; k++) restore_history(lists[k], state[k], roll[k]);
+        if (s->bonds) sim_bonds_restore(s, bonds);
     } else {
         snprintf(err, errlen, "out of memory");
     }
@@ -173,6 +178,7 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
     }
     s->features = scene_features(s);
     if (sim_walls_init(s, err, errlen) != 0) return -1;
+    if (sim_bonds_init(s, err, errlen) != 0 || sim_loads_init(s, err, errlen) != 0) return -1;
     if (sim_neighbour_build(s, err, errlen) != 0) return -1;
     return setup_forces(s, err, errlen);
 }
@@ -204,6 +210,8 @@ void sim_free(jd_sim *s) {
     sim_contact_list_free(&s->pairs);
     sim_contact_list_free(&s->wall_pairs);
     sim_contact_list_free(&s->spare);
+    sim_bonds_free(s);
+    sim_loads_free(s);
     memset(s, 0, sizeof *s);
 }
 
@@ -236,6 +244,14 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
         if (jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->dt,
                                      val[k], err, errlen) != 0)
             return JD_RUN_ERROR;
+    if (s->bonds) {
+        double bv[JD_N_BOND_OBSERVABLES];
+        sim_bond_observables_values(&o.bond, bv);
+        for (int k = 0; h && k < JD_N_BOND_OBSERVABLES; k++)
+            if (jd_h5md_write_observable(h, jd_bond_observable_names[k], s->step,
+                                         (double)s->step * s->dt, bv[k], err, errlen) != 0)
+                return JD_RUN_ERROR;
+    }
     return sim_watchdog_energy(s, &o, err, errlen);
 }
 
@@ -260,6 +276,7 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
     int rc = 0;
     for (;;) {
         if ((rc = sim_watchdog_step(s, err, errlen)) != 0) break;
+        if (s->bonds && (rc = sim_bonds_output(s, h, err, errlen)) != 0) break;
         if (due(s->step, sc->output_every, last)) {
             if ((rc = write_frame(s, h, err, errlen)) != 0) break;
             s->frame_step = s->step;
