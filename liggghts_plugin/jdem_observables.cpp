@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "fix_bond_jiang.h"
+#include "fix_jdem_loads.h"
 #include "fix_wall_jiang.h"
 #include "jdem_kernel.h"
 #include "pair_gran_jiang.h"
@@ -43,6 +44,10 @@ void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]) {
     out[JDO_KINETIC] += 0.5 * m * jd_dot(v[i], v[i]);
     out[JDO_ROTATIONAL] += 0.5 * jd_sphere_inertia(m, atom->radius[i]) * jd_dot(omega[i], omega[i]);
     out[JDO_GRAVITATIONAL] -= m * jd_dot(g, x[i]);
+  }
+  for (int k = 0; k < lmp->modify->nfix; k++) {
+    FixJdemLoads *l = dynamic_cast<FixJdemLoads *>(lmp->modify->fix[k]);
+    if (l) out[JDO_WALL_WORK] += l->work_cum; /* the external work (docs/scenes.md) */
   }
   for (int k = 0; k < lmp->modify->nfix; k++) {
     FixBondJiang *b = dynamic_cast<FixBondJiang *>(lmp->modify->fix[k]);

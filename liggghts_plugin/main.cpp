@@ -6,6 +6,7 @@
  *   fix wall/jiang          modify->fix_map (private: explicit-instantiation access idiom)
  *   fix jdem/watchdog       idem
  *   fix bond/jiang          idem
+ *   fix jdem/loads          idem
  *   dump h5md/jdem          LIGGGHTS 3.8 has no dump map: Output::add_dump() is an if-else chain
  *                           over style_dump.h.  We interpose Output::add_dump (libliggghts.so
  *                           calls it through its PLT, so the executable's definition wins) and
@@ -33,6 +34,7 @@
 
 #include "dump_h5md_jdem.h"
 #include "fix_bond_jiang.h"
+#include "fix_jdem_loads.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_wall_jiang.h"
 #include "pair_gran_jiang.h"
@@ -61,6 +63,10 @@ static Fix *create_fix_bond_jiang(LAMMPS *lmp, int narg, char **arg) {
   return new FixBondJiang(lmp, narg, arg);
 }
 
+static Fix *create_fix_jdem_loads(LAMMPS *lmp, int narg, char **arg) {
+  return new FixJdemLoads(lmp, narg, arg);
+}
+
 static Fix *create_fix_jdem_watchdog(LAMMPS *lmp, int narg, char **arg) {
   return new FixJdemWatchdog(lmp, narg, arg);
 }
@@ -71,6 +77,7 @@ static void register_jdem_styles(LAMMPS *lmp) {
   (*fix_map)["wall/jiang"] = &create_fix_wall_jiang;
   (*fix_map)["jdem/watchdog"] = &create_fix_jdem_watchdog;
   (*fix_map)["bond/jiang"] = &create_fix_bond_jiang;
+  (*fix_map)["jdem/loads"] = &create_fix_jdem_loads;
 }
 
 /* ---- dump h5md/jdem: interposed Output::add_dump ---- */
