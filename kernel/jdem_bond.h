@@ -31,6 +31,10 @@
  * contact (the engines evaluate the contact law for the pair whenever the spheres overlap, in
  * parallel with the bond while it is intact).
  *
+ * Step 0 (LIGGGHTS `setup`, forces evaluated without advancing any history): call jd_bond with
+ * dt = 0.  There is no increment, so the force is the stored one (plus the dashpots), nothing is
+ * booked, and the energy reference of the first step is the stored state.
+ *
  * The hot path (jd_bond) is `static inline` so that each engine inlines it into a loop
  * specialised for its feature set (JD_B_* bits, a compile-time constant at every call site).
  */
@@ -319,16 +323,6 @@ static inline int jd_bond(const unsigned features, const jd_bond_params *p, cons
         out->tb[d] += m[d];
     }
     return JD_BOND_INTACT;
-}
-
-/* Step-0 evaluation (LIGGGHTS `setup`, see jd_contact_keep_reference): keep from an evaluated
- * copy only the energy reference of the next evaluation. */
-static inline void jd_bond_keep_reference(jd_bond_state *s, const jd_bond_state *evaluated) {
-    for (int d = 0; d < 3; d++) {
-        s->f_prev[d] = evaluated->f_prev[d];
-        s->m_prev[d] = evaluated->m_prev[d];
-    }
-    s->u_prev = evaluated->u_prev;
 }
 
 #ifdef __cplusplus

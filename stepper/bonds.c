@@ -200,6 +200,8 @@ static void record_break(jd_sim *s, size_t k, const jd_bond_geom *g, const jd_bo
 /* Returns the number of bonds that broke. */
 static JD_ALWAYS_INLINE size_t bond_loop(jd_sim *s, const unsigned F, int64_t step) {
     jd_bonds *b = s->bonds;
+    /* Step 0 (LIGGGHTS `setup`): no increment, the force is the stored one (bonds.h) */
+    const double dt = s->in_setup ? 0.0 : s->dt;
     size_t broke = 0;
     for (size_t k = 0; k < b->n; k++) {
         const int32_t i = b->i[k], j = b->j[k];
@@ -220,7 +222,7 @@ static JD_ALWAYS_INLINE size_t bond_loop(jd_sim *s, const unsigned F, int64_t st
             kin.wb[d] = wb[d];
         }
         jd_bond_result out;
-        if (jd_bond(F, &b->params[b->type[k]], &g, &kin, s->dt, &b->state[k], &out) !=
+        if (jd_bond(F, &b->params[b->type[k]], &g, &kin, dt, &b->state[k], &out) !=
             JD_BOND_INTACT) {
             record_break(s, k, &g, &out, step);
             broke++;
@@ -271,23 +273,6 @@ void sim_bonds_forces(jd_sim *s) {
     const size_t broke = (b->features & JD_B_DAMPING) ? bond_loop(s, JD_B_ENERGY | JD_B_DAMPING, step)
                                                       : bond_loop(s, JD_B_ENERGY, step);
     if (broke && !s->in_setup) compact(b);
-}
-
-jd_bond_state *sim_bonds_save(const jd_sim *s) {
-    const jd_bonds *b = s->bonds;
-    jd_bond_state *saved = malloc((b->n ? b->n : 1) * sizeof *saved);
-    if (saved) memcpy(saved, b->state, b->n * sizeof *saved);
-    return saved;
-}
-
-void sim_bonds_restore(jd_sim *s, jd_bond_state *saved) {
-    jd_bonds *b = s->bonds;
-    for (size_t k = 0; k < b->n; k++) {
-        const jd_bond_state evaluated = b->state[k];
-        b->state[k] = saved[k];
-        jd_bond_keep_reference(&b->state[k], &evaluated);
-    }
-    free(saved);
 }
 
 /* ---------------------------------------------------------------------------------------- */

@@ -59,13 +59,10 @@ int sim_bonds_init(struct jd_sim *s, char *err, size_t errlen);
 void sim_bonds_free(struct jd_sim *s);
 
 /* Form the bonds of rules due at the step being computed (s->step + 1), then add every intact
- * bond's force and torques to s->f and s->torque.  Called by sim_compute_forces. */
+ * bond's force and torques to s->f and s->torque.  Called by sim_compute_forces.  At step 0
+ * (s->in_setup, LIGGGHTS `setup`) the bonds are evaluated with dt = 0: no increment, the force
+ * is the stored one (zero for a new bond) plus the dashpots, and no rule is applied. */
 void sim_bonds_forces(struct jd_sim *s);
-
-/* Step 0 (LIGGGHTS `setup`): copy the bond states before the evaluation, and put them back
- * keeping the energy reference (jd_bond_keep_reference).  save returns NULL when out of memory. */
-jd_bond_state *sim_bonds_save(const struct jd_sim *s);
-void sim_bonds_restore(struct jd_sim *s, jd_bond_state *saved); /* frees saved */
 
 /* Write the bonds formed and the bonds broken since the last call to /connectivity (h may be
  * NULL: only forget them).  0 or -1 with err. */

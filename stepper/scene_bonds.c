@@ -36,7 +36,13 @@ static int read_strength(loader *L, const yaml_node_t *m, const char *path, cons
         *out = INFINITY;
         return 0;
     }
-    return sd_num(&L->c, n, sub, SD_POSITIVE, out);
+    char *end = NULL;
+    const double v = s ? strtod(s, &end) : NAN;
+    if (!s || end == s || *end != '\0' || !isfinite(v) || !(v > 0.0))
+        return sd_fail(&L->c, n, sub, "'%s' is not a strength; valid: a number > 0 [Pa], or .inf",
+                       s ? s : sd_kind(n));
+    *out = v;
+    return 0;
 }
 
 static int read_type(loader *L, const yaml_node_pair_t *p, jd_bond_type *t) {
@@ -281,7 +287,7 @@ static int sort_bonds(loader *L) {
                          "by the entry at line %zu); valid: at most one bond per pair",
                          (long long)ids[2 * k], (long long)ids[2 * k + 1],
                          bn[k - 1]->start_mark.line + 1);
-    if (rc == 0) {
+    if (rc == 0 && n > 0) {
         memcpy(s->bond_ids, ids, 2 * n * sizeof *ids);
         memcpy(s->bond_type, ty, n * sizeof *ty);
         memcpy(L->bnode, bn, n * sizeof *bn);

@@ -151,15 +151,12 @@ static int setup_forces(jd_sim *s, char *err, size_t errlen) {
         roll[k] = malloc((lists[k]->n + 1) * sizeof *roll[k]);
         ok = ok && state[k] && roll[k];
     }
-    jd_bond_state *bonds = NULL;
-    if (ok && s->bonds) ok = (bonds = sim_bonds_save(s)) != NULL;
     if (ok) {
         for (int k = 0; k < 2; k++) save_history(lists[k], state[k], roll[k]);
         s->in_setup = 1;
         sim_compute_forces(s);
         s->in_setup = 0;
         for (int k = 0; k < 2; k++) restore_history(lists[k], state[k], roll[k]);
-        if (s->bonds) sim_bonds_restore(s, bonds);
     } else {
         snprintf(err, errlen, "out of memory");
     }
