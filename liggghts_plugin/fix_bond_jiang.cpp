@@ -338,8 +338,7 @@ void FixBondJiang::compute(bool commit) {
   }
 }
 
-/* Every bond stored on a local atom, in storage order.  commit false (the set-up evaluation):
- * forces only, the states keep all but their energy reference (jd_bond_keep_reference). */
+/* Every bond stored on a local atom, in storage order.  commit false: the set-up evaluation. */
 template <unsigned F>
 void FixBondJiang::loop(bool commit) {
   double **x = atom->x, **v = atom->v, **f = atom->f;
@@ -347,9 +346,11 @@ void FixBondJiang::loop(bool commit) {
   const double *radius = atom->radius, *rmass = atom->rmass;
   const int *tag = atom->tag;
   const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
-  const double dt = update->dt;
+  /* the set-up evaluation (LIGGGHTS advances no history then) is the kernel's dt = 0 call: the
+   * stored force, and the energy reference of the first step */
+  const double dt = commit ? update->dt : 0.0;
   const bigint step = update->ntimestep;
-  const double time = update->atime + (double)(step - update->atimestep) * dt;
+  const double time = update->atime + (double)(step - update->atimestep) * update->dt;
 
   if (nall > nmax_ghost) {
     nmax_ghost = atom->nmax;
@@ -418,16 +419,9 @@ void FixBondJiang::loop(bool commit) {
         nbond[i]--;
         continue;
       }
-      if (commit) {
-        e_damp += st.e_damp; /* harvested every step, as gran/jiang does */
-        st.e_damp = 0.0;
-        std::memcpy(state(i, k), &st, sizeof st);
-      } else {
-        jd_bond_state kept;
-        std::memcpy(&kept, state(i, k), sizeof kept);
-        jd_bond_keep_reference(&kept, &st);
-        std::memcpy(state(i, k), &kept, sizeof kept);
-      }
+      e_damp += st.e_damp; /* harvested every step, as gran/jiang does */
+      st.e_damp = 0.0;
+      std::memcpy(state(i, k), &st, sizeof st);
       k++;
       if (mode != JD_BOND_INTACT) continue; /* set-up evaluation of a bond that would fail */
       if (F & JD_B_ENERGY) e_el += st.u_prev;

@@ -31,7 +31,7 @@ FixJdemLoads::FixJdemLoads(LAMMPS *lmp, int narg, char **arg)
   create_attribute = 1;
   grow_arrays(atom->nmax);
   atom->add_callback(0);
-  read_file(arg[4]);
+  path = arg[4];
 }
 
 FixJdemLoads::~FixJdemLoads() {
@@ -89,8 +89,14 @@ void FixJdemLoads::read_file(const char *path) {
   if (all != n / 5) error->all(FLERR, "fix jdem/loads: the file names atom ids that do not exist");
 }
 
-/* The set-up evaluation applies the loads (as the stepper's) but books no work. */
-void FixJdemLoads::setup(int vflag) { apply(false); }
+/* The file is read at the first set-up: Modify::add_fix resets the per-atom data of a new fix
+ * (set_arrays) after its constructor.  The set-up evaluation applies the loads (as the
+ * stepper's) but books no work. */
+void FixJdemLoads::setup(int vflag) {
+  if (!path.empty()) read_file(path.c_str());
+  path.clear();
+  apply(false);
+}
 
 void FixJdemLoads::post_force(int vflag) { apply(true); }
 

@@ -13,6 +13,8 @@
 #ifndef JDEM_FIX_JDEM_LOADS_H
 #define JDEM_FIX_JDEM_LOADS_H
 
+#include <string>
+
 #include "fix.h"
 
 namespace LAMMPS_NS {
@@ -40,6 +42,7 @@ class FixJdemLoads : public Fix {
   void read_file(const char *path);
 
   enum { L_FX = 0, L_HELD = 3, L_PREV = 4, L_N = 10 }; /* per atom: force, held, applied x 6 */
+  std::string path; /* the file, until the first set-up reads it */
   double **load;
   int nmax_l;
 };
