@@ -1,16 +1,19 @@
 #!/usr/bin/python3
-"""check_bonds.py — parallel bonds in LIGGGHTS (fix bond/jiang): MPI bookkeeping and guards.
+"""check_bonds.py — parallel bonds in LIGGGHTS (fix bond/jiang): against build/jdem, on 1 and 2
+MPI ranks, and its guards.
 
     tests/liggghts/check_bonds.py [--out DIR] [--keep]
 
-Scenes in tests/liggghts/bond_scenes/, run with scripts/liggghts_run.py:
-  mpi_bonded_slide  a bonded 2x2x1 block slides across the rank boundary: the trajectories on 1
-                    and 2 MPI ranks agree to the scene's tolerance (bond states migrate, ghost
-                    partners get their forces back by reverse communication), and its 4 bonds
-                    stay intact as one fragment;
-  block_drop        a bonded 4x4x4 block breaks on a plate: on 1 and 2 ranks the trajectories
-                    agree, and so do the broken-bond events (step, ids, mode) and the fragment
-                    sizes at the end;
+Scenes in tests/liggghts/bond_scenes/, run with build/jdem and scripts/liggghts_run.py:
+  mpi_bonded_slide  a bonded 2x2x1 block slides across the rank boundary: the trajectories of
+                    jdem and liggghts-jdem, and of liggghts-jdem on 1 and 2 MPI ranks, agree to
+                    the scene's tolerance (bond states migrate, ghost partners get their forces
+                    back by reverse communication), and its 4 bonds stay intact as one fragment;
+  block_drop        a bonded 4x4x4 block breaks on a plate: jdem vs liggghts-jdem and 1 vs 2
+                    ranks, the trajectories agree up to the first broken bond, and the
+                    broken-bond events (step, ids, mode) and the fragment sizes at the end are
+                    the same (the engines sum the forces in the same order, so they agree after
+                    the first break too; a mismatch there is reported with the counts);
   ghost_cutoff      a soft unbreakable bond outgrows the ghost cutoff: the run stops (exit != 0)
                     on 1 and 2 ranks with the message naming the bond, OUT.part kept, nothing
                     under OUT; the reported length is that of the undamped two-body oscillator
@@ -38,6 +41,7 @@ SCENES = os.path.join(HERE, "bond_scenes")
 RUN = os.path.join(ROOT, "scripts", "liggghts_run.py")
 COMPARE = os.path.join(ROOT, "scripts", "compare_trajectories.py")
 LIG = os.path.join(ROOT, "build", "liggghts-jdem")
+JDEM = os.path.join(ROOT, "build", "jdem")
 
 failed = 0
 
@@ -58,8 +62,12 @@ def liggghts(scene, out, np_=1):
     return run([PY, RUN, os.path.join(SCENES, scene + ".yaml"), "-o", out] + (["--np", str(np_)] if np_ > 1 else []))
 
 
-def compare(name, a, b):
-    rc, text = run([PY, COMPARE, a, b])
+def jdem(scene, out):
+    return run([JDEM, "run", os.path.join(SCENES, scene + ".yaml"), "-o", out, "--quiet"])
+
+
+def compare(name, a, b, until=None):
+    rc, text = run([PY, COMPARE, a, b] + (["--until", str(until)] if until is not None else []))
     last = [l for l in text.strip().splitlines() if l.strip()][-1]
     return check(name, rc == 0, last + "\n" + text)
 
@@ -100,35 +108,54 @@ def observable(path, name):
         return f["observables/%s/value" % name][()]
 
 
+def run_three(scene, work):
+    """build/jdem, and liggghts-jdem on 1 and 2 ranks; the three trajectories or None."""
+    paths = [os.path.join(work, "%s.%s.h5" % (scene, e)) for e in ("jdem", "np1", "np2")]
+    rc, text = jdem(scene, paths[0])
+    ok = check("bonds/%s: build/jdem runs" % scene, rc == 0, text[-1500:])
+    for out, n in ((paths[1], 1), (paths[2], 2)):
+        rc, text = liggghts(scene, out, n)
+        ok = check("bonds/%s: liggghts-jdem runs on %d rank(s)" % (scene, n), rc == 0, text[-1500:]) and ok
+    return paths if ok else None
+
+
 def check_slide(work):
-    a, b = os.path.join(work, "slide.np1.h5"), os.path.join(work, "slide.np2.h5")
-    for out, n in ((a, 1), (b, 2)):
-        rc, text = liggghts("mpi_bonded_slide", out, n)
-        if not check("bonds/mpi_bonded_slide: runs on %d rank(s)" % n, rc == 0, text[-1500:]):
-            return
+    paths = run_three("mpi_bonded_slide", work)
+    if not paths:
+        return
+    j, a, b = paths
+    compare("bonds/mpi_bonded_slide: jdem vs liggghts-jdem", j, a)
     compare("bonds/mpi_bonded_slide: liggghts-jdem 1 rank vs 2 ranks", a, b)
     nb, nf = observable(b, "bonds"), observable(b, "fragments")
     check("bonds/mpi_bonded_slide: 4 bonds (2x2x1 block) intact, 1 fragment, on 2 ranks",
           np.all(nb == 4) and np.all(nf == 1), "bonds %s fragments %s" % (nb, nf))
 
 
+def summary(ev):
+    return "%d broken (%d tension, %d shear), first at step %s" % (
+        len(ev), sum(e[3] == 1 for e in ev), sum(e[3] == 2 for e in ev), ev[0][0] if ev else "-")
+
+
 def check_block(work):
-    a, b = os.path.join(work, "block.np1.h5"), os.path.join(work, "block.np2.h5")
-    for out, n in ((a, 1), (b, 2)):
-        rc, text = liggghts("block_drop", out, n)
-        if not check("bonds/block_drop: runs on %d rank(s)" % n, rc == 0, text[-1500:]):
-            return
-    ea, eb = events(a), events(b)
-    check("bonds/block_drop: bonds break (%d: %d tension, %d shear)" % (
-        len(ea), sum(e[3] == 1 for e in ea), sum(e[3] == 2 for e in ea)),
-        len(ea) > 0 and {e[3] for e in ea} == {1, 2}, "expected breaks in both modes: %s" % ea[:10])
-    compare("bonds/block_drop: liggghts-jdem 1 rank vs 2 ranks", a, b)
-    check("bonds/block_drop: broken-bond events (step, ids, mode) on 1 and 2 ranks", ea == eb,
-          "first difference: %s" % (next(((x, y) for x, y in zip(ea, eb) if x != y), (len(ea), len(eb))),))
-    fa, fb = fragment_sizes(a), fragment_sizes(b)
-    nf = observable(a, "fragments")[-1]
-    check("bonds/block_drop: fragment sizes on 1 and 2 ranks (%d fragments, largest %d)" % (len(fa), fa[0]),
-          fa == fb and len(fa) == nf and sum(fa) == 64, "1 rank %s, 2 ranks %s, observable %s" % (fa, fb, nf))
+    paths = run_three("block_drop", work)
+    if not paths:
+        return
+    j, a, b = paths
+    ej = events(j)
+    check("bonds/block_drop: bonds break in both modes (jdem: %s)" % summary(ej),
+          len(ej) > 0 and {e[3] for e in ej} == {1, 2}, "expected breaks in both modes: %s" % ej[:10])
+    if not ej:
+        return
+    first = ej[0][0]
+    for label, x, y in (("jdem vs liggghts-jdem", j, a), ("liggghts-jdem 1 rank vs 2 ranks", a, b)):
+        compare("bonds/block_drop: %s up to the first break (step %d)" % (label, first), x, y, until=first)
+        ex, ey = events(x), events(y)
+        check("bonds/block_drop: %s: broken-bond events (step, ids, mode)" % label, ex == ey,
+              "%s vs %s" % (summary(ex), summary(ey)))
+        fx, fy = fragment_sizes(x), fragment_sizes(y)
+        nf = observable(y, "fragments")[-1]
+        check("bonds/block_drop: %s: fragment sizes (%d fragments, largest %d)" % (label, len(fx), fx[0]),
+              fx == fy and len(fy) == nf and sum(fx) == 64, "%s vs %s, observable %s" % (fx, fy, nf))
 
 
 CUTOFF = re.compile(r"fix bond/jiang: step (\d+): bond 1-2 is (\S+) m long, not within the ghost cutoff (\S+) m")
