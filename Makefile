@@ -6,6 +6,7 @@
 #   make test       unit tests (also under ASan+UBSan), engine tests, Chung–Ooi checks, cross-engine
 #   make demo       build and run the eight Chung–Ooi tests; report in out/chung_ooi/report.md
 #   make chung-ooi  the Chung–Ooi runs and report only (no dependency check)
+#   make bonds      the parallel-bond checks and bench figure; out/bonds/summary.json
 
 SHELL := /bin/bash
 PY    := /usr/bin/python3
@@ -118,6 +119,16 @@ demo: deps
 .PHONY: bench
 bench: all
 	$(PY) scripts/bench.py $(if $(BENCH_SIZES),--sizes $(BENCH_SIZES)) $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
+	$(PY) scripts/bond_bench.py --out out/bench $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
+
+# Parallel bonds (issue 4): every check of scripts/bond_checks.py in full length, in the engines
+# of BONDS_ENGINES (jdem, liggghts-jdem), plus the ns-per-bond-step figure of bond_bench.py;
+# records in out/bonds/summary.json.  `make test` runs the same checks shortened (--quick).
+BONDS_ENGINES ?= jdem
+.PHONY: bonds
+bonds: all
+	$(PY) scripts/bond_bench.py --engines $(BONDS_ENGINES) --out out/bonds
+	$(PY) scripts/bond_checks.py --engines $(BONDS_ENGINES) --out out/bonds --bench out/bonds/bench.json
 
 clean:
 	rm -rf build out

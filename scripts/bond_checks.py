@@ -22,6 +22,7 @@ one number with an independent closed-form reference (docs/model.md §9.6):
   axial_frequency       free chain of N spheres started in its first axial mode: frequency
                         against 2 sqrt(K/m) sin(pi / 2N), K = kn A                         1 %
   axial_energy          the same, undamped, 100 periods: max |E - E0| / E0              1e-3
+  rule_bonds            a bond rule at step 40 bonds exactly the pair touching then
   block_drop_energy     a bonded block dropped on a plate breaks; the energy balance with
                         bond storage, damping and breakage closes                      1e-3
   block_drop_breaks     bonds broken by mode, first break, fragment sizes: recorded for jdem;
@@ -115,7 +116,9 @@ class Runner:
             yaml.safe_dump(sc, f, sort_keys=False)
         traj = os.path.join(d, "%s.h5" % engine)
         if engine == "jdem":
-            cmd = [os.path.join(ROOT, "build", "jdem"), "run", path, "-o", traj, "--quiet"]
+            # JDEM: another build of the stepper (tests/run_tests.py: the sanitized one)
+            jdem = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
+            cmd = [os.path.join(ROOT, jdem), "run", path, "-o", traj, "--quiet"]
         else:
             cmd = [PY, os.path.join(HERE, "liggghts_run.py"), path, "-o", traj, "--np",
                    str(self.np)]
@@ -315,6 +318,24 @@ def check_axial(runner, engine, quick):
     return recs
 
 
+def check_rule(runner, engine, quick):
+    """A rule at step 40 bonds the pairs touching then: spheres 1 and 2 approach at v (gap
+    closed at step 20.5), sphere 3 stays 1 mm away; so exactly one bond (1, 2), formed at 40."""
+    v, dt = 0.01, 5.0e-8
+    gap = v * dt * 20.5
+    parts = [sphere(1, (0, 0, 0), v=(v / 2, 0, 0), fixed=True),
+             sphere(2, (2 * R + gap, 0, 0), v=(-v / 2, 0, 0), fixed=True),
+             sphere(3, (5 * R, 0, 0))]
+    sc = scene("rule", dt, 60, parts, every=10, bond=bond_type(math.inf, math.inf),
+               extra={"bond_rules": [{"type": "cement", "time": 40 * dt}]})
+    t = runner.run(engine, "rule", sc)
+    with h5py.File(os.path.join(runner.out, "rule", "%s.h5" % engine), "r") as f:
+        formed = f["connectivity/bond_formed_step"][()]
+    ok = len(t.bonds) == 1 and tuple(t.bonds[0]) == (1, 2) and list(formed) == [40]
+    return [record("rule_bonds", engine, float(len(t.bonds)), 1.0, 0.0, ok=ok,
+                   detail="bonds %s formed at %s" % (t.bonds.tolist(), formed.tolist()))]
+
+
 BLOCK = {"counts": (4, 4, 4), "speed": 3.0}
 
 
@@ -394,7 +415,7 @@ def check_block(runner, engine, quick, jdem_summary=None):
     return recs, s
 
 
-CHECKS = [check_tension, check_shear, check_twist, check_bend, check_beam, check_axial]
+CHECKS = [check_tension, check_shear, check_twist, check_bend, check_beam, check_axial, check_rule]
 
 
 def main(argv):

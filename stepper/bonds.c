@@ -287,7 +287,7 @@ static int by_event(const void *x, const void *y) {
 
 int sim_bonds_output(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     jd_bonds *b = s->bonds;
-    qsort(b->events, b->n_events, sizeof *b->events, by_event);
+    if (b->n_events) qsort(b->events, b->n_events, sizeof *b->events, by_event);
     int rc = 0; /* step 0 creates the (possibly empty) datasets */
     if (h && (b->n_formed || s->step == 0))
         rc = jd_h5md_write_bonds(h, b->n_formed, b->formed, err, errlen);
