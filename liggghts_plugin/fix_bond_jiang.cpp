@@ -351,6 +351,7 @@ void FixBondJiang::loop(bool commit) {
   const double dt = commit ? update->dt : 0.0;
   const bigint step = update->ntimestep;
   const double time = update->atime + (double)(step - update->atimestep) * update->dt;
+  const bool periodic = domain->xperiodic || domain->yperiodic || domain->zperiodic;
 
   if (nall > nmax_ghost) {
     nmax_ghost = atom->nmax;
@@ -370,8 +371,8 @@ void FixBondJiang::loop(bool commit) {
                       "is neither on this rank nor a ghost", step, partner[i][k], tag[i]);
         error->one(FLERR, msg);
       }
-      j = domain->closest_image(i, j);
-      jd_bond_geom g = jd_bond_geom(); /* zeroed: m_eff, i_eff are read only with damping */
+      if (periodic) j = domain->closest_image(i, j);
+      jd_bond_geom g;
       if (!jd_bond_geom_spheres(x[i], radius[i], x[j], radius[j], &g)) {
         char msg[160];
         std::snprintf(msg, sizeof msg, "fix bond/jiang: step " BIGINT_FORMAT ": bonded atoms %d and %d "
@@ -379,6 +380,7 @@ void FixBondJiang::loop(bool commit) {
         error->one(FLERR, msg);
       }
       g.sec = jd_bond_section_of(params.lambda, radius[i], radius[j]);
+      g.m_eff = g.i_eff = 0.0; /* read only by the dashpots */
       if (F & JD_B_DAMPING) {
         const double Ii = jd_sphere_inertia(rmass[i], radius[i]), Ij = jd_sphere_inertia(rmass[j], radius[j]);
         g.m_eff = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
@@ -436,8 +438,7 @@ void FixBondJiang::loop(bool commit) {
       }
     }
   }
-  if (comm->nprocs > 1 || domain->xperiodic || domain->yperiodic || domain->zperiodic)
-    comm->reverse_comm_fix(this);
+  if (comm->nprocs > 1 || periodic) comm->reverse_comm_fix(this);
   e_elastic_now = e_el;
   if (commit) {
     e_damp_cum += e_damp;

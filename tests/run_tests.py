@@ -37,8 +37,10 @@ SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "line
 SUITES += [("liggghts-bonds", [PY, "tests/liggghts/check_bonds.py"], "lines", {})]
 # The pour (576 spheres, walls, a cylinder): round-off horizons and settled statistics.
 SUITES += [("pour", [PY, "tests/liggghts/check_pour.py"], "lines", {})]
-# Parallel bonds: the checks of `make bonds`, shortened, in the stepper and its sanitized build.
-SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--out", "out/test/bonds"], "lines", {}),
+# Parallel bonds: the checks of `make bonds`, shortened, in both engines (liggghts-jdem's
+# block drop is compared with jdem's) and in the stepper's sanitized build.
+SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--engines", "jdem,liggghts-jdem",
+                      "--out", "out/test/bonds"], "lines", {}),
            ("bonds-sanitized", [PY, "scripts/bond_checks.py", "--quick", "--out",
                                 "out/test/bonds-san"], "lines", SANITIZED)]
 # The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
