@@ -11,6 +11,9 @@ jd_bond_section jd_bond_section_of(double lambda, double Ra, double Rb) {
     s.A = JD_PI * r2;
     s.I = 0.25 * JD_PI * r2 * r2;
     s.J = 0.5 * JD_PI * r2 * r2;
+    s.inv_A = 1.0 / s.A;
+    s.rbar_I = s.rbar / s.I;
+    s.rbar_J = s.rbar / s.J;
     return s;
 }
 

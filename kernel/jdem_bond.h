@@ -85,10 +85,13 @@ typedef struct jd_bond_params {
 
 /* Cross-section of one bond (eq. 15), from jd_bond_section(). */
 typedef struct jd_bond_section {
-    double rbar; /* bond radius lambda min(R_a, R_b)           [m]   */
-    double A;    /* area pi rbar^2                              [m^2] */
-    double I;    /* second moment of area pi rbar^4 / 4         [m^4] */
-    double J;    /* polar moment pi rbar^4 / 2                  [m^4] */
+    double rbar;   /* bond radius lambda min(R_a, R_b)           [m]    */
+    double A;      /* area pi rbar^2                              [m^2]  */
+    double I;      /* second moment of area pi rbar^4 / 4         [m^4]  */
+    double J;      /* polar moment pi rbar^4 / 2                  [m^4]  */
+    double inv_A;  /* 1 / A, for the stresses of eq. (17)         [m^-2] */
+    double rbar_I; /* rbar / I                                    [m^-3] */
+    double rbar_J; /* rbar / J                                    [m^-3] */
 } jd_bond_section;
 
 /* ------------------------------------------------------------------------------------------ */
@@ -152,7 +155,8 @@ typedef struct jd_bond_result {
 /* Set-up (jdem_bond.c).                                                                       */
 /* ------------------------------------------------------------------------------------------ */
 
-/* Cross-section of eq. (15) for radii R_a, R_b [m] and multiplier lambda [-]. */
+/* Cross-section of eq. (15) for radii R_a, R_b [m] and multiplier lambda [-] (with the
+ * reciprocals the hot path multiplies by). */
 jd_bond_section jd_bond_section_of(double lambda, double Ra, double Rb);
 
 /* Square of an upper bound on the angular frequencies of one bond between two free spheres
@@ -218,7 +222,13 @@ static inline double jd_bond_energy(const jd_bond_params *p, const jd_bond_secti
  * out:      force on b, torques, the bond's force and moment magnitudes and stresses.
  * Returns out->mode: JD_BOND_INTACT, or the failure mode.  When both strengths are reached in
  * the same step the mode is the one with the larger stress/strength ratio (tension on a tie). */
-static inline int jd_bond(const unsigned features, const jd_bond_params *p, const jd_bond_geom *g,
+#if defined(__GNUC__)
+#define JD_BOND_INLINE static inline __attribute__((always_inline))
+#else
+#define JD_BOND_INLINE static inline
+#endif
+/* (always inlined: `features` must fold into each engine's specialised loop) */
+JD_BOND_INLINE int jd_bond(const unsigned features, const jd_bond_params *p, const jd_bond_geom *g,
                           const jd_kinematics *k, double dt, jd_bond_state *s,
                           jd_bond_result *out) {
     const jd_bond_section *sec = &g->sec;
@@ -256,11 +266,13 @@ static inline int jd_bond(const unsigned features, const jd_bond_params *p, cons
     out->ft = sqrt(jd_dot(s->ft, s->ft));
     out->mn = fabs(s->mn);
     out->mt = sqrt(jd_dot(s->mt, s->mt));
-    out->sigma_max = -s->fn / sec->A + out->mt * sec->rbar / sec->I;
-    out->tau_max = out->ft / sec->A + out->mn * sec->rbar / sec->J;
-    const double rs = out->sigma_max / p->sigma_c, rt = out->tau_max / p->tau_c;
+    out->sigma_max = -s->fn * sec->inv_A + out->mt * sec->rbar_I;
+    out->tau_max = out->ft * sec->inv_A + out->mn * sec->rbar_J;
     out->mode = JD_BOND_INTACT;
-    if (rs >= 1.0 || rt >= 1.0) out->mode = rs >= rt ? JD_BOND_BROKE_TENSION : JD_BOND_BROKE_SHEAR;
+    if (out->sigma_max >= p->sigma_c || out->tau_max >= p->tau_c) {
+        const double rs = out->sigma_max / p->sigma_c, rt = out->tau_max / p->tau_c;
+        out->mode = rs >= rt ? JD_BOND_BROKE_TENSION : JD_BOND_BROKE_SHEAR;
+    }
 
     if (out->mode != JD_BOND_INTACT) {
         if (features & JD_B_ENERGY) {

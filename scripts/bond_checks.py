@@ -386,9 +386,12 @@ def fragment_sizes(t):
 
 def block_summary(t):
     modes = t.breaks.get("mode", np.zeros(0))
+    steps = t.breaks.get("step", np.zeros(0))
     step, _ = t.first_break()
     return {"tension": int(np.sum(modes == 1)), "shear": int(np.sum(modes == 2)),
-            "first_break_step": step, "fragments": fragment_sizes(t)}
+            "first_break_step": step, "fragments": fragment_sizes(t),
+            "tension_steps": [int(x) for x in steps[modes == 1]],
+            "shear_steps": [int(x) for x in steps[modes == 2]]}
 
 
 def check_block(runner, engine, quick, jdem_summary=None):
