@@ -33,6 +33,7 @@ using namespace FixConst;
 
 static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double),
               "jd_bond_state must be JD_BOND_STATE_LEN doubles");
+static_assert(sizeof(jd_bond_section) % sizeof(double) == 0, "jd_bond_section must be doubles");
 
 FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), e_elastic_now(0.0), e_damp_cum(0.0), e_broken_cum(0.0), max_bonds(12),
@@ -88,8 +89,8 @@ FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
   if (!(params.lambda > 0.0)) error->all(FLERR, "fix bond/jiang: lambda must be > 0");
   if (!(params.gamma >= 0.0)) error->all(FLERR, "fix bond/jiang: damping must be >= 0");
   /* Comm::exchange leaves room for about 1000 doubles beyond an atom's own: stay well inside */
-  if (max_bonds < 1 || 1 + max_bonds * (1 + JD_BOND_STATE_LEN) > 500)
-    error->all(FLERR, "fix bond/jiang: max_bonds must be between 1 and 26");
+  if (max_bonds < 1 || 1 + max_bonds * (1 + REC_LEN) > 500)
+    error->all(FLERR, "fix bond/jiang: max_bonds must be between 1 and 19");
   if (!atom->tag_enable || atom->map_style == 0)
     error->all(FLERR, "fix bond/jiang needs atom IDs and `atom_modify map array` (or hash)");
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
@@ -183,7 +184,10 @@ void FixBondJiang::init() {
 /* Explicit bonds are formed at the first set-up; the set-up evaluation does not advance the
  * bond states (as gran/jiang's contact history). */
 void FixBondJiang::setup(int vflag) {
-  if (!file_read && !bond_file.empty()) read_bond_file(bond_file.c_str());
+  if (!file_read && !bond_file.empty()) {
+    read_bond_file(bond_file.c_str());
+    check_reach(); /* setup_pre_neighbor ran before these bonds existed */
+  }
   file_read = true;
   for (size_t r = 0; r < rules.size(); r++)
     if (rules[r].step == update->ntimestep) form_by_rule(rules[r]);
@@ -214,9 +218,10 @@ bool FixBondJiang::bonded_anywhere(int i, int tag_b) const {
   return false;
 }
 
-/* Store a new bond on local atom i (the lower id) and record it; false when i already holds
- * max_bonds bonds of this type. */
-bool FixBondJiang::add_bond(int i, int partner_tag, int rule) {
+/* Store a new bond between local atom i (the lower id) and atom j (local or ghost) and record
+ * it; false when i already holds max_bonds bonds of this type. */
+bool FixBondJiang::add_bond(int i, int j, int rule) {
+  const int partner_tag = atom->tag[j];
   if (nbond[i] >= max_bonds) return false;
   const int k = nbond[i]++;
   partner[i][k] = partner_tag;
@@ -225,6 +230,8 @@ bool FixBondJiang::add_bond(int i, int partner_tag, int rule) {
   jd_bond_state fresh;
   jd_bond_form(&fresh);
   std::memcpy(state(i, k), &fresh, sizeof fresh);
+  const jd_bond_section sec = jd_bond_section_of(params.lambda, atom->radius[i], atom->radius[j]);
+  std::memcpy(section(i, k), &sec, sizeof sec);
   return true;
 }
 
@@ -288,7 +295,12 @@ void FixBondJiang::read_bond_file(const char *path) {
                       pairs[p], pairs[p + 1]);
         error->one(FLERR, msg);
       }
-      if (!add_bond(ia, pairs[p + 1], -1)) too_many(error, pairs[p], max_bonds);
+      if (ib < 0) { /* not even a ghost here: farther than the ghost cutoff */
+        std::snprintf(msg, sizeof msg, "fix bond/jiang: %s: bond %d-%d is longer than the ghost cutoff; "
+                      "raise it with `communicate single vel yes cutoff X`", path, pairs[p], pairs[p + 1]);
+        error->one(FLERR, msg);
+      }
+      if (!add_bond(ia, ib, -1)) too_many(error, pairs[p], max_bonds);
     }
   }
   int found = 0;
@@ -321,7 +333,7 @@ void FixBondJiang::form_by_rule(const Rule &r) {
       const double gap = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - radius[lo] - radius[hi];
       if (!(gap <= r.max_gap * std::fmin(radius[lo], radius[hi]))) continue;
       if (bonded_anywhere(lo, tag[hi])) continue;
-      if (!add_bond(lo, tag[hi], r.index)) too_many(error, tag[lo], max_bonds);
+      if (!add_bond(lo, hi, r.index)) too_many(error, tag[lo], max_bonds);
     }
   }
 }
@@ -379,7 +391,7 @@ void FixBondJiang::loop(bool commit) {
                       "are at the same position", step, tag[i], partner[i][k]);
         error->one(FLERR, msg);
       }
-      g.sec = jd_bond_section_of(params.lambda, radius[i], radius[j]);
+      std::memcpy(&g.sec, section(i, k), sizeof g.sec);
       g.m_eff = g.i_eff = 0.0; /* read only by the dashpots */
       if (F & JD_B_DAMPING) {
         const double Ii = jd_sphere_inertia(rmass[i], radius[i]), Ij = jd_sphere_inertia(rmass[j], radius[j]);
@@ -416,7 +428,7 @@ void FixBondJiang::loop(bool commit) {
         /* remove the slot, keeping the others in order (the force summation order) */
         for (int m = k + 1; m < nbond[i]; m++) {
           partner[i][m - 1] = partner[i][m];
-          std::memcpy(state(i, m - 1), state(i, m), sizeof st);
+          std::memcpy(state(i, m - 1), state(i, m), REC_LEN * sizeof(double));
         }
         nbond[i]--;
         continue;
@@ -508,7 +520,7 @@ double FixBondJiang::compute_vector(int n) {
 void FixBondJiang::grow_arrays(int nmax) {
   memory->grow(nbond, nmax, "bond/jiang:nbond");
   memory->grow(partner, nmax, max_bonds, "bond/jiang:partner");
-  memory->grow(bstate, nmax, max_bonds * JD_BOND_STATE_LEN, "bond/jiang:state");
+  memory->grow(bstate, nmax, max_bonds * REC_LEN, "bond/jiang:state");
   for (int i = nmax_b; i < nmax; i++) nbond[i] = 0;
   nmax_b = nmax;
 }
@@ -516,7 +528,7 @@ void FixBondJiang::grow_arrays(int nmax) {
 void FixBondJiang::copy_arrays(int i, int j, int delflag) {
   nbond[j] = nbond[i];
   for (int k = 0; k < nbond[i]; k++) partner[j][k] = partner[i][k];
-  std::memcpy(bstate[j], bstate[i], (size_t)nbond[i] * JD_BOND_STATE_LEN * sizeof(double));
+  std::memcpy(bstate[j], bstate[i], (size_t)nbond[i] * REC_LEN * sizeof(double));
 }
 
 void FixBondJiang::set_arrays(int i) { nbond[i] = 0; }
@@ -527,7 +539,7 @@ int FixBondJiang::pack_exchange(int i, double *buf) {
   buf[m++] = nbond[i];
   for (int k = 0; k < nbond[i]; k++) {
     buf[m++] = partner[i][k];
-    for (int s = 0; s < JD_BOND_STATE_LEN; s++) buf[m++] = bstate[i][k * JD_BOND_STATE_LEN + s];
+    for (int s = 0; s < REC_LEN; s++) buf[m++] = bstate[i][k * REC_LEN + s];
   }
   return m;
 }
@@ -537,12 +549,12 @@ int FixBondJiang::unpack_exchange(int nlocal, double *buf) {
   nbond[nlocal] = (int)buf[m++];
   for (int k = 0; k < nbond[nlocal]; k++) {
     partner[nlocal][k] = (int)buf[m++];
-    for (int s = 0; s < JD_BOND_STATE_LEN; s++) bstate[nlocal][k * JD_BOND_STATE_LEN + s] = buf[m++];
+    for (int s = 0; s < REC_LEN; s++) bstate[nlocal][k * REC_LEN + s] = buf[m++];
   }
   return m;
 }
 
 double FixBondJiang::memory_usage() {
-  return (double)nmax_b * (sizeof(int) + max_bonds * (sizeof(int) + JD_BOND_STATE_LEN * sizeof(double))) +
+  return (double)nmax_b * (sizeof(int) + max_bonds * (sizeof(int) + REC_LEN * sizeof(double))) +
          (double)nmax_ghost * 6 * sizeof(double);
 }

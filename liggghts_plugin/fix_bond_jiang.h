@@ -115,8 +115,12 @@ class FixBondJiang : public Fix {
   };
   void form_by_rule(const Rule &r);
   bool bonded_anywhere(int i, int tag_b) const;
-  bool add_bond(int i, int partner_tag, int rule);
-  double *state(int i, int k) { return &bstate[i][k * JD_BOND_STATE_LEN]; }
+  bool add_bond(int i, int j, int rule);
+  /* A bond's record: its kernel state, then its cross-section (fixed at formation, cached so
+   * that the loop does no division). */
+  enum { SEC_LEN = sizeof(jd_bond_section) / sizeof(double), REC_LEN = JD_BOND_STATE_LEN + SEC_LEN };
+  double *state(int i, int k) { return &bstate[i][k * REC_LEN]; }
+  double *section(int i, int k) { return &bstate[i][k * REC_LEN + JD_BOND_STATE_LEN]; }
 
   jd_bond_params params;
   unsigned features; /* JD_B_* of the run */
@@ -129,7 +133,7 @@ class FixBondJiang : public Fix {
   int nmax_b;
   int *nbond;     /* bonds stored on each atom */
   int **partner;  /* their partners' ids */
-  double **bstate; /* their kernel states, JD_BOND_STATE_LEN doubles each */
+  double **bstate; /* their records, REC_LEN doubles each */
   int nmax_ghost;
   double **fghost; /* force and torque on ghost partners, sent home by reverse communication */
   std::vector<Event> events;
