@@ -30,14 +30,13 @@
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
-
 static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double),
               "jd_bond_state must be JD_BOND_STATE_LEN doubles");
 static_assert(sizeof(jd_bond_section) % sizeof(double) == 0, "jd_bond_section must be doubles");
 
 FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), e_elastic_now(0.0), e_damp_cum(0.0), e_broken_cum(0.0), max_bonds(12),
-      file_read(false), record(true), nmax_b(0), nbond(NULL), partner(NULL),
+      file_read(false), rules_done_at(-1), record(true), nmax_b(0), nbond(NULL), partner(NULL),
       bstate(NULL), nmax_ghost(0), fghost(NULL) {
   const char *usage =
       "Illegal fix bond/jiang command: fix ID group bond/jiang kn KN kt KT sigma_c S tau_c T "
@@ -96,7 +95,7 @@ FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
     error->all(FLERR, "fix bond/jiang requires atom_style granular (sphere)");
 
-  features = (params.gamma > 0.0 ? (unsigned)JD_B_DAMPING : 0u);
+  features = 0u; /* set by init() */
   nbroken[0] = nbroken[1] = 0.0;
   scalar_flag = vector_flag = 1;
   size_vector = 3;
@@ -189,15 +188,21 @@ void FixBondJiang::setup(int vflag) {
     check_reach(); /* setup_pre_neighbor ran before these bonds existed */
   }
   file_read = true;
-  for (size_t r = 0; r < rules.size(); r++)
-    if (rules[r].step == update->ntimestep) form_by_rule(rules[r]);
+  form_due();
   compute(false);
 }
 
 void FixBondJiang::post_force(int vflag) {
+  form_due();
+  compute(true);
+}
+
+/* The rules due at this step, once (a run's set-up repeats the last step of the previous run). */
+void FixBondJiang::form_due() {
+  if (update->ntimestep == rules_done_at) return;
+  rules_done_at = update->ntimestep;
   for (size_t r = 0; r < rules.size(); r++)
     if (rules[r].step == update->ntimestep) form_by_rule(rules[r]);
-  compute(true);
 }
 
 /* ---------------------------------------------------------------------------------------- */

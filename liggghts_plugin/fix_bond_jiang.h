@@ -114,6 +114,7 @@ class FixBondJiang : public Fix {
     double max_gap;
   };
   void form_by_rule(const Rule &r);
+  void form_due();
   bool bonded_anywhere(int i, int tag_b) const;
   bool add_bond(int i, int j, int rule);
   /* A bond's record: its kernel state, then its cross-section (fixed at formation, cached so
@@ -128,6 +129,7 @@ class FixBondJiang : public Fix {
   std::string bond_file;
   std::vector<Rule> rules;
   bool file_read;
+  bigint rules_done_at; /* the step whose rules were applied last */
   bool record; /* keep formed/broken records: a dump h5md/jdem collects them */
 
   int nmax_b;
