@@ -4,6 +4,9 @@
  */
 #include "jdem_bond.h"
 
+_Static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double),
+               "jd_bond_state is a flat array of JD_BOND_STATE_LEN doubles");
+
 jd_bond_section jd_bond_section_of(double lambda, double Ra, double Rb) {
     jd_bond_section s;
     s.rbar = lambda * (Ra < Rb ? Ra : Rb);

@@ -336,23 +336,29 @@ def check_rule(runner, engine, quick):
                    detail="bonds %s formed at %s" % (t.bonds.tolist(), formed.tolist()))]
 
 
-BLOCK = {"counts": (4, 4, 4), "speed": 3.0}
+BLOCK = {"counts": (4, 4, 4), "speed": 5.0, "tilt": 0.2}
 
 
 def block_scene(quick):
+    """A 4x4x4 bonded block falling at 5 m/s onto a plate tilted by 0.2 rad about y: one edge
+    strikes first, so the bonds break progressively and in both modes."""
     n = BLOCK["counts"]
     dt = 5e-8
     steps = 2000 if quick else 6000
+    c, s_ = math.cos(BLOCK["tilt"]), math.sin(BLOCK["tilt"])
+    # plate through the origin with normal (s, 0, c) (counter-clockwise seen from above)
+    corners = [[x * c, y, -x * s_] for x, y in ((-0.01, -0.01), (0.02, -0.01), (0.02, 0.02),
+                                                (-0.01, 0.02))]
+    z0 = (R + 1e-5) / c      # the spheres at x = 0 are 10 um above the plate (distance x s + z c)
     mats = {"glass": dict(MATERIAL, restitution=0.5, friction=0.3), "plate": {}}
     return scene("block_drop", dt, steps, None, every=100,
-                 bond=bond_type(2.0e6, 3.0e6, damping=0.1),
+                 bond=bond_type(1.0e6, 1.5e6, damping=0.1),
                  generate=[{"bonded_block": {"material": "glass", "radius": R,
-                                             "origin": [0, 0, R + 1e-5], "counts": list(n),
+                                             "origin": [0, 0, z0], "counts": list(n),
                                              "bond_type": "cement",
                                              "velocity": [0, 0, -BLOCK["speed"]]}}],
                  walls=[{"name": "plate", "type": "plane", "material": "plate",
-                         "corners": [[-0.01, -0.01, 0], [0.02, -0.01, 0], [0.02, 0.02, 0],
-                                     [-0.01, 0.02, 0]]}],
+                         "corners": corners}],
                  materials=mats,
                  extra={"interactions": [{"materials": ["glass", "plate"], "restitution": 0.5,
                                           "friction": 0.3}]})

@@ -152,13 +152,14 @@ static int by_pair(const void *x, const void *y) {
     return p[1] < q[1] ? -1 : p[1] > q[1];
 }
 
-/* Bond the pairs of one rule that are not bonded already (intact).  Out of memory leaves the
- * rule unapplied, and the run continues without it: it is reported by the count of bonds. */
+/* Bond the pairs of one rule that are not bonded already (intact).  Out of memory is recorded
+ * in b->failed and stops the run at the next sim_bonds_output. */
 static void apply_rule(jd_sim *s, const jd_bond_rule *rule, int64_t step) {
     jd_bonds *b = s->bonds;
     int32_t *pairs = NULL;
     const long np = jd_bond_rule_pairs(s->scene, rule, s->x, &pairs);
     int32_t *have = malloc((b->n ? b->n : 1) * 2 * sizeof *have); /* intact pairs, (min, max) */
+    if (np < 0 || !have) b->failed = "out of memory applying a bond rule";
     if (np <= 0 || !have) {
         free(pairs);
         free(have);
@@ -171,8 +172,10 @@ static void apply_rule(jd_sim *s, const jd_bond_rule *rule, int64_t step) {
     qsort(have, b->n, 2 * sizeof *have, by_pair);
     for (long p = 0; p < np; p++)
         if (!bsearch(&pairs[2 * p], have, b->n, 2 * sizeof *have, by_pair) &&
-            add_bond(s, pairs[2 * p], pairs[2 * p + 1], rule->type, step))
+            add_bond(s, pairs[2 * p], pairs[2 * p + 1], rule->type, step)) {
+            b->failed = "out of memory forming the bonds of a rule";
             break;
+        }
     free(pairs);
     free(have);
 }
@@ -184,9 +187,11 @@ static void record_break(jd_sim *s, size_t k, const jd_bond_geom *g, const jd_bo
                          int64_t step) {
     jd_bonds *b = s->bonds;
     b->n_broken[out->mode]++;
-    if (s->in_setup ||
-        grow((void **)&b->events, &b->events_cap, b->n_events + 1, sizeof *b->events))
+    if (s->in_setup) return;
+    if (grow((void **)&b->events, &b->events_cap, b->n_events + 1, sizeof *b->events)) {
+        b->failed = "out of memory recording a broken bond";
         return;
+    }
     jd_h5md_bond_break *e = &b->events[b->n_events++];
     const int32_t i = b->i[k], j = b->j[k];
     *e = (jd_h5md_bond_break){.step = step, .time = (double)step * s->dt,
@@ -287,6 +292,10 @@ static int by_event(const void *x, const void *y) {
 
 int sim_bonds_output(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     jd_bonds *b = s->bonds;
+    if (b->failed) {
+        snprintf(err, errlen, "step %lld: %s", (long long)s->step, b->failed);
+        return -1;
+    }
     if (b->n_events) qsort(b->events, b->n_events, sizeof *b->events, by_event);
     int rc = 0; /* step 0 creates the (possibly empty) datasets */
     if (h && (b->n_formed || s->step == 0))

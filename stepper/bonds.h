@@ -39,6 +39,8 @@ typedef struct jd_bonds {
     size_t n_formed, formed_cap;
     jd_h5md_bond_break *events; /* breaks since the last sim_bonds_output */
     size_t n_events, events_cap;
+    const char *failed;        /* set when the bond loop ran out of memory (reported by
+                                  sim_bonds_output, which stops the run) */
     /* totals */
     int64_t n_broken[3];       /* by jd_bond_mode (index 0 unused) */
     double e_damp_dropped, e_break_dropped; /* energies of removed bonds [J] */
@@ -65,7 +67,8 @@ void sim_bonds_free(struct jd_sim *s);
 void sim_bonds_forces(struct jd_sim *s);
 
 /* Write the bonds formed and the bonds broken since the last call to /connectivity (h may be
- * NULL: only forget them).  0 or -1 with err. */
+ * NULL: only forget them).  0, or -1 with err (a write error, or the bond loop ran out of
+ * memory). */
 int sim_bonds_output(struct jd_sim *s, jd_h5md *h, char *err, size_t errlen);
 
 void sim_bonds_observables(const struct jd_sim *s, jd_bond_observables *o);

@@ -260,6 +260,14 @@ static int by_ids(const void *a, const void *b) {
     return x < y ? -1 : x > y;
 }
 
+/* Whether a bond was made by a bond rule (its node is an item of bond_rules). */
+static int is_rule_node(loader *L, const yaml_node_t *node) {
+    const yaml_node_t *rules = sd_get(&L->c, L->root, "bond_rules");
+    for (size_t r = 0; rules && r < sd_len(rules); r++)
+        if (sd_item(&L->c, rules, r) == node) return 1;
+    return 0;
+}
+
 static int sort_bonds(loader *L) {
     jd_scene *s = L->s;
     const size_t n = s->n_bonds;
@@ -281,16 +289,28 @@ static int sort_bonds(loader *L) {
         ty[k] = s->bond_type[perm[k]];
         bn[k] = L->bnode[perm[k]];
     }
-    for (size_t k = 1; k < n && rc == 0; k++)
-        if (ids[2 * k] == ids[2 * k - 2] && ids[2 * k + 1] == ids[2 * k - 1])
+    /* A pair bonded twice by bonds or generators is an error; a step-0 rule, like a rule during
+     * the run, leaves a pair that is already bonded as it is (the earlier bond is kept). */
+    size_t kept = 0;
+    for (size_t k = 0; k < n && rc == 0; k++) {
+        const int dup = kept > 0 && ids[2 * k] == ids[2 * kept - 2] &&
+                        ids[2 * k + 1] == ids[2 * kept - 1];
+        if (dup && is_rule_node(L, bn[k])) continue;
+        if (dup)
             rc = sd_fail(&L->c, bn[k], "bonds", "particles %lld and %lld are bonded twice (also "
                          "by the entry at line %zu); valid: at most one bond per pair",
                          (long long)ids[2 * k], (long long)ids[2 * k + 1],
-                         bn[k - 1]->start_mark.line + 1);
-    if (rc == 0 && n > 0) {
-        memcpy(s->bond_ids, ids, 2 * n * sizeof *ids);
-        memcpy(s->bond_type, ty, n * sizeof *ty);
-        memcpy(L->bnode, bn, n * sizeof *bn);
+                         bn[kept - 1]->start_mark.line + 1);
+        ids[2 * kept] = ids[2 * k];
+        ids[2 * kept + 1] = ids[2 * k + 1];
+        ty[kept] = ty[k];
+        bn[kept++] = bn[k];
+    }
+    if (rc == 0 && kept > 0) {
+        s->n_bonds = kept;
+        memcpy(s->bond_ids, ids, 2 * kept * sizeof *ids);
+        memcpy(s->bond_type, ty, kept * sizeof *ty);
+        memcpy(L->bnode, bn, kept * sizeof *bn);
     }
 done:
     free(perm);

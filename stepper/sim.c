@@ -272,8 +272,9 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
     progress_start(&p, show_progress, last, s->n);
     int rc = 0;
     for (;;) {
-        if ((rc = sim_watchdog_step(s, err, errlen)) != 0) break;
+        /* the bonds formed and broken by the last step, also when the watchdog stops here */
         if (s->bonds && (rc = sim_bonds_output(s, h, err, errlen)) != 0) break;
+        if ((rc = sim_watchdog_step(s, err, errlen)) != 0) break;
         if (due(s->step, sc->output_every, last)) {
             if ((rc = write_frame(s, h, err, errlen)) != 0) break;
             s->frame_step = s->step;
