@@ -107,6 +107,7 @@ BOND_LOOP = {"jdem": "sim_bonds_forces", "liggghts-jdem": "FixBondJiang::post_fo
 
 def callgrind_instructions(d, engine="jdem", counts=(8, 8, 8), steps=50):
     """Inclusive instructions of the engine's bond loop per bond-step (deterministic)."""
+    d = os.path.abspath(d)  # LIGGGHTS runs in its deck directory
     p = os.path.join(d, "callgrind_%s.yaml" % engine)
     write(p, block_scene(counts, steps, True))
     out = os.path.join(d, "callgrind_%s.out" % engine)

@@ -187,10 +187,15 @@ def bond_lines(scene, tid, deck_dir, rmax, skin):
         held = {}
         for a, _ in pairs:
             held[a] = held.get(a, 0) + 1
+        # slots per atom: what the explicit bonds need, or room for 12 (FCC) when rules may add
+        # more; fewer slots keep the per-atom records dense (and the exchange buffers small)
+        slots = max([1] + list(held.values()))
+        if any(r["type"] == name for r in rules):
+            slots = max(12, slots)
         args = "kn %s kt %s sigma_c %s tau_c %s lambda %s damping %s bending %s max_bonds %d" % (
             num(t["normal_stiffness"]), num(t["shear_stiffness"]), num(t["tensile_strength"]),
             num(t["shear_strength"]), num(t["radius_multiplier"]), num(t.get("damping", 0.0)),
-            BENDING[t.get("bending", "potyondy_cundall")], max([12] + list(held.values())))
+            BENDING[t.get("bending", "potyondy_cundall")], slots)
         if pairs:
             fname = "bonds_%s.txt" % "".join(ch if ch.isalnum() or ch == "_" else "_" for ch in name)
             with open(os.path.join(deck_dir, fname), "w") as f:
