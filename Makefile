@@ -4,8 +4,11 @@
 #   make            build/jdem and build/liggghts-jdem
 #   make deps       install the Debian packages the project needs (as root), else print the command
 #   make test       unit tests (also under ASan+UBSan), engine tests, Chung–Ooi checks, cross-engine
-#   make demo       build and run the eight Chung–Ooi tests; report in out/chung_ooi/report.md
+#   make demo       build and run the eight Chung–Ooi tests and the stability suite; reports in
+#                   out/chung_ooi/report.md and out/stability/report.md
 #   make chung-ooi  the Chung–Ooi runs and report only (no dependency check)
+#   make stability  the stability suite (reference_runs/stability/, both engines, 1x and 2x/5x/10x
+#                   the guard's dt); out/stability/report.md and summary.json
 #   make bonds      the parallel-bond checks and bench figure; out/bonds/summary.json
 
 SHELL := /bin/bash
@@ -28,12 +31,12 @@ SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit
 KERNEL_SRC  := $(wildcard kernel/*.c)
 IO_SRC      := $(wildcard io/*.c)
 STEPPER_SRC := $(wildcard stepper/*.c)
-SCENE_SRC   := $(wildcard stepper/scene*.c)
+SCENE_SRC   := $(wildcard stepper/scene*.c) kernel/jdem_geometry.c
 PLUGIN_SRC  := $(wildcard liggghts_plugin/*.cpp)
 UNIT_SRC    := $(wildcard tests/unit/*.c)
 HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)
 
-.PHONY: all deps test demo chung-ooi unit clean
+.PHONY: all deps test demo chung-ooi stability unit clean
 all: build/jdem build/liggghts-jdem
 
 # ---------------------------------------------------------------------------------------------
@@ -109,10 +112,14 @@ test: deps
 chung-ooi: build/jdem build/liggghts-jdem
 	$(PY) scripts/chung_ooi.py run --engines jdem,liggghts --out out/chung_ooi
 
+stability: build/jdem build/liggghts-jdem
+	$(PY) scripts/stability.py --out out/stability
+
 demo: deps
 	$(MAKE) all
 	$(MAKE) chung-ooi
-	@echo "report: out/chung_ooi/report.md"
+	$(MAKE) stability
+	@echo "reports: out/chung_ooi/report.md out/stability/report.md"
 
 # Performance benchmark (reference_runs/bench/README.md): settled beds, 3 engines, medians of 3.
 #   make bench [BENCH_SIZES=5k,20k,80k] [BENCH_REPEATS=3]     report: out/bench/report.md

@@ -7,6 +7,7 @@
  *   fix jdem/watchdog       idem
  *   fix bond/jiang          idem
  *   fix jdem/loads          idem
+ *   fix jdem/guard          idem
  *   dump h5md/jdem          LIGGGHTS 3.8 has no dump map: Output::add_dump() is an if-else chain
  *                           over style_dump.h.  We interpose Output::add_dump (libliggghts.so
  *                           calls it through its PLT, so the executable's definition wins) and
@@ -35,6 +36,7 @@
 #include "dump_h5md_jdem.h"
 #include "fix_bond_jiang.h"
 #include "fix_jdem_loads.h"
+#include "fix_jdem_guard.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_wall_jiang.h"
 #include "pair_gran_jiang.h"
@@ -71,6 +73,10 @@ static Fix *create_fix_jdem_watchdog(LAMMPS *lmp, int narg, char **arg) {
   return new FixJdemWatchdog(lmp, narg, arg);
 }
 
+static Fix *create_fix_jdem_guard(LAMMPS *lmp, int narg, char **arg) {
+  return new FixJdemGuard(lmp, narg, arg);
+}
+
 static void register_jdem_styles(LAMMPS *lmp) {
   (*lmp->force->pair_map)["gran/jiang"] = &create_pair_gran_jiang;
   FixMap *fix_map = lmp->modify->*get(ModifyFixMap());
@@ -78,6 +84,7 @@ static void register_jdem_styles(LAMMPS *lmp) {
   (*fix_map)["jdem/watchdog"] = &create_fix_jdem_watchdog;
   (*fix_map)["bond/jiang"] = &create_fix_bond_jiang;
   (*fix_map)["jdem/loads"] = &create_fix_jdem_loads;
+  (*fix_map)["jdem/guard"] = &create_fix_jdem_guard;
 }
 
 /* ---- dump h5md/jdem: interposed Output::add_dump ---- */
@@ -141,6 +148,7 @@ static const char *jdem_help =
     "                             cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T\n"
     "                                 [velocity vx vy vz]\n"
     "                jdem/watchdog N [overlap F] [energy J]   (stop a run that goes wrong)\n"
+    "                jdem/guard vmax V [coordination C] [force]   (refuse an unsafe timestep)\n"
     "* Dump styles:  h5md/jdem    N FILE.h5 [scene NAME] [case NAME] [scene_yaml PATH]\n"
     "(gran/jiang presents itself as \"gran\" to LIGGGHTS; do not use `clear` or restart files.)\n\n";
 

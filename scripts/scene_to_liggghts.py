@@ -211,7 +211,19 @@ def bond_lines(scene, tid, deck_dir, rmax, skin):
     return L, 1.25 * longest + skin
 
 
-def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False):
+def guard_lines(scene, builtin, force):
+    """`fix jdem/guard`: the stepper's time-step guard (kernel/jdem_guard.h) at the scene's
+    max_impact_speed and coordination_number; `force` as `jdem run --force`.  It needs
+    gran/jiang: none with --builtin."""
+    if builtin:
+        return []
+    t = scene["time"]
+    return ["fix guard all jdem/guard vmax %s coordination %s%s\n" % (
+        num(t.get("max_impact_speed", 0.0)), num(t.get("coordination_number", 12.0)),
+        " force" if force else "")]
+
+
+def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=False):
     deck_dir = os.path.dirname(os.path.abspath(deck_path))
     os.makedirs(deck_dir, exist_ok=True)
     mats = scene["materials"]
@@ -341,6 +353,7 @@ def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False):
         L.append("fix loads all jdem/loads file loads.txt   # last of the forces, as build/jdem\n")
     L.append("fix integr all nve/sphere\n")
     L.extend(watchdog_lines(scene, builtin))
+    L.extend(guard_lines(scene, builtin, force))
     L.append("\ntimestep        %s\n" % num(dt))
     L.append("thermo          %d\n" % max(1, steps // 10))
     L.append("dump d all h5md/jdem %d %s scene %s case %s scene_yaml %s\n" % (
@@ -358,6 +371,8 @@ def main():
     ap.add_argument("--trajectory", required=True, help="H5MD file the deck's dump writes")
     ap.add_argument("--builtin", action="store_true",
                     help="LIGGGHTS' own hertz/history/epsd2 law and primitive walls instead of jdem's styles")
+    ap.add_argument("--force", action="store_true",
+                    help="run even if the time step is unsafe (fix jdem/guard ... force)")
     a = ap.parse_args()
     text = sys.stdin.read() if a.resolved == "-" else open(a.resolved).read()
     # libyaml's loader when present (the pure-Python one takes ~25 s on 20 000 bonds); same schema
@@ -368,7 +383,7 @@ def main():
     if os.path.abspath(a.resolved) != resolved_copy:
         with open(resolved_copy, "w") as f:
             f.write(text)
-    write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin)
+    write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin, a.force)
 
 
 if __name__ == "__main__":

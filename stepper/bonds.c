@@ -355,14 +355,14 @@ void sim_bonds_permute(jd_bonds *b, const int32_t *new_index) {
 /* ---------------------------------------------------------------------------------------- */
 /* Guard                                                                                     */
 
-double sim_bonds_guard(const jd_scene *sc) {
-    if (!sc->n_bond_types || (!sc->n_bonds && !sc->n_bond_rules)) return INFINITY;
+double sim_bonds_omega2(const jd_scene *sc) {
+    if (!sc->n_bond_types || (!sc->n_bonds && !sc->n_bond_rules)) return 0.0;
     double *w2 = calloc(sc->n_particles ? sc->n_particles : 1, sizeof *w2);
-    if (!w2) return 0.0; /* cannot assess: report as unsafe */
+    if (!w2) return INFINITY; /* cannot assess: report as unsafe */
     double *m = malloc((sc->n_particles ? sc->n_particles : 1) * sizeof *m);
     if (!m) {
         free(w2);
-        return 0.0;
+        return INFINITY;
     }
     for (size_t i = 0; i < sc->n_particles; i++)
         m[i] = jd_sphere_mass(sc->radius[i], sc->materials[sc->material[i]].density);
@@ -397,5 +397,5 @@ double sim_bonds_guard(const jd_scene *sc) {
     for (size_t i = 0; i < sc->n_particles; i++) wmax2 = fmax(wmax2, w2[i]);
     free(w2);
     free(m);
-    return wmax2 > 0.0 ? 2.0 * JD_PI / sqrt(wmax2) / JD_GUARD_STEPS_PER_BOND_PERIOD : INFINITY;
+    return wmax2;
 }

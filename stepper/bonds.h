@@ -76,11 +76,10 @@ void sim_bonds_observables(const struct jd_sim *s, jd_bond_observables *o);
 /* Remap the particle indices after a re-sort: particle k is now new_index[k]. */
 void sim_bonds_permute(jd_bonds *b, const int32_t *new_index);
 
-/* Time-step guard: the shortest step the bonds allow [s] (INFINITY without bonds): 1/20 of the
- * period of the fastest bond mode, bounded per particle by the sum of its bonds' squared
- * frequencies (jd_bond_omega2_bound; Gershgorin).  Particles in a rule's group count 12 more
+/* Time-step guard input (jd_guard_input.bond_omega2): the largest over the particles of the sum
+ * of its bonds' squared frequency bounds (jd_bond_omega2_bound; Gershgorin) [rad^2/s^2]; 0
+ * without bonds, INFINITY when out of memory (the guard then refuses).  Particles in a rule's group count 12 more
  * bonds to neighbours of their own size (the densest packing), since rules bond during the run. */
-double sim_bonds_guard(const struct jd_scene *sc);
-#define JD_GUARD_STEPS_PER_BOND_PERIOD 20.0
+double sim_bonds_omega2(const struct jd_scene *sc);
 
 #endif /* JDEM_BONDS_H */

@@ -13,13 +13,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "jdem_guard.h"
 #include "scene_internal.h"
 
 static const char *const TOP_KEYS[] = {"jdem_scene", "name", "case", "description", "time",
                                        "output", "gravity", "model", "materials", "interactions",
                                        "particles", "generate", "walls", "watchdog", "sweep",
                                        "bond_types", "bonds", "bond_rules", NULL};
-static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_speed", NULL};
+static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_speed",
+                                         "coordination_number", NULL};
 static const char *const OUTPUT_KEYS[] = {"every", "observables_every", "compare_tolerance",
                                           NULL};
 static const char *const MODEL_KEYS[] = {"wall_rule", "damping", "tangential_limit", "mu_r", NULL};
@@ -135,8 +137,11 @@ static int read_time(loader *L) {
     if (sd_req_num(&L->c, t, "time", "dt", SD_POSITIVE, &L->s->dt)) return -1;
     if (read_steps(L, t)) return -1;
     L->max_impact_given = sd_get(&L->c, t, "max_impact_speed") != NULL;
-    return sd_opt_num(&L->c, t, "time", "max_impact_speed", SD_NONNEGATIVE,
-                      &L->s->max_impact_speed);
+    if (sd_opt_num(&L->c, t, "time", "max_impact_speed", SD_NONNEGATIVE, &L->s->max_impact_speed))
+        return -1;
+    L->s->coordination_number = JD_GUARD_DEFAULT_COORDINATION;
+    return sd_opt_num(&L->c, t, "time", "coordination_number", SD_AT_LEAST_ONE,
+                      &L->s->coordination_number);
 }
 
 static int read_output(loader *L) {
@@ -279,7 +284,7 @@ static int read_scene(loader *L) {
                        "particle in particles or generate");
     }
     if (scene_read_interactions(L) || scene_sort_particles(L) || scene_check_overlaps(L) ||
-        scene_resolve_bonds(L))
+        scene_check_wall_overlaps(L) || scene_resolve_bonds(L))
         return -1;
     return L->max_impact_given ? 0 : default_impact_speed(L);
 }

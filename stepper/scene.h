@@ -82,6 +82,8 @@ typedef struct jd_scene {
     double dt;                /* [s] */
     int64_t steps;            /* from steps, or ceil(end_time/dt) */
     double max_impact_speed;  /* [m/s], resolved (given, or estimated as docs/scenes.md says) */
+    double coordination_number; /* expected maximum contacts of one sphere [-], >= 1, for the
+                                   time-step guard (kernel/jdem_guard.h) */
 
     /* output */
     int64_t output_every;

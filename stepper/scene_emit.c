@@ -127,6 +127,7 @@ static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
            key_str(e, "case", s->case_name) || key_str(e, "description", s->description) ||
            str(e, "time") || map_start(e, 0) || key_num(e, "dt", s->dt) ||
            key_int(e, "steps", s->steps) || key_num(e, "max_impact_speed", s->max_impact_speed) ||
+           key_num(e, "coordination_number", s->coordination_number) ||
            map_end(e) || str(e, "output") || map_start(e, 0) ||
            key_int(e, "every", s->output_every) ||
            key_int(e, "observables_every", s->observables_every) ||

@@ -69,6 +69,7 @@ int scene_read_particles(loader *L);
 long scene_add_particle(loader *L, const yaml_node_t *node, int32_t src);
 int scene_sort_particles(loader *L);
 int scene_check_overlaps(loader *L);
+int scene_check_wall_overlaps(loader *L);
 
 /* scene_generate.c */
 int scene_read_generators(loader *L);

@@ -1,10 +1,12 @@
 /*
  * scene_particles.c — the particles section, the per-particle arrays (also filled by the
- * generators), their sort by id with the duplicate-id check, and the start-overlap check.
+ * generators), their sort by id with the duplicate-id check, and the start-overlap checks
+ * (particle against particle, particle against wall).
  */
 #include <stdlib.h>
 #include <string.h>
 
+#include "jdem_geometry.h"
 #include "scene_internal.h"
 
 /* Relative tolerance of docs/scenes.md: initial overlap, fraction of the smaller radius. */
@@ -299,4 +301,35 @@ int scene_check_overlaps(loader *L) {
     }
     free(g.e);
     return rc;
+}
+
+/* Overlap [m] of particle i with wall w at the start (kernel geometry, as the engines see it),
+ * 0 without contact. */
+static double wall_overlap(const jd_scene *s, size_t i, const jd_wall *w) {
+    jd_contact_geom g;
+    const double *x = &s->position[3 * i];
+    if (w->type == JD_WALL_PLANE) {
+        jd_plane p;
+        if (jd_plane_init(&p, w->corners, 1e-6) != JD_GEOM_OK) return 0.0; /* checked already */
+        return jd_geom_plane(&p, x, s->radius[i], &g) ? g.delta : 0.0;
+    }
+    jd_cylinder c = {.rc = w->radius, .inside = w->inside};
+    memcpy(c.a0, w->axis[0], sizeof c.a0);
+    memcpy(c.a1, w->axis[1], sizeof c.a1);
+    return jd_geom_cylinder(&c, x, s->radius[i], &g) ? g.delta : 0.0;
+}
+
+int scene_check_wall_overlaps(loader *L) {
+    const jd_scene *s = L->s;
+    for (size_t i = 0; i < s->n_particles; i++)
+        for (size_t k = 0; k < s->n_walls; k++) {
+            const double by = wall_overlap(s, i, &s->walls[k]);
+            if (!(by > OVERLAP_TOL * s->radius[i])) continue;
+            char path[SD_PATH_MAX];
+            particle_path(L, i, path);
+            return sd_fail(&L->c, L->pnode[i], path, "particle %lld overlaps wall '%s' by %.3g m "
+                           "at the start; valid: an overlap of at most %g of its radius",
+                           (long long)s->id[i], s->walls[k].name, by, OVERLAP_TOL);
+        }
+    return 0;
 }

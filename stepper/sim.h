@@ -31,6 +31,7 @@
 
 #include "bonds.h"
 #include "jdem_geometry.h"
+#include "jdem_guard.h"
 #include "jdem_kernel.h"
 #include "jdem_watchdog.h"
 #include "scene.h"
@@ -169,19 +170,11 @@ extern const char *const jd_observable_names[JD_N_OBSERVABLES];
 void sim_observables(const jd_sim *s, jd_observables *o);
 void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES]);
 
-/* guard.c: time-step bounds of a scene. */
-typedef struct jd_guard {
-    double rayleigh_bound;   /* 0.2 x the smallest Rayleigh step [s]; INFINITY without particles */
-    double contact_time;     /* shortest Hertz contact time at max_impact_speed [s]; INFINITY if none */
-    double contact_bound;    /* contact_time / JD_GUARD_STEPS_PER_CONTACT [s] */
-    double bond_bound;       /* sim_bonds_guard [s]; INFINITY without bonds */
-    double safe_dt;          /* min of the bounds [s] */
-    const char *violated;    /* description of the tightest violated bound, or NULL when safe */
-    double violated_value;   /* its value [s] */
-} jd_guard;
-#define JD_GUARD_RAYLEIGH_FRACTION 0.2
-#define JD_GUARD_STEPS_PER_CONTACT 50.0
-void sim_guard(const jd_scene *scene, jd_guard *g);
+/* guard.c: the kernel's time-step guard (kernel/jdem_guard.h) applied to a scene.  Fills *in
+ * (its species array is malloc'ed into *species: free it) and *r; returns 0, or -1 when out of
+ * memory. */
+int sim_guard(const jd_scene *scene, jd_guard_input *in, jd_guard_species **species,
+              jd_guard_result *r);
 
 /* watchdog.c.  The force loops call sim_watchdog_overlap() (out of line: the rare case) for a
  * contact with jd_overlap_excessive(); the run loop calls the checks below, which return 0 or
