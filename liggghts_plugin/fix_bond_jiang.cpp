@@ -37,7 +37,7 @@ static_assert(sizeof(jd_bond_section) % sizeof(double) == 0, "jd_bond_section mu
 FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), e_elastic_now(0.0), e_damp_cum(0.0), e_broken_cum(0.0), max_bonds(12),
       file_read(false), rules_done_at(-1), record(true), nmax_b(0), nbond(NULL), partner(NULL),
-      bstate(NULL), nmax_ghost(0), fghost(NULL) {
+      bstate(NULL), nmax_ghost(0), fghost(NULL), reverse_len(6) {
   const char *usage =
       "Illegal fix bond/jiang command: fix ID group bond/jiang kn KN kt KT sigma_c S tau_c T "
       "lambda L [damping GAMMA] [bending I|J_literal] [max_bonds N] [file FILE] "
@@ -463,12 +463,15 @@ void FixBondJiang::loop(bool commit) {
   }
 }
 
-/* Comm::reverse_comm_fix takes the return value as the datums per atom (comm_reverse). */
+/* Comm::reverse_comm_fix takes the return value as the datums per atom (at most comm_reverse). */
 int FixBondJiang::pack_reverse_comm(int n, int first, double *buf) {
   int m = 0;
-  for (int i = first; i < first + n; i++)
-    for (int d = 0; d < 6; d++) buf[m++] = fghost[i][d];
-  return 6;
+  for (int i = first; i < first + n; i++) {
+    if (reverse_len == 1) buf[m++] = w2[i];
+    else
+      for (int d = 0; d < 6; d++) buf[m++] = fghost[i][d];
+  }
+  return reverse_len;
 }
 
 void FixBondJiang::unpack_reverse_comm(int n, int *list, double *buf) {
@@ -476,9 +479,50 @@ void FixBondJiang::unpack_reverse_comm(int n, int *list, double *buf) {
   int m = 0;
   for (int i = 0; i < n; i++) {
     const int j = list[i];
+    if (reverse_len == 1) {
+      w2[j] += buf[m++];
+      continue;
+    }
     for (int d = 0; d < 3; d++) f[j][d] += buf[m++];
     for (int d = 0; d < 3; d++) torque[j][d] += buf[m++];
   }
+}
+
+double FixBondJiang::omega2_max() {
+  double **x = atom->x;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  const int nlocal = atom->nlocal, nall = nlocal + atom->nghost, *mask = atom->mask;
+  w2.assign(nall, 0.0);
+  for (int i = 0; i < nlocal; i++) {
+    const double Ii = jd_sphere_inertia(rmass[i], radius[i]);
+    for (int k = 0; k < nbond[i]; k++) {
+      const int j = atom->map(partner[i][k]);
+      if (j < 0) continue; /* check_reach reports it */
+      jd_bond_section sec;
+      std::memcpy(&sec, section(i, k), sizeof sec);
+      const double d[3] = {x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
+      const double dist = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      const double la = std::fabs(radius[i] - 0.5 * (radius[i] + radius[j] - dist)), lb = std::fabs(dist - la);
+      const double wk = jd_bond_omega2_bound(&params, &sec, rmass[i], rmass[j], Ii,
+                                             jd_sphere_inertia(rmass[j], radius[j]), la, lb);
+      w2[i] += wk;
+      w2[j] += wk;
+    }
+  }
+  for (size_t r = 0; r < rules.size(); r++)
+    for (int i = 0; i < nlocal; i++) {
+      if (!(mask[i] & rules[r].groupbit)) continue;
+      const double R = radius[i], I = jd_sphere_inertia(rmass[i], R);
+      const jd_bond_section sec = jd_bond_section_of(params.lambda, R, R);
+      w2[i] += 12.0 * jd_bond_omega2_bound(&params, &sec, rmass[i], rmass[i], I, I, R, R);
+    }
+  reverse_len = 1;
+  comm->reverse_comm_fix(this);
+  reverse_len = 6;
+  double mine = 0.0, all = 0.0;
+  for (int i = 0; i < nlocal; i++) mine = std::fmax(mine, w2[i]);
+  MPI_Allreduce(&mine, &all, 1, MPI_DOUBLE, MPI_MAX, world);
+  return all;
 }
 
 /* ---------------------------------------------------------------------------------------- */

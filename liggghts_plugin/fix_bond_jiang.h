@@ -94,6 +94,12 @@ class FixBondJiang : public Fix {
   /* True when local atom i (the lower id) holds an intact bond with the atom of id tag_b. */
   bool bonded(int i, int tag_b) const;
 
+  /* For the time-step guard (kernel/jdem_guard.h, bond_omega2): the largest over the atoms of
+   * the sum of jd_bond_omega2_bound over the atom's bonds, plus for each rule that may bond it
+   * 12 bonds with its own kind (as build/jdem estimates it) [rad^2/s^2].  Collective; valid
+   * after this fix's set-up (explicit bonds are read then). */
+  double omega2_max();
+
   /* This rank's intact bonds as (lower id, higher id) pairs. */
   void local_bonds(std::vector<int> &pairs) const;
   int local_count() const;
@@ -138,6 +144,8 @@ class FixBondJiang : public Fix {
   double **bstate; /* their records, REC_LEN doubles each */
   int nmax_ghost;
   double **fghost; /* force and torque on ghost partners, sent home by reverse communication */
+  int reverse_len;  /* doubles per atom of the next reverse communication: 6, or 1 (omega2) */
+  std::vector<double> w2;  /* omega2_max's per-atom sums (local and ghost) */
   std::vector<Event> events;
   std::vector<Formed> formed;
   double nbroken[2]; /* this rank's bonds broken in tension, in shear (cumulative) */

@@ -18,7 +18,9 @@ Scenes in tests/liggghts/bond_scenes/, run with build/jdem and scripts/liggghts_
                     on 1 and 2 ranks with the message naming the bond, OUT.part kept, nothing
                     under OUT; the reported length is that of the undamped two-body oscillator
                     (closed form) at the reported step;
-and a malformed bond file stops the run with a message naming the file and the line.
+a malformed bond file stops the run with a message naming the file and the line; and the
+time-step guard (fix jdem/guard) refuses block_drop with stiffer bonds and a longer step, on 1
+and 2 ranks, with the bond bound and the largest safe step of build/jdem's refusal.
 Prints one PASS/FAIL line per check; exit 1 if any fails.
 """
 import argparse
@@ -188,6 +190,33 @@ def check_ghost_cutoff(work):
               abs(length - exact) <= 1e-5 * exact and length >= cut, "length %r exact %r cut %r" % (length, exact, cut))
 
 
+SAFE_DT = re.compile(r"largest safe dt = (\S+) s")
+
+
+def check_guard(work):
+    """block_drop with 10x stiffer bonds at dt 2e-7: both engines refuse it, the bond bound binds."""
+    text = open(os.path.join(SCENES, "block_drop.yaml")).read()
+    text = text.replace("normal_stiffness: 1.0e12, shear_stiffness: 5.0e11",
+                        "normal_stiffness: 1.0e13, shear_stiffness: 5.0e12").replace("dt: 1.0e-7", "dt: 2.0e-7")
+    scene = os.path.join(work, "unsafe_dt.yaml")
+    with open(scene, "w") as f:
+        f.write(text)
+    rc, out = run([JDEM, "run", scene, "-o", os.path.join(work, "unsafe.jdem.h5"), "--quiet"])
+    ref = SAFE_DT.search(out)
+    if not check("bonds/guard: build/jdem refuses the unsafe bonded scene (bond period)",
+                 rc != 0 and ref is not None and "bond period" in out, out[-600:]):
+        return
+    for n in (1, 2):
+        out_h5 = os.path.join(work, "unsafe.np%d.h5" % n)
+        rc, _ = run([PY, RUN, scene, "-o", out_h5] + (["--np", str(n)] if n > 1 else []))
+        log = open(os.path.join(work, "unsafe.np%d.deck" % n, "log.lammps"), errors="replace").read()
+        got = SAFE_DT.search(log)
+        check("bonds/guard: liggghts-jdem refuses it on %d rank(s), largest safe dt %s s as jdem" % (n, ref.group(1)),
+              rc != 0 and got is not None and got.group(1) == ref.group(1) and "bond period" in log
+              and not os.path.exists(out_h5) and not os.path.exists(out_h5 + ".part"),
+              "exit %d, log tail:\n%s" % (rc, log[-600:]))
+
+
 def check_bad_file(work):
     """A deck whose bond file has a line with one id: the message names the file and the line."""
     out = os.path.join(work, "bad.h5")
@@ -215,6 +244,7 @@ def main():
     check_block(work)
     check_ghost_cutoff(work)
     check_bad_file(work)
+    check_guard(work)
     if not a.out and not a.keep and not failed:
         shutil.rmtree(work, ignore_errors=True)
     elif not a.out:
