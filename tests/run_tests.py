@@ -16,7 +16,7 @@ import time
 PY = "/usr/bin/python3"
 
 ENGINE_TESTS = ["neighbour", "fastpaths", "free_flight", "hertz_impact", "energy_balance", "guard",
-                "guard_coordination", "watchdog",
+                "guard_coordination", "dt_auto", "watchdog",
                 "signals"]
 SANITIZED = {"JDEM": "build/san/jdem"}
 
@@ -34,6 +34,8 @@ SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines",
 SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {})]
 # The watchdog in LIGGGHTS (fix jdem/watchdog): the same trips as the stepper's.
 SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "lines", {})]
+# Parallel bonds in LIGGGHTS (fix bond/jiang): 1 vs 2 MPI ranks, the ghost-cutoff guard, bad input.
+SUITES += [("liggghts-bonds", [PY, "tests/liggghts/check_bonds.py"], "lines", {})]
 # The pour (576 spheres, walls, a cylinder): round-off horizons and settled statistics.
 SUITES += [("pour", [PY, "tests/liggghts/check_pour.py"], "lines", {})]
 # The stability suite (make stability), reduced: the harshest one-contact cases at their own dt and
@@ -47,8 +49,10 @@ SUITES += [
                              STABILITY_CASES, "--factors", "10", "--engines", "jdem",
                              "--jdem", "build/san/jdem"], "lines", {}),
 ]
-# Parallel bonds: the checks of `make bonds`, shortened, in the stepper and its sanitized build.
-SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--out", "out/test/bonds"], "lines", {}),
+# Parallel bonds: the checks of `make bonds`, shortened, in both engines (liggghts-jdem's
+# block drop is compared with jdem's) and in the stepper's sanitized build.
+SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--engines", "jdem,liggghts-jdem",
+                      "--out", "out/test/bonds"], "lines", {}),
            ("bonds-sanitized", [PY, "scripts/bond_checks.py", "--quick", "--out",
                                 "out/test/bonds-san"], "lines", SANITIZED)]
 # The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
@@ -57,6 +61,15 @@ CHUNG_OOI = "out/test/chung_ooi"
 SUITES += [
     ("chung-ooi", ["sh", "-c", f"{PY} scripts/chung_ooi.py run --quick --engines jdem,liggghts "
                    f"--out {CHUNG_OOI} && {PY} scripts/chung_ooi.py check --out {CHUNG_OOI}"],
+     "lines", {}),
+]
+
+# The work-precision study reduced to Test 1 in the two engines of the Jiang kernel (`make
+# accuracy` runs all of it): observed order against velocity Verlet's 2, engines against each other.
+ACCURACY = "out/test/accuracy"
+SUITES += [
+    ("accuracy", ["sh", "-c", f"{PY} scripts/accuracy.py run --items test1_glass --engines jdem,liggghts-jdem "
+                  f"--repeats 1 --out {ACCURACY} && {PY} scripts/accuracy.py check --out {ACCURACY}"],
      "lines", {}),
 ]
 
