@@ -155,6 +155,15 @@ static int by_pair(const void *x, const void *y) {
 
 /* Bond the pairs of one rule that are not bonded already (intact).  Out of memory is recorded
  * in b->failed and stops the run at the next sim_bonds_output. */
+/* Positions in scene order (x, 3n) and where[p]: the engine index of scene particle p. */
+static void positions_in_scene_order(const jd_sim *s, double *x, int32_t *where) {
+    for (size_t i = 0; i < s->n; i++) {
+        const size_t p = (size_t)s->orig[i];
+        for (int d = 0; d < 3; d++) x[3 * p + d] = s->x[3 * i + d];
+        where[p] = (int32_t)i;
+    }
+}
+
 static void apply_rule(jd_sim *s, const jd_bond_rule *rule, int64_t step) {
     jd_bonds *b = s->bonds;
     int32_t *pairs = NULL;
@@ -163,7 +172,7 @@ static void apply_rule(jd_sim *s, const jd_bond_rule *rule, int64_t step) {
     const size_t n1 = s->n ? s->n : 1;
     double *x = malloc(3 * n1 * sizeof *x);
     int32_t *where = malloc(n1 * sizeof *where);
-    const long np = x && where ? (sim_positions_in_scene_order(s, x, where),
+    const long np = x && where ? (positions_in_scene_order(s, x, where),
                                   jd_bond_rule_pairs(s->scene, rule, x, &pairs))
                                : -1;
     for (long q = 0; q < 2 * np; q++) pairs[q] = where[pairs[q]];

@@ -155,12 +155,3 @@ void sim_scalars_in_scene_order(const jd_sim *s, const double *a, double *out) {
     for (size_t i = 0; i < s->n; i++) out[s->orig[i]] = a[i];
 }
 
-void sim_positions_in_scene_order(const jd_sim *s, double *x, int32_t *where) {
-    for (size_t i = 0; i < s->n; i++) {
-        const size_t p = (size_t)s->orig[i];
-        for (int d = 0; d < 3; d++) x[3 * p + d] = s->x[3 * i + d];
-        where[p] = (int32_t)i;
-    }
-}
-
-long long sim_particle_id(const jd_sim *s, size_t i) { return (long long)s->scene->id[s->orig[i]]; }

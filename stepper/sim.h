@@ -224,10 +224,10 @@ void sim_vectors_to_scene_order(jd_sim *s);
 void sim_vectors_to_sim_order(jd_sim *s);
 /* A per-particle array in scene order: out[orig[i]] = a[i]. */
 void sim_scalars_in_scene_order(const jd_sim *s, const double *a, double *out);
-/* Positions in scene order (x, 3n) and where[p]: the engine index of scene particle p. */
-void sim_positions_in_scene_order(const jd_sim *s, double *x, int32_t *where);
 /* Scene id of the particle at index i. */
-long long sim_particle_id(const jd_sim *s, size_t i);
+static inline long long sim_particle_id(const jd_sim *s, size_t i) {
+    return (long long)s->scene->id[s->orig[i]];
+}
 
 /* walls.c */
 int sim_walls_init(jd_sim *s, char *err, size_t errlen);
