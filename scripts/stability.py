@@ -15,7 +15,9 @@ failed.  PATTERN selects cases as SCENE/CASE with shell wildcards (fnmatch).
 Quantities (docs/model.md §8 and the report's notes):
   energy_rel_error   max over samples |E(t) - E(0)| / max over samples of the energy in play,
                      E = KE + RE + elastic + gravitational + damping + friction - wall work, the
-                     energy in play KE + RE + elastic + damping + friction + |wall work|
+                     energy in play KE + RE + elastic + damping + friction + |wall work| (with
+                     bonds, elastic includes the bonds' stored energy and damping their damping
+                     and breakage energy)
   max_overlap_over_radius  largest overlap over the smaller radius (pairs) or the radius
                      (walls) in the frames
   energy returned    the most the contacts ever gave back beyond what they had received, over the
@@ -117,10 +119,17 @@ def all_finite(path):
 
 
 def energy_series(f):
+    """The observables, the total energy and the energy in play.  Bonds (docs/model.md §9.3) store
+    energy as bond_elastic_energy and dissipate it as bond_damping_dissipation and
+    bond_breakage_energy; the folds below add them as elastic energy and as damping."""
     o = {k: f["observables"][k]["value"][()] for k in f["observables"]}
-    total = (o["kinetic_energy"] + o["rotational_energy"] + o["elastic_energy"] + o["gravitational_energy"]
-             + o["damping_dissipation"] + o["friction_dissipation"] - o["wall_work"])
-    scale = (o["kinetic_energy"] + o["rotational_energy"] + o["elastic_energy"] + o["damping_dissipation"]
+    zero = np.zeros_like(o["kinetic_energy"])
+    elastic = o["elastic_energy"] + o.get("bond_elastic_energy", zero)
+    damping = (o["damping_dissipation"] + o.get("bond_damping_dissipation", zero)
+               + o.get("bond_breakage_energy", zero))
+    total = (o["kinetic_energy"] + o["rotational_energy"] + elastic + o["gravitational_energy"]
+             + damping + o["friction_dissipation"] - o["wall_work"])
+    scale = (o["kinetic_energy"] + o["rotational_energy"] + elastic + damping
              + o["friction_dissipation"] + np.abs(o["wall_work"]))
     return o, total, scale
 
