@@ -43,6 +43,8 @@ import h5py
 import numpy as np
 import yaml
 
+from bond_checks import beam_reference, mean_between_extrema
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 PY = sys.executable
@@ -163,6 +165,7 @@ def analyse(path, scene):
         F = part["force/value"][()]
         R = part["radius"][()]
         m = part["mass"][()]
+        ids = part["id"][()]
     g = np.array(scene.get("gravity", [0, 0, 0]), float)
     n = len(R)
     worst = 0.0
@@ -202,6 +205,7 @@ def analyse(path, scene):
     r["velocities"] = vel
     r["times"] = times
     r["radius"] = R
+    r["ids"] = ids
     return r
 
 
@@ -244,6 +248,24 @@ def extras(scene_name, doc, a):
         out.append(("velocity_change_vs_closed_form", abs((got - v0) - (want - v0)) / abs(want - v0), 2e-3,
                     "velocity at %.3g s: %.6g m/s vs rigid-body %.6g m/s (%s; relative error of the "
                     "change)" % (t, got, want, "rolling" if eta <= 1.4 * mu else "sliding")))
+    loaded = [p for p in doc["particles"] if any(c != 0.0 for c in p.get("force", [0.0, 0.0, 0.0]))]
+    if scene_name == "bonded_beam" and loaded:
+        # the tip oscillates about its static deflection (the load acts from step 0): its mean
+        # over the last two periods against the discrete chain's exact static deflection
+        # (bond_checks.beam_reference, the reference of `make bonds`' beam_tip_deflection_discrete)
+        tip = loaded[0]
+        bond = doc["bond_types"][doc["bonds"][0]["type"]]
+        r_bond = bond["radius_multiplier"] * tip["radius"]
+        spacing = float(np.linalg.norm(np.subtract(doc["particles"][1]["position"],
+                                                   doc["particles"][0]["position"])))
+        P = abs(tip["force"][2])
+        _, want = beam_reference(len(doc["bonds"]), P, bond["normal_stiffness"], bond["shear_stiffness"],
+                                 r_bond, spacing)
+        z = a["positions"][:, int(np.nonzero(a["ids"] == tip["id"])[0][0]), 2]
+        got = -mean_between_extrema(z - tip["position"][2])
+        out.append(("tip_deflection_vs_discrete_chain", abs(got - want) / want, 0.005,
+                    "static tip deflection %.5g m (mean of the last two periods) vs the discrete "
+                    "chain's %.5g m (relative difference)" % (got, want)))
     if scene_name == "dense_bed":
         piston = [w for w in doc["walls"] if w["name"] == "piston"][0]
         p0, nv = plane_of(piston, float(a["times"][-1]))
