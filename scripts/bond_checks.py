@@ -243,19 +243,30 @@ GAP = 2.0e-7                            # surface gap of the chains [m]: no cont
 L = 2 * R + GAP                         # centre distance of neighbours in a chain
 
 
-def beam_reference(n_bonds, P):
-    """Tip deflection of a chain of n_bonds bonds clamped at sphere 0 under tip load P.
-    Euler–Bernoulli with EI = kn I L (docs/model.md §9.6), and the exact discrete chain:
-    rotations from the bending springs (midpoint rule of M/EI, exact for linear M), centre
-    offsets L/2 (theta_{j-1} + theta_j) plus the shear spring's P/(kt A) per bond."""
-    EI = KN * I * L
-    ell = n_bonds * L
+def beam_reference(n_bonds, P, kn=KN, kt=KT, r=R, spacing=L):
+    """Tip deflection of a chain of n_bonds bonds (bond radius r, centres `spacing` apart)
+    clamped at sphere 0 under tip load P.  Euler–Bernoulli with EI = kn I L (docs/model.md
+    §9.6), and the exact discrete chain: rotations from the bending springs (midpoint rule of
+    M/EI, exact for linear M), centre offsets L/2 (theta_{j-1} + theta_j) plus the shear
+    spring's P/(kt A) per bond.  Also used by scripts/stability.py (bonded_beam)."""
+    inertia, area = math.pi * r ** 4 / 4, math.pi * r ** 2
+    EI = kn * inertia * spacing
+    ell = n_bonds * spacing
     eb = P * ell ** 3 / (3 * EI)
     theta = [0.0]
     for k in range(1, n_bonds + 1):
-        theta.append(theta[-1] + P * (n_bonds - k + 0.5) * L / (KN * I))
-    discrete = sum(0.5 * L * (theta[j - 1] + theta[j]) + P / (KT * A) for j in range(1, n_bonds + 1))
+        theta.append(theta[-1] + P * (n_bonds - k + 0.5) * spacing / (kn * inertia))
+    discrete = sum(0.5 * spacing * (theta[j - 1] + theta[j]) + P / (kt * area)
+                   for j in range(1, n_bonds + 1))
     return eb, discrete
+
+
+def mean_between_extrema(z, half_periods=4):
+    """The static level a damped oscillation z(t) oscillates about: its mean over the last
+    half_periods half periods, between extrema (nan if it has not swung that often)."""
+    dz = np.diff(z)
+    ext = np.nonzero(np.sign(dz[1:]) != np.sign(dz[:-1]))[0] + 1
+    return float(np.mean(z[ext[-1 - half_periods]:ext[-1]])) if len(ext) > half_periods else float("nan")
 
 
 def check_beam(runner, engine, quick):
@@ -278,9 +289,7 @@ def check_beam(runner, engine, quick):
     # the tip oscillates about its static deflection (the load is applied at once, and the bond
     # dashpots damp the fundamental only slowly): the mean over the last two full periods,
     # between extrema of the oscillation, is the static deflection
-    dz = np.diff(z)
-    ext = np.nonzero(np.sign(dz[1:]) != np.sign(dz[:-1]))[0] + 1
-    w_eq = -float(np.mean(z[ext[-5]:ext[-1]])) if len(ext) >= 5 else float("nan")
+    w_eq = -mean_between_extrema(z)
     eb, discrete = beam_reference(n, P)
     return [record("beam_tip_deflection", engine, w_eq, eb, 0.02),
             record("beam_tip_deflection_discrete", engine, w_eq, discrete, 0.005)]

@@ -15,7 +15,9 @@ failed.  PATTERN selects cases as SCENE/CASE with shell wildcards (fnmatch).
 Quantities (docs/model.md §8 and the report's notes):
   energy_rel_error   max over samples |E(t) - E(0)| / max over samples of the energy in play,
                      E = KE + RE + elastic + gravitational + damping + friction - wall work, the
-                     energy in play KE + RE + elastic + damping + friction + |wall work|
+                     energy in play KE + RE + elastic + damping + friction + |wall work| (with
+                     bonds, elastic includes the bonds' stored energy and damping their damping
+                     and breakage energy)
   max_overlap_over_radius  largest overlap over the smaller radius (pairs) or the radius
                      (walls) in the frames
   energy returned    the most the contacts ever gave back beyond what they had received, over the
@@ -40,6 +42,8 @@ import time
 import h5py
 import numpy as np
 import yaml
+
+from bond_checks import beam_reference, mean_between_extrema
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -117,10 +121,17 @@ def all_finite(path):
 
 
 def energy_series(f):
+    """The observables, the total energy and the energy in play.  Bonds (docs/model.md §9.3) store
+    energy as bond_elastic_energy and dissipate it as bond_damping_dissipation and
+    bond_breakage_energy; the folds below add them as elastic energy and as damping."""
     o = {k: f["observables"][k]["value"][()] for k in f["observables"]}
-    total = (o["kinetic_energy"] + o["rotational_energy"] + o["elastic_energy"] + o["gravitational_energy"]
-             + o["damping_dissipation"] + o["friction_dissipation"] - o["wall_work"])
-    scale = (o["kinetic_energy"] + o["rotational_energy"] + o["elastic_energy"] + o["damping_dissipation"]
+    zero = np.zeros_like(o["kinetic_energy"])
+    elastic = o["elastic_energy"] + o.get("bond_elastic_energy", zero)
+    damping = (o["damping_dissipation"] + o.get("bond_damping_dissipation", zero)
+               + o.get("bond_breakage_energy", zero))
+    total = (o["kinetic_energy"] + o["rotational_energy"] + elastic + o["gravitational_energy"]
+             + damping + o["friction_dissipation"] - o["wall_work"])
+    scale = (o["kinetic_energy"] + o["rotational_energy"] + elastic + damping
              + o["friction_dissipation"] + np.abs(o["wall_work"]))
     return o, total, scale
 
@@ -154,6 +165,7 @@ def analyse(path, scene):
         F = part["force/value"][()]
         R = part["radius"][()]
         m = part["mass"][()]
+        ids = part["id"][()]
     g = np.array(scene.get("gravity", [0, 0, 0]), float)
     n = len(R)
     worst = 0.0
@@ -193,6 +205,7 @@ def analyse(path, scene):
     r["velocities"] = vel
     r["times"] = times
     r["radius"] = R
+    r["ids"] = ids
     return r
 
 
@@ -235,6 +248,24 @@ def extras(scene_name, doc, a):
         out.append(("velocity_change_vs_closed_form", abs((got - v0) - (want - v0)) / abs(want - v0), 2e-3,
                     "velocity at %.3g s: %.6g m/s vs rigid-body %.6g m/s (%s; relative error of the "
                     "change)" % (t, got, want, "rolling" if eta <= 1.4 * mu else "sliding")))
+    loaded = [p for p in doc["particles"] if any(c != 0.0 for c in p.get("force", [0.0, 0.0, 0.0]))]
+    if scene_name == "bonded_beam" and loaded:
+        # the tip oscillates about its static deflection (the load acts from step 0): its mean
+        # over the last two periods against the discrete chain's exact static deflection
+        # (bond_checks.beam_reference, the reference of `make bonds`' beam_tip_deflection_discrete)
+        tip = loaded[0]
+        bond = doc["bond_types"][doc["bonds"][0]["type"]]
+        r_bond = bond["radius_multiplier"] * tip["radius"]
+        spacing = float(np.linalg.norm(np.subtract(doc["particles"][1]["position"],
+                                                   doc["particles"][0]["position"])))
+        P = abs(tip["force"][2])
+        _, want = beam_reference(len(doc["bonds"]), P, bond["normal_stiffness"], bond["shear_stiffness"],
+                                 r_bond, spacing)
+        z = a["positions"][:, int(np.nonzero(a["ids"] == tip["id"])[0][0]), 2]
+        got = -mean_between_extrema(z - tip["position"][2])
+        out.append(("tip_deflection_vs_discrete_chain", abs(got - want) / want, 0.005,
+                    "static tip deflection %.5g m (mean of the last two periods) vs the discrete "
+                    "chain's %.5g m (relative difference)" % (got, want)))
     if scene_name == "dense_bed":
         piston = [w for w in doc["walls"] if w["name"] == "piston"][0]
         p0, nv = plane_of(piston, float(a["times"][-1]))

@@ -313,8 +313,44 @@ def bed_scene(jdem):
     return base, finish(jdem, base, {"sc125": {}}, lambda doc: T)
 
 
+def beam_scene(jdem):
+    """A cantilever of 11 bonded glass-like spheres, clamped at sphere 1 (`fixed`)."""
+    R, n, E, nu, rho = 0.001, 10, 7.0e10, 0.3, 2600.0
+    gap = 2.0e-7                                    # surface gap: the bonds alone carry the beam
+    L = 2 * R + gap
+    # the stiff end of realistic parallel bonds: Potyondy & Cundall's kn = E_c / (R_a + R_b)
+    # with a cement as stiff as the grains (E_c = E = 70 GPa), kt = kn / (2 (1 + nu))
+    kn = E / (2 * R)
+    kt = float("%.4g" % (kn / (2 * (1 + nu))))
+    I = math.pi * R ** 4 / 4
+    EI, ell = kn * I * L, n * L                     # the chain's bending stiffness (docs/model.md §9.6)
+    P = 3 * EI * 0.01 * ell / ell ** 3              # tip load of a static deflection of 1 % of l
+    mu_l = mass(R, rho) / L
+    period = 2 * math.pi / (1.8751 ** 2 * math.sqrt(EI / (mu_l * ell ** 4)))   # fundamental mode
+    cement = {"normal_stiffness": kn, "shear_stiffness": kt, "tensile_strength": float("inf"),
+              "shear_strength": float("inf"), "radius_multiplier": 1.0, "damping": 0.0}
+    base = base_doc("bonded_beam", "A stiff bonded beam: 11 spheres (R = 1 mm, E = 70 GPa) in a "
+                    "straight chain (surface gap 0.2 um), neighbours joined by parallel bonds at "
+                    "the stiff end of realistic values (kn = E / 2R = %.3g N/m^3, kt = kn / 2(1 + "
+                    "nu)), clamped at sphere 1 (fixed).  tip_impact: the tip sphere is struck "
+                    "(transverse 1 m/s), undamped bonds; tip_load: a tip load of %.4g N (static "
+                    "deflection 1 %% of the length) applied at once, bond damping 1; 4 fundamental "
+                    "periods (%.3g s each)." % (kn, P, period),
+                    {"glass": {"youngs_modulus": E, "poisson_ratio": nu, "density": rho,
+                               "restitution": 0.5, "friction": 0.3}},
+                    [dict({"id": k + 1, "material": "glass", "radius": R, "position": [k * L, 0.0, 0.0]},
+                          **({"fixed": True} if k == 0 else {})) for k in range(n + 1)],
+                    time={"max_impact_speed": 1.0})
+    base["bond_types"] = {"cement": cement}
+    base["bonds"] = [{"ids": [k, k + 1], "type": "cement"} for k in range(1, n + 1)]
+    tip = "particles.%d" % n
+    cases = {"tip_impact": {tip + ".velocity": [0.0, 0.0, -1.0]},
+             "tip_load": {tip + ".force": [0.0, 0.0, -P], "bond_types.cement.damping": 1.0}}
+    return base, finish(jdem, base, cases, lambda doc: 4 * period)
+
+
 SCENES = [scale_scene, impact_speed_scene, grazing_scene, restitution_scene, friction_scene,
-          rolling_scene, pile_scene, column_scene, bed_scene]
+          rolling_scene, pile_scene, column_scene, bed_scene, beam_scene]
 
 
 def main():

@@ -38,10 +38,11 @@ SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "line
 SUITES += [("liggghts-bonds", [PY, "tests/liggghts/check_bonds.py"], "lines", {})]
 # The pour (576 spheres, walls, a cylinder): round-off horizons and settled statistics.
 SUITES += [("pour", [PY, "tests/liggghts/check_pour.py"], "lines", {})]
-# The stability suite (make stability), reduced: the harshest one-contact cases at their own dt and
-# at 10x the guard's dt, in both engines and in the sanitized stepper.
+# The stability suite (make stability), reduced: the harshest one-contact cases and the damped,
+# tip-loaded stiff bonded beam at their own dt and at 10x the guard's dt, in both engines and in
+# the sanitized stepper.
 STABILITY_CASES = ("restitution/e0p01,grazing/a89p9,friction/mu10,impact_speed/v100,"
-                   "scale/E1e12_R10um,scale/co5_polyethylene,rolling/eta1")
+                   "scale/E1e12_R10um,scale/co5_polyethylene,rolling/eta1,bonded_beam/tip_load")
 SUITES += [
     ("stability", [PY, "scripts/stability.py", "--out", "out/test/stability", "--cases",
                    STABILITY_CASES, "--factors", "10"], "lines", {}),
