@@ -59,11 +59,46 @@ void FixJdemWatchdog::setup(int) { check(); }
 
 void FixJdemWatchdog::end_of_step() { check(); }
 
-/* The stepper's order: the state, the overlaps, then the energy at its samples. */
+/* Is every component of x, v, omega, f and torque of this rank's atoms finite?  0 q is +-0 for
+ * a finite q and NaN for an infinite or NaN one, so the sum of 0 q over every component is NaN
+ * exactly when some component is not finite (it cannot overflow).  Four independent partial
+ * sums over the contiguous per-atom arrays, which the compiler vectorises: a few instructions
+ * per atom and step. */
+static bool all_finite(Atom *atom) {
+  double *const q[] = {atom->x[0], atom->v[0], atom->omega[0], atom->f[0], atom->torque[0]};
+  const int n = 3 * atom->nlocal;
+  double acc[4] = {0.0, 0.0, 0.0, 0.0};
+  for (int k = 0; k < 5; k++) {
+    const double *p = q[k];
+    int i = 0;
+    for (; i + 4 <= n; i += 4)
+      for (int l = 0; l < 4; l++) acc[l] += 0.0 * p[i + l];
+    for (; i < n; i++) acc[0] += 0.0 * p[i];
+  }
+  return std::isfinite(acc[0] + acc[1] + acc[2] + acc[3]);
+}
+
+/* The worst overlap beyond the limit that the force loops of this rank noted. */
+static JdOverlapTrip worst_overlap(LAMMPS *lmp) {
+  JdOverlapTrip worst = dynamic_cast<PairGranJiang *>(lmp->force->pair)->overlap_trip;
+  for (int k = 0; k < lmp->modify->nfix; k++) {
+    FixWallJiang *w = dynamic_cast<FixWallJiang *>(lmp->modify->fix[k]);
+    if (w && w->overlap_trip.fraction > worst.fraction) worst = w->overlap_trip;
+  }
+  return worst;
+}
+
+/* The stepper's order: the state, the overlaps, then the energy at its samples.  One
+ * reduction answers "anything non-finite? any overlap beyond the limit?" for the whole run;
+ * only then do the searches that name the particle run (each with its own reduction). */
 void FixJdemWatchdog::check() {
   std::string msg;
-  if (nonfinite(msg)) trip(msg, false);
-  if (overlap(msg)) trip(msg, true);
+  double mine[2] = {atom->nlocal > 0 && !all_finite(atom) ? 1.0 : 0.0,
+                    worst_overlap(lmp).fraction},
+         any[2];
+  MPI_Allreduce(mine, any, 2, MPI_DOUBLE, MPI_MAX, world);
+  if (any[0] > 0.0 && nonfinite(msg)) trip(msg, false);
+  if (any[1] > 0.0 && overlap(msg)) trip(msg, true);
   const bigint step = update->ntimestep;
   if ((step % energy_every == 0 || step == update->laststep) && energy(msg)) trip(msg, true);
 }
@@ -104,11 +139,7 @@ bool FixJdemWatchdog::nonfinite(std::string &msg) {
 }
 
 bool FixJdemWatchdog::overlap(std::string &msg) {
-  JdOverlapTrip worst = dynamic_cast<PairGranJiang *>(force->pair)->overlap_trip;
-  for (int k = 0; k < modify->nfix; k++) {
-    FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
-    if (w && w->overlap_trip.fraction > worst.fraction) worst = w->overlap_trip;
-  }
+  const JdOverlapTrip worst = worst_overlap(lmp);
   struct { double fraction; int rank; } mine = {worst.fraction, comm->me}, all;
   MPI_Allreduce(&mine, &all, 1, MPI_DOUBLE_INT, MPI_MAXLOC, world);
   if (!(all.fraction > 0.0)) return false;

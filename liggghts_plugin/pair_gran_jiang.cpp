@@ -37,7 +37,7 @@ PairGranJiang::PairGranJiang(LAMMPS *lmp)
     : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
       xi_limit(JD_XI_COULOMB), mu_r(1.0), rolling(false), energy(false), e_damp_cum(0.0),
       e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
-      features_(0), ntypes_(0) {}
+      features_(0), ntypes_(0), kp_ncalls_(-1), kp_nall_(-1) {}
 
 /* ---------------------------------------------------------------------------------------- */
 
@@ -112,6 +112,7 @@ void PairGranJiang::init_granular() {
     feta = static_cast<FixPropertyGlobal *>(modify->find_fix_property(
         "coefficientRollingFriction", "property/global", "peratomtypepair", nt, nt, me));
 
+  kp_ncalls_ = -1; /* the materials may have changed: recompute the prefactors */
   E_.assign(nt + 1, 0.0);
   nu_.assign(nt + 1, 0.0);
   coeffs_.assign((nt + 1) * (nt + 1), jd_pair_coeffs());
@@ -155,6 +156,21 @@ void PairGranJiang::init_granular() {
 
 /* ---------------------------------------------------------------------------------------- */
 
+/* The Hertz prefactor of every local and ghost atom (it depends on the atom's type and radius
+ * only), so that the pair loop does not recompute it per neighbour.  Ghost atoms and their
+ * radii change only at neighbour builds, unless the radii vary during the run (radvary_flag,
+ * e.g. fix adapt), when it is recomputed every step. */
+void PairGranJiang::refresh_prefactors() {
+  const int nall = atom->nlocal + atom->nghost;
+  if (neighbor->ncalls == kp_ncalls_ && nall == kp_nall_ && !atom->radvary_flag) return;
+  const double *radius = atom->radius;
+  const int *type = atom->type;
+  kp_.resize(nall > 0 ? nall : 1);
+  for (int i = 0; i < nall; i++) kp_[i] = jd_hertz_prefactor(E_[type[i]], nu_[type[i]], radius[i]);
+  kp_ncalls_ = neighbor->ncalls;
+  kp_nall_ = nall;
+}
+
 void PairGranJiang::compute_force(int eflag, int vflag, int addflag) {
 #define JD_PAIR_LOOP(b) loop<(b)>(eflag, vflag, addflag)
   JD_DISPATCH(features_, JD_PAIR_LOOP)
@@ -188,6 +204,9 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
   const int *tag = atom->tag;
   overlap_trip = JdOverlapTrip();
 
+  refresh_prefactors();
+  const double *kp = &kp_[0];
+
   for (int ii = 0; ii < inum; ii++) {
     const int i = ilist[ii];
     const int *jlist = firstneigh[i];
@@ -195,7 +214,6 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
     int *touch = firsttouch[i];
     double *allhist = firsthist[i];
     const double Ri = radius[i], mi = rmass[i];
-    const double kpi = jd_hertz_prefactor(E_[type[i]], nu_[type[i]], Ri);
 
     for (int jj = 0; jj < jnum; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
@@ -212,8 +230,8 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
       const double Rj = radius[j], mj = rmass[j];
       if (jd_overlap_excessive(g.delta, Ri, Rj, overlap_limit))
         overlap_trip.note(g.delta, std::fmin(Ri, Rj), tag[i], tag[j], NULL);
-      jd_geom_pair_material(F, &g, kpi, jd_hertz_prefactor(E_[type[j]], nu_[type[j]], Rj), mi, mj,
-                            jd_sphere_inertia(mi, Ri), jd_sphere_inertia(mj, Rj));
+      jd_geom_pair_material(F, &g, kp[i], kp[j], mi, mj, jd_sphere_inertia(mi, Ri),
+                            jd_sphere_inertia(mj, Rj));
       jd_kinematics k;
       for (int d = 0; d < 3; d++) {
         k.va[d] = v[i][d];

@@ -19,7 +19,7 @@
 
 #include "pair_gran.h"
 
-#include "jdem_kernel.h"
+#include "jdem_dispatch.h"
 #include "jdem_overlap.h"
 
 namespace LAMMPS_NS {
@@ -61,13 +61,19 @@ class PairGranJiang : public PairGran {
 
  protected:
   virtual void compute_force(int eflag, int vflag, int addflag);
-  template <unsigned F> void loop(int eflag, int vflag, int addflag);
+  template <unsigned F> JD_SPECIALISED void loop(int eflag, int vflag, int addflag);
 
  private:
   unsigned features_;
   int ntypes_;
   std::vector<double> E_, nu_;
   std::vector<jd_pair_coeffs> coeffs_;
+
+  /* Per-atom Hertz prefactors (local and ghost atoms), refreshed at neighbour builds. */
+  void refresh_prefactors();
+  std::vector<double> kp_;
+  bigint kp_ncalls_;
+  int kp_nall_;
 };
 
 }  // namespace LAMMPS_NS
