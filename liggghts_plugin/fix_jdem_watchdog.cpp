@@ -59,11 +59,11 @@ void FixJdemWatchdog::setup(int) { check(); }
 
 void FixJdemWatchdog::end_of_step() { check(); }
 
-/* Is every component of x, v, omega, f and torque of this rank's atoms finite?  0 q is +-0 for
- * a finite q and NaN for an infinite or NaN one, so the sum of 0 q over every component is NaN
- * exactly when some component is not finite (it cannot overflow).  Four independent partial
- * sums over the contiguous per-atom arrays, which the compiler vectorises: a few instructions
- * per atom and step. */
+/* Is every component of x, v, omega, f and torque of this rank's atoms finite?  A sum is finite
+ * only if every term is (inf - inf is NaN), so a finite sum proves it; a sum that overflows
+ * without a non-finite term only costs the detailed search (nonfinite), which then finds
+ * nothing.  Four independent partial sums over the contiguous per-atom arrays: about one
+ * instruction per component. */
 static bool all_finite(Atom *atom) {
   double *const q[] = {atom->x[0], atom->v[0], atom->omega[0], atom->f[0], atom->torque[0]};
   const int n = 3 * atom->nlocal;
@@ -72,8 +72,8 @@ static bool all_finite(Atom *atom) {
     const double *p = q[k];
     int i = 0;
     for (; i + 4 <= n; i += 4)
-      for (int l = 0; l < 4; l++) acc[l] += 0.0 * p[i + l];
-    for (; i < n; i++) acc[0] += 0.0 * p[i];
+      for (int l = 0; l < 4; l++) acc[l] += p[i + l];
+    for (; i < n; i++) acc[0] += p[i];
   }
   return std::isfinite(acc[0] + acc[1] + acc[2] + acc[3]);
 }

@@ -187,7 +187,8 @@ void FixWallJiang::loop(bool commit) {
   const int *type = atom->type, *mask = atom->mask;
   const int nlocal = atom->nlocal;
   const double dt = update->dt;
-  const int rule = pair->wall_rule;
+  pair->refresh_prefactors();
+  const double *kw = pair->wall_prefactors();
   double e_damp = 0.0, e_fric = 0.0, e_el = 0.0, ncontacts = 0.0, work = 0.0;
   const int *tag = atom->tag;
   overlap_trip = JdOverlapTrip();
@@ -210,36 +211,28 @@ void FixWallJiang::loop(bool commit) {
     if (jd_overlap_excessive(g.delta, R, INFINITY, overlap_limit))
       overlap_trip.note(g.delta, R, tag[i], 0, id);
     const double m = rmass[i];
-    jd_geom_wall_material(F, &g, jd_kn_wall(rule, pair->youngs(type[i]), pair->poisson(type[i]), R),
-                          m, jd_sphere_inertia(m, R));
+    jd_geom_wall_material(F, &g, kw[i], m, jd_sphere_inertia(m, R));
     jd_kinematics k;
-    for (int d = 0; d < 3; d++) {
-      k.va[d] = v[i][d];
-      k.wa[d] = omega[i][d];
-      k.vb[d] = vel[d];
-      k.wb[d] = 0.0;
-    }
-    jd_contact_state st;
-    jd_rolling_state rs;
-    jd_rolling_state *rsp = (F & JD_F_ROLLING) ? &rs : NULL;
-    jd_load_history(h, st, rsp);
+    jd_copy3(k.va, v[i]);
+    jd_copy3(k.wa, omega[i]);
+    jd_copy3(k.vb, vel);
+    k.wb[0] = k.wb[1] = k.wb[2] = 0.0;
+    JdHistory hs(h, F & JD_F_ROLLING, commit);
     jd_contact_result out;
-    const double f_prev[3] = {st.f_prev[0], st.f_prev[1], st.f_prev[2]};
-    const int carries = jd_contact(F, &pair->coeffs(type[i], wtype), &g, &k, dt, &st, rsp, &out);
+    const double f_prev[3] = {hs.st->f_prev[0], hs.st->f_prev[1], hs.st->f_prev[2]};
+    const int carries = jd_contact(F, &pair->coeffs(type[i], wtype), &g, &k, dt, hs.st, hs.rs, &out);
     work += jd_wall_work(f_prev, out.f, vel, dt); /* also over the step a contact ends */
     if (F & JD_F_ENERGY) {
-      e_damp += st.e_damp;
-      e_fric += st.e_fric;
-      st.e_damp = st.e_fric = 0.0;
-      if (carries) e_el += jd_contact_elastic_energy(&st);
+      e_damp += hs.st->e_damp;
+      e_fric += hs.st->e_fric;
+      hs.st->e_damp = hs.st->e_fric = 0.0;
+      if (carries) e_el += jd_contact_elastic_energy(hs.st);
     }
-    jd_store_history(h, st, rsp, commit);
+    hs.finish();
     if (!carries) continue;
     ncontacts += 1.0;
-    for (int d = 0; d < 3; d++) {
-      f[i][d] -= out.f[d];
-      torque[i][d] += out.ta[d];
-    }
+    jd_sub3(f[i], out.f);
+    jd_add3(torque[i], out.ta);
   }
   if (commit) {
     e_damp_cum += e_damp;
