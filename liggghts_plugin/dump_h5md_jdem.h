@@ -39,6 +39,7 @@ class DumpH5mdJdem : public Dump {
   void write_stop_frame(bigint step) {
     if (step != last_step) write();
   }
+  bigint last_frame_step() const { return last_step; } /* -1: no frame yet */
 
  protected:
   virtual void init_style();

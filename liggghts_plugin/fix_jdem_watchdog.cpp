@@ -205,9 +205,9 @@ void FixJdemWatchdog::trip(const std::string &msg, bool write_frame) {
   std::string full = msg;
   for (int k = 0; k < output->ndump; k++) {
     DumpH5mdJdem *d = dynamic_cast<DumpH5mdJdem *>(output->dump[k]);
-    if (d)
+    if (d) /* a non-finite state gets no frame: the file ends with the step before */
       full += format("; the trajectory up to step " BIGINT_FORMAT " is kept, closed, as %s.part "
-                     "(the run failed)", update->ntimestep, d->file_name().c_str());
+                     "(the run failed)", d->last_frame_step(), d->file_name().c_str());
   }
   error->all(FLERR, full.c_str());
 }
