@@ -4,8 +4,12 @@
 #   make            build/jdem and build/liggghts-jdem
 #   make deps       install the Debian packages the project needs (as root), else print the command
 #   make test       unit tests (also under ASan+UBSan), engine tests, Chung–Ooi checks, cross-engine
-#   make demo       build and run the eight Chung–Ooi tests; report in out/chung_ooi/report.md
+#   make demo       build and run the eight Chung–Ooi tests and the stability suite; reports in
+#                   out/chung_ooi/report.md and out/stability/report.md
 #   make chung-ooi  the Chung–Ooi runs and report only (no dependency check)
+#   make stability  the stability suite (reference_runs/stability/, both engines, 1x and 2x/5x/10x
+#                   the guard's dt); out/stability/report.md and summary.json
+#   make bonds      the parallel-bond checks and bench figure; out/bonds/summary.json
 
 SHELL := /bin/bash
 PY    := /usr/bin/python3
@@ -27,12 +31,12 @@ SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit
 KERNEL_SRC  := $(wildcard kernel/*.c)
 IO_SRC      := $(wildcard io/*.c)
 STEPPER_SRC := $(wildcard stepper/*.c)
-SCENE_SRC   := $(wildcard stepper/scene*.c)
+SCENE_SRC   := $(wildcard stepper/scene*.c) kernel/jdem_geometry.c
 PLUGIN_SRC  := $(wildcard liggghts_plugin/*.cpp)
 UNIT_SRC    := $(wildcard tests/unit/*.c)
 HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)
 
-.PHONY: all deps test demo chung-ooi unit clean
+.PHONY: all deps test demo chung-ooi stability unit clean
 all: build/jdem build/liggghts-jdem
 
 # ---------------------------------------------------------------------------------------------
@@ -111,16 +115,30 @@ test: deps
 chung-ooi: build/jdem build/liggghts-jdem
 	$(PY) scripts/chung_ooi.py run --engines jdem,liggghts --out out/chung_ooi
 
+stability: build/jdem build/liggghts-jdem
+	$(PY) scripts/stability.py --out out/stability
+
 demo: deps
 	$(MAKE) all
 	$(MAKE) chung-ooi
-	@echo "report: out/chung_ooi/report.md"
+	$(MAKE) stability
+	@echo "reports: out/chung_ooi/report.md out/stability/report.md"
 
 # Performance benchmark (reference_runs/bench/README.md): settled beds, 3 engines, medians of 3.
 #   make bench [BENCH_SIZES=5k,20k,80k] [BENCH_REPEATS=3]     report: out/bench/report.md
 .PHONY: bench
 bench: all
 	$(PY) scripts/bench.py $(if $(BENCH_SIZES),--sizes $(BENCH_SIZES)) $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
+	$(PY) scripts/bond_bench.py --out out/bench/bonds $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
+
+# Parallel bonds (issue 4): every check of scripts/bond_checks.py in full length, in the engines
+# of BONDS_ENGINES (jdem, liggghts-jdem), plus the ns-per-bond-step figure of bond_bench.py;
+# records in out/bonds/summary.json.  `make test` runs the same checks shortened (--quick).
+BONDS_ENGINES ?= jdem
+.PHONY: bonds
+bonds: all
+	$(PY) scripts/bond_bench.py --engines $(BONDS_ENGINES) --out out/bonds
+	$(PY) scripts/bond_checks.py --engines $(BONDS_ENGINES) --out out/bonds --bench out/bonds/bench.json
 
 clean:
 	rm -rf build out

@@ -79,6 +79,10 @@ struct jd_h5md {
 
 /* ------------------------------------------------------------------------------------------ */
 
+h5md_view h5md_view_of(jd_h5md *h) {
+    return (h5md_view){h->file, h->part, h->h5detail, &h->broken};
+}
+
 static void free_handle(jd_h5md *h) {
     for (size_t i = 0; i < h->nobs; ++i) {
         h5md_close_id(&h->obs[i].step);

@@ -13,7 +13,13 @@
  *   /particles/all/{position,velocity,angular_velocity,force,torque}/{step,time,value}
  *                               step [F] int64, time [F] f64, value [F][N][3] f64
  *   /observables/NAME/{step,time,value}            value [F] f64 (counts stored as f64 too)
- *   /connectivity/...           reserved for bonds (issue 4)
+ *   /connectivity/bonds         [B][2] int64 ids of every bond formed, in formation order (attr
+ *                               particles_group = "/particles/all"), with bond_type [B] int32
+ *                               and bond_formed_step [B] int64 (jd_h5md_write_bonds)
+ *   /connectivity/broken_bonds/{step,time,ids,mode,position,normal_force,shear_force,
+ *                               twisting_moment,bending_moment,sigma_max,tau_max}
+ *                               one row per broken bond (jd_h5md_write_bond_breaks);
+ *                               docs/scenes.md "Bonds" gives units and meaning
  *
  * Fault safety: the file is written as PATH.part and renamed to PATH by jd_h5md_close(ok = 1);
  * every frame is flushed, so a run that dies leaves a readable PATH.part with every frame so far.
@@ -74,6 +80,39 @@ int jd_h5md_write_frame(jd_h5md *h, const jd_h5md_frame *frame, char *err, size_
  * sampled on their own schedule.  Returns 0 or -1 with a reason in err. */
 int jd_h5md_write_observable(jd_h5md *h, const char *name, int64_t step, double time,
                              double value, char *err, size_t errlen);
+
+/* A bond as recorded in /connectivity. */
+typedef struct jd_h5md_bond {
+    int64_t id[2];       /* particle ids, id[0] < id[1] */
+    int32_t type;        /* index of its bond type in the resolved scene's bond_types */
+    int64_t formed_step; /* step at which it formed */
+} jd_h5md_bond;
+
+/* Append n bonds (formed at some step) to /connectivity/bonds, bond_type, bond_formed_step; the
+ * datasets are created by the first call (n may be 0: an empty list).  The caller orders them
+ * (docs/scenes.md: by step, then ids).  Returns 0 or -1 with a reason in err. */
+int jd_h5md_write_bonds(jd_h5md *h, size_t n, const jd_h5md_bond *bonds, char *err,
+                        size_t errlen);
+
+/* One broken-bond event. */
+typedef struct jd_h5md_bond_break {
+    int64_t step;
+    double time;            /* [s] */
+    int64_t id[2];          /* particle ids, id[0] < id[1] */
+    int32_t mode;           /* jd_bond_mode: 1 tension, 2 shear */
+    double position[3];     /* bond point x_C [m] */
+    double normal_force;    /* > 0 in compression [N] */
+    double shear_force;     /* magnitude [N] */
+    double twisting_moment; /* magnitude [N m] */
+    double bending_moment;  /* magnitude [N m] */
+    double sigma_max;       /* [Pa] */
+    double tau_max;         /* [Pa] */
+} jd_h5md_bond_break;
+
+/* Append n events to /connectivity/broken_bonds (created by the first call; n may be 0).  The
+ * caller orders them (by step, then ids).  Returns 0 or -1 with a reason in err. */
+int jd_h5md_write_bond_breaks(jd_h5md *h, size_t n, const jd_h5md_bond_break *events, char *err,
+                              size_t errlen);
 
 /* Close the file.  ok = 1: rename PATH.part to PATH and write the XDMF sidecar (PATH with its
  * extension replaced by .xdmf).  ok = 0: leave PATH.part.  Returns 0 or -1 with err. */

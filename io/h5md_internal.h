@@ -42,6 +42,19 @@ hid_t h5md_dset_extendible(hid_t loc, const char *name, hid_t ftype, int rank,
 int h5md_append_row(hid_t d, hsize_t at, int rank, const hsize_t *rest, hid_t mtype,
                     const void *buf);
 
+/* h5md.c: what io/h5md_bonds.c needs of a writer.  A write that fails part-way sets *broken. */
+typedef struct h5md_view {
+    hid_t file;
+    const char *part;   /* the file's current name (PATH.part) */
+    char *detail;       /* HDF5 error capture buffer for h5md_quiet_on */
+    int *broken;        /* set to 1 when a failed write left datasets inconsistent */
+} h5md_view;
+h5md_view h5md_view_of(jd_h5md *h);
+
+/* h5md_util.c: append n rows (from `at`) to an extendible dataset of rank 1..3. */
+int h5md_append_rows(hid_t d, hsize_t at, hsize_t n, int rank, const hsize_t *rest, hid_t mtype,
+                     const void *buf);
+
 /* xdmf.c: what the sidecar needs of a closed writer */
 typedef struct xdmf_info {
     const char *path; /* final .h5 path */

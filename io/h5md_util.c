@@ -175,12 +175,18 @@ hid_t h5md_dset_extendible(hid_t loc, const char *name, hid_t ftype, int rank,
 /* Append one row (row index `at`) to an extendible dataset of rank 1..3. */
 int h5md_append_row(hid_t d, hsize_t at, int rank, const hsize_t *rest, hid_t mtype,
                     const void *buf) {
+    return h5md_append_rows(d, at, 1, rank, rest, mtype, buf);
+}
+
+int h5md_append_rows(hid_t d, hsize_t at, hsize_t n, int rank, const hsize_t *rest, hid_t mtype,
+                     const void *buf) {
     hsize_t dims[3], start[3] = {0, 0, 0}, count[3];
-    dims[0] = at + 1;
+    dims[0] = at + n;
     start[0] = at;
-    count[0] = 1;
+    count[0] = n;
     for (int i = 1; i < rank; ++i) dims[i] = count[i] = rest[i - 1];
     if (H5Dset_extent(d, dims) < 0) return -1;
+    if (n == 0) return 0;
     hid_t fs = H5Dget_space(d);
     if (fs < 0) return -1;
     int rc = -1;

@@ -5,6 +5,7 @@
  *   pair_style gran/jiang   force->pair_map (public)
  *   fix wall/jiang          modify->fix_map (private: explicit-instantiation access idiom)
  *   fix jdem/watchdog       idem
+ *   fix jdem/guard          idem
  *   dump h5md/jdem          LIGGGHTS 3.8 has no dump map: Output::add_dump() is an if-else chain
  *                           over style_dump.h.  We interpose Output::add_dump (libliggghts.so
  *                           calls it through its PLT, so the executable's definition wins) and
@@ -33,6 +34,7 @@
 #include "update.h"
 
 #include "dump_h5md_jdem.h"
+#include "fix_jdem_guard.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_wall_jiang.h"
 #include "jdem_stop.h"
@@ -62,11 +64,16 @@ static Fix *create_fix_jdem_watchdog(LAMMPS *lmp, int narg, char **arg) {
   return new FixJdemWatchdog(lmp, narg, arg);
 }
 
+static Fix *create_fix_jdem_guard(LAMMPS *lmp, int narg, char **arg) {
+  return new FixJdemGuard(lmp, narg, arg);
+}
+
 static void register_jdem_styles(LAMMPS *lmp) {
   (*lmp->force->pair_map)["gran/jiang"] = &create_pair_gran_jiang;
   FixMap *fix_map = lmp->modify->*get(ModifyFixMap());
   (*fix_map)["wall/jiang"] = &create_fix_wall_jiang;
   (*fix_map)["jdem/watchdog"] = &create_fix_jdem_watchdog;
+  (*fix_map)["jdem/guard"] = &create_fix_jdem_guard;
 }
 
 /* ---- dump h5md/jdem: interposed Output::add_dump ---- */
@@ -130,6 +137,7 @@ static const char *jdem_help =
     "                             cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T\n"
     "                                 [velocity vx vy vz]\n"
     "                jdem/watchdog N [overlap F] [energy J]   (stop a run that goes wrong)\n"
+    "                jdem/guard vmax V [coordination C] [force]   (refuse an unsafe timestep)\n"
     "* Dump styles:  h5md/jdem    N FILE.h5 [scene NAME] [case NAME] [scene_yaml PATH]\n"
     "(gran/jiang presents itself as \"gran\" to LIGGGHTS; do not use `clear` or restart files.)\n\n";
 

@@ -1,12 +1,13 @@
 #!/usr/bin/python3
 """liggghts_run.py — run one case of a jdem scene in LIGGGHTS (build/liggghts-jdem).
 
-    scripts/liggghts_run.py SCENE [--case NAME] -o OUT.h5 [--np N]
+    scripts/liggghts_run.py SCENE [--case NAME] -o OUT.h5 [--np N] [--force]
 
 Resolves the scene with `build/jdem resolve`, generates the deck with scene_to_liggghts.py into
 OUT minus .h5 plus `.deck/` (in.jdem, particles.data, resolved.yaml, log.lammps) and runs
 build/liggghts-jdem there (through mpirun for N > 1; the root flags of Open MPI are added only
-when running as root).  Exits non-zero on failure with the tail of the log.
+when running as root).  --force runs an unsafe time step anyway (fix jdem/guard ... force).
+Exits non-zero on failure with the tail of the log.
 """
 import argparse
 import os
@@ -32,6 +33,7 @@ def main():
     ap.add_argument("--case", default=None)
     ap.add_argument("-o", "--output", required=True, help="trajectory (H5MD) to write")
     ap.add_argument("--np", type=int, default=1, help="MPI ranks (default 1)")
+    ap.add_argument("--force", action="store_true", help="run even if the time step is unsafe")
     ap.add_argument("--jdem", default=os.path.join(ROOT, "build", "jdem"))
     ap.add_argument("--liggghts", default=os.path.join(ROOT, "build", "liggghts-jdem"))
     a = ap.parse_args()
@@ -54,7 +56,8 @@ def main():
         f.write(r.stdout)
     deck = os.path.join(deck_dir, "in.jdem")
     r = subprocess.run([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), resolved,
-                        "-o", deck, "--trajectory", out], capture_output=True, text=True)
+                        "-o", deck, "--trajectory", out] + (["--force"] if a.force else []),
+                       capture_output=True, text=True)
     if r.returncode != 0:
         sys.stderr.write("liggghts_run: deck generation failed:\n%s" % r.stderr)
         return 1

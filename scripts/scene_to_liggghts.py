@@ -138,7 +138,19 @@ def watchdog_lines(scene, builtin):
         every, num(wd.get("max_overlap_fraction", 0.5)), num(wd.get("max_energy_jump", 0.05)))]
 
 
-def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False):
+def guard_lines(scene, builtin, force):
+    """`fix jdem/guard`: the stepper's time-step guard (kernel/jdem_guard.h) at the scene's
+    max_impact_speed and coordination_number; `force` as `jdem run --force`.  It needs
+    gran/jiang: none with --builtin."""
+    if builtin:
+        return []
+    t = scene["time"]
+    return ["fix guard all jdem/guard vmax %s coordination %s%s\n" % (
+        num(t.get("max_impact_speed", 0.0)), num(t.get("coordination_number", 12.0)),
+        " force" if force else "")]
+
+
+def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=False):
     deck_dir = os.path.dirname(os.path.abspath(deck_path))
     os.makedirs(deck_dir, exist_ok=True)
     mats = scene["materials"]
@@ -254,6 +266,7 @@ def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False):
         L.append("fix grav all gravity %s vector %s\n" % (num(gm), vec(g)))
     L.append("fix integr all nve/sphere\n")
     L.extend(watchdog_lines(scene, builtin))
+    L.extend(guard_lines(scene, builtin, force))
     L.append("\ntimestep        %s\n" % num(dt))
     L.append("thermo          %d\n" % max(1, steps // 10))
     L.append("dump d all h5md/jdem %d %s scene %s case %s scene_yaml %s\n" % (
@@ -271,6 +284,8 @@ def main():
     ap.add_argument("--trajectory", required=True, help="H5MD file the deck's dump writes")
     ap.add_argument("--builtin", action="store_true",
                     help="LIGGGHTS' own hertz/history/epsd2 law and primitive walls instead of jdem's styles")
+    ap.add_argument("--force", action="store_true",
+                    help="run even if the time step is unsafe (fix jdem/guard ... force)")
     a = ap.parse_args()
     text = sys.stdin.read() if a.resolved == "-" else open(a.resolved).read()
     scene = yaml.safe_load(text)
@@ -280,7 +295,7 @@ def main():
     if os.path.abspath(a.resolved) != resolved_copy:
         with open(resolved_copy, "w") as f:
             f.write(text)
-    write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin)
+    write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin, a.force)
 
 
 if __name__ == "__main__":

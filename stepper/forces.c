@@ -120,6 +120,7 @@ void sim_compute_forces(jd_sim *s) {
         JD_FORCE_CASE(8) JD_FORCE_CASE(9) JD_FORCE_CASE(10) JD_FORCE_CASE(11)
         JD_FORCE_CASE(12) JD_FORCE_CASE(13) JD_FORCE_CASE(14) JD_FORCE_CASE(15)
     }
+    if (s->bonds) sim_bonds_forces(s); /* in parallel with the contacts (bonds.c) */
     const double *g = s->g;
     if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0) {
         for (size_t i = 0; i < s->n; i++) {
@@ -127,4 +128,5 @@ void sim_compute_forces(jd_sim *s) {
             for (int d = 0; d < 3; d++) s->f[3 * i + d] += m * g[d];
         }
     }
+    if (s->loads) sim_loads_apply(s); /* last, as LIGGGHTS' post-force fixes (loads.c) */
 }

@@ -48,8 +48,10 @@ static const char usage_text[] =
     "  --quiet                  no summary and no progress line on stderr (run)\n"
     "\n"
     "time-step guard (run): dt must not exceed 20 % of the Rayleigh time step of the smallest\n"
-    "sphere, nor 1/50 of the shortest Hertz contact time at time.max_impact_speed; otherwise\n"
-    "the run is refused (exit status 2) unless --force is given.\n"
+    "sphere, nor 1/50 of the shortest Hertz contact time at time.max_impact_speed, nor the\n"
+    "Verlet stability limit of a sphere with time.coordination_number contacts, nor (with\n"
+    "bonds) 1/20 of the period of the fastest bond mode; otherwise the run is refused (exit\n"
+    "status 2) unless --force is given.\n"
     "\n"
     "environment:\n"
     "  JDEM_NEIGHBOUR=allpairs  debugging aid: evaluate every particle pair and every\n"
@@ -167,29 +169,39 @@ static int make_parent_dirs(const char *path, char *err, size_t errlen) {
     return 0;
 }
 
-/* The guard's verdict; prints the summary.  Returns 0 to go ahead, else an exit status. */
+/* The guard's verdict (kernel/jdem_guard.h); prints the summary.  Returns 0 to go ahead, else an
+ * exit status. */
 static int check_time_step(const jd_scene *sc, const cli *c) {
-    jd_guard g;
-    sim_guard(sc, &g);
+    jd_guard_input in;
+    jd_guard_species *species;
+    jd_guard_result g;
+    if (sim_guard(sc, &in, &species, &g) != 0) {
+        fprintf(stderr, "jdem: out of memory in the time-step guard\n");
+        return EXIT_RUNTIME;
+    }
+    free(species);
     if (!c->quiet) {
         fprintf(stderr, "jdem: dt = %.6g s; 20 %% Rayleigh bound = %.6g s; shortest contact time = %.6g s",
                 sc->dt, g.rayleigh_bound, g.contact_time);
         if (isfinite(g.contact_time))
-            fprintf(stderr, " at %.6g m/s (%.1f steps per contact)\n", sc->max_impact_speed,
-                    g.contact_time / sc->dt);
+            fprintf(stderr, " at %.6g m/s (%.1f steps per contact); Verlet limit at coordination "
+                    "number %g = %.6g s", sc->max_impact_speed, g.contact_time / sc->dt,
+                    sc->coordination_number, g.coordination_bound);
         else
-            fprintf(stderr, " (no impact to resolve)\n");
+            fprintf(stderr, " (no impact to resolve)");
+        if (isfinite(g.bond_bound))
+            fprintf(stderr, "; 1/20 of the fastest bond period = %.6g s", g.bond_bound);
+        fprintf(stderr, "; largest safe dt = %.9g s\n", g.safe_dt);
     }
     if (!g.violated) return 0;
+    char msg[512];
     if (!c->force) {
-        fprintf(stderr,
-                "jdem: time step %g s is unsafe: it exceeds %s (%.6g s); largest safe dt = %.6g s. "
-                "Use --force to run anyway.\n",
-                sc->dt, g.violated, g.violated_value, g.safe_dt);
+        jd_guard_refusal(&in, &g, "Use --force to run anyway.", msg, sizeof msg);
+        fprintf(stderr, "jdem: %s\n", msg);
         return EXIT_USAGE;
     }
-    fprintf(stderr, "jdem: warning: time step %g s exceeds %s (%.6g s); running anyway (--force)\n",
-            sc->dt, g.violated, g.violated_value);
+    jd_guard_warning(&in, &g, "--force", msg, sizeof msg);
+    fprintf(stderr, "jdem: %s\n", msg);
     return 0;
 }
 

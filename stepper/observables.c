@@ -62,4 +62,5 @@ void sim_observables(const jd_sim *s, jd_observables *o) {
     list_energies(&s->pairs, &o->damping_dissipation, &o->friction_dissipation);
     list_energies(&s->wall_pairs, &o->damping_dissipation, &o->friction_dissipation);
     o->wall_work = s->wall_work;
+    if (s->bonds) sim_bonds_observables(s, &o->bond);
 }

@@ -13,13 +13,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "jdem_guard.h"
 #include "scene_internal.h"
 
 static const char *const TOP_KEYS[] = {"jdem_scene", "name", "case", "description", "time",
                                        "output", "gravity", "model", "materials", "interactions",
                                        "particles", "generate", "walls", "watchdog", "sweep",
-                                       NULL};
-static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_speed", NULL};
+                                       "bond_types", "bonds", "bond_rules", NULL};
+static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_speed",
+                                         "coordination_number", NULL};
 static const char *const OUTPUT_KEYS[] = {"every", "observables_every", "compare_tolerance",
                                           NULL};
 static const char *const MODEL_KEYS[] = {"wall_rule", "damping", "tangential_limit", "mu_r", NULL};
@@ -135,8 +137,11 @@ static int read_time(loader *L) {
     if (sd_req_num(&L->c, t, "time", "dt", SD_POSITIVE, &L->s->dt)) return -1;
     if (read_steps(L, t)) return -1;
     L->max_impact_given = sd_get(&L->c, t, "max_impact_speed") != NULL;
-    return sd_opt_num(&L->c, t, "time", "max_impact_speed", SD_NONNEGATIVE,
-                      &L->s->max_impact_speed);
+    if (sd_opt_num(&L->c, t, "time", "max_impact_speed", SD_NONNEGATIVE, &L->s->max_impact_speed))
+        return -1;
+    L->s->coordination_number = JD_GUARD_DEFAULT_COORDINATION;
+    return sd_opt_num(&L->c, t, "time", "coordination_number", SD_AT_LEAST_ONE,
+                      &L->s->coordination_number);
 }
 
 static int read_output(loader *L) {
@@ -269,15 +274,17 @@ static int read_scene(loader *L) {
      * file; interactions come last because their defaults depend on which materials meet. */
     if (sd_keys(&L->c, L->root, NULL, TOP_KEYS) || read_header(L) || read_time(L) ||
         read_output(L) || sd_opt_vec3(&L->c, L->root, NULL, "gravity", s->gravity) ||
-        read_model(L) || read_watchdog(L) || scene_read_materials(L) || scene_read_particles(L) ||
-        scene_read_generators(L) || scene_read_walls(L))
+        read_model(L) || read_watchdog(L) || scene_read_materials(L) ||
+        scene_read_bond_types(L) || scene_read_particles(L) || scene_read_generators(L) ||
+        scene_read_walls(L) || scene_read_bonds(L))
         return -1;
     if (s->n_particles == 0) {
         const yaml_node_t *p = sd_get(&L->c, L->root, "particles");
         return sd_fail(&L->c, p ? p : L->root, "particles", "no particles; valid: at least one "
                        "particle in particles or generate");
     }
-    if (scene_read_interactions(L) || scene_sort_particles(L) || scene_check_overlaps(L))
+    if (scene_read_interactions(L) || scene_sort_particles(L) || scene_check_overlaps(L) ||
+        scene_check_wall_overlaps(L) || scene_resolve_bonds(L))
         return -1;
     return L->max_impact_given ? 0 : default_impact_speed(L);
 }
@@ -352,6 +359,7 @@ int scene_load(const char *path, const char *case_name, jd_scene *scene, char *e
     free(L.psrc);
     free(L.by_particle);
     free(L.by_wall);
+    free(L.bnode);
     sd_free_names(names, n);
     yaml_document_delete(&doc);
     if (rc) scene_free(scene);
@@ -368,6 +376,13 @@ void scene_free(jd_scene *scene) {
     free(scene->position);
     free(scene->velocity);
     free(scene->angular_velocity);
+    free(scene->fixed);
+    free(scene->force);
     free(scene->walls);
+    free(scene->bond_types);
+    free(scene->bond_ids);
+    free(scene->bond_type);
+    for (size_t r = 0; r < scene->n_bond_rules; r++) free(scene->bond_rules[r].materials);
+    free(scene->bond_rules);
     memset(scene, 0, sizeof *scene);
 }

@@ -11,6 +11,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "jdem_bond.h"
+
 #define JD_NAME_MAX 64
 
 typedef struct jd_material {
@@ -54,6 +56,22 @@ typedef struct jd_watchdog_limits {
                                     relative to the energy in play (kernel/jdem_watchdog.h) [-] */
 } jd_watchdog_limits;
 
+/* A named bond type (bond_types section). */
+typedef struct jd_bond_type {
+    char name[JD_NAME_MAX];
+    jd_bond_params p;         /* kernel parameters (kn, kt [N/m^3], sigma_c, tau_c [Pa], ...) */
+} jd_bond_type;
+
+/* A bond rule that forms bonds during the run (bond_rules with a step > 0; step-0 rules are
+ * resolved into explicit bonds). */
+typedef struct jd_bond_rule {
+    int type;                 /* index into bond_types */
+    int64_t step;             /* formed before the forces of this step */
+    unsigned char *materials; /* n_materials flags: 1 = particles of that material take part */
+    int64_t id_range[2];      /* ids in [first, last] take part */
+    double max_gap;           /* surface gap <= max_gap x the smaller radius [-] */
+} jd_bond_rule;
+
 typedef struct jd_scene {
     char path[1024];          /* the scene file */
     char name[JD_NAME_MAX];   /* scene name */
@@ -64,6 +82,8 @@ typedef struct jd_scene {
     double dt;                /* [s] */
     int64_t steps;            /* from steps, or ceil(end_time/dt) */
     double max_impact_speed;  /* [m/s], resolved (given, or estimated as docs/scenes.md says) */
+    double coordination_number; /* expected maximum contacts of one sphere [-], >= 1, for the
+                                   time-step guard (kernel/jdem_guard.h) */
 
     /* output */
     int64_t output_every;
@@ -93,9 +113,22 @@ typedef struct jd_scene {
     double *position;         /* 3n [m] */
     double *velocity;         /* 3n [m/s] */
     double *angular_velocity; /* 3n [rad/s] */
+    unsigned char *fixed;     /* n: 1 = force and torque held at zero (moves at its initial
+                                 velocity and spin, like LIGGGHTS fix freeze) */
+    double *force;            /* 3n: constant external force [N] (LIGGGHTS fix addforce) */
+    int has_loads;            /* some particle is fixed or has an external force */
 
     size_t n_walls;
     jd_wall *walls;
+
+    /* bonds (docs/scenes.md "Bonds") */
+    size_t n_bond_types;
+    jd_bond_type *bond_types;
+    size_t n_bonds;           /* bonds formed at step 0, sorted by (id[0], id[1]) */
+    int64_t *bond_ids;        /* 2 n_bonds particle ids, id[0] < id[1] */
+    int32_t *bond_type;       /* n_bonds indices into bond_types */
+    size_t n_bond_rules;
+    jd_bond_rule *bond_rules; /* sorted by step (stable) */
 } jd_scene;
 
 /* List the case names of a scene file.  Returns the number of cases (>= 1) and an array of
@@ -115,5 +148,13 @@ int scene_emit_yaml(const jd_scene *scene, FILE *out);
 char *scene_yaml_string(const jd_scene *scene);
 
 void scene_free(jd_scene *scene);
+
+/* The pairs a bond rule bonds at positions x (3 n_particles [m], in the scene's order): particles
+ * i < j (indices) both in the rule's group (material flag set, id in id_range) with
+ * |x_j - x_i| - R_i - R_j <= max_gap min(R_i, R_j).  Returns the number of pairs with
+ * 2 per pair in *pairs (malloc'ed, sorted by (i, j); NULL when none), or -1 when out of memory.
+ * scene_bond_rules.c; used by the scene (rules at step 0) and by the stepper (later steps). */
+long jd_bond_rule_pairs(const jd_scene *s, const jd_bond_rule *rule, const double *x,
+                        int32_t **pairs);
 
 #endif /* JDEM_SCENE_H */

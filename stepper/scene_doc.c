@@ -17,6 +17,7 @@
 const sd_range SD_ANY = {-INFINITY, INFINITY, 1, 1};
 const sd_range SD_POSITIVE = {0.0, INFINITY, 1, 1};
 const sd_range SD_NONNEGATIVE = {0.0, INFINITY, 0, 1};
+const sd_range SD_AT_LEAST_ONE = {1.0, INFINITY, 0, 1};
 
 #define SD_MAX_CASES 100000
 

@@ -29,7 +29,7 @@ typedef struct sd_range {
     int lo_open, hi_open;
 } sd_range;
 
-extern const sd_range SD_ANY, SD_POSITIVE, SD_NONNEGATIVE;
+extern const sd_range SD_ANY, SD_POSITIVE, SD_NONNEGATIVE, SD_AT_LEAST_ONE;
 
 /* Errors. */
 int sd_fail(sd_ctx *c, const yaml_node_t *at, const char *path, const char *fmt, ...)

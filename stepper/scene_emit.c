@@ -7,6 +7,7 @@
  * sweep case loads back under its own name.
  */
 #include <inttypes.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -126,6 +127,7 @@ static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
            key_str(e, "case", s->case_name) || key_str(e, "description", s->description) ||
            str(e, "time") || map_start(e, 0) || key_num(e, "dt", s->dt) ||
            key_int(e, "steps", s->steps) || key_num(e, "max_impact_speed", s->max_impact_speed) ||
+           key_num(e, "coordination_number", s->coordination_number) ||
            map_end(e) || str(e, "output") || map_start(e, 0) ||
            key_int(e, "every", s->output_every) ||
            key_int(e, "observables_every", s->observables_every) ||
@@ -171,7 +173,11 @@ static int emit_particles(yaml_emitter_t *e, const jd_scene *s) {
             key_str(e, "material", s->materials[s->material[i]].name) ||
             key_num(e, "radius", s->radius[i]) || key_vec(e, "position", &s->position[3 * i]) ||
             key_vec(e, "velocity", &s->velocity[3 * i]) ||
-            key_vec(e, "angular_velocity", &s->angular_velocity[3 * i]) || map_end(e))
+            key_vec(e, "angular_velocity", &s->angular_velocity[3 * i]) ||
+            (s->fixed[i] && (str(e, "fixed") || scalar(e, "true", YAML_PLAIN_SCALAR_STYLE))) ||
+            ((s->force[3 * i] != 0.0 || s->force[3 * i + 1] != 0.0 || s->force[3 * i + 2] != 0.0) &&
+             key_vec(e, "force", &s->force[3 * i])) ||
+            map_end(e))
             return 1;
     return seq_end(e);
 }
@@ -196,6 +202,50 @@ static int emit_wall(yaml_emitter_t *e, const jd_scene *s, const jd_wall *w) {
            key_vec(e, "velocity", w->velocity) || map_end(e);
 }
 
+/* A strength: INFINITY as YAML's .inf. */
+static int num_or_inf(yaml_emitter_t *e, double v) {
+    return isinf(v) ? scalar(e, ".inf", YAML_PLAIN_SCALAR_STYLE) : num(e, v);
+}
+
+static const char *const BENDINGS[] = {"potyondy_cundall", "jiang2021_literal"};
+
+/* Bonds (docs/scenes.md "Bonds"): the types, every step-0 bond, the rules of later steps; only
+ * for scenes with bond types, so scenes without bonds resolve as before. */
+static int emit_bonds(yaml_emitter_t *e, const jd_scene *s) {
+    if (!s->n_bond_types) return 0;
+    if (str(e, "bond_types") || map_start(e, 0)) return 1;
+    for (size_t i = 0; i < s->n_bond_types; i++) {
+        const jd_bond_params *p = &s->bond_types[i].p;
+        if (str(e, s->bond_types[i].name) || map_start(e, 1) ||
+            key_num(e, "normal_stiffness", p->kn) || key_num(e, "shear_stiffness", p->kt) ||
+            str(e, "tensile_strength") || num_or_inf(e, p->sigma_c) ||
+            str(e, "shear_strength") || num_or_inf(e, p->tau_c) ||
+            key_num(e, "radius_multiplier", p->lambda) || key_num(e, "damping", p->gamma) ||
+            key_str(e, "bending", BENDINGS[p->bending]) || map_end(e))
+            return 1;
+    }
+    if (map_end(e) || str(e, "bonds") || seq_start(e, 0)) return 1;
+    for (size_t k = 0; k < s->n_bonds; k++)
+        if (map_start(e, 1) || str(e, "ids") || seq_start(e, 1) ||
+            integer(e, s->bond_ids[2 * k]) || integer(e, s->bond_ids[2 * k + 1]) || seq_end(e) ||
+            key_str(e, "type", s->bond_types[s->bond_type[k]].name) || map_end(e))
+            return 1;
+    if (seq_end(e) || str(e, "bond_rules") || seq_start(e, 0)) return 1;
+    for (size_t r = 0; r < s->n_bond_rules; r++) {
+        const jd_bond_rule *b = &s->bond_rules[r];
+        if (map_start(e, 1) || key_str(e, "type", s->bond_types[b->type].name) ||
+            key_int(e, "step", b->step) || str(e, "materials") || seq_start(e, 1))
+            return 1;
+        for (size_t m = 0; m < s->n_materials; m++)
+            if (b->materials[m] && str(e, s->materials[m].name)) return 1;
+        if (seq_end(e) || str(e, "id_range") || seq_start(e, 1) || integer(e, b->id_range[0]) ||
+            integer(e, b->id_range[1]) || seq_end(e) || key_num(e, "max_gap", b->max_gap) ||
+            map_end(e))
+            return 1;
+    }
+    return seq_end(e);
+}
+
 static int emit_scene(yaml_emitter_t *e, const jd_scene *s) {
     yaml_event_t ev;
     if (emit(e, &ev, yaml_stream_start_event_initialize(&ev, YAML_UTF8_ENCODING)) ||
@@ -209,7 +259,7 @@ static int emit_scene(yaml_emitter_t *e, const jd_scene *s) {
         return 1;
     for (size_t i = 0; i < s->n_walls; i++)
         if (emit_wall(e, s, &s->walls[i])) return 1;
-    return seq_end(e) || map_end(e) ||
+    return seq_end(e) || emit_bonds(e, s) || map_end(e) ||
            emit(e, &ev, yaml_document_end_event_initialize(&ev, 1)) ||
            emit(e, &ev, yaml_stream_end_event_initialize(&ev)) || !yaml_emitter_flush(e);
 }

@@ -1,11 +1,12 @@
 /*
- * scene_generate.c — the generate section: lattice generators and their seeded PRNG.
+ * scene_generate.c — the generate section: lattice generators and their seeded PRNG (the bonded
+ * generators are in scene_bond_generators.c).
  */
 #include <stdlib.h>
 
 #include "scene_internal.h"
 
-static const char *const GENERATOR_KEYS[] = {"lattice", NULL};
+static const char *const GENERATOR_KEYS[] = {"lattice", "bonded_block", "bonded_sphere", NULL};
 static const char *const LATTICE_KEYS[] = {"material", "radius", "radii", "origin", "spacing",
                                            "counts", "jitter", "velocity", "seed", NULL};
 static const char *const RADII_KEYS[] = {"values", "fractions", NULL};
@@ -193,7 +194,9 @@ static int generate_lattice(loader *L, const yaml_node_t *lat, int32_t gen, latt
 int scene_read_generators(loader *L) {
     const yaml_node_t *list = sd_get(&L->c, L->root, "generate");
     if (!list) return 0;
-    if (sd_sequence(&L->c, list, "generate", "a list of {lattice: {...}}")) return -1;
+    if (sd_sequence(&L->c, list, "generate",
+                    "a list of {lattice: {...}}, {bonded_block: {...}}, {bonded_sphere: {...}}"))
+        return -1;
     int64_t next_id = 1;
     for (size_t i = 0; i < L->s->n_particles; i++)
         next_id = L->s->id[i] >= next_id ? L->s->id[i] + 1 : next_id;
@@ -202,8 +205,20 @@ int scene_read_generators(loader *L) {
         sd_join_index(path, "generate", k);
         const yaml_node_t *e = sd_item(&L->c, list, k);
         if (sd_keys(&L->c, e, path, GENERATOR_KEYS)) return -1;
+        if (e->data.mapping.pairs.top - e->data.mapping.pairs.start > 1)
+            return sd_fail(&L->c, e, path, "more than one generator in one entry; valid: one of "
+                           "lattice, bonded_block, bonded_sphere per list item");
         const yaml_node_t *lat = sd_get(&L->c, e, "lattice");
-        if (!lat) return sd_missing(&L->c, e, path, "lattice", "a lattice generator");
+        if (!lat) {
+            const char *key = sd_get(&L->c, e, "bonded_block") ? "bonded_block" : "bonded_sphere";
+            const yaml_node_t *b = sd_get(&L->c, e, key);
+            if (!b)
+                return sd_missing(&L->c, e, path, "lattice", "one of lattice, bonded_block, "
+                                  "bonded_sphere");
+            sd_join(sub, path, key);
+            if (scene_generate_bonded(L, b, key, sub, (int32_t)k, &next_id)) return -1;
+            continue;
+        }
         sd_join(sub, path, "lattice");
         lattice g = {0};
         if (read_lattice(L, lat, sub, &g) || generate_lattice(L, lat, (int32_t)k, &g, &next_id))

@@ -8,6 +8,9 @@
  *   scene_particles.c   explicit particles, the sort by id (duplicate ids), the start-overlap check
  *   scene_generate.c    the lattice generator
  *   scene_walls.c       walls and their geometry checks
+ *   scene_bonds.c       bond_types, explicit bonds, bond_rules; their resolution after the sort
+ *   scene_bond_generators.c   the bonded_block and bonded_sphere generators
+ *   scene_bond_rules.c  the pair test of a bond rule (shared with the stepper, scene.h)
  *
  * Every reader reports the first problem into L->c (see scene_doc.h) and returns -1; 0 means
  * success.
@@ -39,6 +42,8 @@ typedef struct loader {
     unsigned char *by_particle; /* per material: used by a particle */
     unsigned char *by_wall;     /* per material: used by a wall */
     int max_impact_given;
+    size_t bond_cap;            /* allocated bonds */
+    const yaml_node_t **bnode;  /* per bond: the node that made it (for messages) */
 } loader;
 
 static inline double norm3(const double v[3]) { return sqrt(jd_dot(v, v)); }
@@ -64,11 +69,29 @@ int scene_read_particles(loader *L);
 long scene_add_particle(loader *L, const yaml_node_t *node, int32_t src);
 int scene_sort_particles(loader *L);
 int scene_check_overlaps(loader *L);
+int scene_check_wall_overlaps(loader *L);
 
 /* scene_generate.c */
 int scene_read_generators(loader *L);
 
 /* scene_walls.c */
 int scene_read_walls(loader *L);
+
+/* scene_materials.c: material index named by scalar node n, or -1 after reporting. */
+int scene_material_ref(loader *L, const yaml_node_t *n, const char *path);
+
+/* scene_bonds.c */
+int scene_read_bond_types(loader *L);
+/* The required map.key naming a bond type: its index in *out. */
+int scene_req_bond_type(loader *L, const yaml_node_t *map, const char *path, const char *key,
+                        int *out);
+/* Append a bond between ids a and b (any order) made by node. */
+int scene_add_bond(loader *L, const yaml_node_t *node, int64_t a, int64_t b, int type);
+int scene_read_bonds(loader *L);      /* bonds and bond_rules; before the sort */
+int scene_resolve_bonds(loader *L);   /* after the sort: ids exist, step-0 rules, duplicates */
+
+/* scene_bond_generators.c: one generator entry (key is "bonded_block" or "bonded_sphere"). */
+int scene_generate_bonded(loader *L, const yaml_node_t *g, const char *key, const char *path,
+                          int32_t gen, int64_t *next_id);
 
 #endif

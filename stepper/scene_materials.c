@@ -45,6 +45,10 @@ static int material_ref(loader *L, const yaml_node_t *n, const char *path) {
     return sd_fail(&L->c, n, path, "unknown material '%s'; valid: %s", name, valid);
 }
 
+int scene_material_ref(loader *L, const yaml_node_t *n, const char *path) {
+    return material_ref(L, n, path);
+}
+
 int scene_req_material(loader *L, const yaml_node_t *map, const char *path, int *out) {
     const yaml_node_t *n = sd_get(&L->c, map, "material");
     char sub[SD_PATH_MAX], valid[512];

@@ -1,17 +1,20 @@
 /*
  * scene_particles.c — the particles section, the per-particle arrays (also filled by the
- * generators), their sort by id with the duplicate-id check, and the start-overlap check.
+ * generators), their sort by id with the duplicate-id check, and the start-overlap checks
+ * (particle against particle, particle against wall).
  */
 #include <stdlib.h>
 #include <string.h>
 
+#include "jdem_geometry.h"
 #include "scene_internal.h"
 
 /* Relative tolerance of docs/scenes.md: initial overlap, fraction of the smaller radius. */
 #define OVERLAP_TOL 1e-6
 
 static const char *const PARTICLE_KEYS[] = {"id", "material", "radius", "position", "velocity",
-                                            "angular_velocity", NULL};
+                                            "angular_velocity", "fixed", "force", NULL};
+static const char *const BOOLEANS[] = {"false", "true", NULL};
 
 /* ---------------------------------------------------------------------------------------- */
 /* Particles                                                                                 */
@@ -33,6 +36,8 @@ static int grow_particles(loader *L, size_t need) {
     GROW(s->position, 3);
     GROW(s->velocity, 3);
     GROW(s->angular_velocity, 3);
+    GROW(s->fixed, 1);
+    GROW(s->force, 3);
     GROW(L->pnode, 1);
     GROW(L->psrc, 1);
 #undef GROW
@@ -50,6 +55,8 @@ long scene_add_particle(loader *L, const yaml_node_t *node, int32_t src) {
     size_t i = s->n_particles++;
     memset(&s->velocity[3 * i], 0, 3 * sizeof(double));
     memset(&s->angular_velocity[3 * i], 0, 3 * sizeof(double));
+    memset(&s->force[3 * i], 0, 3 * sizeof(double));
+    s->fixed[i] = 0;
     L->pnode[i] = node;
     L->psrc[i] = src;
     return (long)i;
@@ -81,8 +88,14 @@ static int read_particle(loader *L, const yaml_node_t *p, size_t index) {
         sd_req_num(&L->c, p, path, "radius", SD_POSITIVE, &s->radius[i]) ||
         sd_req_vec3(&L->c, p, path, "position", &s->position[3 * i]) ||
         sd_opt_vec3(&L->c, p, path, "velocity", &s->velocity[3 * i]) ||
-        sd_opt_vec3(&L->c, p, path, "angular_velocity", &s->angular_velocity[3 * i]))
+        sd_opt_vec3(&L->c, p, path, "angular_velocity", &s->angular_velocity[3 * i]) ||
+        sd_opt_vec3(&L->c, p, path, "force", &s->force[3 * i]))
         return -1;
+    int fixed = 0;
+    if (sd_opt_enum(&L->c, p, path, "fixed", BOOLEANS, &fixed)) return -1;
+    s->fixed[i] = (unsigned char)fixed;
+    s->has_loads |= fixed || s->force[3 * i] != 0.0 || s->force[3 * i + 1] != 0.0 ||
+                    s->force[3 * i + 2] != 0.0;
     s->material[i] = mat;
     return 0;
 }
@@ -137,6 +150,8 @@ static int permute(loader *L, const id_index *perm) {
     PERMUTE(s->position, 3);
     PERMUTE(s->velocity, 3);
     PERMUTE(s->angular_velocity, 3);
+    PERMUTE(s->fixed, 1);
+    PERMUTE(s->force, 3);
     PERMUTE(L->pnode, 1);
     PERMUTE(L->psrc, 1);
 #undef PERMUTE
@@ -286,4 +301,35 @@ int scene_check_overlaps(loader *L) {
     }
     free(g.e);
     return rc;
+}
+
+/* Overlap [m] of particle i with wall w at the start (kernel geometry, as the engines see it),
+ * 0 without contact. */
+static double wall_overlap(const jd_scene *s, size_t i, const jd_wall *w) {
+    jd_contact_geom g;
+    const double *x = &s->position[3 * i];
+    if (w->type == JD_WALL_PLANE) {
+        jd_plane p;
+        if (jd_plane_init(&p, w->corners, 1e-6) != JD_GEOM_OK) return 0.0; /* checked already */
+        return jd_geom_plane(&p, x, s->radius[i], &g) ? g.delta : 0.0;
+    }
+    jd_cylinder c = {.rc = w->radius, .inside = w->inside};
+    memcpy(c.a0, w->axis[0], sizeof c.a0);
+    memcpy(c.a1, w->axis[1], sizeof c.a1);
+    return jd_geom_cylinder(&c, x, s->radius[i], &g) ? g.delta : 0.0;
+}
+
+int scene_check_wall_overlaps(loader *L) {
+    const jd_scene *s = L->s;
+    for (size_t i = 0; i < s->n_particles; i++)
+        for (size_t k = 0; k < s->n_walls; k++) {
+            const double by = wall_overlap(s, i, &s->walls[k]);
+            if (!(by > OVERLAP_TOL * s->radius[i])) continue;
+            char path[SD_PATH_MAX];
+            particle_path(L, i, path);
+            return sd_fail(&L->c, L->pnode[i], path, "particle %lld overlaps wall '%s' by %.3g m "
+                           "at the start; valid: an overlap of at most %g of its radius",
+                           (long long)s->id[i], s->walls[k].name, by, OVERLAP_TOL);
+        }
+    return 0;
 }

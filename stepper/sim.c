@@ -153,7 +153,9 @@ static int setup_forces(jd_sim *s, char *err, size_t errlen) {
     }
     if (ok) {
         for (int k = 0; k < 2; k++) save_history(lists[k], state[k], roll[k]);
+        s->in_setup = 1;
         sim_compute_forces(s);
+        s->in_setup = 0;
         for (int k = 0; k < 2; k++) restore_history(lists[k], state[k], roll[k]);
     } else {
         snprintf(err, errlen, "out of memory");
@@ -173,6 +175,7 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
     }
     s->features = scene_features(s);
     if (sim_walls_init(s, err, errlen) != 0) return -1;
+    if (sim_bonds_init(s, err, errlen) != 0 || sim_loads_init(s, err, errlen) != 0) return -1;
     if (sim_neighbour_build(s, err, errlen) != 0) return -1;
     return setup_forces(s, err, errlen);
 }
@@ -204,6 +207,8 @@ void sim_free(jd_sim *s) {
     sim_contact_list_free(&s->pairs);
     sim_contact_list_free(&s->wall_pairs);
     sim_contact_list_free(&s->spare);
+    sim_bonds_free(s);
+    sim_loads_free(s);
     memset(s, 0, sizeof *s);
 }
 
@@ -236,6 +241,14 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
         if (jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->dt,
                                      val[k], err, errlen) != 0)
             return JD_RUN_ERROR;
+    if (s->bonds) {
+        double bv[JD_N_BOND_OBSERVABLES];
+        sim_bond_observables_values(&o.bond, bv);
+        for (int k = 0; h && k < JD_N_BOND_OBSERVABLES; k++)
+            if (jd_h5md_write_observable(h, jd_bond_observable_names[k], s->step,
+                                         (double)s->step * s->dt, bv[k], err, errlen) != 0)
+                return JD_RUN_ERROR;
+    }
     return sim_watchdog_energy(s, &o, err, errlen);
 }
 
@@ -259,6 +272,8 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
     progress_start(&p, show_progress, last, s->n);
     int rc = 0;
     for (;;) {
+        /* the bonds formed and broken by the last step, also when the watchdog stops here */
+        if (s->bonds && (rc = sim_bonds_output(s, h, err, errlen)) != 0) break;
         if ((rc = sim_watchdog_step(s, err, errlen)) != 0) break;
         if (due(s->step, sc->output_every, last)) {
             if ((rc = write_frame(s, h, err, errlen)) != 0) break;

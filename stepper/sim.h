@@ -10,6 +10,8 @@
  *   integrate.c    one velocity-Verlet step exactly as LIGGGHTS fix nve/sphere
  *   observables.c  energies and contact counts
  *   guard.c        the time-step guard
+ *   bonds.c        parallel bonds: list, rules, bond loop, events, observables (bonds.h)
+ *   loads.c        held particles and constant external forces, with their work
  *   watchdog.c     the run-time watchdog: non-finite state, excessive overlap, energy jumps
  *   progress.c     the progress line on stderr
  *
@@ -27,7 +29,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bonds.h"
 #include "jdem_geometry.h"
+#include "jdem_guard.h"
 #include "jdem_kernel.h"
 #include "jdem_watchdog.h"
 #include "scene.h"
@@ -93,6 +97,10 @@ typedef struct jd_sim {
     int32_t *cell_of, *cell_items, *cell_start;
     size_t cell_cap;   /* capacity of cell_start */
 
+    jd_bonds *bonds;   /* parallel bonds (bonds.h); NULL when the scene has no bond types */
+    struct jd_loads *loads; /* held particles and external forces (loads.c); NULL if none */
+    int in_setup;      /* the step-0 force evaluation (LIGGGHTS `setup`) is running */
+
     /* energy bookkeeping */
     double e_damp_dropped, e_fric_dropped; /* accumulators of contacts dropped from the lists */
     double wall_work;  /* work done on the particles by the walls [J] */
@@ -141,6 +149,12 @@ void sim_walls_move(jd_sim *s);
 /* forces.c: zero f and torque, then pair forces, wall forces, gravity. */
 void sim_compute_forces(jd_sim *s);
 
+/* loads.c: set up (0 or -1 with err), free, and apply after every other force (forces.c). */
+typedef struct jd_loads jd_loads;
+int sim_loads_init(jd_sim *s, char *err, size_t errlen);
+void sim_loads_free(jd_sim *s);
+void sim_loads_apply(jd_sim *s);
+
 /* integrate.c: one full step.  Returns 0, or -1 with a reason in err. */
 int sim_step(jd_sim *s, char *err, size_t errlen);
 
@@ -149,24 +163,18 @@ typedef struct jd_observables {
     double kinetic_energy, rotational_energy, elastic_energy, gravitational_energy;
     double damping_dissipation, friction_dissipation, wall_work;
     double contacts, wall_contacts;
+    jd_bond_observables bond;  /* scenes with bond types only (s->bonds) */
 } jd_observables;
 #define JD_N_OBSERVABLES 9
 extern const char *const jd_observable_names[JD_N_OBSERVABLES];
 void sim_observables(const jd_sim *s, jd_observables *o);
 void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES]);
 
-/* guard.c: time-step bounds of a scene. */
-typedef struct jd_guard {
-    double rayleigh_bound;   /* 0.2 x the smallest Rayleigh step [s]; INFINITY without particles */
-    double contact_time;     /* shortest Hertz contact time at max_impact_speed [s]; INFINITY if none */
-    double contact_bound;    /* contact_time / JD_GUARD_STEPS_PER_CONTACT [s] */
-    double safe_dt;          /* min of the two bounds [s] */
-    const char *violated;    /* description of the tightest violated bound, or NULL when safe */
-    double violated_value;   /* its value [s] */
-} jd_guard;
-#define JD_GUARD_RAYLEIGH_FRACTION 0.2
-#define JD_GUARD_STEPS_PER_CONTACT 50.0
-void sim_guard(const jd_scene *scene, jd_guard *g);
+/* guard.c: the kernel's time-step guard (kernel/jdem_guard.h) applied to a scene.  Fills *in
+ * (its species array is malloc'ed into *species: free it) and *r; returns 0, or -1 when out of
+ * memory. */
+int sim_guard(const jd_scene *scene, jd_guard_input *in, jd_guard_species **species,
+              jd_guard_result *r);
 
 /* watchdog.c.  The force loops call sim_watchdog_overlap() (out of line: the rare case) for a
  * contact with jd_overlap_excessive(); the run loop calls the checks below, which return 0 or

@@ -62,11 +62,15 @@ int sim_watchdog_step(const jd_sim *s, char *msg, size_t len) {
     return 0;
 }
 
+/* Bonds enter the balance as stored (elastic) and dissipated (damping) energy. */
 static void energy_terms(const jd_observables *o, jd_energy_terms *e) {
+    const jd_bond_observables *b = &o->bond;
     *e = (jd_energy_terms){.kinetic = o->kinetic_energy, .rotational = o->rotational_energy,
-                           .elastic = o->elastic_energy, .gravitational = o->gravitational_energy,
-                           .damping = o->damping_dissipation, .friction = o->friction_dissipation,
-                           .wall_work = o->wall_work};
+                           .elastic = o->elastic_energy + b->elastic_energy,
+                           .gravitational = o->gravitational_energy,
+                           .damping = o->damping_dissipation + b->damping_dissipation +
+                                      b->breakage_energy,
+                           .friction = o->friction_dissipation, .wall_work = o->wall_work};
 }
 
 /* The particle with the largest kinetic energy: where a spurious energy gain usually sits. */

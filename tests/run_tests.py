@@ -15,7 +15,8 @@ import time
 
 PY = "/usr/bin/python3"
 
-ENGINE_TESTS = ["neighbour", "free_flight", "hertz_impact", "energy_balance", "guard", "watchdog",
+ENGINE_TESTS = ["neighbour", "free_flight", "hertz_impact", "energy_balance", "guard",
+                "guard_coordination", "watchdog",
                 "signals"]
 SANITIZED = {"JDEM": "build/san/jdem"}
 
@@ -37,6 +38,21 @@ SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "line
 SUITES += [("liggghts-signals", [PY, "tests/liggghts/check_signals.py"], "lines", {})]
 # The pour (576 spheres, walls, a cylinder): round-off horizons and settled statistics.
 SUITES += [("pour", [PY, "tests/liggghts/check_pour.py"], "lines", {})]
+# The stability suite (make stability), reduced: the harshest one-contact cases at their own dt and
+# at 10x the guard's dt, in both engines and in the sanitized stepper.
+STABILITY_CASES = ("restitution/e0p01,grazing/a89p9,friction/mu10,impact_speed/v100,"
+                   "scale/E1e12_R10um,scale/co5_polyethylene,rolling/eta1")
+SUITES += [
+    ("stability", [PY, "scripts/stability.py", "--out", "out/test/stability", "--cases",
+                   STABILITY_CASES, "--factors", "10"], "lines", {}),
+    ("stability-sanitized", [PY, "scripts/stability.py", "--out", "out/test/stability-san", "--cases",
+                             STABILITY_CASES, "--factors", "10", "--engines", "jdem",
+                             "--jdem", "build/san/jdem"], "lines", {}),
+]
+# Parallel bonds: the checks of `make bonds`, shortened, in the stepper and its sanitized build.
+SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--out", "out/test/bonds"], "lines", {}),
+           ("bonds-sanitized", [PY, "scripts/bond_checks.py", "--quick", "--out",
+                                "out/test/bonds-san"], "lines", SANITIZED)]
 # The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
 # `make demo` runs the full sweeps.
 CHUNG_OOI = "out/test/chung_ooi"

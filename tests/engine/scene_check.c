@@ -176,6 +176,26 @@ static const char *diff_scenes(const jd_scene *a, const jd_scene *b) {
     SAME_ARRAY(position, 3 * a->n_particles);
     SAME_ARRAY(velocity, 3 * a->n_particles);
     SAME_ARRAY(angular_velocity, 3 * a->n_particles);
+    SAME_ARRAY(fixed, a->n_particles);
+    SAME_ARRAY(force, 3 * a->n_particles);
+    SAME(has_loads);
+    SAME(n_bond_types);
+    for (size_t i = 0; i < a->n_bond_types; i++) {
+        if (strcmp(a->bond_types[i].name, b->bond_types[i].name)) return "bond_types.name";
+        SAME(bond_types[i].p);
+    }
+    SAME(n_bonds);
+    SAME_ARRAY(bond_ids, 2 * a->n_bonds);
+    SAME_ARRAY(bond_type, a->n_bonds);
+    SAME(n_bond_rules);
+    for (size_t r = 0; r < a->n_bond_rules; r++) {
+        SAME(bond_rules[r].type);
+        SAME(bond_rules[r].step);
+        SAME(bond_rules[r].id_range);
+        SAME(bond_rules[r].max_gap);
+        if (memcmp(a->bond_rules[r].materials, b->bond_rules[r].materials, a->n_materials))
+            return "bond_rules.materials";
+    }
     for (size_t i = 0; i < a->n_walls; i++) {
         const char *d = diff_wall(&a->walls[i], &b->walls[i]);
         if (d) return d;
@@ -261,13 +281,35 @@ static const char *check_lattice(const jd_scene *s) {
     return NULL;
 }
 
+/* Counts in closed form: a simple-cubic n x m x k block has 3nmk - nm - mk - nk face bonds; the
+ * FCC cluster of diameter 6.9 r is a centre sphere with its 12 neighbours (a cuboctahedron: 12
+ * spokes + 24 edges); the step-0 rule bonds the two touching explicit spheres (ids 1, 2) and not
+ * the distant one; the later rule stays a rule with its step = ceil(time/dt). */
+static const char *check_bonds(const jd_scene *s) {
+    if (s->n_particles != 3 + 12 + 13) return "particle count";
+    if (s->n_bonds != 1 + 20 + 36) return "bond count";
+    if (s->bond_ids[0] != 1 || s->bond_ids[1] != 2) return "step-0 rule bond";
+    for (size_t k = 1; k < s->n_bonds; k++)
+        if (s->bond_ids[2 * k] < s->bond_ids[2 * k - 2] ||
+            (s->bond_ids[2 * k] == s->bond_ids[2 * k - 2] &&
+             s->bond_ids[2 * k + 1] <= s->bond_ids[2 * k - 1]))
+            return "bonds sorted by ids";
+    if (s->n_bond_rules != 1 || s->bond_rules[0].step != 3) return "later rule";
+    if (s->bond_rules[0].id_range[0] != 1 || s->bond_rules[0].id_range[1] != 28)
+        return "default id_range";
+    if (!isinf(s->bond_types[0].p.tau_c) || s->bond_types[0].p.bending != 1) return "bond type";
+    if (!s->fixed[0] || s->force[3 * 2 + 2] != -0.5 || !s->has_loads) return "loads";
+    return NULL;
+}
+
 static void check_values(const char *file, const jd_scene *s) {
     static const struct {
         const char *file;
         const char *(*check)(const jd_scene *);
     } checks[] = {{"two_spheres.yaml", check_two_spheres},
                   {"sweep.yaml", check_sweep},
-                  {"lattice_box.yaml", check_lattice}};
+                  {"lattice_box.yaml", check_lattice},
+                  {"bonds.yaml", check_bonds}};
     for (size_t i = 0; i < sizeof checks / sizeof checks[0]; i++) {
         if (strcmp(file, checks[i].file) != 0) continue;
         char name[512];

@@ -57,7 +57,7 @@ def check_part(name, out, step):
 def liggghts(tmp, case, np_):
     out = os.path.join(tmp, "%s_np%d.h5" % (case, np_))
     r = subprocess.run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), SCENE, "--case", case,
-                        "-o", out, "--np", str(np_)], capture_output=True, text=True)
+                        "-o", out, "--np", str(np_), "--force"], capture_output=True, text=True)
     with open(os.path.join(tmp, "%s_np%d.deck" % (case, np_), "log.lammps"), errors="replace") as f:
         log = f.read()
     return r.returncode, log, out

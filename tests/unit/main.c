@@ -7,5 +7,8 @@ int main(void) {
     failed += run_geometry_tests();
     failed += run_h5md_tests();
     failed += run_watchdog_tests();
+    failed += run_guard_tests();
+    failed += run_bond_tests();
+    failed += run_h5md_bonds_tests();
     return failed;
 }

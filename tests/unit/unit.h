@@ -25,5 +25,8 @@ int run_kernel_tests(void);
 int run_geometry_tests(void);
 int run_h5md_tests(void);
 int run_watchdog_tests(void);
+int run_guard_tests(void);
+int run_bond_tests(void);
+int run_h5md_bonds_tests(void);
 
 #endif

@@ -1,0 +1,137 @@
+/*
+ * jdem_guard.c — the time-step guard (jdem_guard.h; docs/model.md §8).
+ *
+ * The coordination bound.  Linearised about a contact, velocity Verlet is stable while
+ * omega_max dt <= 2, omega_max^2 the largest eigenvalue of M^-1/2 K M^-1/2 (6 degrees of freedom
+ * per sphere).  By the block Gershgorin theorem (Feingold & Varga 1962) that eigenvalue is at most
+ * max_i sum_{contacts c of i} (||D_ci|| + ||O_c||), D_ci the block a contact adds on particle i's
+ * diagonal and O_c the block coupling it to its partner.  With the secant stiffness K = k_n
+ * sqrt(delta) of Jiang's law, the normal tangent stiffness is 3/2 K, the tangential spring K
+ * (K_t = K_n, Sec. 2.3.2) acting at the lever arm R, and the rolling spring K r_roll^2:
+ *   ||D_ai|| <= max(3/2 K/m_a, K (1/m_a + R_a^2/I_a)) + K r_roll^2/I_a
+ *   ||O||    <= max(3/2 K/sqrt(m_a m_b), K sqrt((1/m_a + R_a^2/I_a)(1/m_b + R_b^2/I_b)))
+ *               + K r_roll^2/sqrt(I_a I_b)
+ * (the normal and the two tangential directions are orthogonal in the mass-scaled coordinates,
+ * so their parts combine by max; the rolling part is added).  For two equal spheres without
+ * rolling this is exact: omega^2 = 7 K/m, the coupled sliding-rolling mode.  K is taken at the
+ * peak overlap of an impact at max_impact_speed, and a particle is assumed to carry
+ * `coordination` contacts of the stiffest kind its species has.  Viscous damping of ratio zeta
+ * lowers the limit of the central-difference scheme to (2/omega)(sqrt(1 + zeta^2) - zeta).
+ */
+#include "jdem_guard.h"
+
+#include <math.h>
+#include <stdio.h>
+
+#include "jdem_kernel.h"
+
+const char *jd_guard_bound_name(int bound) {
+    switch (bound) {
+    case JD_GUARD_RAYLEIGH: return "20 % of the Rayleigh time step";
+    case JD_GUARD_CONTACT_TIME: return "1/50 of the shortest Hertz contact time";
+    case JD_GUARD_COORDINATION: return "the Verlet stability limit at coordination number";
+    case JD_GUARD_BOND: return "1/20 of the fastest bond period";
+    default: return "";
+    }
+}
+
+/* One side of a contact: mass, inertia and 1/m + R^2/I (the tangential mobility). */
+typedef struct side {
+    double m, I, mob;
+} side;
+
+static side side_of(double R, double rho) {
+    const double m = jd_sphere_mass(R, rho), I = jd_sphere_inertia(m, R);
+    return (side){.m = m, .I = I, .mob = 1.0 / m + R * R / I};
+}
+
+/* Gershgorin row sum ||D_a|| + ||O|| of one contact of a (b NULL: a wall) with secant
+ * stiffness K and rolling arm r [1/s^2]. */
+static double row_sum(const side *a, const side *b, double K, double r) {
+    const double Kr = K * r * r;
+    double s = fmax(1.5 * K / a->m, K * a->mob) + Kr / a->I;
+    if (b) s += fmax(1.5 * K / sqrt(a->m * b->m), K * sqrt(a->mob * b->mob)) + Kr / sqrt(a->I * b->I);
+    return s;
+}
+
+static void tighten(jd_guard_result *r, double dt, double bound, int which) {
+    if (bound < r->safe_dt) {
+        r->safe_dt = bound;
+        r->binding = which;
+    }
+    if (dt > bound && (!r->violated || bound < r->violated_value)) {
+        r->violated = which;
+        r->violated_value = bound;
+    }
+}
+
+void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
+    *out = (jd_guard_result){.rayleigh_bound = INFINITY, .contact_time = INFINITY,
+                             .contact_bound = INFINITY, .coordination_bound = INFINITY,
+                             .bond_bound = INFINITY,
+                             .safe_dt = INFINITY, .binding = JD_GUARD_SAFE,
+                             .violated = JD_GUARD_SAFE};
+    const double v = in->max_impact_speed;
+    double omega2 = 0.0; /* the largest row sum of one contact */
+    for (size_t a = 0; a < in->n_species; a++) {
+        const jd_guard_species *sa = &in->species[a];
+        if (!sa->count) continue;
+        out->rayleigh_bound = fmin(out->rayleigh_bound, JD_GUARD_RAYLEIGH_FRACTION *
+                                   jd_rayleigh_step(sa->rmin, sa->density, sa->E, sa->nu));
+        if (!(v > 0.0)) continue; /* nothing moves: no impact to resolve */
+        const side pa = side_of(sa->rmin, sa->density);
+        const double kp_a = jd_hertz_prefactor(sa->E, sa->nu, sa->rmin);
+        for (size_t b = 0; b < in->n_species; b++) {
+            const jd_guard_species *sb = &in->species[b];
+            if (!sb->count || (b == a && sa->count < 2)) continue;
+            const side pb = side_of(sb->rmin, sb->density);
+            const double m_eff = pa.m * pb.m / (pa.m + pb.m);
+            const double kn = jd_kn_pair(kp_a, jd_hertz_prefactor(sb->E, sb->nu, sb->rmin));
+            out->contact_time = fmin(out->contact_time, jd_hertz_contact_time(m_eff, kn, v));
+            const double K = kn * sqrt(jd_hertz_peak_overlap(m_eff, kn, v));
+            omega2 = fmax(omega2, row_sum(&pa, &pb, K, sa->rmin * sb->rmin / (sa->rmin + sb->rmin)));
+        }
+        if (in->has_walls) {
+            const double kw = jd_kn_wall(in->wall_rule, sa->E, sa->nu, sa->rmin);
+            out->contact_time = fmin(out->contact_time, jd_hertz_contact_time(pa.m, kw, v));
+            const double K = kw * sqrt(jd_hertz_peak_overlap(pa.m, kw, v));
+            omega2 = fmax(omega2, row_sum(&pa, NULL, K, sa->rmin));
+        }
+    }
+    out->contact_bound = out->contact_time / JD_GUARD_STEPS_PER_CONTACT;
+    if (omega2 > 0.0) {
+        const double z = in->damping_ratio;
+        out->omega_max = sqrt(in->coordination * omega2);
+        out->coordination_bound = 2.0 / out->omega_max * (sqrt(1.0 + z * z) - z);
+    }
+    tighten(out, in->dt, out->rayleigh_bound, JD_GUARD_RAYLEIGH);
+    tighten(out, in->dt, out->contact_bound, JD_GUARD_CONTACT_TIME);
+    tighten(out, in->dt, out->coordination_bound, JD_GUARD_COORDINATION);
+    if (in->bond_omega2 > 0.0)
+        out->bond_bound = 2.0 * JD_PI / sqrt(in->bond_omega2) / JD_GUARD_STEPS_PER_BOND_PERIOD;
+    tighten(out, in->dt, out->bond_bound, JD_GUARD_BOND);
+}
+
+/* "BOUND (V s)", with the coordination number where it is that bound. */
+static int describe(const jd_guard_input *in, int bound, double value, char *buf, size_t len) {
+    if (bound == JD_GUARD_COORDINATION)
+        return snprintf(buf, len, "%s %g (%.6g s)", jd_guard_bound_name(bound), in->coordination,
+                        value);
+    return snprintf(buf, len, "%s (%.6g s)", jd_guard_bound_name(bound), value);
+}
+
+int jd_guard_refusal(const jd_guard_input *in, const jd_guard_result *r, const char *hint,
+                     char *buf, size_t len) {
+    char what[160];
+    describe(in, r->violated, r->violated_value, what, sizeof what);
+    return snprintf(buf, len, "time step %g s is unsafe: it exceeds %s; largest safe dt = %.6g s. "
+                    "%s", in->dt, what, r->safe_dt, hint);
+}
+
+int jd_guard_warning(const jd_guard_input *in, const jd_guard_result *r, const char *how,
+                     char *buf, size_t len) {
+    char what[160];
+    describe(in, r->violated, r->violated_value, what, sizeof what);
+    return snprintf(buf, len, "warning: time step %g s exceeds %s; running anyway (%s)", in->dt,
+                    what, how);
+}

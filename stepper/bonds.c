@@ -1,0 +1,401 @@
+/*
+ * bonds.c — the bond list of the standalone engine (bonds.h): set-up from the scene, rules
+ * during the run, the bond loop (specialised for its JD_B_* features like the contact loops),
+ * broken-bond events, /connectivity output, observables, the guard's bond bound.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bonds.h"
+#include "sim.h"
+
+#if defined(__GNUC__)
+#define JD_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define JD_ALWAYS_INLINE inline
+#endif
+
+const char *const jd_bond_observable_names[JD_N_BOND_OBSERVABLES] = {
+    "bonds", "fragments", "bond_elastic_energy", "bond_damping_dissipation",
+    "bond_breakage_energy"};
+
+void sim_bond_observables_values(const jd_bond_observables *o, double out[JD_N_BOND_OBSERVABLES]) {
+    const double v[JD_N_BOND_OBSERVABLES] = {o->bonds, o->fragments, o->elastic_energy,
+                                             o->damping_dissipation, o->breakage_energy};
+    for (int k = 0; k < JD_N_BOND_OBSERVABLES; k++) out[k] = v[k];
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Growing arrays                                                                            */
+
+static int grow(void **p, size_t *cap, size_t need, size_t size) {
+    if (need <= *cap) return 0;
+    size_t c = *cap ? *cap : 64;
+    while (c < need) c *= 2;
+    void *q = realloc(*p, c * size);
+    if (!q) return -1;
+    *p = q;
+    *cap = c;
+    return 0;
+}
+
+static int reserve(jd_bonds *b, size_t need) {
+    if (need <= b->cap) return 0;
+    size_t c = b->cap ? b->cap : 64;
+    while (c < need) c *= 2;
+#define RE(p)                                          \
+    do {                                               \
+        void *q = realloc((p), c * sizeof *(p));       \
+        if (!q) return -1;                             \
+        (p) = q;                                       \
+    } while (0)
+    RE(b->i);
+    RE(b->j);
+    RE(b->type);
+    RE(b->sec);
+    RE(b->m_eff);
+    RE(b->i_eff);
+    RE(b->state);
+#undef RE
+    b->cap = c;
+    return 0;
+}
+
+/* Append an intact bond between particle indices i and j (a = the smaller id). */
+static int add_bond(jd_sim *s, int32_t i, int32_t j, int32_t type, int64_t step) {
+    jd_bonds *b = s->bonds;
+    if (s->scene->id[j] < s->scene->id[i]) {
+        const int32_t t = i;
+        i = j;
+        j = t;
+    }
+    if (reserve(b, b->n + 1) ||
+        grow((void **)&b->formed, &b->formed_cap, b->n_formed + 1, sizeof *b->formed))
+        return -1;
+    const size_t k = b->n++;
+    b->i[k] = i;
+    b->j[k] = j;
+    b->type[k] = type;
+    b->sec[k] = jd_bond_section_of(b->params[type].lambda, s->radius[i], s->radius[j]);
+    b->m_eff[k] = s->mass[i] * s->mass[j] / (s->mass[i] + s->mass[j]);
+    b->i_eff[k] = s->inertia[i] * s->inertia[j] / (s->inertia[i] + s->inertia[j]);
+    jd_bond_form(&b->state[k]);
+    b->ever[i] = b->ever[j] = 1;
+    b->formed[b->n_formed++] = (jd_h5md_bond){{s->scene->id[i], s->scene->id[j]}, type, step};
+    return 0;
+}
+
+static long index_of_id(const jd_scene *sc, int64_t id) {
+    size_t lo = 0, hi = sc->n_particles;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (sc->id[mid] < id) lo = mid + 1; else hi = mid;
+    }
+    return lo < sc->n_particles && sc->id[lo] == id ? (long)lo : -1;
+}
+
+int sim_bonds_init(jd_sim *s, char *err, size_t errlen) {
+    const jd_scene *sc = s->scene;
+    if (!sc->n_bond_types) return 0;
+    jd_bonds *b = calloc(1, sizeof *b);
+    if (!b || !(b->ever = calloc(s->n ? s->n : 1, 1))) {
+        free(b);
+        snprintf(err, errlen, "out of memory for the bonds");
+        return -1;
+    }
+    s->bonds = b;
+    b->n_types = sc->n_bond_types;
+    jd_bond_params *p = malloc(b->n_types * sizeof *p);
+    if (!p) goto oom;
+    b->features = JD_B_ENERGY;
+    for (size_t t = 0; t < b->n_types; t++) {
+        p[t] = sc->bond_types[t].p;
+        if (p[t].gamma > 0.0) b->features |= JD_B_DAMPING;
+    }
+    b->params = p;
+    for (size_t k = 0; k < sc->n_bonds; k++) {
+        /* indices equal ids' positions: the scene's particles are sorted by id */
+        const long i = index_of_id(sc, sc->bond_ids[2 * k]), j = index_of_id(sc, sc->bond_ids[2 * k + 1]);
+        if (i < 0 || j < 0 || add_bond(s, (int32_t)i, (int32_t)j, sc->bond_type[k], 0)) goto oom;
+    }
+    return 0;
+oom:
+    snprintf(err, errlen, "out of memory for %zu bonds", sc->n_bonds);
+    return -1;
+}
+
+void sim_bonds_free(jd_sim *s) {
+    jd_bonds *b = s->bonds;
+    if (!b) return;
+    free((void *)b->params);
+    free(b->i);
+    free(b->j);
+    free(b->type);
+    free(b->sec);
+    free(b->m_eff);
+    free(b->i_eff);
+    free(b->state);
+    free(b->ever);
+    free(b->formed);
+    free(b->events);
+    free(b);
+    s->bonds = NULL;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Rules                                                                                     */
+
+static int by_pair(const void *x, const void *y) {
+    const int32_t *p = x, *q = y;
+    if (p[0] != q[0]) return p[0] < q[0] ? -1 : 1;
+    return p[1] < q[1] ? -1 : p[1] > q[1];
+}
+
+/* Bond the pairs of one rule that are not bonded already (intact).  Out of memory is recorded
+ * in b->failed and stops the run at the next sim_bonds_output. */
+static void apply_rule(jd_sim *s, const jd_bond_rule *rule, int64_t step) {
+    jd_bonds *b = s->bonds;
+    int32_t *pairs = NULL;
+    const long np = jd_bond_rule_pairs(s->scene, rule, s->x, &pairs);
+    int32_t *have = malloc((b->n ? b->n : 1) * 2 * sizeof *have); /* intact pairs, (min, max) */
+    if (np < 0 || !have) b->failed = "out of memory applying a bond rule";
+    if (np <= 0 || !have) {
+        free(pairs);
+        free(have);
+        return;
+    }
+    for (size_t k = 0; k < b->n; k++) {
+        have[2 * k] = b->i[k] < b->j[k] ? b->i[k] : b->j[k];
+        have[2 * k + 1] = b->i[k] < b->j[k] ? b->j[k] : b->i[k];
+    }
+    qsort(have, b->n, 2 * sizeof *have, by_pair);
+    for (long p = 0; p < np; p++)
+        if (!bsearch(&pairs[2 * p], have, b->n, 2 * sizeof *have, by_pair) &&
+            add_bond(s, pairs[2 * p], pairs[2 * p + 1], rule->type, step)) {
+            b->failed = "out of memory forming the bonds of a rule";
+            break;
+        }
+    free(pairs);
+    free(have);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* The bond loop                                                                             */
+
+static void record_break(jd_sim *s, size_t k, const jd_bond_geom *g, const jd_bond_result *out,
+                         int64_t step) {
+    jd_bonds *b = s->bonds;
+    b->n_broken[out->mode]++;
+    if (s->in_setup) return;
+    if (grow((void **)&b->events, &b->events_cap, b->n_events + 1, sizeof *b->events)) {
+        b->failed = "out of memory recording a broken bond";
+        return;
+    }
+    jd_h5md_bond_break *e = &b->events[b->n_events++];
+    const int32_t i = b->i[k], j = b->j[k];
+    *e = (jd_h5md_bond_break){.step = step, .time = (double)step * s->dt,
+                              .id = {s->scene->id[i], s->scene->id[j]}, .mode = out->mode,
+                              .normal_force = out->fn, .shear_force = out->ft,
+                              .twisting_moment = out->mn, .bending_moment = out->mt,
+                              .sigma_max = out->sigma_max, .tau_max = out->tau_max};
+    for (int d = 0; d < 3; d++) e->position[d] = s->x[3 * (size_t)i + d] + g->ra[d];
+}
+
+/* Returns the number of bonds that broke. */
+static JD_ALWAYS_INLINE size_t bond_loop(jd_sim *s, const unsigned F, int64_t step) {
+    jd_bonds *b = s->bonds;
+    /* Step 0 (LIGGGHTS `setup`): no increment, the force is the stored one (bonds.h) */
+    const double dt = s->in_setup ? 0.0 : s->dt;
+    size_t broke = 0;
+    for (size_t k = 0; k < b->n; k++) {
+        const int32_t i = b->i[k], j = b->j[k];
+        jd_bond_geom g;
+        if (!jd_bond_geom_spheres(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
+                                  s->radius[j], &g))
+            continue; /* coincident centres: no direction (the contact watchdog reports it) */
+        g.sec = b->sec[k];
+        g.m_eff = b->m_eff[k];
+        g.i_eff = b->i_eff[k];
+        jd_kinematics kin;
+        const double *va = s->v + 3 * (size_t)i, *wa = s->omega + 3 * (size_t)i;
+        const double *vb = s->v + 3 * (size_t)j, *wb = s->omega + 3 * (size_t)j;
+        for (int d = 0; d < 3; d++) {
+            kin.va[d] = va[d];
+            kin.wa[d] = wa[d];
+            kin.vb[d] = vb[d];
+            kin.wb[d] = wb[d];
+        }
+        jd_bond_result out;
+        if (jd_bond(F, &b->params[b->type[k]], &g, &kin, dt, &b->state[k], &out) !=
+            JD_BOND_INTACT) {
+            record_break(s, k, &g, &out, step);
+            broke++;
+            continue;
+        }
+        double *fa = s->f + 3 * (size_t)i, *fb = s->f + 3 * (size_t)j;
+        double *ta = s->torque + 3 * (size_t)i, *tb = s->torque + 3 * (size_t)j;
+        for (int d = 0; d < 3; d++) {
+            fa[d] -= out.f[d];
+            fb[d] += out.f[d];
+            ta[d] += out.ta[d];
+            tb[d] += out.tb[d];
+        }
+    }
+    return broke;
+}
+
+/* Drop broken bonds, keeping the order of the others; their energies go to the totals. */
+static void compact(jd_bonds *b) {
+    size_t w = 0;
+    for (size_t k = 0; k < b->n; k++) {
+        if (!jd_bond_intact(&b->state[k])) {
+            b->e_damp_dropped += b->state[k].e_damp;
+            b->e_break_dropped += b->state[k].e_break;
+            continue;
+        }
+        if (w != k) {
+            b->i[w] = b->i[k];
+            b->j[w] = b->j[k];
+            b->type[w] = b->type[k];
+            b->sec[w] = b->sec[k];
+            b->m_eff[w] = b->m_eff[k];
+            b->i_eff[w] = b->i_eff[k];
+            b->state[w] = b->state[k];
+        }
+        w++;
+    }
+    b->n = w;
+}
+
+void sim_bonds_forces(jd_sim *s) {
+    jd_bonds *b = s->bonds;
+    const jd_scene *sc = s->scene;
+    const int64_t step = s->step + (s->in_setup ? 0 : 1); /* the step whose forces these are */
+    while (!s->in_setup && b->next_rule < sc->n_bond_rules &&
+           sc->bond_rules[b->next_rule].step <= step)
+        apply_rule(s, &sc->bond_rules[b->next_rule++], step);
+    const size_t broke = (b->features & JD_B_DAMPING) ? bond_loop(s, JD_B_ENERGY | JD_B_DAMPING, step)
+                                                      : bond_loop(s, JD_B_ENERGY, step);
+    if (broke && !s->in_setup) compact(b);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Output, observables, permutation                                                          */
+
+static int by_event(const void *x, const void *y) {
+    const jd_h5md_bond_break *p = x, *q = y;
+    if (p->step != q->step) return p->step < q->step ? -1 : 1;
+    if (p->id[0] != q->id[0]) return p->id[0] < q->id[0] ? -1 : 1;
+    return p->id[1] < q->id[1] ? -1 : p->id[1] > q->id[1];
+}
+
+int sim_bonds_output(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
+    jd_bonds *b = s->bonds;
+    if (b->failed) {
+        snprintf(err, errlen, "step %lld: %s", (long long)s->step, b->failed);
+        return -1;
+    }
+    if (b->n_events) qsort(b->events, b->n_events, sizeof *b->events, by_event);
+    int rc = 0; /* step 0 creates the (possibly empty) datasets */
+    if (h && (b->n_formed || s->step == 0))
+        rc = jd_h5md_write_bonds(h, b->n_formed, b->formed, err, errlen);
+    if (h && rc == 0 && (b->n_events || s->step == 0))
+        rc = jd_h5md_write_bond_breaks(h, b->n_events, b->events, err, errlen);
+    b->n_formed = b->n_events = 0;
+    return rc;
+}
+
+static int32_t find(int32_t *parent, int32_t x) {
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+void sim_bonds_observables(const jd_sim *s, jd_bond_observables *o) {
+    const jd_bonds *b = s->bonds;
+    *o = (jd_bond_observables){.bonds = (double)b->n,
+                               .damping_dissipation = b->e_damp_dropped,
+                               .breakage_energy = b->e_break_dropped};
+    for (size_t k = 0; k < b->n; k++) {
+        o->elastic_energy += b->state[k].u_prev;
+        o->damping_dissipation += b->state[k].e_damp;
+        o->breakage_energy += b->state[k].e_break;
+    }
+    /* fragments: union-find over the intact bonds; components among the particles ever bonded */
+    int32_t *parent = malloc((s->n ? s->n : 1) * sizeof *parent);
+    if (!parent) {
+        o->fragments = NAN;
+        return;
+    }
+    for (size_t i = 0; i < s->n; i++) parent[i] = (int32_t)i;
+    size_t merges = 0, ever = 0;
+    for (size_t k = 0; k < b->n; k++) {
+        const int32_t x = find(parent, b->i[k]), y = find(parent, b->j[k]);
+        if (x != y) {
+            parent[x] = y;
+            merges++;
+        }
+    }
+    for (size_t i = 0; i < s->n; i++) ever += b->ever[i];
+    o->fragments = (double)(ever - merges);
+    free(parent);
+}
+
+void sim_bonds_permute(jd_bonds *b, const int32_t *new_index) {
+    if (!b) return;
+    for (size_t k = 0; k < b->n; k++) {
+        b->i[k] = new_index[b->i[k]];
+        b->j[k] = new_index[b->j[k]];
+    }
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Guard                                                                                     */
+
+double sim_bonds_omega2(const jd_scene *sc) {
+    if (!sc->n_bond_types || (!sc->n_bonds && !sc->n_bond_rules)) return 0.0;
+    double *w2 = calloc(sc->n_particles ? sc->n_particles : 1, sizeof *w2);
+    if (!w2) return INFINITY; /* cannot assess: report as unsafe */
+    double *m = malloc((sc->n_particles ? sc->n_particles : 1) * sizeof *m);
+    if (!m) {
+        free(w2);
+        return INFINITY;
+    }
+    for (size_t i = 0; i < sc->n_particles; i++)
+        m[i] = jd_sphere_mass(sc->radius[i], sc->materials[sc->material[i]].density);
+    for (size_t k = 0; k < sc->n_bonds; k++) {
+        const long i = index_of_id(sc, sc->bond_ids[2 * k]), j = index_of_id(sc, sc->bond_ids[2 * k + 1]);
+        if (i < 0 || j < 0) continue;
+        const jd_bond_params *p = &sc->bond_types[sc->bond_type[k]].p;
+        const double Ri = sc->radius[i], Rj = sc->radius[j];
+        const jd_bond_section sec = jd_bond_section_of(p->lambda, Ri, Rj);
+        double dx[3];
+        for (int d = 0; d < 3; d++) dx[d] = sc->position[3 * j + d] - sc->position[3 * i + d];
+        const double dist = sqrt(jd_dot(dx, dx)), delta = Ri + Rj - dist;
+        const double la = fabs(Ri - 0.5 * delta), lb = fabs(dist - la);
+        const double wk = jd_bond_omega2_bound(p, &sec, m[i], m[j], jd_sphere_inertia(m[i], Ri),
+                                               jd_sphere_inertia(m[j], Rj), la, lb);
+        w2[i] += wk;
+        w2[j] += wk;
+    }
+    for (size_t r = 0; r < sc->n_bond_rules; r++) {
+        const jd_bond_rule *rule = &sc->bond_rules[r];
+        const jd_bond_params *p = &sc->bond_types[rule->type].p;
+        for (size_t i = 0; i < sc->n_particles; i++) {
+            if (!rule->materials[sc->material[i]] || sc->id[i] < rule->id_range[0] ||
+                sc->id[i] > rule->id_range[1])
+                continue;
+            const double R = sc->radius[i], I = jd_sphere_inertia(m[i], R);
+            const jd_bond_section sec = jd_bond_section_of(p->lambda, R, R);
+            w2[i] += 12.0 * jd_bond_omega2_bound(p, &sec, m[i], m[i], I, I, R, R);
+        }
+    }
+    double wmax2 = 0.0;
+    for (size_t i = 0; i < sc->n_particles; i++) wmax2 = fmax(wmax2, w2[i]);
+    free(w2);
+    free(m);
+    return wmax2;
+}

@@ -1,0 +1,85 @@
+/*
+ * bonds.h — parallel bonds in the standalone engine (docs/scenes.md "Bonds"; the law is
+ * kernel/jdem_bond.h).  The bond loop is separate from the contact loops: a bonded pair is also
+ * an ordinary contact candidate, and the contact law acts whenever the spheres overlap, in
+ * parallel with the bond.
+ *
+ * Bonds are stored by particle index (a = i, b = j as formed, i.e. the smaller id first), in
+ * formation order: the scene's step-0 bonds sorted by ids, then each rule's bonds sorted by ids.
+ * Only intact bonds are kept; a bond that breaks is removed at the end of the loop that broke it
+ * (order kept) after its event is recorded and its energies are moved to the totals.  A spatial
+ * re-sort of the particles remaps the list with sim_bonds_permute().
+ */
+#ifndef JDEM_BONDS_H
+#define JDEM_BONDS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "h5md.h"
+#include "jdem_bond.h"
+
+struct jd_sim;
+struct jd_scene;
+
+typedef struct jd_bonds {
+    unsigned features;         /* JD_B_* of the bond loop, fixed for the run */
+    size_t n_types;
+    const jd_bond_params *params; /* per type (n_types), copied from the scene */
+    size_t n, cap;             /* intact bonds */
+    int32_t *i, *j;            /* particle indices of a and b */
+    int32_t *type;             /* index into params */
+    jd_bond_section *sec;      /* cross-section of eq. (15) */
+    double *m_eff, *i_eff;     /* for the dashpots [kg], [kg m^2] */
+    jd_bond_state *state;
+    size_t next_rule;          /* first scene rule not yet applied */
+    unsigned char *ever;       /* per particle: 1 once it has been bonded (fragment count) */
+    /* output not yet written */
+    jd_h5md_bond *formed;      /* bonds formed since the last sim_bonds_output */
+    size_t n_formed, formed_cap;
+    jd_h5md_bond_break *events; /* breaks since the last sim_bonds_output */
+    size_t n_events, events_cap;
+    const char *failed;        /* set when the bond loop ran out of memory (reported by
+                                  sim_bonds_output, which stops the run) */
+    /* totals */
+    int64_t n_broken[3];       /* by jd_bond_mode (index 0 unused) */
+    double e_damp_dropped, e_break_dropped; /* energies of removed bonds [J] */
+} jd_bonds;
+
+/* Bond observables (the /observables written for scenes with bond types). */
+typedef struct jd_bond_observables {
+    double bonds, fragments;   /* intact bonds; components of the intact-bond graph over the
+                                  particles ever bonded */
+    double elastic_energy, damping_dissipation, breakage_energy; /* [J] */
+} jd_bond_observables;
+#define JD_N_BOND_OBSERVABLES 5
+extern const char *const jd_bond_observable_names[JD_N_BOND_OBSERVABLES];
+void sim_bond_observables_values(const jd_bond_observables *o, double out[JD_N_BOND_OBSERVABLES]);
+
+/* Set up s->bonds from the scene (NULL when the scene has no bond types).  0 or -1 with err. */
+int sim_bonds_init(struct jd_sim *s, char *err, size_t errlen);
+void sim_bonds_free(struct jd_sim *s);
+
+/* Form the bonds of rules due at the step being computed (s->step + 1), then add every intact
+ * bond's force and torques to s->f and s->torque.  Called by sim_compute_forces.  At step 0
+ * (s->in_setup, LIGGGHTS `setup`) the bonds are evaluated with dt = 0: no increment, the force
+ * is the stored one (zero for a new bond) plus the dashpots, and no rule is applied. */
+void sim_bonds_forces(struct jd_sim *s);
+
+/* Write the bonds formed and the bonds broken since the last call to /connectivity (h may be
+ * NULL: only forget them).  0, or -1 with err (a write error, or the bond loop ran out of
+ * memory). */
+int sim_bonds_output(struct jd_sim *s, jd_h5md *h, char *err, size_t errlen);
+
+void sim_bonds_observables(const struct jd_sim *s, jd_bond_observables *o);
+
+/* Remap the particle indices after a re-sort: particle k is now new_index[k]. */
+void sim_bonds_permute(jd_bonds *b, const int32_t *new_index);
+
+/* Time-step guard input (jd_guard_input.bond_omega2): the largest over the particles of the sum
+ * of its bonds' squared frequency bounds (jd_bond_omega2_bound; Gershgorin) [rad^2/s^2]; 0
+ * without bonds, INFINITY when out of memory (the guard then refuses).  Particles in a rule's group count 12 more
+ * bonds to neighbours of their own size (the densest packing), since rules bond during the run. */
+double sim_bonds_omega2(const struct jd_scene *sc);
+
+#endif /* JDEM_BONDS_H */

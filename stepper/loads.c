@@ -1,0 +1,82 @@
+/*
+ * loads.c — held particles and constant external forces (scene keys particles[].fixed and
+ * particles[].force, docs/scenes.md), applied after every other force as LIGGGHTS' post-force
+ * fixes do (fix addforce, then fix freeze): the external force is added, then a held particle's
+ * force and torque are set to zero, so it keeps its initial velocity and spin.
+ *
+ * Both do work on the particles, which the energy balance books into wall_work (the external
+ * work term) with the trapezoidal rule of the contacts: half the sum of the forces at the two
+ * ends of a step times the step's displacement (v at force time is the half-step velocity).
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim.h"
+
+struct jd_loads {
+    size_t n;
+    int32_t *index;   /* loaded particles */
+    double *f_prev;   /* 6 per loaded particle: force and torque applied at the previous
+                         evaluation (external force, or the constraint's reaction) */
+};
+
+int sim_loads_init(jd_sim *s, char *err, size_t errlen) {
+    const jd_scene *sc = s->scene;
+    if (!sc->has_loads) return 0;
+    jd_loads *l = calloc(1, sizeof *l);
+    size_t n = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        const double *F = &sc->force[3 * i];
+        n += sc->fixed[i] || F[0] != 0.0 || F[1] != 0.0 || F[2] != 0.0;
+    }
+    if (l) {
+        l->index = malloc((n ? n : 1) * sizeof *l->index);
+        l->f_prev = calloc(6 * (n ? n : 1), sizeof *l->f_prev);
+    }
+    if (!l || !l->index || !l->f_prev) {
+        if (l) {
+            free(l->index);
+            free(l->f_prev);
+        }
+        free(l);
+        snprintf(err, errlen, "out of memory for the particle loads");
+        return -1;
+    }
+    for (size_t i = 0; i < s->n; i++) {
+        const double *F = &sc->force[3 * i];
+        if (sc->fixed[i] || F[0] != 0.0 || F[1] != 0.0 || F[2] != 0.0) l->index[l->n++] = (int32_t)i;
+    }
+    s->loads = l;
+    return 0;
+}
+
+void sim_loads_free(jd_sim *s) {
+    if (!s->loads) return;
+    free(s->loads->index);
+    free(s->loads->f_prev);
+    free(s->loads);
+    s->loads = NULL;
+}
+
+void sim_loads_apply(jd_sim *s) {
+    jd_loads *l = s->loads;
+    const jd_scene *sc = s->scene;
+    double work = 0.0;
+    for (size_t k = 0; k < l->n; k++) {
+        const size_t i = (size_t)l->index[k];
+        double *f = s->f + 3 * i, *t = s->torque + 3 * i, *prev = l->f_prev + 6 * k;
+        double applied[6];
+        for (int d = 0; d < 3; d++) {
+            f[d] += sc->force[3 * i + d];
+            /* a held particle: the constraint applies minus everything else */
+            applied[d] = sc->fixed[i] ? -f[d] : sc->force[3 * i + d];
+            applied[3 + d] = sc->fixed[i] ? -t[d] : 0.0;
+            if (sc->fixed[i]) f[d] = t[d] = 0.0;
+        }
+        const double *v = s->v + 3 * i, *w = s->omega + 3 * i;
+        for (int d = 0; d < 3; d++)
+            work += 0.5 * ((prev[d] + applied[d]) * v[d] + (prev[3 + d] + applied[3 + d]) * w[d]);
+        memcpy(prev, applied, sizeof applied);
+    }
+    if (!s->in_setup) s->wall_work += work * s->dt;
+}

@@ -1,0 +1,95 @@
+/* test_guard.c — the time-step guard (kernel/jdem_guard.h) against published values: the
+ * Rayleigh steps of jiang_model.md §10.2, the Hertz contact time of Chung & Ooi test 1
+ * (anchors.md §1.3), and the damped central-difference limit. */
+#include <string.h>
+
+#include "unit.h"
+
+#include "jdem_guard.h"
+#include "jdem_kernel.h"
+
+/* Chung & Ooi test 1: two glass spheres R = 10 mm at 20 m/s relative speed. */
+static jd_guard_input glass_pair(jd_guard_species *sp, double dt) {
+    *sp = (jd_guard_species){.count = 2, .rmin = 0.01, .density = 2800, .E = 4.8e10, .nu = 0.2};
+    return (jd_guard_input){.species = sp, .n_species = 1, .max_impact_speed = 20.0,
+                            .coordination = JD_GUARD_DEFAULT_COORDINATION, .dt = dt};
+}
+
+static void bounds_match_published_values(void **state) {
+    (void)state;
+    jd_guard_species sp;
+    const jd_guard_input in = glass_pair(&sp, 1e-7);
+    jd_guard_result r;
+    jd_guard_assess(&in, &r);
+    assert_rel(r.rayleigh_bound, 2.59e-6, 2e-3);        /* §10.2: 0.2 x 1.293e-5 s */
+    assert_rel(r.contact_time, 4.034e-5, 1e-3);         /* Chung & Ooi test 1 */
+    assert_rel(r.contact_bound, 4.034e-5 / 50, 1e-3);
+    assert_int_equal(r.binding, JD_GUARD_CONTACT_TIME);
+    assert_rel(r.safe_dt, r.contact_bound, 0.0);
+    assert_int_equal(r.violated, JD_GUARD_SAFE);
+}
+
+static void the_tightest_broken_bound_is_named(void **state) {
+    (void)state;
+    jd_guard_species sp;
+    jd_guard_input in = glass_pair(&sp, 3e-6); /* above all three bounds */
+    jd_guard_result r;
+    jd_guard_assess(&in, &r);
+    assert_int_equal(r.violated, JD_GUARD_CONTACT_TIME);
+    char msg[512];
+    jd_guard_refusal(&in, &r, "Use --force to run anyway.", msg, sizeof msg);
+    assert_string_equal(msg, "time step 3e-06 s is unsafe: it exceeds 1/50 of the shortest Hertz "
+                        "contact time (8.06789e-07 s); largest safe dt = 8.06789e-07 s. Use --force "
+                        "to run anyway.");
+    /* nothing moves: only the Rayleigh bound remains */
+    in.max_impact_speed = 0.0;
+    jd_guard_assess(&in, &r);
+    assert_true(isinf(r.contact_bound) && isinf(r.coordination_bound));
+    assert_int_equal(r.violated, JD_GUARD_RAYLEIGH);
+    jd_guard_warning(&in, &r, "--force", msg, sizeof msg);
+    assert_non_null(strstr(msg, "exceeds 20 % of the Rayleigh time step"));
+}
+
+static void coordination_and_damping_scale_the_verlet_limit(void **state) {
+    (void)state;
+    jd_guard_species sp;
+    jd_guard_input in = glass_pair(&sp, 1e-9);
+    jd_guard_result one, four, damped;
+    in.coordination = 1.0;
+    jd_guard_assess(&in, &one);
+    in.coordination = 4.0;
+    jd_guard_assess(&in, &four);
+    assert_rel(four.coordination_bound, one.coordination_bound / 2.0, 1e-12); /* omega ~ sqrt(C) */
+    in.damping_ratio = 0.75; /* (2/omega)(sqrt(1 + 0.5625) - 0.75) = (2/omega) 0.5 */
+    jd_guard_assess(&in, &damped);
+    assert_rel(damped.coordination_bound, four.coordination_bound * 0.5, 1e-12);
+}
+
+/* Two glass spheres (as above) joined by a bond whose fastest mode is 1 MHz: the bond bound is
+ * 1/20 of its period, 5e-8 s, tighter than the contact bound (8.07e-7 s), and it is named. */
+static void a_stiff_bond_binds(void **state) {
+    (void)state;
+    jd_guard_species sp;
+    jd_guard_input in = glass_pair(&sp, 1e-7);
+    const double omega = 2.0 * JD_PI * 1e6;
+    in.bond_omega2 = omega * omega;
+    jd_guard_result r;
+    jd_guard_assess(&in, &r);
+    assert_rel(r.bond_bound, 1e-6 / 20.0, 1e-14);
+    assert_int_equal(r.binding, JD_GUARD_BOND);
+    assert_int_equal(r.violated, JD_GUARD_BOND);
+    char msg[512];
+    jd_guard_refusal(&in, &r, "Use --force to run anyway.", msg, sizeof msg);
+    assert_string_equal(msg, "time step 1e-07 s is unsafe: it exceeds 1/20 of the fastest bond "
+                             "period (5e-08 s); largest safe dt = 5e-08 s. Use --force to run anyway.");
+}
+
+int run_guard_tests(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(bounds_match_published_values),
+        cmocka_unit_test(the_tightest_broken_bound_is_named),
+        cmocka_unit_test(coordination_and_damping_scale_the_verlet_limit),
+        cmocka_unit_test(a_stiff_bond_binds),
+    };
+    return cmocka_run_group_tests_name("guard", tests, NULL, NULL);
+}
