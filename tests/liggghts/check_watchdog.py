@@ -76,7 +76,7 @@ def nonfinite_force(tmp, np_):
     with open(os.path.join(d, "resolved.yaml"), "w") as f:
         f.write(r.stdout)
     subprocess.run([PY, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), os.path.join(d, "resolved.yaml"),
-                    "-o", os.path.join(d, "in.jdem"), "--trajectory", out], check=True)
+                    "-o", os.path.join(d, "in.jdem"), "--trajectory", out, "--force"], check=True)
     with open(os.path.join(d, "in.jdem")) as f:
         deck = f.read()
     deck = deck.replace("\nrun ", "\ngroup boom id 2\nvariable fx equal step*1e300*1e300\n"
