@@ -22,6 +22,7 @@
 #include "dump_h5md_jdem.h"
 #include "fix_wall_jiang.h"
 #include "jdem_observables.h"
+#include "jdem_stop.h"
 #include "pair_gran_jiang.h"
 
 using namespace LAMMPS_NS;
@@ -93,13 +94,16 @@ static JdOverlapTrip worst_overlap(LAMMPS *lmp) {
 
 /* The stepper's order: the state, the overlaps, then the energy at its samples.  One
  * reduction answers "anything non-finite? any overlap beyond the limit?" for the whole run;
- * only then do the searches that name the particle run (each with its own reduction). */
+ * only then do the searches that name the particle run (each with its own reduction).  The
+ * same reduction carries a pending SIGINT/SIGTERM (jdem_stop.h), so that stopping costs the
+ * next step no reduction of its own. */
 void FixJdemWatchdog::check() {
   std::string msg;
-  double mine[2] = {atom->nlocal > 0 && !all_finite(atom) ? 1.0 : 0.0,
-                    worst_overlap(lmp).fraction},
-         any[2];
-  MPI_Allreduce(mine, any, 2, MPI_DOUBLE, MPI_MAX, world);
+  double mine[3] = {atom->nlocal > 0 && !all_finite(atom) ? 1.0 : 0.0,
+                    worst_overlap(lmp).fraction, (double)jdem_stop_pending()},
+         any[3];
+  MPI_Allreduce(mine, any, 3, MPI_DOUBLE, MPI_MAX, world);
+  jdem_stop_agreed((long long)update->ntimestep, (int)any[2]);
   if (any[0] > 0.0 && nonfinite(msg)) trip(msg, false);
   if (any[1] > 0.0 && overlap(msg)) trip(msg, true);
   const bigint step = update->ntimestep;

@@ -208,7 +208,8 @@ void FixWallJiang::loop(bool commit) {
         for (int k = 0; k < slen; k++) h[k] = 0.0;
       continue;
     }
-    if (jd_overlap_excessive(g.delta, R, INFINITY, overlap_limit))
+    if (g.delta > overlap_limit * R && /* skips the exact test's libm fmin call (pair loop) */
+        jd_overlap_excessive(g.delta, R, INFINITY, overlap_limit))
       overlap_trip.note(g.delta, R, tag[i], 0, id);
     const double m = rmass[i];
     jd_geom_wall_material(F, &g, kw[i], m, jd_sphere_inertia(m, R));

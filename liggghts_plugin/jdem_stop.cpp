@@ -37,11 +37,25 @@ void jdem_catch_stop_signals() {
   sigaction(SIGTERM, &sa, NULL);
 }
 
+/* The signal all ranks agreed on at the end of step agreed_step (jdem_stop_agreed). */
+static long long agreed_step = -1;
+static int agreed_signal = 0;
+
+int jdem_stop_pending() { return stop_signal; }
+
+void jdem_stop_agreed(long long step, int sig) {
+  agreed_step = step;
+  agreed_signal = sig;
+}
+
 void jdem_stop_if_signalled(LAMMPS *lmp, long long step) {
   int sig = stop_signal;
   int nprocs = 1;
   MPI_Comm_size(lmp->world, &nprocs);
-  if (nprocs > 1) MPI_Allreduce(MPI_IN_PLACE, &sig, 1, MPI_INT, MPI_MAX, lmp->world);
+  if (nprocs > 1) {
+    if (agreed_step == step) sig = agreed_signal; /* reduced at the end of this step already */
+    else MPI_Allreduce(MPI_IN_PLACE, &sig, 1, MPI_INT, MPI_MAX, lmp->world);
+  }
   if (sig == 0) return;
 
   /* The frame of the step reached, then every dump h5md/jdem keeps FILE.part (Output's

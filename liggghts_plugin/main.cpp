@@ -155,7 +155,9 @@ int main(int argc, char **argv) {
   register_jdem_styles(lmp);
   jdem_catch_stop_signals();
   lmp->input->file();
-  /* a signal after the last run: stopped all the same (exit 128 + N, files kept as .part) */
+  /* a signal after the last run: stopped all the same (exit 128 + N, files kept as .part);
+   * forget the last step's agreement, a signal may have come since */
+  jdem_stop_agreed(-1, 0);
   jdem_stop_if_signalled(lmp, (long long)lmp->update->ntimestep);
   jdem_dump_close_ok = 1; /* the input finished: dumps complete their files */
   delete lmp;
