@@ -129,12 +129,12 @@ demo: deps
 .PHONY: bench
 bench: all
 	$(PY) scripts/bench.py $(if $(BENCH_SIZES),--sizes $(BENCH_SIZES)) $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
-	$(PY) scripts/bond_bench.py --out out/bench/bonds $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
+	$(PY) scripts/bond_bench.py --engines jdem,liggghts-jdem --out out/bench/bonds $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
 
 # Parallel bonds (issue 4): every check of scripts/bond_checks.py in full length, in the engines
 # of BONDS_ENGINES (jdem, liggghts-jdem), plus the ns-per-bond-step figure of bond_bench.py;
 # records in out/bonds/summary.json.  `make test` runs the same checks shortened (--quick).
-BONDS_ENGINES ?= jdem
+BONDS_ENGINES ?= jdem,liggghts-jdem
 .PHONY: bonds
 bonds: all
 	$(PY) scripts/bond_bench.py --engines $(BONDS_ENGINES) --out out/bonds

@@ -111,20 +111,7 @@ void DumpH5mdJdem::write() {
   MPI_Reduce(obs, all_obs, JDO_N, MPI_DOUBLE, MPI_SUM, 0, world);
 
   /* gather the rows on rank 0 */
-  const int nme_d = (int)mine.size();
-  std::vector<int> counts(nprocs), displs(nprocs);
-  MPI_Gather(&nme_d, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
-  std::vector<double> all;
-  if (me == 0) {
-    int tot = 0;
-    for (int p = 0; p < nprocs; p++) {
-      displs[p] = tot;
-      tot += counts[p];
-    }
-    all.resize(tot > 0 ? tot : 1);
-  }
-  MPI_Gatherv(mine.empty() ? NULL : mine.data(), nme_d, MPI_DOUBLE, me == 0 ? all.data() : NULL,
-              counts.data(), displs.data(), MPI_DOUBLE, 0, world);
+  const std::vector<double> all = jdem_gather_rows(world, mine);
 
   int failed = 0;
   char err[512] = "";
@@ -132,8 +119,7 @@ void DumpH5mdJdem::write() {
   const bigint step = update->ntimestep;
   const double time = update->atime + (double)(step - update->atimestep) * dt;
   if (me == 0) {
-    size_t nat = 0;
-    for (int p = 0; p < nprocs; p++) nat += counts[p] / NCOL;
+    const size_t nat = all.size() / NCOL;
     std::vector<int> order(nat);
     for (size_t i = 0; i < nat; i++) order[i] = (int)i;
     RowById cmp = {all.data()};
@@ -208,6 +194,21 @@ void DumpH5mdJdem::write() {
     };
     for (size_t k = 0; !failed && k < sizeof o / sizeof o[0]; k++)
       if (o[k].on && jd_h5md_write_observable(h5, o[k].name, (int64_t)step, time, o[k].value, err, sizeof err) != 0)
+        failed = 1;
+  }
+  /* bonds (collective); rank 0 holds a file unless the frame failed */
+  MPI_Bcast(&failed, 1, MPI_INT, 0, world);
+  if (!failed && bonds.write(lmp, h5, err, sizeof err) != 0) failed = 1;
+  if (me == 0 && !failed && bonds.active()) {
+    const struct { const char *name; double value; } b[] = {
+        {"bonds", bonds.bonds()},
+        {"fragments", bonds.fragments()},
+        {"bond_elastic_energy", all_obs[JDO_BOND_ELASTIC]},
+        {"bond_damping_dissipation", all_obs[JDO_BOND_DAMPING]},
+        {"bond_breakage_energy", all_obs[JDO_BOND_BREAKAGE]},
+    };
+    for (size_t k = 0; !failed && k < sizeof b / sizeof b[0]; k++)
+      if (jd_h5md_write_observable(h5, b[k].name, (int64_t)step, time, b[k].value, err, sizeof err) != 0)
         failed = 1;
   }
   /* Like the standalone engine, also write the last step of the run when it is not a multiple of

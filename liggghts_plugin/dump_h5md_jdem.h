@@ -6,7 +6,9 @@
  * sorted by id (species = type - 1), and the observables kinetic_energy, rotational_energy,
  * gravitational_energy (with fix gravity) and, with pair_style gran/jiang and fix wall/jiang,
  * elastic_energy, damping_dissipation, friction_dissipation, wall_work, contacts,
- * wall_contacts; also the last step of a run that is not a multiple of N (runs of at least N
+ * wall_contacts; with fix bond/jiang the bonds formed and broken (/connectivity) and the
+ * observables bonds, fragments, bond_elastic_energy, bond_damping_dissipation,
+ * bond_breakage_energy (jdem_bond_output.h); also the last step of a run that is not a multiple of N (runs of at least N
  * steps), like build/jdem.  The file is FILE.h5.part while the run goes on and is renamed to FILE.h5
  * when LIGGGHTS ends normally or at `undump`; after an error it stays FILE.h5.part.  The optional keywords only annotate
  * /parameters.  The particle set must not change during the run. */
@@ -17,6 +19,8 @@
 #include <vector>
 
 #include "dump.h"
+
+#include "jdem_bond_output.h"
 
 struct jd_h5md;
 
@@ -52,6 +56,7 @@ class DumpH5mdJdem : public Dump {
   std::string path, scene_name, case_name, scene_yaml;
   bigint natoms0;
   bigint last_step; /* of the last frame written; -1: none */
+  JdemBondOutput bonds;
 };
 
 }  // namespace LAMMPS_NS

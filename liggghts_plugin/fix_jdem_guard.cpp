@@ -15,6 +15,7 @@
 #include "modify.h"
 #include "update.h"
 
+#include "fix_bond_jiang.h"
 #include "fix_wall_jiang.h"
 #include "jdem_guard.h"
 #include "jdem_kernel.h"
@@ -40,7 +41,17 @@ FixJdemGuard::FixJdemGuard(LAMMPS *lmp, int narg, char **arg)
   }
 }
 
+/* At set-up, after the bond fixes' (explicit bonds are read then): they must come first. */
 void FixJdemGuard::init() {
+  bool seen_me = false;
+  for (int k = 0; k < modify->nfix; k++) {
+    if (modify->fix[k] == this) seen_me = true;
+    else if (seen_me && dynamic_cast<FixBondJiang *>(modify->fix[k]))
+      error->all(FLERR, "fix jdem/guard must be defined after every fix bond/jiang");
+  }
+}
+
+void FixJdemGuard::setup(int) {
   PairGranJiang *pair = dynamic_cast<PairGranJiang *>(force->pair);
   if (!pair) error->all(FLERR, "fix jdem/guard requires pair_style gran/jiang");
   const int nt = atom->ntypes;
@@ -82,7 +93,11 @@ void FixJdemGuard::init() {
   in.max_impact_speed = vmax;
   in.coordination = coordination;
   in.damping_ratio = zeta;
-  in.bond_omega2 = 0.0; // bonds are not consulted here (yet): no bond bound in LIGGGHTS
+  in.bond_omega2 = 0.0; /* bonds of several types add up on an atom: a sum of bounds bounds it */
+  for (int k = 0; k < modify->nfix; k++) {
+    FixBondJiang *b = dynamic_cast<FixBondJiang *>(modify->fix[k]);
+    if (b) in.bond_omega2 += b->omega2_max();
+  }
   in.dt = update->dt;
   jd_guard_result r;
   jd_guard_assess(&in, &r);

@@ -185,9 +185,11 @@ bool FixJdemWatchdog::energy(std::string &msg) {
   jd_energy_terms now;
   now.kinetic = sum[JDO_KINETIC];
   now.rotational = sum[JDO_ROTATIONAL];
-  now.elastic = sum[JDO_ELASTIC];
+  /* bonds (docs/scenes.md "Bonds"): their stored energy is elastic, their dashpots' and what
+   * broken bonds released is dissipated */
+  now.elastic = sum[JDO_ELASTIC] + sum[JDO_BOND_ELASTIC];
   now.gravitational = sum[JDO_GRAVITATIONAL];
-  now.damping = sum[JDO_DAMPING];
+  now.damping = sum[JDO_DAMPING] + sum[JDO_BOND_DAMPING] + sum[JDO_BOND_BREAKAGE];
   now.friction = sum[JDO_FRICTION];
   now.wall_work = sum[JDO_WALL_WORK];
   const double jump = has_ref ? jd_energy_jump(&ref, &now) : 0.0;

@@ -5,7 +5,7 @@
  * Every step (end_of_step, and once at set-up): a non-finite force, torque, position, velocity
  * or angular velocity of an atom of the group; an overlap beyond F (default 0.5) of the smaller
  * radius in pair_style gran/jiang or any fix wall/jiang.  Every N steps, and at the last step:
- * a jump of the total energy (the observables of dump h5md/jdem) beyond J (default 0.05)
+ * a jump of the total energy (the observables of dump h5md/jdem, bonds included) beyond J (default 0.05)
  * relative to the energy in play, since the previous check.  On a trip the dumps write the
  * frame of this step (not for a non-finite state) and the run ends through error->all with
  * "jdem: watchdog: step S: QUANTITY VALUE for particle(s) IDS exceeds LIMIT ...": dump

@@ -6,7 +6,14 @@
 #include "force.h"
 #include "lammps.h"
 #include "modify.h"
+#include "output.h"
+#include "dump.h"
+#include "fix.h"
 
+#include <cstring>
+
+#include "fix_bond_jiang.h"
+#include "fix_jdem_loads.h"
 #include "fix_wall_jiang.h"
 #include "jdem_kernel.h"
 #include "pair_gran_jiang.h"
@@ -38,6 +45,17 @@ void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]) {
     out[JDO_ROTATIONAL] += 0.5 * jd_sphere_inertia(m, atom->radius[i]) * jd_dot(omega[i], omega[i]);
     out[JDO_GRAVITATIONAL] -= m * jd_dot(g, x[i]);
   }
+  for (int k = 0; k < lmp->modify->nfix; k++) {
+    FixJdemLoads *l = dynamic_cast<FixJdemLoads *>(lmp->modify->fix[k]);
+    if (l) out[JDO_WALL_WORK] += l->work_cum; /* the external work (docs/scenes.md) */
+  }
+  for (int k = 0; k < lmp->modify->nfix; k++) {
+    FixBondJiang *b = dynamic_cast<FixBondJiang *>(lmp->modify->fix[k]);
+    if (!b) continue;
+    out[JDO_BOND_ELASTIC] += b->e_elastic_now;
+    out[JDO_BOND_DAMPING] += b->e_damp_cum;
+    out[JDO_BOND_BREAKAGE] += b->e_broken_cum;
+  }
   PairGranJiang *pair = dynamic_cast<PairGranJiang *>(lmp->force->pair);
   if (!pair) return;
   out[JDO_ELASTIC] += pair->e_elastic_now;
@@ -53,6 +71,14 @@ void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]) {
     out[JDO_WALL_WORK] += w->work_cum;
     out[JDO_WALL_CONTACTS] += w->contacts_now;
   }
+}
+
+bool jdem_wants_energy(LAMMPS *lmp) {
+  for (int k = 0; k < lmp->output->ndump; k++)
+    if (std::strcmp(lmp->output->dump[k]->style, "h5md/jdem") == 0) return true;
+  for (int k = 0; k < lmp->modify->nfix; k++)
+    if (std::strcmp(lmp->modify->fix[k]->style, "jdem/watchdog") == 0) return true;
+  return false;
 }
 
 }  // namespace LAMMPS_NS

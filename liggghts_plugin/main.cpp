@@ -5,6 +5,8 @@
  *   pair_style gran/jiang   force->pair_map (public)
  *   fix wall/jiang          modify->fix_map (private: explicit-instantiation access idiom)
  *   fix jdem/watchdog       idem
+ *   fix bond/jiang          idem
+ *   fix jdem/loads          idem
  *   fix jdem/guard          idem
  *   dump h5md/jdem          LIGGGHTS 3.8 has no dump map: Output::add_dump() is an if-else chain
  *                           over style_dump.h.  We interpose Output::add_dump (libliggghts.so
@@ -34,6 +36,8 @@
 #include "update.h"
 
 #include "dump_h5md_jdem.h"
+#include "fix_bond_jiang.h"
+#include "fix_jdem_loads.h"
 #include "fix_jdem_guard.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_wall_jiang.h"
@@ -60,6 +64,14 @@ static Fix *create_fix_wall_jiang(LAMMPS *lmp, int narg, char **arg) {
   return new FixWallJiang(lmp, narg, arg);
 }
 
+static Fix *create_fix_bond_jiang(LAMMPS *lmp, int narg, char **arg) {
+  return new FixBondJiang(lmp, narg, arg);
+}
+
+static Fix *create_fix_jdem_loads(LAMMPS *lmp, int narg, char **arg) {
+  return new FixJdemLoads(lmp, narg, arg);
+}
+
 static Fix *create_fix_jdem_watchdog(LAMMPS *lmp, int narg, char **arg) {
   return new FixJdemWatchdog(lmp, narg, arg);
 }
@@ -73,6 +85,8 @@ static void register_jdem_styles(LAMMPS *lmp) {
   FixMap *fix_map = lmp->modify->*get(ModifyFixMap());
   (*fix_map)["wall/jiang"] = &create_fix_wall_jiang;
   (*fix_map)["jdem/watchdog"] = &create_fix_jdem_watchdog;
+  (*fix_map)["bond/jiang"] = &create_fix_bond_jiang;
+  (*fix_map)["jdem/loads"] = &create_fix_jdem_loads;
   (*fix_map)["jdem/guard"] = &create_fix_jdem_guard;
 }
 

@@ -9,7 +9,6 @@
 
 #include "atom.h"
 #include "comm.h"
-#include "dump.h"
 #include "error.h"
 #include "fix.h"
 #include "fix_property_global.h"
@@ -17,11 +16,11 @@
 #include "modify.h"
 #include "neigh_list.h"
 #include "neighbor.h"
-#include "output.h"
 #include "update.h"
 
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
+#include "jdem_observables.h"
 #include "jdem_geometry.h"
 #include "jdem_watchdog.h"
 
@@ -140,11 +139,7 @@ void PairGranJiang::init_granular() {
 
   /* Energies only when a dump h5md/jdem records the observables or fix jdem/watchdog checks
    * their balance. */
-  energy = false;
-  for (int k = 0; k < output->ndump; k++)
-    if (std::strcmp(output->dump[k]->style, "h5md/jdem") == 0) energy = true;
-  for (int k = 0; k < modify->nfix; k++)
-    if (std::strcmp(modify->fix[k]->style, "jdem/watchdog") == 0) energy = true;
+  energy = jdem_wants_energy(lmp);
 
   features_ = 0u;
   if (any_damp) features_ |= JD_F_DAMPING;

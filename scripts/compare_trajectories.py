@@ -18,9 +18,10 @@ of each field is scaled by the scene's scale of that field:
     torque            largest |torque| over both runs, else force scale x R
 
 The observables present in both files are compared too (energies relative to the largest
-kinetic + rotational + elastic energy of A, contact counts absolutely; --no-observables skips
-them).  Prints a compact table (a sample of frames and the worst frame) and exits 1 when any
-scaled difference exceeds the tolerance (2 on unusable input).
+kinetic + rotational + elastic energy of A, counts of contacts, bonds and fragments absolutely;
+--no-observables skips them).  --until STEP compares the frames up to STEP only (e.g. up to the
+first broken bond).  Prints a compact table (a sample of frames and the worst frame) and exits 1
+when any scaled difference exceeds the tolerance (2 on unusable input).
 """
 import argparse
 import sys
@@ -30,6 +31,7 @@ import numpy as np
 import yaml
 
 FIELDS = ("position", "velocity", "angular_velocity", "force", "torque")
+COUNTS = ("contacts", "wall_contacts", "bonds", "fragments")  # observables compared absolutely
 SHORT = {"position": "x", "velocity": "v", "angular_velocity": "w", "force": "f", "torque": "t"}
 
 
@@ -112,7 +114,7 @@ def field_differences(A, B, fields, common, scale):
     return table
 
 
-def observable_differences(A, B):
+def observable_differences(A, B, until=None):
     """{name: largest difference} of the observables present in both files at common steps:
     energies relative to the largest kinetic + rotational + elastic energy of A, counts
     absolute; and that energy scale."""
@@ -129,14 +131,17 @@ def observable_differences(A, B):
     diffs = {}
     for k in sorted(set(oa.keys()) & set(ob.keys())):
         cs, ka, kb = np.intersect1d(oa[k]["step"][()], ob[k]["step"][()], return_indices=True)
+        if until is not None:
+            keep = cs <= until
+            cs, ka, kb = cs[keep], ka[keep], kb[keep]
         if not len(cs):
             continue
         d = np.abs(oa[k]["value"][()][ka] - ob[k]["value"][()][kb])
-        diffs[k] = float(d.max()) / (1.0 if k.endswith("contacts") else escale)
+        diffs[k] = float(d.max()) / (1.0 if k in COUNTS else escale)
     return diffs, escale
 
 
-def compare(path_a, path_b, observables=True):
+def compare(path_a, path_b, observables=True, until=None):
     """Compare two trajectories.  Returns a dict with the loaded files (A, B), the compared
     fields, the common steps, the scales, the per-frame table, the observable differences and
     `worst`, the largest scaled difference of all.  Raises Unusable."""
@@ -150,11 +155,13 @@ def compare(path_a, path_b, observables=True):
     if "position" not in fields:
         raise Unusable("no common position data")
     common = np.intersect1d(A["fields"]["position"][0], B["fields"]["position"][0])
+    if until is not None:
+        common = common[common <= until]
     if len(common) == 0:
         raise Unusable("no common steps")
     scale = scales(A, B, fields, common)
     table = field_differences(A, B, fields, common, scale)
-    obs, escale = observable_differences(A, B) if observables else ({}, 1.0)
+    obs, escale = observable_differences(A, B, until) if observables else ({}, 1.0)
     worst = max([float(table.max())] + list(obs.values()))
     return {"A": A, "B": B, "fields": fields, "common": common, "scale": scale, "table": table,
             "observables": obs, "energy_scale": escale, "worst": worst}
@@ -188,9 +195,11 @@ def main():
                     help="tolerance (default: the scene's output.compare_tolerance, else 1e-10)")
     ap.add_argument("--rows", type=int, default=12, help="frames shown in the table (plus the worst)")
     ap.add_argument("--no-observables", action="store_true", help="compare the per-particle fields only")
+    ap.add_argument("--until", type=int, default=None,
+                    help="compare the frames up to this step only (e.g. before the first broken bond)")
     args = ap.parse_args()
     try:
-        c = compare(args.a, args.b, not args.no_observables)
+        c = compare(args.a, args.b, not args.no_observables, args.until)
     except Unusable as e:
         print("FAIL %s" % e)
         return 2

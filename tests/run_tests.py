@@ -36,6 +36,8 @@ SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {
 SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "lines", {})]
 # SIGINT/SIGTERM stop liggghts-jdem cleanly (exit 130/143, OUT.part kept), on 1 and 2 ranks.
 SUITES += [("liggghts-signals", [PY, "tests/liggghts/check_signals.py"], "lines", {})]
+# Parallel bonds in LIGGGHTS (fix bond/jiang): 1 vs 2 MPI ranks, the ghost-cutoff guard, bad input.
+SUITES += [("liggghts-bonds", [PY, "tests/liggghts/check_bonds.py"], "lines", {})]
 # The pour (576 spheres, walls, a cylinder): round-off horizons and settled statistics.
 SUITES += [("pour", [PY, "tests/liggghts/check_pour.py"], "lines", {})]
 # The stability suite (make stability), reduced: the harshest one-contact cases at their own dt and
@@ -49,8 +51,10 @@ SUITES += [
                              STABILITY_CASES, "--factors", "10", "--engines", "jdem",
                              "--jdem", "build/san/jdem"], "lines", {}),
 ]
-# Parallel bonds: the checks of `make bonds`, shortened, in the stepper and its sanitized build.
-SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--out", "out/test/bonds"], "lines", {}),
+# Parallel bonds: the checks of `make bonds`, shortened, in both engines (liggghts-jdem's
+# block drop is compared with jdem's) and in the stepper's sanitized build.
+SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--engines", "jdem,liggghts-jdem",
+                      "--out", "out/test/bonds"], "lines", {}),
            ("bonds-sanitized", [PY, "scripts/bond_checks.py", "--quick", "--out",
                                 "out/test/bonds-san"], "lines", SANITIZED)]
 # The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
