@@ -7,6 +7,7 @@
 #   make demo       build and run the eight Chung–Ooi tests and the stability suite; reports in
 #                   out/chung_ooi/report.md and out/stability/report.md
 #   make chung-ooi  the Chung–Ooi runs and report only (no dependency check)
+#   make accuracy   error against run time, three engines; report in out/accuracy/report.md
 #   make stability  the stability suite (reference_runs/stability/, both engines, 1x and 2x/5x/10x
 #                   the guard's dt); out/stability/report.md and summary.json
 #   make bonds      the parallel-bond checks and bench figure; out/bonds/summary.json
@@ -31,7 +32,9 @@ SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit
 KERNEL_SRC  := $(wildcard kernel/*.c)
 IO_SRC      := $(wildcard io/*.c)
 STEPPER_SRC := $(wildcard stepper/*.c)
-SCENE_SRC   := $(wildcard stepper/scene*.c) kernel/jdem_geometry.c
+# the scene reader and what it calls for dt: auto: the guard, the kernel, the bonds' bound (whose file
+# also writes bond frames: io/)
+SCENE_SRC   := $(wildcard stepper/scene*.c) stepper/guard.c stepper/bonds.c $(KERNEL_SRC) $(IO_SRC)
 PLUGIN_SRC  := $(wildcard liggghts_plugin/*.cpp)
 UNIT_SRC    := $(wildcard tests/unit/*.c)
 HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)
@@ -139,6 +142,13 @@ BONDS_ENGINES ?= jdem,liggghts-jdem
 bonds: all
 	$(PY) scripts/bond_bench.py --engines $(BONDS_ENGINES) --out out/bonds
 	$(PY) scripts/bond_checks.py --engines $(BONDS_ENGINES) --out out/bonds --bench out/bonds/bench.json
+
+# Error against run time (issue 6): Chung–Ooi tests 1, 3, 4 and a settling bed, dt swept over
+# factors of the time-step guard's dt, in jdem, liggghts-jdem and LIGGGHTS hertz/history; timings
+# medians of ACCURACY_REPEATS (default 3).  ~11 min on 2 busy cores.  Report: out/accuracy/report.md
+.PHONY: accuracy
+accuracy: all
+	$(PY) scripts/accuracy.py run $(if $(ACCURACY_REPEATS),--repeats $(ACCURACY_REPEATS))
 
 clean:
 	rm -rf build out

@@ -109,14 +109,19 @@ def fill(template, **kw):
         return string.Template(f.read()).substitute(**{k: str(v) for k, v in kw.items()})
 
 
-def safe_dt(scene_path):
-    """The stepper's largest safe dt for this scene (from its guard message), rounded down to
-    two significant digits."""
+def guard_dt(scene_path):
+    """The stepper's largest safe dt for this scene, from its guard message (6 digits): the
+    scene's own dt must exceed it (bench.py and accuracy.py first write dt = 1 s)."""
     r = subprocess.run([JDEM, "run", scene_path, "-o", "/dev/null/x.h5"], capture_output=True, text=True)
     m = re.search(r"largest safe dt = ([0-9.eE+-]+)", r.stderr)
     if not m:
         raise RuntimeError("no safe dt in the stepper's message:\n" + r.stderr)
-    v = float(m.group(1))
+    return float(m.group(1))
+
+
+def safe_dt(scene_path):
+    """guard_dt() rounded down to two significant digits."""
+    v = guard_dt(scene_path)
     e = math.floor(math.log10(v)) - 1
     return math.floor(v / 10.0 ** e) * 10.0 ** e
 

@@ -181,8 +181,10 @@ static int check_time_step(const jd_scene *sc, const cli *c) {
     }
     free(species);
     if (!c->quiet) {
-        fprintf(stderr, "jdem: dt = %.6g s; 20 %% Rayleigh bound = %.6g s; shortest contact time = %.6g s",
-                sc->dt, g.rayleigh_bound, g.contact_time);
+        char how[64] = "";
+        if (sc->dt_auto) snprintf(how, sizeof how, " (auto: %g x the guard's safe dt)", JD_DT_AUTO_FACTOR);
+        fprintf(stderr, "jdem: dt = %.6g s%s; 20 %% Rayleigh bound = %.6g s; shortest contact time = %.6g s",
+                sc->dt, how, g.rayleigh_bound, g.contact_time);
         if (isfinite(g.contact_time))
             fprintf(stderr, " at %.6g m/s (%.1f steps per contact); Verlet limit at coordination "
                     "number %g = %.6g s", sc->max_impact_speed, g.contact_time / sc->dt,

@@ -15,6 +15,7 @@
 
 #include "jdem_guard.h"
 #include "scene_internal.h"
+#include "sim.h"
 
 static const char *const TOP_KEYS[] = {"jdem_scene", "name", "case", "description", "time",
                                        "output", "gravity", "model", "materials", "interactions",
@@ -130,12 +131,42 @@ static int read_steps(loader *L, const yaml_node_t *t) {
     return 0;
 }
 
+/* time.dt: a number > 0, or `auto` (also when absent), resolved by auto_dt() once the particles
+ * and walls are known.  sd_num's messages all end in "valid: a number > 0": ", or auto" is
+ * appended to it. */
+static int read_dt(loader *L, const yaml_node_t *t) {
+    const yaml_node_t *n = sd_get(&L->c, t, "dt");
+    L->s->dt_auto = !n || (n->type == YAML_SCALAR_NODE &&
+                           n->data.scalar.style == YAML_PLAIN_SCALAR_STYLE &&
+                           strcmp((const char *)n->data.scalar.value, "auto") == 0);
+    if (L->s->dt_auto || sd_num(&L->c, n, "time.dt", SD_POSITIVE, &L->s->dt) == 0) return 0;
+    size_t len = strlen(L->c.err);
+    snprintf(L->c.err + len, L->c.errlen - len, ", or auto");
+    return -1;
+}
+
+/* An auto dt: JD_DT_AUTO_FACTOR x the guard's largest safe dt (guard.c) for the resolved
+ * particles, walls, bonds and max_impact_speed; then the steps of an end_time. */
+static int auto_dt(loader *L) {
+    jd_guard_input in;
+    jd_guard_species *species;
+    jd_guard_result g;
+    if (sim_guard(L->s, &in, &species, &g) != 0)
+        return sd_fail(&L->c, L->time, "time.dt", "auto: out of memory in the time-step guard");
+    free(species);
+    if (!(g.safe_dt > 0.0 && isfinite(g.safe_dt)))
+        return sd_fail(&L->c, L->time, "time.dt", "auto: the time-step guard finds no bound (%g s); "
+                       "valid: a number > 0", g.safe_dt);
+    L->s->dt = JD_DT_AUTO_FACTOR * g.safe_dt;
+    return read_steps(L, L->time);
+}
+
 static int read_time(loader *L) {
     const yaml_node_t *t = sd_get(&L->c, L->root, "time");
-    if (!t) return sd_missing(&L->c, L->root, NULL, "time", "a mapping with dt and steps");
-    if (sd_keys(&L->c, t, "time", TIME_KEYS)) return -1;
-    if (sd_req_num(&L->c, t, "time", "dt", SD_POSITIVE, &L->s->dt)) return -1;
-    if (read_steps(L, t)) return -1;
+    if (!t) return sd_missing(&L->c, L->root, NULL, "time", "a mapping with steps or end_time");
+    if (sd_keys(&L->c, t, "time", TIME_KEYS) || read_dt(L, t)) return -1;
+    L->time = t;
+    if (!L->s->dt_auto && read_steps(L, t)) return -1;
     L->max_impact_given = sd_get(&L->c, t, "max_impact_speed") != NULL;
     if (sd_opt_num(&L->c, t, "time", "max_impact_speed", SD_NONNEGATIVE, &L->s->max_impact_speed))
         return -1;
@@ -286,7 +317,8 @@ static int read_scene(loader *L) {
     if (scene_read_interactions(L) || scene_sort_particles(L) || scene_check_overlaps(L) ||
         scene_check_wall_overlaps(L) || scene_resolve_bonds(L))
         return -1;
-    return L->max_impact_given ? 0 : default_impact_speed(L);
+    if (!L->max_impact_given && default_impact_speed(L)) return -1;
+    return L->s->dt_auto ? auto_dt(L) : 0;
 }
 
 /* Index of case_name among the cases (NULL: the only one), or -1 after reporting. */

@@ -79,7 +79,9 @@ typedef struct jd_scene {
     char description[512];
 
     /* time */
-    double dt;                /* [s] */
+    double dt;                /* [s]; time.dt, or JD_DT_AUTO_FACTOR x the guard's safe dt when
+                                 the scene omits dt or says `dt: auto` (sim.h) */
+    int dt_auto;              /* 1: dt was chosen by the guard (auto) */
     int64_t steps;            /* from steps, or ceil(end_time/dt) */
     double max_impact_speed;  /* [m/s], resolved (given, or estimated as docs/scenes.md says) */
     double coordination_number; /* expected maximum contacts of one sphere [-], >= 1, for the

@@ -464,18 +464,29 @@ static int case_name(sd_ctx *c, const yaml_node_t *sweep, const size_t *pick, ch
     return *out ? 0 : sd_fail(c, sweep, "sweep", "out of memory");
 }
 
+static int compare_names(const void *a, const void *b) {
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+/* Names of every case; two equal names are an error.  Duplicates are found on a sorted copy
+ * (O(n log n): a sweep may have up to SD_MAX_CASES cases). */
 static int sweep_names(sd_ctx *c, const yaml_node_t *sweep, char **names, size_t total) {
     size_t *pick = calloc(sd_len(sweep), sizeof *pick);
-    if (!pick) return sd_fail(c, sweep, "sweep", "out of memory");
-    int rc = 0;
+    char **sorted = malloc((total ? total : 1) * sizeof *sorted);
+    int rc = (pick && sorted) ? 0 : sd_fail(c, sweep, "sweep", "out of memory");
     for (size_t i = 0; i < total && rc == 0; i++) {
         decompose(c, sweep, i, pick);
         rc = case_name(c, sweep, pick, &names[i]);
-        for (size_t j = 0; j < i && rc == 0; j++)
-            if (strcmp(names[i], names[j]) == 0)
-                rc = sd_fail(c, sweep, "sweep", "two cases are named '%s'; valid: value names "
-                             "that give distinct case names", names[i]);
+        sorted[i] = names[i];
     }
+    if (rc == 0) {
+        qsort(sorted, total, sizeof *sorted, compare_names);
+        for (size_t i = 1; i < total && rc == 0; i++)
+            if (strcmp(sorted[i], sorted[i - 1]) == 0)
+                rc = sd_fail(c, sweep, "sweep", "two cases are named '%s'; valid: value names "
+                             "that give distinct case names", sorted[i]);
+    }
+    free(sorted);
     free(pick);
     return rc;
 }

@@ -44,6 +44,7 @@ typedef struct loader {
     int max_impact_given;
     size_t bond_cap;            /* allocated bonds */
     const yaml_node_t **bnode;  /* per bond: the node that made it (for messages) */
+    const yaml_node_t *time;    /* the time mapping: steps from end_time wait for an auto dt */
 } loader;
 
 static inline double norm3(const double v[3]) { return sqrt(jd_dot(v, v)); }

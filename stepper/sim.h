@@ -175,6 +175,10 @@ void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES
  * memory. */
 int sim_guard(const jd_scene *scene, jd_guard_input *in, jd_guard_species **species,
               jd_guard_result *r);
+/* dt of a scene without dt (or `dt: auto`): this multiple of the guard's largest safe dt.  The
+ * work-precision study (`make accuracy`, docs/model.md "Default time step") finds every measured
+ * error <= 1 % up to 2.7x the guard's dt, so the guard's dt itself, with that margin. */
+#define JD_DT_AUTO_FACTOR 1.0
 
 /* watchdog.c.  The force loops call sim_watchdog_overlap() (out of line: the rare case) for a
  * contact with jd_overlap_excessive(); the run loop calls the checks below, which return 0 or

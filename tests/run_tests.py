@@ -16,7 +16,7 @@ import time
 PY = "/usr/bin/python3"
 
 ENGINE_TESTS = ["neighbour", "free_flight", "hertz_impact", "energy_balance", "guard",
-                "guard_coordination", "watchdog",
+                "guard_coordination", "dt_auto", "watchdog",
                 "signals"]
 SANITIZED = {"JDEM": "build/san/jdem"}
 
@@ -63,6 +63,15 @@ CHUNG_OOI = "out/test/chung_ooi"
 SUITES += [
     ("chung-ooi", ["sh", "-c", f"{PY} scripts/chung_ooi.py run --quick --engines jdem,liggghts "
                    f"--out {CHUNG_OOI} && {PY} scripts/chung_ooi.py check --out {CHUNG_OOI}"],
+     "lines", {}),
+]
+
+# The work-precision study reduced to Test 1 in the two engines of the Jiang kernel (`make
+# accuracy` runs all of it): observed order against velocity Verlet's 2, engines against each other.
+ACCURACY = "out/test/accuracy"
+SUITES += [
+    ("accuracy", ["sh", "-c", f"{PY} scripts/accuracy.py run --items test1_glass --engines jdem,liggghts-jdem "
+                  f"--repeats 1 --out {ACCURACY} && {PY} scripts/accuracy.py check --out {ACCURACY}"],
      "lines", {}),
 ]
 
