@@ -31,7 +31,7 @@ enum { COL_ID = 0, COL_TYPE, COL_R, COL_M, COL_X, COL_V = COL_X + 3, COL_W = COL
        COL_F = COL_W + 3, COL_T = COL_F + 3, NCOL = COL_T + 3 };
 
 DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
-    : Dump(lmp, narg, arg), h5(NULL), natoms0(-1) {
+    : Dump(lmp, narg, arg), h5(NULL), natoms0(-1), last_step(-1) {
   if (narg < 5) error->all(FLERR, "Illegal dump h5md/jdem command: dump ID group h5md/jdem N FILE.h5");
   path = arg[4];
   if (path.find('*') != std::string::npos || path.find('%') != std::string::npos)
@@ -220,6 +220,7 @@ void DumpH5mdJdem::write() {
       if (every > 0 && step < last && step + every > last) output->next_dump[k] = last - every;
     }
 
+  last_step = step;
   MPI_Bcast(&failed, 1, MPI_INT, 0, world);
   if (failed) {
     MPI_Bcast(err, sizeof err, MPI_CHAR, 0, world);

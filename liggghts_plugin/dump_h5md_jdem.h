@@ -38,6 +38,12 @@ class DumpH5mdJdem : public Dump {
   virtual ~DumpH5mdJdem();
   virtual void write();
   const std::string &file_name() const { return path; } /* FILE.h5 (FILE.h5.part while open) */
+  /* A run stopped early (jdem_stop.h): write the frame of `step` unless it is the last one
+   * written (collective, like write()). */
+  void write_stop_frame(bigint step) {
+    if (step != last_step) write();
+  }
+  bigint last_frame_step() const { return last_step; } /* -1: no frame yet */
 
  protected:
   virtual void init_style();
@@ -49,6 +55,7 @@ class DumpH5mdJdem : public Dump {
   struct jd_h5md *h5;
   std::string path, scene_name, case_name, scene_yaml;
   bigint natoms0;
+  bigint last_step; /* of the last frame written; -1: none */
   JdemBondOutput bonds;
 };
 

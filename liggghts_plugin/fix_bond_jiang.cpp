@@ -389,7 +389,7 @@ void FixBondJiang::loop(bool commit) {
         error->one(FLERR, msg);
       }
       if (periodic) j = domain->closest_image(i, j);
-      jd_bond_geom g;
+      jd_bond_geom g = jd_bond_geom(); /* zeroed: at -O3 GCC cannot see that error->one ends */
       if (!jd_bond_geom_spheres(x[i], radius[i], x[j], radius[j], &g)) {
         char msg[160];
         std::snprintf(msg, sizeof msg, "fix bond/jiang: step " BIGINT_FORMAT ": bonded atoms %d and %d "

@@ -6,6 +6,7 @@
 #include <mpi.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
@@ -21,6 +22,7 @@
 #include "dump_h5md_jdem.h"
 #include "fix_wall_jiang.h"
 #include "jdem_observables.h"
+#include "jdem_stop.h"
 #include "pair_gran_jiang.h"
 
 using namespace LAMMPS_NS;
@@ -59,11 +61,51 @@ void FixJdemWatchdog::setup(int) { check(); }
 
 void FixJdemWatchdog::end_of_step() { check(); }
 
-/* The stepper's order: the state, the overlaps, then the energy at its samples. */
+/* Is every component of x, v, omega, f and torque of this rank's atoms finite?  A double is not
+ * finite exactly when its exponent bits are all ones; adding 2^52 to the exponent bits then
+ * carries into the sign bit.  OR-ing those sums over the contiguous per-atom arrays needs no
+ * floating-point comparison and no chain of dependent additions, so the compiler vectorises
+ * it: a fraction of a cycle per component. */
+static bool all_finite(Atom *atom) {
+  double *const q[] = {atom->x[0], atom->v[0], atom->omega[0], atom->f[0], atom->torque[0]};
+  const int n = 3 * atom->nlocal;
+  const uint64_t exponent = 0x7ff0000000000000ULL, one = 0x0010000000000000ULL;
+  uint64_t acc = 0;
+  for (int k = 0; k < 5; k++) {
+    const double *p = q[k];
+    for (int i = 0; i < n; i++) {
+      uint64_t bits;
+      std::memcpy(&bits, &p[i], sizeof bits);
+      acc |= (bits & exponent) + one;
+    }
+  }
+  return (acc >> 63) == 0;
+}
+
+/* The worst overlap beyond the limit that the force loops of this rank noted. */
+static JdOverlapTrip worst_overlap(LAMMPS *lmp) {
+  JdOverlapTrip worst = dynamic_cast<PairGranJiang *>(lmp->force->pair)->overlap_trip;
+  for (int k = 0; k < lmp->modify->nfix; k++) {
+    FixWallJiang *w = dynamic_cast<FixWallJiang *>(lmp->modify->fix[k]);
+    if (w && w->overlap_trip.fraction > worst.fraction) worst = w->overlap_trip;
+  }
+  return worst;
+}
+
+/* The stepper's order: the state, the overlaps, then the energy at its samples.  One
+ * reduction answers "anything non-finite? any overlap beyond the limit?" for the whole run;
+ * only then do the searches that name the particle run (each with its own reduction).  The
+ * same reduction carries a pending SIGINT/SIGTERM (jdem_stop.h), so that stopping costs the
+ * next step no reduction of its own. */
 void FixJdemWatchdog::check() {
   std::string msg;
-  if (nonfinite(msg)) trip(msg, false);
-  if (overlap(msg)) trip(msg, true);
+  double mine[3] = {atom->nlocal > 0 && !all_finite(atom) ? 1.0 : 0.0,
+                    worst_overlap(lmp).fraction, (double)jdem_stop_pending()},
+         any[3];
+  MPI_Allreduce(mine, any, 3, MPI_DOUBLE, MPI_MAX, world);
+  jdem_stop_agreed((long long)update->ntimestep, (int)any[2]);
+  if (any[0] > 0.0 && nonfinite(msg)) trip(msg, false);
+  if (any[1] > 0.0 && overlap(msg)) trip(msg, true);
   const bigint step = update->ntimestep;
   if ((step % energy_every == 0 || step == update->laststep) && energy(msg)) trip(msg, true);
 }
@@ -104,11 +146,7 @@ bool FixJdemWatchdog::nonfinite(std::string &msg) {
 }
 
 bool FixJdemWatchdog::overlap(std::string &msg) {
-  JdOverlapTrip worst = dynamic_cast<PairGranJiang *>(force->pair)->overlap_trip;
-  for (int k = 0; k < modify->nfix; k++) {
-    FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
-    if (w && w->overlap_trip.fraction > worst.fraction) worst = w->overlap_trip;
-  }
+  const JdOverlapTrip worst = worst_overlap(lmp);
   struct { double fraction; int rank; } mine = {worst.fraction, comm->me}, all;
   MPI_Allreduce(&mine, &all, 1, MPI_DOUBLE_INT, MPI_MAXLOC, world);
   if (!(all.fraction > 0.0)) return false;
@@ -176,9 +214,9 @@ void FixJdemWatchdog::trip(const std::string &msg, bool write_frame) {
   std::string full = msg;
   for (int k = 0; k < output->ndump; k++) {
     DumpH5mdJdem *d = dynamic_cast<DumpH5mdJdem *>(output->dump[k]);
-    if (d)
+    if (d) /* a non-finite state gets no frame: the file ends with the step before */
       full += format("; the trajectory up to step " BIGINT_FORMAT " is kept, closed, as %s.part "
-                     "(the run failed)", update->ntimestep, d->file_name().c_str());
+                     "(the run failed)", d->last_frame_step(), d->file_name().c_str());
   }
   error->all(FLERR, full.c_str());
 }

@@ -10,10 +10,12 @@
 #include "error.h"
 #include "force.h"
 #include "memory.h"
+#include "neighbor.h"
 #include "update.h"
 
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
+#include "jdem_wall_near.h"
 #include "jdem_watchdog.h"
 #include "pair_gran_jiang.h"
 
@@ -23,7 +25,7 @@ using namespace FixConst;
 FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), e_damp_cum(0.0), e_fric_cum(0.0), work_cum(0.0),
       e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY), shape(-1), wtype(0), slen(0), hist(NULL),
-      nmax_hist(0), pair(NULL) {
+      nmax_hist(0), pair(NULL), use_candidates(false), cand_ncalls(-1), cand_nlocal(0) {
   const char *usage =
       "Illegal fix wall/jiang command: fix ID group wall/jiang plane corners x1 y1 z1 x2 y2 z2 "
       "x3 y3 z3 x4 y4 z4 type T [velocity vx vy vz] | cylinder axis x1 y1 z1 x2 y2 z2 radius R "
@@ -108,10 +110,20 @@ void FixWallJiang::init() {
     error->all(FLERR, "fix wall/jiang: pair_style gran/jiang changed its rolling option after the wall was defined");
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
     error->all(FLERR, "fix wall/jiang requires atom_style granular (sphere)");
+  /* The candidate list relies on LIGGGHTS' guarantee that no atom has moved more than skin/2
+   * since the last neighbour build when the forces are computed: true when the distance is
+   * checked every step (or the lists are rebuilt every step), i.e. neigh_modify every 1
+   * delay 0.  Otherwise every particle is tested every step. */
+  use_candidates = neighbor->every == 1 && neighbor->delay == 0 && neighbor->skin > 0.0;
+  cand_ncalls = -1;
 }
 
-/* The set-up force evaluation does not advance the history (as LIGGGHTS' pair set-up). */
-void FixWallJiang::setup(int vflag) { compute(false); }
+/* The set-up force evaluation does not advance the history (as LIGGGHTS' pair set-up).  It
+ * tests every particle; the first step of the run builds the candidate list. */
+void FixWallJiang::setup(int vflag) {
+  cand_ncalls = -1;
+  compute(false);
+}
 
 void FixWallJiang::post_force(int vflag) {
   /* translate the wall first: x += v dt per defining point, as the standalone engine does */
@@ -122,9 +134,43 @@ void FixWallJiang::post_force(int vflag) {
       for (int c = 0; c < 4; c++) plane.p[c][d] += dx;
       cyl.a0[d] += dx;
       cyl.a1[d] += dx;
+      shift[d] += dx;
     }
   }
+  if (use_candidates) {
+    const double halfskin = 0.5 * neighbor->skin;
+    if (neighbor->ncalls != cand_ncalls || atom->nlocal != cand_nlocal ||
+        !(jd_dot(shift, shift) <= halfskin * halfskin))
+      refresh_candidates();
+  }
   compute(true);
+}
+
+/* The particles of the group that can touch the wall before the next neighbour build: each
+ * moves at most skin/2 from where it is now (LIGGGHTS' rebuild criterion), and a moving wall at
+ * most skin/2 before the list is refreshed (post_force).  The others do not touch the wall now,
+ * so their history is reset here, as the full loop would reset it this step; until the next
+ * refresh they cannot touch it, so nothing else would change it.  Ascending indices: the
+ * forces and energies are summed in the same order as by the full loop. */
+void FixWallJiang::refresh_candidates() {
+  double **x = atom->x;
+  const double *radius = atom->radius;
+  const int *mask = atom->mask;
+  const int nlocal = atom->nlocal;
+  const bool moving = vel[0] != 0.0 || vel[1] != 0.0 || vel[2] != 0.0;
+  const double margin = 0.5 * neighbor->skin * (moving ? 2.0 : 1.0);
+  candidates.clear();
+  for (int i = 0; i < nlocal; i++) {
+    if (!(mask[i] & groupbit)) continue;
+    const bool near = shape == 0 ? jd_plane_near(&plane, x[i], radius[i], margin)
+                                 : jd_cylinder_near(&cyl, x[i], radius[i], margin);
+    if (near) candidates.push_back(i);
+    else
+      for (int k = 0; k < slen; k++) hist[i][k] = 0.0;
+  }
+  cand_ncalls = neighbor->ncalls;
+  cand_nlocal = nlocal;
+  shift[0] = shift[1] = shift[2] = 0.0;
 }
 
 void FixWallJiang::compute(bool commit) {
@@ -141,13 +187,18 @@ void FixWallJiang::loop(bool commit) {
   const int *type = atom->type, *mask = atom->mask;
   const int nlocal = atom->nlocal;
   const double dt = update->dt;
-  const int rule = pair->wall_rule;
+  pair->refresh_prefactors();
+  const double *kw = pair->wall_prefactors();
   double e_damp = 0.0, e_fric = 0.0, e_el = 0.0, ncontacts = 0.0, work = 0.0;
   const int *tag = atom->tag;
   overlap_trip = JdOverlapTrip();
+  /* the candidates (refresh_candidates), or every particle of the group */
+  const bool listed = commit && use_candidates;
+  const int n = listed ? (int)candidates.size() : nlocal;
 
-  for (int i = 0; i < nlocal; i++) {
-    if (!(mask[i] & groupbit)) continue;
+  for (int c = 0; c < n; c++) {
+    const int i = listed ? candidates[c] : c;
+    if (!listed && !(mask[i] & groupbit)) continue;
     const double R = radius[i];
     double *h = hist[i];
     jd_contact_geom g;
@@ -157,39 +208,32 @@ void FixWallJiang::loop(bool commit) {
         for (int k = 0; k < slen; k++) h[k] = 0.0;
       continue;
     }
-    if (jd_overlap_excessive(g.delta, R, INFINITY, overlap_limit))
+    if (g.delta > overlap_limit * R && /* skips the exact test's libm fmin call (pair loop) */
+        jd_overlap_excessive(g.delta, R, INFINITY, overlap_limit))
       overlap_trip.note(g.delta, R, tag[i], 0, id);
     const double m = rmass[i];
-    jd_geom_wall_material(F, &g, jd_kn_wall(rule, pair->youngs(type[i]), pair->poisson(type[i]), R),
-                          m, jd_sphere_inertia(m, R));
+    jd_geom_wall_material(F, &g, kw[i], m, jd_sphere_inertia(m, R));
     jd_kinematics k;
-    for (int d = 0; d < 3; d++) {
-      k.va[d] = v[i][d];
-      k.wa[d] = omega[i][d];
-      k.vb[d] = vel[d];
-      k.wb[d] = 0.0;
-    }
-    jd_contact_state st;
-    jd_rolling_state rs;
-    jd_rolling_state *rsp = (F & JD_F_ROLLING) ? &rs : NULL;
-    jd_load_history(h, st, rsp);
+    jd_copy3(k.va, v[i]);
+    jd_copy3(k.wa, omega[i]);
+    jd_copy3(k.vb, vel);
+    k.wb[0] = k.wb[1] = k.wb[2] = 0.0;
+    JdHistory hs(h, F & JD_F_ROLLING, commit);
     jd_contact_result out;
-    const double f_prev[3] = {st.f_prev[0], st.f_prev[1], st.f_prev[2]};
-    const int carries = jd_contact(F, &pair->coeffs(type[i], wtype), &g, &k, dt, &st, rsp, &out);
+    const double f_prev[3] = {hs.st->f_prev[0], hs.st->f_prev[1], hs.st->f_prev[2]};
+    const int carries = jd_contact(F, &pair->coeffs(type[i], wtype), &g, &k, dt, hs.st, hs.rs, &out);
     work += jd_wall_work(f_prev, out.f, vel, dt); /* also over the step a contact ends */
     if (F & JD_F_ENERGY) {
-      e_damp += st.e_damp;
-      e_fric += st.e_fric;
-      st.e_damp = st.e_fric = 0.0;
-      if (carries) e_el += jd_contact_elastic_energy(&st);
+      e_damp += hs.st->e_damp;
+      e_fric += hs.st->e_fric;
+      hs.st->e_damp = hs.st->e_fric = 0.0;
+      if (carries) e_el += jd_contact_elastic_energy(hs.st);
     }
-    jd_store_history(h, st, rsp, commit);
+    hs.finish();
     if (!carries) continue;
     ncontacts += 1.0;
-    for (int d = 0; d < 3; d++) {
-      f[i][d] -= out.f[d];
-      torque[i][d] += out.ta[d];
-    }
+    jd_sub3(f[i], out.f);
+    jd_add3(torque[i], out.ta);
   }
   if (commit) {
     e_damp_cum += e_damp;

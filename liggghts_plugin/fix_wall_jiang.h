@@ -14,12 +14,18 @@
  * Requires pair_style gran/jiang defined before the fix.  Geometry: kernel/jdem_geometry.h.
  *
  * History: one jd_contact_state (+ jd_rolling_state with rolling on) per atom, migrating with
- * the atom; reset when the particle leaves the wall. */
+ * the atom; reset when the particle leaves the wall.
+ *
+ * Cost: each step only the particles found near the wall at the last neighbour build are
+ * evaluated (with neigh_modify every 1 delay 0; see refresh_candidates). */
 #ifndef JDEM_FIX_WALL_JIANG_H
 #define JDEM_FIX_WALL_JIANG_H
 
+#include <vector>
+
 #include "fix.h"
 
+#include "jdem_dispatch.h"
 #include "jdem_geometry.h"
 #include "jdem_overlap.h"
 
@@ -50,8 +56,9 @@ class FixWallJiang : public Fix {
   JdOverlapTrip overlap_trip;
 
  private:
-  template <unsigned F> void loop(bool commit);
+  template <unsigned F> JD_SPECIALISED void loop(bool commit);
   void compute(bool commit);
+  void refresh_candidates();
 
   int shape; /* 0 plane, 1 cylinder */
   jd_plane plane;
@@ -62,6 +69,15 @@ class FixWallJiang : public Fix {
   double **hist;
   int nmax_hist;
   class PairGranJiang *pair;
+
+  /* Candidate list (refresh_candidates): local indices of the particles that can touch the
+   * wall before the next neighbour build; valid while LIGGGHTS' neighbour count is cand_ncalls,
+   * nlocal is cand_nlocal and the wall has moved by less than skin/2 (shift) since. */
+  bool use_candidates;
+  std::vector<int> candidates;
+  bigint cand_ncalls;
+  int cand_nlocal;
+  double shift[3];
 };
 
 }  // namespace LAMMPS_NS

@@ -28,4 +28,51 @@ static inline void jd_store_history(double *h, const jd_contact_state &st,
   if (rs) std::memcpy(h + JD_CONTACT_STATE_LEN, &rout, sizeof rout);
 }
 
+/* The state of one contact during an evaluation: in a time step, the stored history itself
+ * (the kernel advances it in place; jd_contact_state and jd_rolling_state are plain doubles,
+ * laid out as LIGGGHTS' history array, see the static_asserts in pair_gran_jiang.cpp); in
+ * LIGGGHTS' set-up evaluation (commit false), a copy, of which finish() stores back only the
+ * energy reference (jd_store_history). */
+struct JdHistory {
+  jd_contact_state *st;
+  jd_rolling_state *rs; /* NULL without rolling */
+
+  JdHistory(double *h, bool rolling, bool commit) : st(NULL), rs(NULL), h_(h), commit_(commit) {
+    if (commit) {
+      st = reinterpret_cast<jd_contact_state *>(h);
+      if (rolling) rs = reinterpret_cast<jd_rolling_state *>(h + JD_CONTACT_STATE_LEN);
+    } else {
+      st = &st_copy_;
+      if (rolling) rs = &rs_copy_;
+      jd_load_history(h, st_copy_, rs);
+    }
+  }
+  void finish() {
+    if (!commit_) jd_store_history(h_, st_copy_, rs, false);
+  }
+
+ private:
+  double *h_;
+  bool commit_;
+  jd_contact_state st_copy_;
+  jd_rolling_state rs_copy_;
+};
+
+/* Small vector updates of the force loops, component by component. */
+static inline void jd_copy3(double a[3], const double b[3]) {
+  a[0] = b[0];
+  a[1] = b[1];
+  a[2] = b[2];
+}
+static inline void jd_add3(double a[3], const double b[3]) {
+  a[0] += b[0];
+  a[1] += b[1];
+  a[2] += b[2];
+}
+static inline void jd_sub3(double a[3], const double b[3]) {
+  a[0] -= b[0];
+  a[1] -= b[1];
+  a[2] -= b[2];
+}
+
 #endif

@@ -15,6 +15,7 @@
  *                           dlsym(RTLD_NEXT).  Output::delete_dump (undump) is interposed the
  *                           same way, so that h5md/jdem can tell a normal end from LIGGGHTS'
  *                           error path (Error::all deletes Output) and keep PATH.part then.
+ * SIGINT/SIGTERM stop a run cleanly (jdem_stop.h: Integrate::ev_set is interposed the same way).
  * Do not use the `clear` command: it re-creates Force and Modify and drops the registrations. */
 #include <dlfcn.h>
 #include <mpi.h>
@@ -32,6 +33,7 @@
 #include "memory.h"
 #include "modify.h"
 #include "output.h"
+#include "update.h"
 
 #include "dump_h5md_jdem.h"
 #include "fix_bond_jiang.h"
@@ -39,6 +41,7 @@
 #include "fix_jdem_guard.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_wall_jiang.h"
+#include "jdem_stop.h"
 #include "pair_gran_jiang.h"
 
 using namespace LAMMPS_NS;
@@ -164,7 +167,12 @@ int main(int argc, char **argv) {
     }
   LAMMPS *lmp = new LAMMPS(argc, argv, MPI_COMM_WORLD);
   register_jdem_styles(lmp);
+  jdem_catch_stop_signals();
   lmp->input->file();
+  /* a signal after the last run: stopped all the same (exit 128 + N, files kept as .part);
+   * forget the last step's agreement, a signal may have come since */
+  jdem_stop_agreed(-1, 0);
+  jdem_stop_if_signalled(lmp, (long long)lmp->update->ntimestep);
   jdem_dump_close_ok = 1; /* the input finished: dumps complete their files */
   delete lmp;
   MPI_Barrier(MPI_COMM_WORLD);

@@ -36,7 +36,7 @@ PairGranJiang::PairGranJiang(LAMMPS *lmp)
     : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
       xi_limit(JD_XI_COULOMB), mu_r(1.0), rolling(false), energy(false), e_damp_cum(0.0),
       e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
-      features_(0), ntypes_(0) {}
+      features_(0), ntypes_(0), kp_ncalls_(-1), kp_nall_(-1) {}
 
 /* ---------------------------------------------------------------------------------------- */
 
@@ -111,6 +111,7 @@ void PairGranJiang::init_granular() {
     feta = static_cast<FixPropertyGlobal *>(modify->find_fix_property(
         "coefficientRollingFriction", "property/global", "peratomtypepair", nt, nt, me));
 
+  kp_ncalls_ = -1; /* the materials may have changed: recompute the prefactors */
   E_.assign(nt + 1, 0.0);
   nu_.assign(nt + 1, 0.0);
   coeffs_.assign((nt + 1) * (nt + 1), jd_pair_coeffs());
@@ -150,6 +151,24 @@ void PairGranJiang::init_granular() {
 
 /* ---------------------------------------------------------------------------------------- */
 
+/* Computed once per atom instead of once per contact.  The atoms (local and ghost) and their
+ * radii change only at neighbour builds, unless the radii vary during the run (radvary_flag,
+ * e.g. fix adapt): then every step. */
+void PairGranJiang::refresh_prefactors() {
+  const int nall = atom->nlocal + atom->nghost;
+  if (neighbor->ncalls == kp_ncalls_ && nall == kp_nall_ && !atom->radvary_flag) return;
+  const double *radius = atom->radius;
+  const int *type = atom->type;
+  kp_.resize(nall > 0 ? nall : 1);
+  kw_.resize(nall > 0 ? nall : 1);
+  for (int i = 0; i < nall; i++) {
+    kp_[i] = jd_hertz_prefactor(E_[type[i]], nu_[type[i]], radius[i]);
+    kw_[i] = jd_kn_wall(wall_rule, E_[type[i]], nu_[type[i]], radius[i]);
+  }
+  kp_ncalls_ = neighbor->ncalls;
+  kp_nall_ = nall;
+}
+
 void PairGranJiang::compute_force(int eflag, int vflag, int addflag) {
 #define JD_PAIR_LOOP(b) loop<(b)>(eflag, vflag, addflag)
   JD_DISPATCH(features_, JD_PAIR_LOOP)
@@ -183,6 +202,9 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
   const int *tag = atom->tag;
   overlap_trip = JdOverlapTrip();
 
+  refresh_prefactors();
+  const double *kp = pair_prefactors();
+
   for (int ii = 0; ii < inum; ii++) {
     const int i = ilist[ii];
     const int *jlist = firstneigh[i];
@@ -190,7 +212,10 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
     int *touch = firsttouch[i];
     double *allhist = firsthist[i];
     const double Ri = radius[i], mi = rmass[i];
-    const double kpi = jd_hertz_prefactor(E_[type[i]], nu_[type[i]], Ri);
+    const jd_pair_coeffs *coeffs_i = &coeffs_[type[i] * (ntypes_ + 1)];
+    /* overlaps at most overlap_limit x R_i and x R_j are never excessive: skips the exact test
+     * (jd_overlap_excessive, a libm fmin call) for almost every contact */
+    const double olim_i = overlap_limit * Ri;
 
     for (int jj = 0; jj < jnum; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
@@ -205,46 +230,39 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
         continue;
       }
       const double Rj = radius[j], mj = rmass[j];
-      if (jd_overlap_excessive(g.delta, Ri, Rj, overlap_limit))
+      if ((g.delta > olim_i || g.delta > overlap_limit * Rj) &&
+          jd_overlap_excessive(g.delta, Ri, Rj, overlap_limit))
         overlap_trip.note(g.delta, std::fmin(Ri, Rj), tag[i], tag[j], NULL);
-      jd_geom_pair_material(F, &g, kpi, jd_hertz_prefactor(E_[type[j]], nu_[type[j]], Rj), mi, mj,
-                            jd_sphere_inertia(mi, Ri), jd_sphere_inertia(mj, Rj));
+      jd_geom_pair_material(F, &g, kp[i], kp[j], mi, mj, jd_sphere_inertia(mi, Ri),
+                            jd_sphere_inertia(mj, Rj));
       jd_kinematics k;
-      for (int d = 0; d < 3; d++) {
-        k.va[d] = v[i][d];
-        k.wa[d] = omega[i][d];
-        k.vb[d] = v[j][d];
-        k.wb[d] = omega[j][d];
-      }
-      jd_contact_state st;
-      jd_rolling_state rs;
-      jd_rolling_state *rsp = (F & JD_F_ROLLING) ? &rs : NULL;
-      jd_load_history(hist, st, rsp);
+      jd_copy3(k.va, v[i]);
+      jd_copy3(k.wa, omega[i]);
+      jd_copy3(k.vb, v[j]);
+      jd_copy3(k.wb, omega[j]);
+      /* the kernel advances the stored history in place; the set-up evaluation on a copy */
+      JdHistory h(hist, F & JD_F_ROLLING, commit);
       jd_contact_result out;
-      const int carries = jd_contact(F, &coeffs_[type[i] * (ntypes_ + 1) + type[j]], &g, &k,
-                                     dt_run, &st, rsp, &out);
+      const int carries = jd_contact(F, &coeffs_i[type[j]], &g, &k,
+                                     dt_run, h.st, h.rs, &out);
       /* a pair with a ghost partner is evaluated on both ranks: count it half on each */
       const double w = j < nlocal ? 1.0 : 0.5;
       if (F & JD_F_ENERGY) {
-        e_damp += w * st.e_damp;
-        e_fric += w * st.e_fric;
-        st.e_damp = st.e_fric = 0.0;
-        if (carries) e_el += w * jd_contact_elastic_energy(&st);
+        e_damp += w * h.st->e_damp;
+        e_fric += w * h.st->e_fric;
+        h.st->e_damp = h.st->e_fric = 0.0;
+        if (carries) e_el += w * jd_contact_elastic_energy(h.st);
       }
       if (carries) ncontacts += w;
       touch[jj] = 1; /* keep the history across neighbour rebuilds while overlapping */
-      jd_store_history(hist, st, rsp, commit);
+      h.finish();
       if (!carries || !apply) continue;
 
-      for (int d = 0; d < 3; d++) {
-        f[i][d] -= out.f[d];
-        torque[i][d] += out.ta[d];
-      }
+      jd_sub3(f[i], out.f);
+      jd_add3(torque[i], out.ta);
       if (j < nlocal) {
-        for (int d = 0; d < 3; d++) {
-          f[j][d] += out.f[d];
-          torque[j][d] += out.tb[d];
-        }
+        jd_add3(f[j], out.f);
+        jd_add3(torque[j], out.tb);
       }
       if (evflag)
         ev_tally_xyz(i, j, nlocal, 0, 0.0, 0.0, -out.f[0], -out.f[1], -out.f[2],

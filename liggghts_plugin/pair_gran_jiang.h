@@ -19,7 +19,7 @@
 
 #include "pair_gran.h"
 
-#include "jdem_kernel.h"
+#include "jdem_dispatch.h"
 #include "jdem_overlap.h"
 
 namespace LAMMPS_NS {
@@ -46,6 +46,13 @@ class PairGranJiang : public PairGran {
   double youngs(int t) const { return E_[t]; }
   double poisson(int t) const { return nu_[t]; }
   const jd_pair_coeffs &coeffs(int it, int jt) const { return coeffs_[it * (ntypes_ + 1) + jt]; }
+  /* Per-atom stiffness prefactors [N/m^1.5] of the local and ghost atoms (they depend on the
+   * atom's type and radius only): jd_hertz_prefactor for pairs, jd_kn_wall (wall_rule) against
+   * a wall.  refresh_prefactors() brings them up to date (the pair loop calls it every step;
+   * it recomputes them only after a neighbour build or when the radii vary). */
+  void refresh_prefactors();
+  const double *pair_prefactors() const { return &kp_[0]; }
+  const double *wall_prefactors() const { return &kw_[0]; }
   /* Pair-history layout: jd_contact_state first, then jd_rolling_state when rolling is on. */
   int state_len() const { return JD_CONTACT_STATE_LEN + (rolling ? JD_ROLLING_STATE_LEN : 0); }
 
@@ -61,13 +68,17 @@ class PairGranJiang : public PairGran {
 
  protected:
   virtual void compute_force(int eflag, int vflag, int addflag);
-  template <unsigned F> void loop(int eflag, int vflag, int addflag);
+  template <unsigned F> JD_SPECIALISED void loop(int eflag, int vflag, int addflag);
 
  private:
   unsigned features_;
   int ntypes_;
   std::vector<double> E_, nu_;
   std::vector<jd_pair_coeffs> coeffs_;
+
+  std::vector<double> kp_, kw_;
+  bigint kp_ncalls_;
+  int kp_nall_;
 };
 
 }  // namespace LAMMPS_NS

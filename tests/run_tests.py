@@ -34,6 +34,8 @@ SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines",
 SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {})]
 # The watchdog in LIGGGHTS (fix jdem/watchdog): the same trips as the stepper's.
 SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "lines", {})]
+# SIGINT/SIGTERM stop liggghts-jdem cleanly (exit 130/143, OUT.part kept), on 1 and 2 ranks.
+SUITES += [("liggghts-signals", [PY, "tests/liggghts/check_signals.py"], "lines", {})]
 # Parallel bonds in LIGGGHTS (fix bond/jiang): 1 vs 2 MPI ranks, the ghost-cutoff guard, bad input.
 SUITES += [("liggghts-bonds", [PY, "tests/liggghts/check_bonds.py"], "lines", {})]
 # The pour (576 spheres, walls, a cylinder): round-off horizons and settled statistics.

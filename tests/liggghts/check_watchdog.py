@@ -7,7 +7,9 @@ For each case of tests/engine/scenes/watchdog_blowup.yaml (an overlap trip, an e
 trip) both engines must stop at the same step with the same message "jdem: watchdog: step N:
 QUANTITY VALUE for particle(s) IDS exceeds LIMIT" (LIGGGHTS through error->all, on 1 and on 2
 MPI ranks), exit non-zero, and leave a readable OUT.part (nothing under OUT) whose last frame is
-that step with finite values.  A resolved impact (Chung & Ooi test 1) must run to the end in
+that step with finite values.  An infinite force injected at step 1 (fix addforce; particle 2,
+on rank 1 of 2 too) must stop the run at step 1 with the stepper's message for a non-finite
+state, the file ending at step 0.  A resolved impact (Chung & Ooi test 1) must run to the end in
 LIGGGHTS with the watchdog in its deck.  Prints one PASS/FAIL line per check; exit 1 on failure.
 """
 import argparse
@@ -61,6 +63,41 @@ def liggghts(tmp, case, np_):
     return r.returncode, log, out
 
 
+def nonfinite_force(tmp, np_):
+    """The `energy` case with an infinite force on particle 2 from step 1 on (fix addforce of
+    step x 1e300 x 1e300: 0 at set-up, inf at step 1), on rank 1 of 2 with np_ = 2: the watchdog
+    must stop at step 1 naming the force of particle 2 (the stepper's message for a non-finite
+    state), before the integrator moves it, and keep the file with the frames up to step 0."""
+    name = "liggghts_nonfinite_np%d" % np_
+    d = os.path.join(tmp, name)
+    os.makedirs(d)
+    out = os.path.join(d, "out.h5")
+    r = subprocess.run([JDEM, "resolve", SCENE, "--case", "energy"], capture_output=True, text=True)
+    with open(os.path.join(d, "resolved.yaml"), "w") as f:
+        f.write(r.stdout)
+    subprocess.run([PY, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), os.path.join(d, "resolved.yaml"),
+                    "-o", os.path.join(d, "in.jdem"), "--trajectory", out, "--force"], check=True)
+    with open(os.path.join(d, "in.jdem")) as f:
+        deck = f.read()
+    deck = deck.replace("\nrun ", "\ngroup boom id 2\nvariable fx equal step*1e300*1e300\n"
+                        "fix boom boom addforce v_fx 0 0\nrun ", 1)
+    if np_ > 1:  # particle 2 (x > 0) on rank 1
+        deck = re.sub(r"(?m)^(boundary .*)$", r"\1\nprocessors 2 1 1", deck, count=1)
+    with open(os.path.join(d, "in.jdem"), "w") as f:
+        f.write(deck)
+    mpi = [] if np_ == 1 else ["mpirun"] + (["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []) + \
+        ["-np", str(np_)]
+    r = subprocess.run(mpi + [os.path.join(ROOT, "build", "liggghts-jdem"), "-in", "in.jdem", "-log", "log.lammps",
+                              "-screen", "none"], cwd=d, capture_output=True, text=True)
+    with open(os.path.join(d, "log.lammps"), errors="replace") as f:
+        log = f.read()
+    check(name + "_fails", r.returncode != 0, "exit status 0")
+    want = ("jdem: watchdog: step 1: force inf for particle(s) 2 is not finite; the trajectory up to step 0 "
+            "is kept, closed, as %s.part (the run failed)" % out)
+    if check(name + "_message", want in log, "expected %r in the log: %r" % (want, log[-1500:])):
+        check_part(name, out, 0)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--keep", action="store_true", help="keep the runs (printed directory)")
@@ -82,6 +119,8 @@ def main():
                      "jdem: %r, LIGGGHTS: %r" % (m.group(0), lm.group(0) if lm else log[-1500:])):
                 check(name + "_names_part", lout + ".part" in log, "the message does not name %s.part" % lout)
                 check_part(name, lout, int(lm.group(1)))
+    for n in (1, 2):
+        nonfinite_force(tmp, n)
     out = os.path.join(tmp, "impact.h5")
     r = subprocess.run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"),
                         os.path.join(ROOT, "tests", "engine", "scenes", "chung_ooi_1.yaml"), "-o", out],
