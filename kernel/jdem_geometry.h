@@ -185,6 +185,41 @@ static inline void jd_geom_wall_material(const unsigned features, jd_contact_geo
     g->i_eff = (features & JD_F_ROLLING) ? I : 0.0;
 }
 
+/* Candidate tests for wall contact lists: can a sphere (x [m], R [m]) touch the wall after the
+ * sphere and the wall have moved by at most `margin` [m] relative to each other?  The contact
+ * tests above (jd_geom_plane, jd_geom_cylinder) with every distance widened by the margin, so
+ * they hold for every sphere that touches the wall now or can touch it within that motion.  Both
+ * engines keep the spheres for which they hold at a neighbour rebuild (margin: the skin) and
+ * evaluate only those until the next rebuild.  Return 1 or 0. */
+static inline int jd_geom_plane_near(const jd_plane *w, const double x[3], double R,
+                                     double margin) {
+    const double rel[3] = {x[0] - w->p[0][0], x[1] - w->p[0][1], x[2] - w->p[0][2]};
+    const double sd = jd_dot(w->n, rel);
+    if (!(sd > -margin && sd < R + margin)) return 0;
+    /* the centre's projection within margin of the quad: signed distance to each edge line */
+    for (int k = 0; k < 4; k++) {
+        const double *p = w->p[k], *q = w->p[(k + 1) & 3];
+        const double e[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        const double c[3] = {x[0] - p[0], x[1] - p[1], x[2] - p[2]};
+        double cr[3];
+        jd_cross(e, c, cr);
+        if (jd_dot(cr, w->n) < -margin * sqrt(jd_dot(e, e))) return 0;
+    }
+    return 1;
+}
+
+static inline int jd_geom_cylinder_near(const jd_cylinder *c, const double x[3], double R,
+                                        double margin) {
+    const double ab[3] = {c->a1[0] - c->a0[0], c->a1[1] - c->a0[1], c->a1[2] - c->a0[2]};
+    const double len = sqrt(jd_dot(ab, ab));
+    const double rel[3] = {x[0] - c->a0[0], x[1] - c->a0[1], x[2] - c->a0[2]};
+    const double t = jd_dot(rel, ab) / len;
+    if (!(t > -margin && t < len + margin)) return 0;
+    const double d2 = jd_dot(rel, rel) - t * t;
+    const double d = sqrt(d2 > 0.0 ? d2 : 0.0); /* distance from the axis */
+    return c->inside ? d > c->rc - R - margin : d < c->rc + R + margin;
+}
+
 #ifdef __cplusplus
 }
 #endif

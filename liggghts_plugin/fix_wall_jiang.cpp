@@ -15,7 +15,6 @@
 
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
-#include "jdem_wall_near.h"
 #include "jdem_watchdog.h"
 #include "pair_gran_jiang.h"
 
@@ -162,8 +161,8 @@ void FixWallJiang::refresh_candidates() {
   candidates.clear();
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit)) continue;
-    const bool near = shape == 0 ? jd_plane_near(&plane, x[i], radius[i], margin)
-                                 : jd_cylinder_near(&cyl, x[i], radius[i], margin);
+    const bool near = shape == 0 ? jd_geom_plane_near(&plane, x[i], radius[i], margin)
+                                 : jd_geom_cylinder_near(&cyl, x[i], radius[i], margin);
     if (near) candidates.push_back(i);
     else
       for (int k = 0; k < slen; k++) hist[i][k] = 0.0;

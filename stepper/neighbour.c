@@ -94,33 +94,10 @@ static void carry_over(jd_sim *s, const jd_contact_list *old, jd_contact_list *n
     }
 }
 
-/* Can particle i touch wall w before the next rebuild (relative motion <= skin)?  The kernel's
- * contact tests with every distance widened by the skin. */
+/* Can particle i touch wall w before the next rebuild (relative motion <= skin)? */
 static int wall_candidate(const jd_sim_wall *w, const double *x, double R, double skin) {
-    if (w->type == JD_WALL_PLANE) {
-        const jd_plane *pl = &w->plane;
-        const double rel[3] = {x[0] - pl->p[0][0], x[1] - pl->p[0][1], x[2] - pl->p[0][2]};
-        const double sd = jd_dot(pl->n, rel);
-        if (!(sd > -skin && sd < R + skin)) return 0;
-        /* projection within skin of the quadrilateral: signed distance to each edge line */
-        for (int k = 0; k < 4; k++) {
-            const double *p = pl->p[k], *q = pl->p[(k + 1) & 3];
-            const double e[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-            const double c[3] = {x[0] - p[0], x[1] - p[1], x[2] - p[2]};
-            double cr[3];
-            jd_cross(e, c, cr);
-            if (jd_dot(cr, pl->n) < -skin * sqrt(jd_dot(e, e))) return 0;
-        }
-        return 1;
-    }
-    const jd_cylinder *cy = &w->cyl;
-    const double ab[3] = {cy->a1[0] - cy->a0[0], cy->a1[1] - cy->a0[1], cy->a1[2] - cy->a0[2]};
-    const double len = sqrt(jd_dot(ab, ab));
-    const double rel[3] = {x[0] - cy->a0[0], x[1] - cy->a0[1], x[2] - cy->a0[2]};
-    const double t = jd_dot(rel, ab) / len;
-    if (!(t > -skin && t < len + skin)) return 0;
-    const double d = sqrt(fmax(jd_dot(rel, rel) - t * t, 0.0)); /* distance from the axis */
-    return cy->inside ? d > cy->rc - R - skin : d < cy->rc + R + skin;
+    return w->type == JD_WALL_PLANE ? jd_geom_plane_near(&w->plane, x, R, skin)
+                                    : jd_geom_cylinder_near(&w->cyl, x, R, skin);
 }
 
 static unsigned list_kind(const jd_sim *s, unsigned pairs) {
