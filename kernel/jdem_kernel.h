@@ -471,6 +471,16 @@ static inline double jd_wall_work(const double f_prev[3], const double f[3],
     return -0.5 * (jd_dot(f_prev, v_wall) + jd_dot(f, v_wall)) * dt;
 }
 
+/* Work done on a particle during a step by an external load or a holding constraint [J]: the
+ * same trapezoidal rule on the force and torque applied to the particle at the start (prev[0..2]
+ * force [N], prev[3..5] torque [N m]) and at the end (now) of the step, with the particle's
+ * velocity v [m/s] and angular velocity w [rad/s]. */
+static inline double jd_load_work(const double prev[6], const double now[6], const double v[3],
+                                  const double w[3], double dt) {
+    return 0.5 * (jd_dot(prev, v) + jd_dot(now, v) + jd_dot(prev + 3, w) + jd_dot(now + 3, w)) *
+           dt;
+}
+
 /* Energy stored in a contact (normal spring + tangential and rolling springs) at its last
  * evaluation [J] (JD_F_ENERGY); zero once the contact has ended. */
 static inline double jd_contact_elastic_energy(const jd_contact_state *s) { return s->u_prev; }

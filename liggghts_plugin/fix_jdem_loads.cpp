@@ -116,15 +116,7 @@ void FixJdemLoads::apply(bool commit) {
       applied[3 + d] = held ? -torque[i][d] : 0.0;
       if (held) f[i][d] = torque[i][d] = 0.0;
     }
-    /* the trapezoidal rule of a wall's work, whose force on the particle is -f: here f = -applied */
-    double fp[3], fa[3], tp[3], ta[3];
-    for (int d = 0; d < 3; d++) {
-      fp[d] = -l[L_PREV + d];
-      fa[d] = -applied[d];
-      tp[d] = -l[L_PREV + 3 + d];
-      ta[d] = -applied[3 + d];
-    }
-    work += jd_wall_work(fp, fa, v[i], dt) + jd_wall_work(tp, ta, omega[i], dt);
+    work += jd_load_work(&l[L_PREV], applied, v[i], omega[i], dt);
     for (int k = 0; k < 6; k++) l[L_PREV + k] = applied[k];
   }
   if (commit) work_cum += work;

@@ -5,8 +5,9 @@
  * force and torque are set to zero, so it keeps its initial velocity and spin.
  *
  * Both do work on the particles, which the energy balance books into wall_work (the external
- * work term) with the trapezoidal rule of the contacts: half the sum of the forces at the two
- * ends of a step times the step's displacement (v at force time is the half-step velocity).
+ * work term) with the trapezoidal rule of the contacts (jd_load_work, kernel/jdem_kernel.h, the
+ * same call as LIGGGHTS' fix jdem/loads): half the sum of the forces at the two ends of a step
+ * times the step's displacement (v at force time is the half-step velocity).
  */
 #include <stdlib.h>
 #include <string.h>
@@ -80,9 +81,8 @@ void sim_loads_apply(jd_sim *s) {
             if (sc->fixed[p]) f[d] = t[d] = 0.0;
         }
         const double *v = s->v + 3 * i, *w = s->omega + 3 * i;
-        for (int d = 0; d < 3; d++)
-            work += 0.5 * ((prev[d] + applied[d]) * v[d] + (prev[3 + d] + applied[3 + d]) * w[d]);
+        work += jd_load_work(prev, applied, v, w, s->dt);
         memcpy(prev, applied, sizeof applied);
     }
-    if (!s->in_setup) s->wall_work += work * s->dt;
+    if (!s->in_setup) s->wall_work += work;
 }
