@@ -42,22 +42,16 @@ enum {
 /* Rolling radius of two spheres R_a R_b/(R_a + R_b) [m]. */
 static inline double jd_rolling_radius(double Ra, double Rb) { return Ra * Rb / (Ra + Rb); }
 
-/* Sphere a (centre xa [m], radius Ra [m]) against sphere b (xb, Rb), the geometric fields
- * without r_roll (an engine that keeps r_roll per pair fills it from jd_rolling_radius).
- * Contact when rsq < (Ra + Rb)^2, rsq = |xb - xa|^2 (LIGGGHTS' test), with delta > 0 and r > 0.
- * Fills n = (xb - xa)/r (as (xb - xa) * (1/r)), delta = Ra + Rb - r,
- * ra = (Ra - delta/2) n (= x_C - xa), rb = ra - (xb - xa) (= x_C - xb), and returns 1; returns
- * 0 without contact. */
-static inline int jd_geom_spheres_contact(const double xa[3], double Ra, const double xb[3],
-                                          double Rb, jd_contact_geom *g) {
-    const double dx[3] = {xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]};
-    const double rsq = jd_dot(dx, dx);
-    const double radsum = Ra + Rb;
-    if (rsq >= radsum * radsum) return 0;
+/* The geometric fields of spheres a (radius Ra [m]) and b (Rb) whose centres are dx = xb - xa
+ * apart [m], rsq = |dx|^2 [m^2]: r = sqrt(rsq), n = dx * (1/r), delta = Ra + Rb - r,
+ * ra = (Ra - delta/2) n (= x_C - xa), rb = ra - dx (= x_C - xb).  Returns 1 when delta > 0 and
+ * r > 0; otherwise 0, and g holds finite values of no meaning.  No branches (an engine may
+ * evaluate a batch of candidates in SIMD lanes). */
+static inline int jd_geom_spheres_fill(const double dx[3], double rsq, double Ra, double Rb,
+                                       jd_contact_geom *g) {
     const double d = sqrt(rsq);
-    const double delta = radsum - d;
-    if (!(delta > 0.0) || d == 0.0) return 0;
-    const double rinv = 1.0 / d;
+    const double delta = (Ra + Rb) - d;
+    const double rinv = 1.0 / (d != 0.0 ? d : 1.0);
     const double la = Ra - 0.5 * delta; /* |x_C - x_a| [m] */
     for (int k = 0; k < 3; k++) {
         g->n[k] = dx[k] * rinv;
@@ -65,7 +59,20 @@ static inline int jd_geom_spheres_contact(const double xa[3], double Ra, const d
         g->rb[k] = g->ra[k] - dx[k];
     }
     g->delta = delta;
-    return 1;
+    return (delta > 0.0) & (d != 0.0);
+}
+
+/* Sphere a (centre xa [m], radius Ra [m]) against sphere b (xb, Rb), the geometric fields
+ * without r_roll (an engine that keeps r_roll per pair fills it from jd_rolling_radius).
+ * Contact when rsq < (Ra + Rb)^2, rsq = |xb - xa|^2 (LIGGGHTS' test), with delta > 0 and r > 0
+ * (jd_geom_spheres_fill); returns 1 with g filled, or 0 without contact. */
+static inline int jd_geom_spheres_contact(const double xa[3], double Ra, const double xb[3],
+                                          double Rb, jd_contact_geom *g) {
+    const double dx[3] = {xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]};
+    const double rsq = jd_dot(dx, dx);
+    const double radsum = Ra + Rb;
+    if (rsq >= radsum * radsum) return 0;
+    return jd_geom_spheres_fill(dx, rsq, Ra, Rb, g);
 }
 
 /* jd_geom_spheres_contact plus r_roll = jd_rolling_radius(Ra, Rb) [m]. */

@@ -113,7 +113,7 @@ typedef struct jd_kinematics {
 /* ------------------------------------------------------------------------------------------ */
 typedef struct jd_contact_state {
     double xi[3];     /* cumulative tangential displacement, kept in the tangent plane     [m]    */
-    double flags;     /* JD_S_* bits stored as a small integer value                        [-]    */
+    double flags;     /* phase: 0 (sticking, or not yet touched), JD_S_ENDED or JD_S_SLIDING [-]   */
     /* Energy bookkeeping (JD_F_ENERGY), second order in dt like the velocity-Verlet integrator:
      * the work of a step is the average of the forces at its two ends times the displacement. */
     double f_prev[3]; /* force on b at the previous evaluation                             [N]    */
@@ -123,6 +123,7 @@ typedef struct jd_contact_state {
     double e_fric;    /* energy dissipated by the tangential and rolling springs/sliders  [J]    */
 } jd_contact_state;
 
+/* Phases of a contact (jd_contact_state.flags; one at a time, compared as doubles). */
 enum { JD_S_ENDED = 1, JD_S_SLIDING = 2 };
 
 #define JD_CONTACT_STATE_LEN 11 /* doubles in jd_contact_state */
@@ -237,31 +238,27 @@ static inline void jd_contact_separate(jd_contact_state *s, jd_rolling_state *r)
 
 /* Keep a stored tangential vector in the current tangent plane: remove its normal component and
  * rescale it to its previous length, so that a turning contact frame neither creates nor destroys
- * spring energy (§4.3). */
+ * spring energy (§4.3).  A zero vector stays as it is; one that lies along n is projected to zero
+ * length and not rescaled.  Written with selects instead of branches (see jd_contact). */
 JD_CONTACT_INLINE void jd_rotate_into_plane(double v[3], const double n[3]) {
     const double len2 = jd_dot(v, v);
-    if (len2 == 0.0) return;
     const double vn = jd_dot(v, n);
-    v[0] -= vn * n[0];
-    v[1] -= vn * n[1];
-    v[2] -= vn * n[2];
-    const double new2 = jd_dot(v, v);
-    if (new2 > 0.0) {
-        const double s = sqrt(len2 / new2);
-        v[0] *= s;
-        v[1] *= s;
-        v[2] *= s;
-    }
+    const double p[3] = {v[0] - vn * n[0], v[1] - vn * n[1], v[2] - vn * n[2]};
+    const double new2 = jd_dot(p, p);
+    const int rescale = new2 > 0.0;
+    const double s = sqrt(len2 / (rescale ? new2 : 1.0));
+    for (int d = 0; d < 3; d++) v[d] = len2 == 0.0 ? v[d] : (rescale ? p[d] * s : p[d]);
 }
 
 /* Normal law (§3, §7, §8): F_n = K_n delta + C_n d(delta)/dt with K_n = k_n sqrt(delta) and
- * C_n = 2 gamma sqrt(m_eff K_n).  ddelta is the overlap rate [m/s].  Returns the unclamped force
- * [N] (it is negative only while unloading with strong damping: Luding's end of collision);
- * *c_n receives C_n [N s/m] and *k_sec the secant stiffness K_n [N/m]. */
-static inline double jd_normal_force(double k_n, double delta, double ddelta, double gamma,
-                                     double m_eff, double *k_sec, double *c_n) {
+ * C_n = 2 gamma sqrt(m_eff K_n).  ddelta is the overlap rate [m/s]; damped = 0 means gamma = 0
+ * (C_n = 0 without evaluating the square root; the same value).  Returns the unclamped force [N]
+ * (it is negative only while unloading with strong damping: Luding's end of collision); *c_n
+ * receives C_n [N s/m] and *k_sec the secant stiffness K_n [N/m]. */
+static inline double jd_normal_force(double k_n, double delta, double ddelta, int damped,
+                                     double gamma, double m_eff, double *k_sec, double *c_n) {
     const double K = k_n * sqrt(delta);
-    const double C = 2.0 * gamma * sqrt(m_eff * K);
+    const double C = damped ? 2.0 * gamma * sqrt(m_eff * K) : 0.0;
     *k_sec = K;
     *c_n = C;
     return K * delta + C * ddelta;
@@ -277,27 +274,23 @@ static inline double jd_normal_energy(double k_n, double delta) {
  * (vt or w_rel), cap the magnitude limit (mu F_n, or eta r F_n).  On return out holds the force
  * (or moment) on b; the return value is 1 when the cap was active (sliding).  With
  * JD_XI_COULOMB the stored vector is reset to -out/K while sliding (the dashpot is off while
- * sliding, as the seed states), so K |stored| never exceeds the cap. */
+ * sliding, as the seed states), so K |stored| never exceeds the cap.  Written with selects. */
 JD_CONTACT_INLINE int jd_capped_spring(double stored[3], const double rate[3], double K, double C,
-                                   double cap, double dt, int xi_limit, double out[3]) {
-    stored[0] += rate[0] * dt;
-    stored[1] += rate[1] * dt;
-    stored[2] += rate[2] * dt;
-    out[0] = -K * stored[0] - C * rate[0];
-    out[1] = -K * stored[1] - C * rate[1];
-    out[2] = -K * stored[2] - C * rate[2];
-    const double m2 = jd_dot(out, out);
-    if (m2 <= cap * cap) return 0;
-    const double s = cap / sqrt(m2);
-    out[0] *= s;
-    out[1] *= s;
-    out[2] *= s;
-    if (xi_limit == JD_XI_COULOMB && K > 0.0) {
-        stored[0] = -out[0] / K;
-        stored[1] = -out[1] / K;
-        stored[2] = -out[2] / K;
+                                       double cap, double dt, int xi_limit, double out[3]) {
+    for (int d = 0; d < 3; d++) {
+        stored[d] += rate[d] * dt;
+        out[d] = -K * stored[d] - C * rate[d];
     }
-    return 1;
+    const double m2 = jd_dot(out, out);
+    const int sliding = !(m2 <= cap * cap);
+    const double s = cap / sqrt(sliding ? m2 : 1.0);
+    const int reset = sliding & (xi_limit == JD_XI_COULOMB) & (K > 0.0);
+    const double K_div = K > 0.0 ? K : 1.0;
+    for (int d = 0; d < 3; d++) {
+        out[d] = sliding ? out[d] * s : out[d];
+        stored[d] = reset ? -out[d] / K_div : stored[d];
+    }
+    return sliding;
 }
 
 /* One evaluation of a contact (the reference algorithm of docs/model.md §9).
@@ -309,10 +302,20 @@ JD_CONTACT_INLINE int jd_capped_spring(double stored[3], const double rate[3], d
  * out:      force on b and the torques on a and b; all zero when the contact has ended.
  * Returns 1 while the contact carries force, 0 once it has ended (Luding's rule: the total
  * normal force reached zero while unloading; it stays ended until the bodies separate or start
- * approaching again, which begins a new contact). */
+ * approaching again, which begins a new contact).
+ *
+ * The energy fields of s (f_prev, fd_prev, u_prev, e_damp, e_fric) and r->m_prev are read and
+ * written only with JD_F_ENERGY: without it an engine may keep just xi and flags (and theta).
+ *
+ * The law has no branches that depend on the contact's data: every case (still ended, new
+ * approach, Luding's end, sticking, sliding) is computed and the result selected, so that an
+ * engine can evaluate a batch of contacts in SIMD lanes (`#pragma omp simd` over the batch); the
+ * arithmetic of each case is exactly that of the case alone. */
 JD_CONTACT_INLINE int jd_contact(const unsigned features, const jd_pair_coeffs *c,
-                             const jd_contact_geom *g, const jd_kinematics *k, double dt,
-                             jd_contact_state *s, jd_rolling_state *r, jd_contact_result *out) {
+                                 const jd_contact_geom *g, const jd_kinematics *k, double dt,
+                                 jd_contact_state *s, jd_rolling_state *r, jd_contact_result *out) {
+    const int damping = (features & JD_F_DAMPING) != 0, friction = (features & JD_F_FRICTION) != 0;
+    const int rolling = (features & JD_F_ROLLING) != 0, energy = (features & JD_F_ENERGY) != 0;
     /* Relative velocity at the contact point, eq. (6). */
     double wxa[3], wxb[3];
     jd_cross(k->wa, g->ra, wxa);
@@ -322,128 +325,160 @@ JD_CONTACT_INLINE int jd_contact(const unsigned features, const jd_pair_coeffs *
     const double vn = jd_dot(vrel, g->n);
     const double ddelta = -vn; /* overlap rate */
     double wrel[3] = {0.0, 0.0, 0.0};
-    if (features & JD_F_ROLLING)
+    if (rolling)
         for (int d = 0; d < 3; d++) wrel[d] = k->wb[d] - k->wa[d];
-    int flags = (int)s->flags;
 
-    for (int d = 0; d < 3; d++) out->f[d] = out->ta[d] = out->tb[d] = 0.0;
-    out->fn = 0.0;
-
-    if (flags & JD_S_ENDED) {
-        if (ddelta <= 0.0) return 0; /* still separating after the end of the collision */
-        jd_contact_separate(s, r);   /* a new approach while still overlapping: new contact */
-        flags = 0;
-        if (features & JD_F_ENERGY) {
-            /* Its normal spring is already compressed.  That energy was booked as damping at the
-             * end of the collision and is stored again now: take it back from damping, so that
-             * the friction term does not see it. */
-            s->u_prev = jd_normal_energy(g->k_n, g->delta);
-            s->e_damp -= s->u_prev;
+    /* The history this step starts from.  An ended contact stays ended while the bodies keep
+     * separating; a new approach while still overlapping begins a new contact (the history as
+     * jd_contact_separate leaves it). */
+    const int was_ended = s->flags == (double)JD_S_ENDED;
+    const int still_ended = was_ended & (ddelta <= 0.0);
+    const int restart = was_ended & !still_ended;
+    double flags = restart ? 0.0 : s->flags;
+    double xi[3], theta[3] = {0.0, 0.0, 0.0};
+    for (int d = 0; d < 3; d++) xi[d] = restart ? 0.0 : s->xi[d];
+    if (rolling)
+        for (int d = 0; d < 3; d++) theta[d] = restart ? 0.0 : r->theta[d];
+    double f_prev[3] = {0.0, 0.0, 0.0}, m_prev[3] = {0.0, 0.0, 0.0};
+    double fd_prev = 0.0, u_prev = 0.0, e_damp = 0.0, e_fric = 0.0;
+    if (energy) {
+        for (int d = 0; d < 3; d++) {
+            f_prev[d] = restart ? 0.0 : s->f_prev[d];
+            if (rolling) m_prev[d] = restart ? 0.0 : r->m_prev[d];
         }
+        fd_prev = restart ? 0.0 : s->fd_prev;
+        /* The restarted contact's normal spring is already compressed.  That energy was booked as
+         * damping at the end of the collision and is stored again now: take it back from
+         * damping, so that the friction term does not see it. */
+        const double u_spring = jd_normal_energy(g->k_n, g->delta);
+        u_prev = restart ? u_spring : s->u_prev;
+        e_damp = restart ? s->e_damp - u_spring : s->e_damp;
+        e_fric = s->e_fric;
     }
 
     /* Normal law. */
-    const double gamma = (features & JD_F_DAMPING) ? c->gamma : 0.0;
     double Kn, Cn;
-    const double fn = jd_normal_force(g->k_n, g->delta, ddelta, gamma, g->m_eff, &Kn, &Cn);
-    if ((features & JD_F_DAMPING) && fn <= 0.0) {
-        /* Luding's end of collision: no tensile force; history resets.  The energy still stored
-         * in the springs is never returned, so it counts as dissipated, less the work the
-         * previous step's force still does during this step (trapezoidal rule, see below). */
-        if (features & JD_F_ENERGY) {
-            double w = jd_dot(s->f_prev, vrel);
-            if (features & JD_F_ROLLING) w += jd_dot(r->m_prev, wrel);
-            s->e_damp += s->u_prev - 0.5 * w * dt;
-        }
-        jd_contact_separate(s, r);
-        s->flags = (double)JD_S_ENDED;
-        return 0;
-    }
-    out->fn = fn;
+    const double fn =
+        jd_normal_force(g->k_n, g->delta, ddelta, damping, damping ? c->gamma : 0.0, g->m_eff, &Kn, &Cn);
+    /* Luding's end of collision (damped contacts only): no tensile force; history resets. */
+    const int ends = damping ? !still_ended & (fn <= 0.0) : 0;
+    const int carries = !still_ended & !ends;
+
     double f[3] = {fn * g->n[0], fn * g->n[1], fn * g->n[2]};
     double m_roll[3] = {0.0, 0.0, 0.0};
-    double u_new = (features & JD_F_ENERGY) ? jd_normal_energy(g->k_n, g->delta) : 0.0;
+    double u_new = energy ? jd_normal_energy(g->k_n, g->delta) : 0.0;
     double dash = 0.0; /* dashpot share of this step's dissipation [J] */
 
-    if (features & JD_F_FRICTION) {
-        double vt[3];
-        for (int d = 0; d < 3; d++) vt[d] = vrel[d] - vn * g->n[d];
-        double vt_law[3] = {vt[0], vt[1], vt[2]};
-        if ((features & JD_F_MU_R) && (flags & JD_S_SLIDING)) {
+    if (friction) {
+        double vt[3], vt_law[3];
+        for (int d = 0; d < 3; d++) vt_law[d] = vt[d] = vrel[d] - vn * g->n[d];
+        if (features & JD_F_MU_R) {
             /* eq. (76): while sliding only mu_R of the rotational slip acts on the spring. */
+            const int was_sliding = flags == (double)JD_S_SLIDING;
             const double red = 1.0 - c->mu_r;
             double wr[3];
             for (int d = 0; d < 3; d++) wr[d] = wxb[d] - wxa[d];
             const double wrn = jd_dot(wr, g->n);
-            for (int d = 0; d < 3; d++) vt_law[d] -= red * (wr[d] - wrn * g->n[d]);
+            for (int d = 0; d < 3; d++)
+                vt_law[d] = was_sliding ? vt_law[d] - red * (wr[d] - wrn * g->n[d]) : vt_law[d];
         }
-        jd_rotate_into_plane(s->xi, g->n);
+        jd_rotate_into_plane(xi, g->n);
         const double Kt = Kn, Ct = Cn; /* K_t = K_n (Sec. 2.3.2), hence C_t = C_n (eq. 29) */
         double ft[3];
-        const int sliding = jd_capped_spring(s->xi, vt_law, Kt, Ct, c->mu * fn, dt, c->xi_limit, ft);
-        flags = sliding ? (flags | JD_S_SLIDING) : (flags & ~JD_S_SLIDING);
+        const int sliding = jd_capped_spring(xi, vt_law, Kt, Ct, c->mu * fn, dt, c->xi_limit, ft);
+        flags = sliding ? (double)JD_S_SLIDING : 0.0;
         for (int d = 0; d < 3; d++) f[d] += ft[d];
-        if (features & JD_F_ENERGY) {
+        if (energy) {
             /* the spring carries the whole force while sliding, -K_t xi while sticking */
             double fs[3];
-            for (int d = 0; d < 3; d++) fs[d] = sliding ? ft[d] : -Kt * s->xi[d];
-            u_new += Kt > 0.0 ? 0.5 * jd_dot(fs, fs) / Kt : 0.0;
-            if (!sliding) dash += Ct * jd_dot(vt_law, vt) * dt; /* the dashpot acts on vt_law */
+            for (int d = 0; d < 3; d++) fs[d] = sliding ? ft[d] : -Kt * xi[d];
+            u_new += Kt > 0.0 ? 0.5 * jd_dot(fs, fs) / (Kt > 0.0 ? Kt : 1.0) : 0.0;
+            /* the dashpot acts on vt_law, and only while sticking */
+            dash = sliding ? dash : dash + Ct * jd_dot(vt_law, vt) * dt;
         }
     }
 
-    if (features & JD_F_ROLLING) {
-        const double Kr = Kn * g->r_roll * g->r_roll;         /* K_r = K_t r^2 */
-        const double Cr = 2.0 * gamma * sqrt(g->i_eff * Kr); /* eq. (32) */
-        const int rsl = jd_capped_spring(r->theta, wrel, Kr, Cr, c->eta * g->r_roll * fn, dt,
+    if (rolling) {
+        const double Kr = Kn * g->r_roll * g->r_roll; /* K_r = K_t r^2 */
+        const double Cr = damping ? 2.0 * c->gamma * sqrt(g->i_eff * Kr) : 0.0; /* eq. (32) */
+        const int rsl = jd_capped_spring(theta, wrel, Kr, Cr, c->eta * g->r_roll * fn, dt,
                                          c->xi_limit, m_roll);
-        if (features & JD_F_ENERGY) {
+        if (energy) {
             double ms[3];
-            for (int d = 0; d < 3; d++) ms[d] = rsl ? m_roll[d] : -Kr * r->theta[d];
-            u_new += Kr > 0.0 ? 0.5 * jd_dot(ms, ms) / Kr : 0.0;
-            if (!rsl) dash += Cr * jd_dot(wrel, wrel) * dt;
+            for (int d = 0; d < 3; d++) ms[d] = rsl ? m_roll[d] : -Kr * theta[d];
+            u_new += Kr > 0.0 ? 0.5 * jd_dot(ms, ms) / (Kr > 0.0 ? Kr : 1.0) : 0.0;
+            dash = rsl ? dash : dash + Cr * jd_dot(wrel, wrel) * dt;
         }
     }
 
-    if (features & JD_F_ENERGY) {
+    double fd = 0.0, e_damp_new = e_damp, e_fric_new = e_fric;
+    if (energy) {
         /* Velocity Verlet changes the bodies' kinetic energy by the average of the forces at the
          * two ends of a step times its displacement (exactly, up to terms that cancel over a
          * collision), so the contact books the same: work W on the bodies this step, and what it
          * dissipated is -W less the change of its stored energy.  The normal dashpot's share is
          * the same trapezoid on its own force; the remainder is the sliders' (friction), or the
          * dashpot's too when there are no sliders. */
-        double w = jd_dot(s->f_prev, vrel) + jd_dot(f, vrel);
-        if (features & JD_F_ROLLING) w += jd_dot(r->m_prev, wrel) + jd_dot(m_roll, wrel);
-        const double fd = Cn * ddelta;
-        dash += 0.5 * (s->fd_prev + fd) * ddelta * dt;
-        const double diss = -0.5 * w * dt - (u_new - s->u_prev);
-        if (features & (JD_F_FRICTION | JD_F_ROLLING)) {
-            s->e_damp += dash;
-            s->e_fric += diss - dash;
+        double w_prev = jd_dot(f_prev, vrel);
+        if (rolling) w_prev += jd_dot(m_prev, wrel);
+        double w = w_prev + jd_dot(f, vrel);
+        if (rolling) w += jd_dot(m_roll, wrel);
+        fd = Cn * ddelta;
+        dash += 0.5 * (fd_prev + fd) * ddelta * dt;
+        const double diss = -0.5 * w * dt - (u_new - u_prev);
+        if (friction | rolling) {
+            e_damp_new = e_damp + dash;
+            e_fric_new = e_fric + diss - dash;
         } else {
-            s->e_damp += diss; /* no sliders: all of it is the dashpot's (to O(dt^2)) */
+            e_damp_new = e_damp + diss; /* no sliders: all of it is the dashpot's (to O(dt^2)) */
         }
-        s->fd_prev = fd;
-        s->u_prev = u_new;
-        for (int d = 0; d < 3; d++) s->f_prev[d] = f[d];
-        if (features & JD_F_ROLLING)
-            for (int d = 0; d < 3; d++) r->m_prev[d] = m_roll[d];
+        /* At Luding's end the energy still stored in the springs is never returned, so it counts
+         * as dissipated, less the work the previous step's force still does during this step
+         * (the same trapezoid). */
+        if (damping) {
+            e_damp_new = ends ? e_damp + (u_prev - 0.5 * w_prev * dt) : e_damp_new;
+            e_fric_new = ends ? e_fric : e_fric_new;
+        }
     }
-    s->flags = (double)flags;
+
+    /* The history after this step: unchanged while still ended, reset (and marked ended) at
+     * Luding's end, else the evaluated one. */
+    s->flags = still_ended ? s->flags : (ends ? (double)JD_S_ENDED : flags);
+    for (int d = 0; d < 3; d++) s->xi[d] = carries ? xi[d] : (still_ended ? s->xi[d] : 0.0);
+    if (rolling)
+        for (int d = 0; d < 3; d++)
+            r->theta[d] = carries ? theta[d] : (still_ended ? r->theta[d] : 0.0);
+    if (energy) {
+        for (int d = 0; d < 3; d++) {
+            s->f_prev[d] = carries ? f[d] : (still_ended ? s->f_prev[d] : 0.0);
+            if (rolling) r->m_prev[d] = carries ? m_roll[d] : (still_ended ? r->m_prev[d] : 0.0);
+        }
+        s->fd_prev = carries ? fd : (still_ended ? s->fd_prev : 0.0);
+        s->u_prev = carries ? u_new : (still_ended ? s->u_prev : 0.0);
+        s->e_damp = still_ended ? s->e_damp : e_damp_new;
+        s->e_fric = still_ended ? s->e_fric : e_fric_new;
+    }
 
     /* Assemble: force on b, torques about each centre (eq. 19), rolling moment on b (without
      * rolling resistance nothing is added: the engines' torque sums start from +0, so adding a
-     * +0 moment could only have turned a -0 torque into +0, which their sums never see). */
-    double fa[3] = {-f[0], -f[1], -f[2]};
-    jd_cross(g->ra, fa, out->ta);
-    jd_cross(g->rb, f, out->tb);
-    for (int d = 0; d < 3; d++) out->f[d] = f[d];
-    if (features & JD_F_ROLLING)
+     * +0 moment could only have turned a -0 torque into +0, which their sums never see).  All
+     * zero once the contact has ended. */
+    const double fa[3] = {-f[0], -f[1], -f[2]};
+    double ta[3], tb[3];
+    jd_cross(g->ra, fa, ta);
+    jd_cross(g->rb, f, tb);
+    if (rolling)
         for (int d = 0; d < 3; d++) {
-            out->ta[d] -= m_roll[d];
-            out->tb[d] += m_roll[d];
+            ta[d] -= m_roll[d];
+            tb[d] += m_roll[d];
         }
-    return 1;
+    for (int d = 0; d < 3; d++) {
+        out->f[d] = carries ? f[d] : 0.0;
+        out->ta[d] = carries ? ta[d] : 0.0;
+        out->tb[d] = carries ? tb[d] : 0.0;
+    }
+    out->fn = carries ? fn : 0.0;
+    return carries;
 }
 
 /* LIGGGHTS evaluates the forces of step 0 (`setup`) without advancing the contact history, and

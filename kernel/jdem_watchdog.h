@@ -15,9 +15,10 @@ extern "C" {
 /* Overlap delta [m] of spheres Ra, Rb [m] (Rb = INFINITY for a wall) beyond frac of the smaller
  * radius.  A limit of INFINITY never trips (the engines use it for "watchdog off", so that the
  * force loops need no branch on it); a NaN delta does not trip here (the non-finite check
- * reports it with the right quantity). */
+ * reports it with the right quantity).  The radii are positive (the scene reader's rule), so the
+ * smaller one is a plain comparison (fmin is a library call that force loops cannot vectorise). */
 static inline int jd_overlap_excessive(double delta, double Ra, double Rb, double frac) {
-    return delta > frac * fmin(Ra, Rb);
+    return delta > frac * (Ra < Rb ? Ra : Rb);
 }
 
 /* The terms of the energy balance of docs/scenes.md [J]. */

@@ -36,12 +36,6 @@ double sim_clock(void) {
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-int sim_forces_init(jd_sim *s) {
-    const size_t nb = s->threads > 1 ? (size_t)s->threads * 6 * s->n : 0;
-    s->tbuf = nb ? calloc(nb, sizeof *s->tbuf) : NULL;
-    s->trips = calloc((size_t)s->threads, sizeof *s->trips);
-    return (nb && !s->tbuf) || !s->trips ? -1 : 0;
-}
 
 /* Where thread `tid` adds its forces and torques. */
 typedef struct acc {
@@ -60,45 +54,199 @@ static void chunk(size_t n, int tid, int nt, size_t *lo, size_t *hi) {
     *hi = n * (size_t)(tid + 1) / (size_t)nt;
 }
 
-static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
-                                       jd_overlap_trip *trip) {
+/* Contacts per batch of the pair loop: a multiple of the widest SIMD vector, few enough that
+ * the batch's lanes stay in L1. */
+#define JD_BATCH 32
+
+/* One batch of overlapping candidates, one lane each, in structure-of-arrays form: which entry
+ * and particles, and what the law returns. */
+struct jd_batch {
+    int32_t c[JD_BATCH], i[JD_BATCH], j[JD_BATCH]; /* list entry and its particles */
+    double dx[3][JD_BATCH];                        /* x_j - x_i [m] */
+    /* results: force on j, torques on i and j, history after the step */
+    double f[3][JD_BATCH], ta[3][JD_BATCH], tb[3][JD_BATCH];
+    double xi[3][JD_BATCH], flags[JD_BATCH], theta[3][JD_BATCH];
+    double f_prev[3][JD_BATCH], fd_prev[JD_BATCH], u_prev[JD_BATCH], e_damp[JD_BATCH],
+        e_fric[JD_BATCH], m_prev[3][JD_BATCH];
+    double delta[JD_BATCH];
+    int carries[JD_BATCH], excessive[JD_BATCH];
+};
+typedef struct jd_batch batch;
+
+/* The force loops' buffers (sim_init). */
+int sim_forces_init(jd_sim *s) {
+    const size_t nb = s->threads > 1 ? (size_t)s->threads * 6 * s->n : 0;
+    s->tbuf = nb ? calloc(nb, sizeof *s->tbuf) : NULL;
+    s->trips = calloc((size_t)s->threads, sizeof *s->trips);
+    return (nb && !s->tbuf) || !s->trips ? -1 : 0;
+}
+
+/* Geometry and law for lanes [0, nb), reading the particles and the history through the lanes'
+ * indices and writing the results into the lanes.  The compiler vectorises this loop: the
+ * kernel's geometry and law have no data-dependent branches, and a lane writes only its own
+ * fields. */
+static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, batch *restrict B,
+                                            int nb) {
     const jd_contact_list *L = &s->pairs;
+    const double *restrict v = s->v, *restrict w = s->omega, *restrict rad = s->radius;
+    const jd_contact_state *restrict state = L->state;
+    const jd_rolling_state *restrict roll = L->roll;
+    const jd_pair_const *restrict pc = L->pc;
+    const jd_pair_const_roll *restrict pcr = L->pcr;
     const size_t nm = s->n_materials;
-    const double *x_v = s->v, *x_w = s->omega;
-    const jd_pair_coeffs *co1 = nm == 1 ? s->coeffs : NULL; /* one material: no lookup */
-    for (size_t c = c0; c < c1; c++) {
-        const int32_t i = L->i[c], j = L->j[c];
-        jd_contact_state *st = &L->state[c];
-        jd_rolling_state *rs = (F & JD_F_ROLLING) ? &L->roll[c] : NULL;
+    const jd_pair_coeffs *restrict coeffs = s->coeffs;
+    const int32_t *restrict species = s->species;
+    const double dt = s->dt, max_overlap = s->max_overlap;
+    for (int b = 0; b < nb; b++) {
+        /* int indices (vectorisable arithmetic; 3 n < 2^31 is checked at set-up) */
+        const int32_t c = B->c[b], i = B->i[b], j = B->j[b];
+        const double dx[3] = {B->dx[0][b], B->dx[1][b], B->dx[2][b]};
         jd_contact_geom g;
-        if (!sim_pair_geom(s, F, c, i, j, &g)) {
-            jd_contact_separate(st, rs);
-            continue;
-        }
-        if (jd_overlap_excessive(g.delta, s->radius[i], s->radius[j], s->max_overlap))
-            sim_watchdog_overlap(trip, i, j, g.delta, fmin(s->radius[i], s->radius[j]));
+        const int touch = jd_geom_spheres_fill(dx, jd_dot(dx, dx), rad[i], rad[j], &g);
+        g.k_n = pc[c].k_n;
+        g.m_eff = pc[c].m_eff;
+        g.i_eff = (F & JD_F_ROLLING) ? pcr[c].i_eff : 0.0;
+        g.r_roll = (F & JD_F_ROLLING) ? pcr[c].r_roll : 0.0;
+        const int32_t k_co = species[i] * (int32_t)nm + species[j];
+        const jd_pair_coeffs co = {coeffs[k_co].gamma, coeffs[k_co].mu, coeffs[k_co].eta,
+                                   coeffs[k_co].mu_r, coeffs[k_co].xi_limit};
         jd_kinematics k;
-        const double *va = x_v + 3 * (size_t)i, *wa = x_w + 3 * (size_t)i;
-        const double *vb = x_v + 3 * (size_t)j, *wb = x_w + 3 * (size_t)j;
+        jd_contact_state st;
+        jd_rolling_state rs;
         for (int d = 0; d < 3; d++) {
-            k.va[d] = va[d];
-            k.wa[d] = wa[d];
-            k.vb[d] = vb[d];
-            k.wb[d] = wb[d];
+            k.va[d] = v[3 * i + d];
+            k.wa[d] = w[3 * i + d];
+            k.vb[d] = v[3 * j + d];
+            k.wb[d] = w[3 * j + d];
+            st.xi[d] = state[c].xi[d];
+            st.f_prev[d] = (F & JD_F_ENERGY) ? state[c].f_prev[d] : 0.0;
+            rs.theta[d] = (F & JD_F_ROLLING) ? roll[c].theta[d] : 0.0;
+            rs.m_prev[d] = (F & JD_F_ROLLING) && (F & JD_F_ENERGY) ? roll[c].m_prev[d] : 0.0;
         }
-        const jd_pair_coeffs *co =
-            co1 ? co1 : &s->coeffs[(size_t)s->species[i] * nm + (size_t)s->species[j]];
+        st.flags = state[c].flags;
+        st.fd_prev = (F & JD_F_ENERGY) ? state[c].fd_prev : 0.0;
+        st.u_prev = (F & JD_F_ENERGY) ? state[c].u_prev : 0.0;
+        st.e_damp = (F & JD_F_ENERGY) ? state[c].e_damp : 0.0;
+        st.e_fric = (F & JD_F_ENERGY) ? state[c].e_fric : 0.0;
+        const double e_damp_in = st.e_damp, e_fric_in = st.e_fric;
         jd_contact_result out;
-        if (!jd_contact(F, co, &g, &k, s->dt, st, rs, &out)) continue;
-        double *fa = a.f + 3 * (size_t)i, *fb = a.f + 3 * (size_t)j;
-        double *ta = a.t + 3 * (size_t)i, *tb = a.t + 3 * (size_t)j;
+        const int carries =
+            jd_contact(F, &co, &g, &k, dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
+        /* a candidate that does not overlap after all (delta <= 0, or r = 0) is separated
+         * (as jd_contact_separate: everything but the dissipation accumulators to zero) */
         for (int d = 0; d < 3; d++) {
-            fa[d] -= out.f[d];
-            fb[d] += out.f[d];
-            ta[d] += out.ta[d];
-            tb[d] += out.tb[d];
+            B->xi[d][b] = touch ? st.xi[d] : 0.0;
+            if (F & JD_F_ENERGY) B->f_prev[d][b] = touch ? st.f_prev[d] : 0.0;
+            if (F & JD_F_ROLLING) B->theta[d][b] = touch ? rs.theta[d] : 0.0;
+            if ((F & JD_F_ROLLING) && (F & JD_F_ENERGY))
+                B->m_prev[d][b] = touch ? rs.m_prev[d] : 0.0;
+            B->f[d][b] = out.f[d];
+            B->ta[d][b] = out.ta[d];
+            B->tb[d][b] = out.tb[d];
+        }
+        B->flags[b] = touch ? st.flags : 0.0;
+        if (F & JD_F_ENERGY) {
+            B->fd_prev[b] = touch ? st.fd_prev : 0.0;
+            B->u_prev[b] = touch ? st.u_prev : 0.0;
+            B->e_damp[b] = touch ? st.e_damp : e_damp_in;
+            B->e_fric[b] = touch ? st.e_fric : e_fric_in;
+        }
+        B->delta[b] = g.delta;
+        B->carries[b] = touch & carries;
+        B->excessive[b] = touch & jd_overlap_excessive(g.delta, rad[i], rad[j], max_overlap);
+    }
+}
+
+/* Lanes [0, nb) back: the history into the list, the forces and torques added in list order,
+ * overlaps beyond the watchdog's limit.  The list is sorted by i, so consecutive lanes mostly
+ * share particle i: its force and torque are summed in registers over the run of lanes and added
+ * once (the sums differ from one addition per contact by round-off only). */
+static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const unsigned F, const batch *B, int nb,
+                                           acc a, jd_overlap_trip *trip) {
+    jd_contact_list *L = &s->pairs;
+    int32_t run_i = nb ? B->i[0] : 0;
+    double fi[3] = {0.0, 0.0, 0.0}, ti[3] = {0.0, 0.0, 0.0};
+    for (int b = 0; b < nb; b++) {
+        const size_t c = (size_t)B->c[b];
+        const int32_t i = B->i[b], j = B->j[b];
+        jd_contact_state *st = &L->state[c];
+        for (int d = 0; d < 3; d++) st->xi[d] = B->xi[d][b];
+        st->flags = B->flags[b];
+        if (F & JD_F_ENERGY) {
+            for (int d = 0; d < 3; d++) st->f_prev[d] = B->f_prev[d][b];
+            st->fd_prev = B->fd_prev[b];
+            st->u_prev = B->u_prev[b];
+            st->e_damp = B->e_damp[b];
+            st->e_fric = B->e_fric[b];
+        }
+        if (F & JD_F_ROLLING)
+            for (int d = 0; d < 3; d++) {
+                L->roll[c].theta[d] = B->theta[d][b];
+                if (F & JD_F_ENERGY) L->roll[c].m_prev[d] = B->m_prev[d][b];
+            }
+        if (B->excessive[b])
+            sim_watchdog_overlap(trip, i, j, B->delta[b], fmin(s->radius[i], s->radius[j]));
+        if (i != run_i) {
+            double *fa = a.f + 3 * (size_t)run_i, *ta = a.t + 3 * (size_t)run_i;
+            for (int d = 0; d < 3; d++) {
+                fa[d] += fi[d];
+                ta[d] += ti[d];
+                fi[d] = ti[d] = 0.0;
+            }
+            run_i = i;
+        }
+        if (!B->carries[b]) continue;
+        double *fb = a.f + 3 * (size_t)j, *tb = a.t + 3 * (size_t)j;
+        for (int d = 0; d < 3; d++) {
+            fi[d] -= B->f[d][b];
+            ti[d] += B->ta[d][b];
+            fb[d] += B->f[d][b];
+            tb[d] += B->tb[d][b];
         }
     }
+    if (nb) {
+        double *fa = a.f + 3 * (size_t)run_i, *ta = a.t + 3 * (size_t)run_i;
+        for (int d = 0; d < 3; d++) {
+            fa[d] += fi[d];
+            ta[d] += ti[d];
+        }
+    }
+}
+
+/* The pair loop over list entries [c0, c1), in batches: candidates whose spheres overlap
+ * (rsq < radsum^2, LIGGGHTS' test) go into the lanes of a batch, the others have their history
+ * reset (jd_contact_separate); a full batch is evaluated (SIMD) and scattered back.  Each
+ * contact's arithmetic is exactly that of a plain loop over the list calling
+ * jd_geom_spheres_contact and jd_contact. */
+static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
+                                       jd_overlap_trip *trip) {
+    jd_contact_list *L = &s->pairs;
+    const double *x = s->x, *rad = s->radius;
+    batch lanes; /* on the stack: the compiler then knows that no list or particle array aliases it */
+    batch *B = &lanes;
+    int nb = 0;
+    for (size_t c = c0; c < c1; c++) {
+        const int32_t i = L->i[c], j = L->j[c];
+        const double dx[3] = {x[3 * (size_t)j] - x[3 * (size_t)i],
+                              x[3 * (size_t)j + 1] - x[3 * (size_t)i + 1],
+                              x[3 * (size_t)j + 2] - x[3 * (size_t)i + 2]};
+        const double radsum = rad[i] + rad[j];
+        if (!(jd_dot(dx, dx) < radsum * radsum)) {
+            jd_contact_separate(&L->state[c], (F & JD_F_ROLLING) ? &L->roll[c] : NULL);
+            continue;
+        }
+        B->c[nb] = (int32_t)c;
+        B->i[nb] = i;
+        B->j[nb] = j;
+        for (int d = 0; d < 3; d++) B->dx[d][nb] = dx[d];
+        if (++nb == JD_BATCH) {
+            batch_evaluate(s, F, B, nb);
+            batch_scatter(s, F, B, nb, a, trip);
+            nb = 0;
+        }
+    }
+    batch_evaluate(s, F, B, nb);
+    batch_scatter(s, F, B, nb, a, trip);
 }
 
 /* Returns the work the walls did on the particles of the chunk. */

@@ -31,7 +31,7 @@ static void list_energies(const jd_contact_list *l, double *damp, double *fric) 
 }
 
 static int carries_force(const jd_contact_state *st) {
-    return !(((int)st->flags) & JD_S_ENDED);
+    return st->flags != (double)JD_S_ENDED;
 }
 
 void sim_observables(const jd_sim *s, jd_observables *o) {
