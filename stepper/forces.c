@@ -12,6 +12,7 @@
  * the serial loop.
  */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -54,6 +55,36 @@ static void chunk(size_t n, int tid, int nt, size_t *lo, size_t *hi) {
     *hi = n * (size_t)(tid + 1) / (size_t)nt;
 }
 
+/* History widths of a feature set (sim.h, jd_contact_list), compile-time constants in the
+ * specialised loops, and where each field of the kernel's structs sits in an entry. */
+#define HW(F) (((F) & JD_F_ENERGY) ? JD_CONTACT_STATE_LEN : JD_HIST_CORE)
+#define RW(F) (((F) & JD_F_ROLLING) ? (((F) & JD_F_ENERGY) ? JD_ROLLING_STATE_LEN : JD_RHIST_CORE) : 0)
+#define AT(type, field) ((int32_t)(offsetof(type, field) / sizeof(double)))
+
+/* Entry c's history as the kernel's structs, and back (sim_hist_get/set with the widths known
+ * at compile time). */
+static JD_ALWAYS_INLINE void hist_load(const jd_contact_list *L, const unsigned F, size_t c,
+                                       jd_contact_state *st, jd_rolling_state *rs) {
+    double *a = (double *)st, *b = (double *)rs;
+    for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) a[k] = k < HW(F) ? L->hist[HW(F) * c + (size_t)k] : 0.0;
+    for (int k = 0; k < JD_ROLLING_STATE_LEN; k++) b[k] = k < RW(F) ? L->rhist[RW(F) * c + (size_t)k] : 0.0;
+}
+static JD_ALWAYS_INLINE void hist_store(jd_contact_list *L, const unsigned F, size_t c,
+                                        const jd_contact_state *st, const jd_rolling_state *rs) {
+    const double *a = (const double *)st, *b = (const double *)rs;
+    for (int k = 0; k < HW(F); k++) L->hist[HW(F) * c + (size_t)k] = a[k];
+    for (int k = 0; k < RW(F); k++) L->rhist[RW(F) * c + (size_t)k] = b[k];
+}
+
+/* The pair or wall entry c no longer overlaps: jd_contact_separate on its history. */
+static JD_ALWAYS_INLINE void hist_separate(jd_contact_list *L, const unsigned F, size_t c) {
+    jd_contact_state st;
+    jd_rolling_state rs;
+    hist_load(L, F, c, &st, &rs);
+    jd_contact_separate(&st, &rs);
+    hist_store(L, F, c, &st, &rs);
+}
+
 /* Contacts per batch of the pair loop: a multiple of the widest SIMD vector, few enough that
  * the batch's lanes stay in L1. */
 #define JD_BATCH 32
@@ -89,8 +120,7 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, b
                                             int nb) {
     const jd_contact_list *L = &s->pairs;
     const double *restrict v = s->v, *restrict w = s->omega, *restrict rad = s->radius;
-    const jd_contact_state *restrict state = L->state;
-    const jd_rolling_state *restrict roll = L->roll;
+    const double *restrict hist = L->hist, *restrict rhist = L->rhist;
     const jd_pair_const *restrict pc = L->pc;
     const jd_pair_const_roll *restrict pcr = L->pcr;
     const size_t nm = s->n_materials;
@@ -113,21 +143,15 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, b
         jd_kinematics k;
         jd_contact_state st;
         jd_rolling_state rs;
+        double *sa = (double *)&st, *ra = (double *)&rs;
+        for (int q = 0; q < JD_CONTACT_STATE_LEN; q++) sa[q] = q < HW(F) ? hist[HW(F) * c + q] : 0.0;
+        for (int q = 0; q < JD_ROLLING_STATE_LEN; q++) ra[q] = q < RW(F) ? rhist[RW(F) * c + q] : 0.0;
         for (int d = 0; d < 3; d++) {
             k.va[d] = v[3 * i + d];
             k.wa[d] = w[3 * i + d];
             k.vb[d] = v[3 * j + d];
             k.wb[d] = w[3 * j + d];
-            st.xi[d] = state[c].xi[d];
-            st.f_prev[d] = (F & JD_F_ENERGY) ? state[c].f_prev[d] : 0.0;
-            rs.theta[d] = (F & JD_F_ROLLING) ? roll[c].theta[d] : 0.0;
-            rs.m_prev[d] = (F & JD_F_ROLLING) && (F & JD_F_ENERGY) ? roll[c].m_prev[d] : 0.0;
         }
-        st.flags = state[c].flags;
-        st.fd_prev = (F & JD_F_ENERGY) ? state[c].fd_prev : 0.0;
-        st.u_prev = (F & JD_F_ENERGY) ? state[c].u_prev : 0.0;
-        st.e_damp = (F & JD_F_ENERGY) ? state[c].e_damp : 0.0;
-        st.e_fric = (F & JD_F_ENERGY) ? state[c].e_fric : 0.0;
         const double e_damp_in = st.e_damp, e_fric_in = st.e_fric;
         jd_contact_result out;
         const int carries =
@@ -169,20 +193,20 @@ static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const unsigned F, const ba
     for (int b = 0; b < nb; b++) {
         const size_t c = (size_t)B->c[b];
         const int32_t i = B->i[b], j = B->j[b];
-        jd_contact_state *st = &L->state[c];
-        for (int d = 0; d < 3; d++) st->xi[d] = B->xi[d][b];
-        st->flags = B->flags[b];
+        double *h = L->hist + (size_t)HW(F) * c, *r = L->rhist + (size_t)RW(F) * c;
+        for (int d = 0; d < 3; d++) h[AT(jd_contact_state, xi) + d] = B->xi[d][b];
+        h[AT(jd_contact_state, flags)] = B->flags[b];
         if (F & JD_F_ENERGY) {
-            for (int d = 0; d < 3; d++) st->f_prev[d] = B->f_prev[d][b];
-            st->fd_prev = B->fd_prev[b];
-            st->u_prev = B->u_prev[b];
-            st->e_damp = B->e_damp[b];
-            st->e_fric = B->e_fric[b];
+            for (int d = 0; d < 3; d++) h[AT(jd_contact_state, f_prev) + d] = B->f_prev[d][b];
+            h[AT(jd_contact_state, fd_prev)] = B->fd_prev[b];
+            h[AT(jd_contact_state, u_prev)] = B->u_prev[b];
+            h[AT(jd_contact_state, e_damp)] = B->e_damp[b];
+            h[AT(jd_contact_state, e_fric)] = B->e_fric[b];
         }
         if (F & JD_F_ROLLING)
             for (int d = 0; d < 3; d++) {
-                L->roll[c].theta[d] = B->theta[d][b];
-                if (F & JD_F_ENERGY) L->roll[c].m_prev[d] = B->m_prev[d][b];
+                r[AT(jd_rolling_state, theta) + d] = B->theta[d][b];
+                if (F & JD_F_ENERGY) r[AT(jd_rolling_state, m_prev) + d] = B->m_prev[d][b];
             }
         if (B->excessive[b])
             sim_watchdog_overlap(trip, i, j, B->delta[b], fmin(s->radius[i], s->radius[j]));
@@ -232,7 +256,7 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, size_t c0, s
                               x[3 * (size_t)j + 2] - x[3 * (size_t)i + 2]};
         const double radsum = rad[i] + rad[j];
         if (!(jd_dot(dx, dx) < radsum * radsum)) {
-            jd_contact_separate(&L->state[c], (F & JD_F_ROLLING) ? &L->roll[c] : NULL);
+            hist_separate(L, F, c);
             continue;
         }
         B->c[nb] = (int32_t)c;
@@ -252,17 +276,15 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, size_t c0, s
 /* Returns the work the walls did on the particles of the chunk. */
 static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
                                          jd_overlap_trip *trip) {
-    const jd_contact_list *L = &s->wall_pairs;
+    jd_contact_list *L = &s->wall_pairs;
     const size_t nm = s->n_materials;
     double work = 0.0;
     for (size_t c = c0; c < c1; c++) {
         const int32_t i = L->i[c];
         const jd_sim_wall *w = &s->walls[L->j[c]];
-        jd_contact_state *st = &L->state[c];
-        jd_rolling_state *rs = (F & JD_F_ROLLING) ? &L->roll[c] : NULL;
         jd_contact_geom g;
         if (!sim_wall_geom(s, i, w, &g)) {
-            jd_contact_separate(st, rs);
+            hist_separate(L, F, c);
             continue;
         }
         if (jd_overlap_excessive(g.delta, s->radius[i], INFINITY, s->max_overlap))
@@ -275,9 +297,13 @@ static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0,
             k.wb[d] = 0.0;
         }
         const jd_pair_coeffs *co = &s->coeffs[(size_t)s->species[i] * nm + (size_t)w->material];
+        jd_contact_state st;
+        jd_rolling_state rs;
+        hist_load(L, F, c, &st, &rs);
         jd_contact_result out;
-        const double f_prev[3] = {st->f_prev[0], st->f_prev[1], st->f_prev[2]};
-        const int carries = jd_contact(F, co, &g, &k, s->dt, st, rs, &out);
+        const double f_prev[3] = {st.f_prev[0], st.f_prev[1], st.f_prev[2]};
+        const int carries = jd_contact(F, co, &g, &k, s->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
+        hist_store(L, F, c, &st, &rs);
         if (F & JD_F_ENERGY) /* also over the step a contact ends */
             work += jd_wall_work(f_prev, out.f, w->v, s->dt);
         if (!carries) continue;

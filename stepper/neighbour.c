@@ -22,10 +22,14 @@
 
 /* The buffers of a list swap roles between the pair and the wall list (sim_neighbour_build,
  * sim_reorder), so a list may lack the arrays of its new kind even with enough capacity; every
- * array a list has is kept at its capacity. */
+ * array a list has is kept at its capacity.  The history widths (hw, rw) are the run's. */
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
     const int rolling = (kind & JD_LIST_ROLLING) != 0, pairs = (kind & JD_LIST_PAIRS) != 0;
-    const int complete = (!rolling || l->roll) && (!pairs || l->pc) && (!(pairs && rolling) || l->pcr);
+    const int energy = (kind & JD_LIST_ENERGY) != 0;
+    const int hw = energy ? JD_CONTACT_STATE_LEN : JD_HIST_CORE;
+    const int rw = rolling ? (energy ? JD_ROLLING_STATE_LEN : JD_RHIST_CORE) : 0;
+    const int complete = l->hw == hw && l->rw == rw && (!rolling || l->rhist) && (!pairs || l->pc) &&
+                         (!(pairs && rolling) || l->pcr);
     if (need <= l->cap && complete) return 0;
     size_t cap = l->cap ? l->cap : 256;
     while (cap < need) cap += cap / 2;
@@ -34,18 +38,19 @@ int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
     if (i) l->i = i;
     int32_t *j = realloc(l->j, cap * sizeof *j);
     if (j) l->j = j;
-    jd_contact_state *st = realloc(l->state, cap * sizeof *st);
-    if (st) l->state = st;
-    const int want_r = rolling || (grow && l->roll), want_pc = pairs || (grow && l->pc),
-              want_pcr = (pairs && rolling) || (grow && l->pcr);
-    jd_rolling_state *r = want_r ? realloc(l->roll, cap * sizeof *r) : l->roll;
-    if (r) l->roll = r;
+    double *h = realloc(l->hist, cap * (size_t)hw * sizeof *h);
+    if (h) l->hist = h;
+    double *r = rolling ? realloc(l->rhist, cap * (size_t)rw * sizeof *r) : l->rhist;
+    if (r) l->rhist = r;
+    const int want_pc = pairs || (grow && l->pc), want_pcr = (pairs && rolling) || (grow && l->pcr);
     jd_pair_const *pc = want_pc ? realloc(l->pc, cap * sizeof *pc) : l->pc;
     if (pc) l->pc = pc;
     jd_pair_const_roll *pcr = want_pcr ? realloc(l->pcr, cap * sizeof *pcr) : l->pcr;
     if (pcr) l->pcr = pcr;
-    if (!i || !j || !st || (want_r && !r) || (want_pc && !pc) || (want_pcr && !pcr)) return -1;
+    if (!i || !j || !h || (rolling && !r) || (want_pc && !pc) || (want_pcr && !pcr)) return -1;
     l->cap = cap;
+    l->hw = hw;
+    l->rw = rw;
     return 0;
 }
 
@@ -60,8 +65,8 @@ static int list_push(jd_contact_list *l, int32_t i, int32_t j, unsigned kind) {
 void sim_contact_list_free(jd_contact_list *l) {
     free(l->i);
     free(l->j);
-    free(l->state);
-    free(l->roll);
+    free(l->hist);
+    free(l->rhist);
     free(l->pc);
     free(l->pcr);
     memset(l, 0, sizeof *l);
@@ -71,27 +76,33 @@ static int key_less(const jd_contact_list *a, size_t p, const jd_contact_list *b
     return a->i[p] < b->i[q] || (a->i[p] == b->i[q] && a->j[p] < b->j[q]);
 }
 
+/* The dissipation accumulated by entry c (energy bookkeeping only), added to the run's totals
+ * when the entry is dropped. */
+static void drop_entry(jd_sim *s, const jd_contact_list *l, size_t c) {
+    if (l->hw < JD_CONTACT_STATE_LEN) return;
+    jd_contact_state st;
+    sim_hist_get(l, c, &st, NULL);
+    s->e_damp_dropped += st.e_damp;
+    s->e_fric_dropped += st.e_fric;
+}
+
 /* Give every entry of nw the history of the same (i, j) in old, or a fresh (zero) history. */
 static void carry_over(jd_sim *s, const jd_contact_list *old, jd_contact_list *nw) {
+    const size_t hw = (size_t)nw->hw, rw = (size_t)nw->rw;
     size_t a = 0;
     for (size_t b = 0; b < nw->n; b++) {
-        for (; a < old->n && key_less(old, a, nw, b); a++) {
-            s->e_damp_dropped += old->state[a].e_damp;
-            s->e_fric_dropped += old->state[a].e_fric;
-        }
-        if (a < old->n && !key_less(nw, b, old, a)) {
-            nw->state[b] = old->state[a];
-            if (nw->roll) nw->roll[b] = old->roll[a];
+        for (; a < old->n && key_less(old, a, nw, b); a++) drop_entry(s, old, a);
+        const int kept = a < old->n && !key_less(nw, b, old, a);
+        if (kept) {
+            memcpy(nw->hist + hw * b, old->hist + hw * a, hw * sizeof *nw->hist);
+            if (rw) memcpy(nw->rhist + rw * b, old->rhist + rw * a, rw * sizeof *nw->rhist);
             a++;
         } else {
-            memset(&nw->state[b], 0, sizeof nw->state[b]);
-            if (nw->roll) memset(&nw->roll[b], 0, sizeof nw->roll[b]);
+            memset(nw->hist + hw * b, 0, hw * sizeof *nw->hist);
+            if (rw) memset(nw->rhist + rw * b, 0, rw * sizeof *nw->rhist);
         }
     }
-    for (; a < old->n; a++) {
-        s->e_damp_dropped += old->state[a].e_damp;
-        s->e_fric_dropped += old->state[a].e_fric;
-    }
+    for (; a < old->n; a++) drop_entry(s, old, a);
 }
 
 /* Can particle i touch wall w before the next rebuild (relative motion <= skin)? */
@@ -101,7 +112,8 @@ static int wall_candidate(const jd_sim_wall *w, const double *x, double R, doubl
 }
 
 static unsigned list_kind(const jd_sim *s, unsigned pairs) {
-    return ((s->features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) | pairs;
+    return ((s->features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) |
+           ((s->features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u) | pairs;
 }
 
 static int build_wall_list(jd_sim *s, jd_contact_list *l) {

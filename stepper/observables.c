@@ -25,8 +25,10 @@ void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES
  * accumulators survive jd_contact_separate). */
 static void list_energies(const jd_contact_list *l, double *damp, double *fric) {
     for (size_t c = 0; c < l->n; c++) {
-        *damp += l->state[c].e_damp;
-        *fric += l->state[c].e_fric;
+        jd_contact_state st;
+        sim_hist_get(l, c, &st, NULL);
+        *damp += st.e_damp;
+        *fric += st.e_fric;
     }
 }
 
@@ -46,19 +48,21 @@ void sim_observables(const jd_sim *s, jd_observables *o) {
      * geometry decides which contacts count. */
     for (size_t c = 0; c < s->pairs.n; c++) {
         jd_contact_geom g;
-        const jd_contact_state *st = &s->pairs.state[c];
-        o->elastic_energy += jd_contact_elastic_energy(st);
+        jd_contact_state st;
+        sim_hist_get(&s->pairs, c, &st, NULL);
+        o->elastic_energy += jd_contact_elastic_energy(&st);
         const int32_t i = s->pairs.i[c], j = s->pairs.j[c];
-        if (carries_force(st) &&
+        if (carries_force(&st) &&
             jd_geom_spheres_contact(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
                                     s->radius[j], &g))
             o->contacts += 1.0;
     }
     for (size_t c = 0; c < s->wall_pairs.n; c++) {
         jd_contact_geom g;
-        const jd_contact_state *st = &s->wall_pairs.state[c];
-        o->elastic_energy += jd_contact_elastic_energy(st);
-        if (carries_force(st) && sim_wall_geom(s, s->wall_pairs.i[c], &s->walls[s->wall_pairs.j[c]], &g))
+        jd_contact_state st;
+        sim_hist_get(&s->wall_pairs, c, &st, NULL);
+        o->elastic_energy += jd_contact_elastic_energy(&st);
+        if (carries_force(&st) && sim_wall_geom(s, s->wall_pairs.i[c], &s->walls[s->wall_pairs.j[c]], &g))
             o->wall_contacts += 1.0;
     }
     o->damping_dissipation = s->e_damp_dropped;

@@ -30,15 +30,13 @@ static void gather_ints(int32_t *a, const int32_t *old_of_new, size_t n, int32_t
     memcpy(a, scratch, n * sizeof *a);
 }
 
-static void turn_around(jd_contact_state *st, jd_rolling_state *r) {
-    double *v = (double *)st;
-    for (int k = 0; k < JD_CONTACT_STATE_LEN; k++)
+static void turn_around(jd_contact_list *l, size_t c) {
+    double *v = l->hist + (size_t)l->hw * c;
+    for (int k = 0; k < l->hw; k++)
         if (jd_contact_state_newton[k]) v[k] = -v[k];
-    if (r) {
-        double *w = (double *)r;
-        for (int k = 0; k < JD_ROLLING_STATE_LEN; k++)
-            if (jd_rolling_state_newton[k]) w[k] = -w[k];
-    }
+    double *w = l->rhist + (size_t)l->rw * c;
+    for (int k = 0; k < l->rw; k++)
+        if (jd_rolling_state_newton[k]) w[k] = -w[k];
 }
 
 /* Re-key list l to the new indices (j too when `pairs`), turn around swapped pairs, and sort it
@@ -61,7 +59,7 @@ static int rekey(jd_contact_list *l, int pairs, const int32_t *new_of_old, size_
                 const int32_t t = i;
                 i = j;
                 j = t;
-                turn_around(&l->state[c], l->roll ? &l->roll[c] : NULL);
+                turn_around(l, c);
             }
             l->j[c] = j;
         }
@@ -84,8 +82,9 @@ static int rekey(jd_contact_list *l, int pairs, const int32_t *new_of_old, size_
         const int32_t c = order[p];
         out->i[p] = l->i[c];
         out->j[p] = l->j[c];
-        out->state[p] = l->state[c];
-        if (l->roll) out->roll[p] = l->roll[c];
+        const size_t hw = (size_t)l->hw, rw = (size_t)l->rw;
+        memcpy(out->hist + hw * p, l->hist + hw * (size_t)c, hw * sizeof *out->hist);
+        if (rw) memcpy(out->rhist + rw * p, l->rhist + rw * (size_t)c, rw * sizeof *out->rhist);
     }
     out->n = m;
     free(start);
@@ -96,7 +95,8 @@ static int rekey(jd_contact_list *l, int pairs, const int32_t *new_of_old, size_
 static int reorder_list(jd_sim *s, jd_contact_list *l, int pairs, const int32_t *new_of_old) {
     if (l->n == 0) return 0;
     jd_contact_list *spare = &s->spare;
-    if (sim_list_reserve(spare, l->n, l->roll ? JD_LIST_ROLLING : 0u) != 0 ||
+    const unsigned kind = (l->rw ? JD_LIST_ROLLING : 0u) | (l->hw == JD_CONTACT_STATE_LEN ? JD_LIST_ENERGY : 0u);
+    if (sim_list_reserve(spare, l->n, kind) != 0 ||
         rekey(l, pairs, new_of_old, s->n, spare) != 0)
         return -1;
     const jd_contact_list t = *l;

@@ -116,26 +116,21 @@ oom:
     return -1;
 }
 
-/* Save the contact history of a list (its first n entries), or put it back keeping the energy
- * reference of the evaluation in between (jd_contact_keep_reference). */
+/* Save the contact history of a list (its first n entries) into state and roll (n entries
+ * each), or put it back keeping the energy reference of the evaluation in between
+ * (jd_contact_keep_reference). */
 static void save_history(const jd_contact_list *l, jd_contact_state *state, jd_rolling_state *roll) {
-    if (l->n == 0) return; /* the buffers may not exist yet */
-    memcpy(state, l->state, l->n * sizeof *state);
-    if (l->roll) memcpy(roll, l->roll, l->n * sizeof *roll);
+    for (size_t c = 0; c < l->n; c++) sim_hist_get(l, c, &state[c], &roll[c]);
 }
 
 static void restore_history(jd_contact_list *l, const jd_contact_state *state,
                             const jd_rolling_state *roll) {
     for (size_t c = 0; c < l->n; c++) {
-        const jd_contact_state evaluated = l->state[c];
-        l->state[c] = state[c];
-        if (l->roll) {
-            const jd_rolling_state r_evaluated = l->roll[c];
-            l->roll[c] = roll[c];
-            jd_contact_keep_reference(&l->state[c], &evaluated, &l->roll[c], &r_evaluated);
-        } else {
-            jd_contact_keep_reference(&l->state[c], &evaluated, NULL, NULL);
-        }
+        jd_contact_state evaluated, kept = state[c];
+        jd_rolling_state r_evaluated, r_kept = roll[c];
+        sim_hist_get(l, c, &evaluated, &r_evaluated);
+        jd_contact_keep_reference(&kept, &evaluated, l->rw ? &r_kept : NULL, l->rw ? &r_evaluated : NULL);
+        sim_hist_set(l, c, &kept, l->rw ? &r_kept : NULL);
     }
 }
 
@@ -229,8 +224,8 @@ void sim_free(jd_sim *s) {
 }
 
 static size_t list_bytes(const jd_contact_list *l) {
-    const size_t entry = 2 * sizeof(int32_t) + sizeof(jd_contact_state) +
-                         (l->roll ? sizeof(jd_rolling_state) : 0) + (l->pc ? sizeof(jd_pair_const) : 0) +
+    const size_t entry = 2 * sizeof(int32_t) + (size_t)(l->hw + l->rw) * sizeof(double) +
+                         (l->pc ? sizeof(jd_pair_const) : 0) +
                          (l->pcr ? sizeof(jd_pair_const_roll) : 0);
     return l->cap * entry;
 }

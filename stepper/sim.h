@@ -87,15 +87,51 @@ typedef struct jd_timing {
 
 /* A list of contact candidates (i, j) sorted by (i, j), with the history of each contact stored
  * alongside.  For particle pairs j is a particle index (> i); for wall candidates a wall index.
- * Buffers grow geometrically and are reused across rebuilds (no allocation per contact). */
+ * Buffers grow geometrically and are reused across rebuilds (no allocation per contact).
+ *
+ * The history of entry c is the first hw doubles of the kernel's jd_contact_state (xi and flags;
+ * all of it with the energy bookkeeping) at hist + hw c, and the first rw doubles of
+ * jd_rolling_state (theta; with the bookkeeping also m_prev; rw = 0 without rolling resistance)
+ * at rhist + rw c: a scene stores only the history its laws use (jd_contact reads and writes
+ * the energy fields only with JD_F_ENERGY). */
 typedef struct jd_contact_list {
     size_t n, cap;
     int32_t *i, *j;
-    jd_contact_state *state;
-    jd_rolling_state *roll; /* NULL unless the scene has rolling resistance */
+    int hw, rw;             /* doubles of history per entry */
+    double *hist;           /* cap x hw */
+    double *rhist;          /* cap x rw; NULL without rolling resistance */
     jd_pair_const *pc;      /* particle pairs only (walls: NULL): per-pair constants */
     jd_pair_const_roll *pcr; /* particle pairs of scenes with rolling resistance, else NULL */
 } jd_contact_list;
+
+/* History doubles without the energy bookkeeping: jd_contact_state's xi[3] and flags, and
+ * jd_rolling_state's theta[3] (the leading fields of the structs). */
+enum { JD_HIST_CORE = 4, JD_RHIST_CORE = 3 };
+_Static_assert(sizeof(jd_contact_state) == JD_CONTACT_STATE_LEN * sizeof(double) &&
+                   sizeof(jd_rolling_state) == JD_ROLLING_STATE_LEN * sizeof(double),
+               "the kernel's history structs are plain arrays of doubles");
+
+/* The history of entry c as the kernel's structs (fields the list does not keep are zero); r may
+ * be NULL. */
+static inline void sim_hist_get(const jd_contact_list *l, size_t c, jd_contact_state *st,
+                                jd_rolling_state *r) {
+    double *a = (double *)st;
+    for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) a[k] = k < l->hw ? l->hist[(size_t)l->hw * c + (size_t)k] : 0.0;
+    if (r) {
+        double *b = (double *)r;
+        for (int k = 0; k < JD_ROLLING_STATE_LEN; k++)
+            b[k] = k < l->rw ? l->rhist[(size_t)l->rw * c + (size_t)k] : 0.0;
+    }
+}
+
+/* Store the kept fields of st (and r, if the list has rolling history) as entry c's history. */
+static inline void sim_hist_set(jd_contact_list *l, size_t c, const jd_contact_state *st,
+                                const jd_rolling_state *r) {
+    const double *a = (const double *)st;
+    for (int k = 0; k < l->hw; k++) l->hist[(size_t)l->hw * c + (size_t)k] = a[k];
+    if (r)
+        for (int k = 0; k < l->rw; k++) l->rhist[(size_t)l->rw * c + (size_t)k] = ((const double *)r)[k];
+}
 
 /* A wall as the engine moves it: the kernel's shape (translated in place) plus what the engine
  * needs around it. */
@@ -209,7 +245,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
  * rebuild criterion rides in the drift, integrate.c) */
 int sim_neighbour_walls_moved(const jd_sim *s);
 /* Capacity for `need` entries of a list of this kind (JD_LIST_* bits).  Returns 0 or -1. */
-enum { JD_LIST_ROLLING = 1, JD_LIST_PAIRS = 2 };
+enum { JD_LIST_ROLLING = 1, JD_LIST_PAIRS = 2, JD_LIST_ENERGY = 4 };
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind);
 void sim_contact_list_free(jd_contact_list *l);
 
