@@ -5,11 +5,10 @@
  * scene does not need").  Order as LIGGGHTS: pair forces in list order, wall forces, gravity.
  *
  * Threads (sim.h, "Threads"): each list is cut into one contiguous chunk per thread (the same
- * cut for a given list length and thread count); each thread adds into its own buffer of forces
- * and torques, and the reduction sets f and torque per particle to the sum of the buffers in
- * thread order (plus gravity) and zeroes them for the next evaluation: one barrier per
- * evaluation, no atomics.  With one thread the loops add into f and torque directly: exactly
- * the serial loop.
+ * cut for a given list length and thread count); thread 0 adds into f and torque, every other
+ * thread into its own buffer, and the reduction adds the buffers to f and torque per particle
+ * in thread order (then gravity) and zeroes them for the next evaluation: one barrier per
+ * evaluation, no atomics.  With one thread this is exactly the serial loop.
  */
 #include <math.h>
 #include <stddef.h>
@@ -44,8 +43,8 @@ typedef struct acc {
 } acc;
 
 static acc acc_of(const jd_sim *s, int tid) {
-    if (s->threads == 1) return (acc){s->f, s->torque};
-    double *b = s->tbuf + (size_t)tid * 6 * s->n;
+    if (tid == 0) return (acc){s->f, s->torque};
+    double *b = s->tbuf + (size_t)(tid - 1) * 6 * s->n;
     return (acc){b, b + 3 * s->n};
 }
 
@@ -106,7 +105,7 @@ typedef struct jd_batch batch;
 
 /* The force loops' buffers (sim_init). */
 int sim_forces_init(jd_sim *s) {
-    const size_t nb = s->threads > 1 ? (size_t)s->threads * 6 * s->n : 0;
+    const size_t nb = s->threads > 1 ? (size_t)(s->threads - 1) * 6 * s->n : 0;
     s->tbuf = nb ? calloc(nb, sizeof *s->tbuf) : NULL;
     s->trips = calloc((size_t)s->threads, sizeof *s->trips);
     return (nb && !s->tbuf) || !s->trips ? -1 : 0;
@@ -359,11 +358,11 @@ static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
  * particles [lo, hi). */
 static void reduce(jd_sim *s, size_t lo, size_t hi) {
     const size_t n = s->n;
-    for (int t = 0; t < s->threads; t++) {
-        double *bf = s->tbuf + (size_t)t * 6 * n, *bt = bf + 3 * n;
+    for (int t = 1; t < s->threads; t++) {
+        double *bf = s->tbuf + (size_t)(t - 1) * 6 * n, *bt = bf + 3 * n;
         for (size_t k = 3 * lo; k < 3 * hi; k++) {
-            s->f[k] = t ? s->f[k] + bf[k] : bf[k];
-            s->torque[k] = t ? s->torque[k] + bt[k] : bt[k];
+            s->f[k] += bf[k];
+            s->torque[k] += bt[k];
             bf[k] = bt[k] = 0.0;
         }
     }
@@ -385,6 +384,8 @@ void sim_compute_forces(jd_sim *s) {
     double work[nt > 0 ? nt : 1];
     double t_pairs_end = 0.0, t_walls_end = 0.0;
     const double t0 = sim_clock();
+    memset(s->f, 0, 3 * s->n * sizeof *s->f);
+    memset(s->torque, 0, 3 * s->n * sizeof *s->torque);
 #pragma omp parallel num_threads(nt) if (nt > 1)
     {
 #ifdef _OPENMP
@@ -392,10 +393,6 @@ void sim_compute_forces(jd_sim *s) {
 #else
         const int tid = 0;
 #endif
-        if (nt == 1) { /* the loops add into f and torque directly */
-            memset(s->f, 0, 3 * s->n * sizeof *s->f);
-            memset(s->torque, 0, 3 * s->n * sizeof *s->torque);
-        }
         s->trips[tid].fraction = 0.0;
         work[tid] = dispatch(s, tid, nt, &t_pairs_end);
         if (nt > 1) {

@@ -7,54 +7,58 @@
  */
 #include "sim.h"
 
+/* Whether a double is not finite, as arithmetic (x - x is 0 for every finite x, NaN for inf
+ * and NaN), so that the integration loops stay vectorisable: the watchdog's non-finite probe
+ * costs no branch per element. */
+static inline int not_finite(double x) { return x - x != 0.0; }
+
 /* initial_integrate: v += (0.5 dt/m) f; omega += (0.5 dt/0.4)/(r r m) torque; x += dt v.
  * dtfm and dtirot are precomputed per particle with exactly LIGGGHTS' expressions, so the
  * products are bit-identical; each particle's update is independent, so doing the kick and the
  * drift in one pass gives LIGGGHTS' numbers exactly.  The same pass checks whether some
  * particle moved more than half the skin since the last neighbour build (*moved; !(<=) so that a
- * NaN position forces a rebuild, which reports it) and returns 1 when some new x is not finite:
- * 0 * inf and 0 * NaN are NaN, so the probe sum is 0 or NaN (-O2 without -ffast-math keeps the
- * multiply), and the watchdog's non-finite check costs no branch per element. */
+ * NaN position forces a rebuild, which reports it) and returns 1 when some new x is not
+ * finite. */
 static int initial_integrate(jd_sim *s, int *moved) {
     const long n = (long)s->n;
-    double *x = s->x, *v = s->v, *w = s->omega;
-    const double *x0 = s->x_build, *f = s->f, *t = s->torque, *dtfm = s->dtfm, *dtirot = s->dtirot;
+    double *restrict x = s->x, *restrict v = s->v, *restrict w = s->omega;
+    const double *restrict x0 = s->x_build, *restrict f = s->f, *restrict t = s->torque,
+                 *restrict dtfm = s->dtfm, *restrict dtirot = s->dtirot;
     const double dt = s->dt, lim = 0.25 * s->skin * s->skin; /* (skin/2)^2 */
-    double probe = 0.0;
-    int far = 0;
+    int bad = 0, far = 0;
 #pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1) \
-    reduction(+ : probe) reduction(| : far)
+    reduction(| : bad, far)
     for (long i = 0; i < n; i++) {
         double d[3];
         for (int k = 0; k < 3; k++) {
             v[3 * i + k] += dtfm[i] * f[3 * i + k];
             w[3 * i + k] += dtirot[i] * t[3 * i + k];
             x[3 * i + k] += dt * v[3 * i + k];
-            probe += 0.0 * x[3 * i + k];
+            bad |= not_finite(x[3 * i + k]);
             d[k] = x[3 * i + k] - x0[3 * i + k];
         }
         far |= !(jd_dot(d, d) <= lim);
     }
     *moved = far && !s->allpairs;
-    return probe != 0.0;
+    return bad;
 }
 
-/* final_integrate: the same half kick, returning 1 when some new v or omega is not finite (the
- * same probe). */
+/* final_integrate: the same half kick, returning 1 when some new v or omega is not finite. */
 static int final_integrate(jd_sim *s) {
     const long n = (long)s->n;
-    double *v = s->v, *w = s->omega;
-    const double *f = s->f, *t = s->torque, *dtfm = s->dtfm, *dtirot = s->dtirot;
-    double probe = 0.0;
-#pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1) reduction(+ : probe)
+    double *restrict v = s->v, *restrict w = s->omega;
+    const double *restrict f = s->f, *restrict t = s->torque, *restrict dtfm = s->dtfm,
+                 *restrict dtirot = s->dtirot;
+    int bad = 0;
+#pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1) reduction(| : bad)
     for (long i = 0; i < n; i++) {
         for (int d = 0; d < 3; d++) {
             v[3 * i + d] += dtfm[i] * f[3 * i + d];
             w[3 * i + d] += dtirot[i] * t[3 * i + d];
-            probe += 0.0 * v[3 * i + d] + 0.0 * w[3 * i + d];
+            bad |= not_finite(v[3 * i + d]) | not_finite(w[3 * i + d]);
         }
     }
-    return probe != 0.0;
+    return bad;
 }
 
 int sim_step(jd_sim *s, char *err, size_t errlen) {

@@ -32,11 +32,11 @@
  * (sim_bonds_permute, sim_loads_permute), and reads scene data through orig.
  *
  * Threads (OpenMP).  The force loops split the contact lists into one contiguous chunk per
- * thread; each thread adds into its own buffer, and after one barrier the buffers are summed
- * into f and torque per particle, in thread order.  No two threads write the same memory, no
- * atomics (a contact adds to two particles that any thread may also touch, so the alternatives
- * are atomics on every addition, or a colouring of the contacts that costs a sort per rebuild
- * and still leaves a thread-count-dependent order).  For a given thread count the sums are always
+ * thread; the first thread adds into f and torque, every other one into its own buffer, and
+ * after one barrier the buffers are added to f and torque per particle, in thread order.  No
+ * two threads write the same memory, no atomics (a contact adds to two particles that any
+ * thread may also touch, so the alternatives are atomics on every addition, or a colouring of
+ * the contacts that costs a sort per rebuild and still leaves a thread-count-dependent order).  For a given thread count the sums are always
  * taken in the same order, so a run is reproducible bit for bit, and runs with different thread
  * counts differ only by the round-off of that order.  Integration loops are split by particle.
  */
@@ -179,8 +179,9 @@ typedef struct jd_sim {
 
     jd_sim_options opt;
     int threads;       /* threads actually used (opt.threads clamped to >= 1) */
-    double *tbuf;      /* with threads > 1: threads x 6n, each thread's force and torque buffer
-                          (zero between force evaluations); NULL with one thread */
+    double *tbuf;      /* with threads > 1: (threads - 1) x 6n, the force and torque buffer of
+                          each thread but the first, which adds into f and torque (zero between
+                          force evaluations); NULL with one thread */
     jd_overlap_trip *trips; /* one per thread, merged into overlap_trip */
     double *scratch;   /* 3n doubles: reordering and frames in scene order */
     jd_timing timing;
