@@ -444,41 +444,94 @@ def make_scene(out, size, variant, bed_path, steps):
     return path, dt
 
 
-def make_decks(out, size, variant, scene, steps, engines=ENGINES):
-    """Resolved scene and the LIGGGHTS decks (ours and stock) of `engines` in
-    OUT/decks/SIZE_VARIANT/ (at 1M each deck takes a minute: only those that will run)."""
-    d = os.path.join(out, "decks", "%s_%s" % (size, variant))
-    if not any(e in engines for e in ("liggghts-jdem", "liggghts")):
-        return {}
+def resolved_scene(scene, bed_path, d):
+    """The resolved scene of `scene` (what `jdem resolve` prints) as the dict that
+    scene_to_liggghts.write_deck reads, without loading the resolved YAML of every particle and
+    bond: at 1M that is ~25 million YAML nodes, ~14 GB and minutes per deck.  The full resolved
+    text still goes to D/resolved.yaml (the LIGGGHTS trajectory keeps it in /parameters).  Parsed
+    as YAML: `jdem resolve` of the scene cut to its first particle (materials, walls, time, bond
+    types: everything but the particles and bonds).  The particles are the bed's, the values the
+    scene lists, in the resolved schema of that first particle; the bonds are those jdem forms at
+    step 0 (/connectivity/bonds of a 1-step run), so the deck gets exactly jdem's.
+    tests/engine/test_bench_tiling.py checks that the decks equal those scene_to_liggghts.py
+    writes from the whole resolved YAML."""
+    import h5py
+    import yaml
     os.makedirs(d, exist_ok=True)
-    resolved = os.path.join(d, "resolved.yaml")
-    r = subprocess.run([JDEM, "resolve", scene], capture_output=True, text=True)
+    with open(os.path.join(d, "resolved.yaml"), "w") as f:
+        r = subprocess.run([JDEM, "resolve", scene], stdout=f, stderr=subprocess.PIPE, text=True)
     if r.returncode != 0:
-        raise RuntimeError(r.stderr)
-    with open(resolved, "w") as f:
-        f.write(r.stdout)
+        raise RuntimeError("jdem resolve %s failed:\n%s" % (scene, r.stderr))
+    with open(scene) as f:
+        text = f.read()
+    first = text.index("\nparticles:\n") + len("\nparticles:\n")
+    head = os.path.join(d, "first_particle.yaml")
+    with open(head, "w") as f:
+        f.write(text[:text.index("\n", first) + 1])
+    r = subprocess.run([JDEM, "resolve", head], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError("jdem resolve %s failed:\n%s" % (head, r.stderr))
+    sc = yaml.load(r.stdout, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    p0 = sc["particles"][0]
+    bed = np.load(bed_path)
+    sc["particles"] = [dict(p0, id=int(i), radius=float(rad), position=[float(c) for c in x])
+                       for i, rad, x in zip(bed["id"], bed["radius"], bed["x"])]
+    if sc.get("bond_types"):
+        one = os.path.join(d, "bonds_step0.yaml")
+        with open(one, "w") as f:
+            f.write(re.sub(r"(?m)^  steps: \d+", "  steps: 1", text))
+        h5 = os.path.join(d, "bonds_step0.h5")
+        r = subprocess.run([JDEM, "run", one, "-o", h5, "--quiet", "--force"], capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError("jdem run %s failed:\n%s" % (one, r.stderr))
+        names = list(sc["bond_types"])
+        with h5py.File(h5, "r") as f:
+            g = f["connectivity"]
+            step0 = g["bond_formed_step"][...] == 0
+            ids, types = g["bonds"][...][step0], g["bond_type"][...][step0]
+        sc["bonds"] = [{"ids": [int(a), int(b)], "type": names[t]} for (a, b), t in zip(ids.tolist(), types.tolist())]
+        os.remove(h5)
+    return sc
+
+
+def adapt_deck(text, engine, steps):
+    """The bench's edits of a deck from scene_to_liggghts: thermo at the last step only, no
+    domain split along z, and for stock LIGGGHTS its own contact count instead of our dump."""
+    text = re.sub(r"(?m)^thermo\s+\d+\s*$", "thermo          %d" % steps, text)
+    # the box reaches twice the bed's height (the walls' extent): never split it along z,
+    # or one rank would own every particle
+    text = re.sub(r"(?m)^(boundary .*)$", r"\1\nprocessors      * * 1", text, count=1)
+    if engine == "liggghts":
+        # stock LIGGGHTS has no dump h5md/jdem: count contacts with its own computes instead
+        text = re.sub(r"(?m)^dump .*$\n", "", text)
+        text = text.replace("\nrun ", "\ncompute cc all contact/atom\ncompute csum all reduce sum c_cc\n"
+                            "thermo_style    custom step atoms ke c_csum\nrun ", 1)
+    return text
+
+
+def make_decks(out, size, variant, scene, bed_path, steps, engines=ENGINES):
+    """The LIGGGHTS decks (ours and stock) of `engines` in OUT/decks/SIZE_VARIANT/ENGINE/in.bench,
+    from resolved_scene() of the bench scene on its bed."""
+    import scene_to_liggghts
+    d = os.path.join(out, "decks", "%s_%s" % (size, variant))
+    wanted = [e for e in ("liggghts-jdem", "liggghts") if e in engines
+              and not (e == "liggghts" and is_bonded(variant))]  # stock LIGGGHTS has no parallel bonds
+    if not wanted:
+        return {}
+    sc = resolved_scene(scene, bed_path, d)
     decks = {}
-    for engine, extra in (("liggghts-jdem", []), ("liggghts", ["--builtin"])):
-        if engine not in engines or engine == "liggghts" and is_bonded(variant):
-            continue  # not asked for; stock LIGGGHTS has no parallel bonds
+    for engine in wanted:
         dd = os.path.join(d, engine)
         os.makedirs(dd, exist_ok=True)
         deck = os.path.join(dd, "in.bench")
-        r = subprocess.run([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), resolved, "-o", deck,
-                            "--trajectory", os.path.join(dd, "out.h5")] + extra, capture_output=True, text=True)
-        if r.returncode != 0:
-            raise RuntimeError("deck generation failed:\n" + r.stderr)
+        shutil.copyfile(os.path.join(d, "resolved.yaml"), os.path.join(dd, "resolved.yaml"))
+        try:
+            scene_to_liggghts.write_deck(sc, os.path.join(dd, "resolved.yaml"), deck, os.path.join(dd, "out.h5"),
+                                         builtin=engine == "liggghts")
+        except SystemExit:  # scene_to_liggghts.fail() has printed the reason
+            raise RuntimeError("deck generation failed for %s (%s)" % (scene, engine))
         with open(deck) as f:
-            text = f.read()
-        text = re.sub(r"(?m)^thermo\s+\d+\s*$", "thermo          %d" % steps, text)
-        # the box reaches twice the bed's height (the walls' extent): never split it along z,
-        # or one rank would own every particle
-        text = re.sub(r"(?m)^(boundary .*)$", r"\1\nprocessors      * * 1", text, count=1)
-        if engine == "liggghts":
-            # stock LIGGGHTS has no dump h5md/jdem: count contacts with its own computes instead
-            text = re.sub(r"(?m)^dump .*$\n", "", text)
-            text = text.replace("\nrun ", "\ncompute cc all contact/atom\ncompute csum all reduce sum c_cc\n"
-                                "thermo_style    custom step atoms ke c_csum\nrun ", 1)
+            text = adapt_deck(f.read(), engine, steps)
         with open(deck, "w") as f:
             f.write(text)
         decks[engine] = deck
@@ -790,6 +843,8 @@ def main():
     ap.add_argument("--timeout", type=float, default=RUN_TIMEOUT_S,
                     help="seconds after which one engine run is killed and recorded as failed")
     ap.add_argument("--report-only", action="store_true")
+    ap.add_argument("--prepare-only", action="store_true",
+                    help="generate the beds, scenes and decks only (no timings, no report)")
     ap.add_argument("--no-profile", action="store_true", help="skip the callgrind profile of jdem")
     a = ap.parse_args()
     RUN_TIMEOUT_S = a.timeout
@@ -831,8 +886,10 @@ def main():
                 t_scene = time.time() - t0
                 n = int(np.load(beds[disp])["id"].shape[0])
                 t0 = time.time()
-                decks = make_decks(out, size, variant, scene, steps, engines)
+                decks = make_decks(out, size, variant, scene, beds[disp], steps, engines)
                 log("%s %s: scene and decks ready (%.0f s)" % (size, variant, time.time() - t0 + t_scene))
+                if a.prepare_only:
+                    continue
                 jobs = []
                 for engine in engines:
                     if engine == "jdem":
@@ -883,6 +940,8 @@ def main():
                                    steps=steps, dt=dt, repeat=rep, load_average=os.getloadavg()[0])
                         with open(runs_path, "a") as f:
                             f.write(json.dumps(res) + "\n")
+    if a.prepare_only:
+        return 0
     # the feature check and the profile on the smallest size run (callgrind is ~50x slower than
     # the run itself: never above PROFILE_MAX_SIZE)
     small = min(sizes, key=SIZES.get)
