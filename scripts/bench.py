@@ -490,8 +490,18 @@ def resolved_scene(scene, bed_path, d):
             step0 = g["bond_formed_step"][...] == 0
             ids, types = g["bonds"][...][step0], g["bond_type"][...][step0]
         sc["bonds"] = [{"ids": [int(a), int(b)], "type": names[t]} for (a, b), t in zip(ids.tolist(), types.tolist())]
-        os.remove(h5)
+        for f in (one, h5, h5[:-3] + ".xdmf"):
+            os.remove(f)
     return sc
+
+
+def link_or_copy(src, dst):
+    if os.path.exists(dst):
+        os.remove(dst)
+    try:
+        os.link(src, dst)
+    except OSError:
+        shutil.copyfile(src, dst)
 
 
 def adapt_deck(text, engine, steps):
@@ -509,11 +519,15 @@ def adapt_deck(text, engine, steps):
     return text
 
 
+def deck_dir(out, size, variant):
+    return os.path.join(out, "decks", "%s_%s" % (size, variant))
+
+
 def make_decks(out, size, variant, scene, bed_path, steps, engines=ENGINES):
     """The LIGGGHTS decks (ours and stock) of `engines` in OUT/decks/SIZE_VARIANT/ENGINE/in.bench,
     from resolved_scene() of the bench scene on its bed."""
     import scene_to_liggghts
-    d = os.path.join(out, "decks", "%s_%s" % (size, variant))
+    d = deck_dir(out, size, variant)
     wanted = [e for e in ("liggghts-jdem", "liggghts") if e in engines
               and not (e == "liggghts" and is_bonded(variant))]  # stock LIGGGHTS has no parallel bonds
     if not wanted:
@@ -524,7 +538,7 @@ def make_decks(out, size, variant, scene, bed_path, steps, engines=ENGINES):
         dd = os.path.join(d, engine)
         os.makedirs(dd, exist_ok=True)
         deck = os.path.join(dd, "in.bench")
-        shutil.copyfile(os.path.join(d, "resolved.yaml"), os.path.join(dd, "resolved.yaml"))
+        link_or_copy(os.path.join(d, "resolved.yaml"), os.path.join(dd, "resolved.yaml"))  # 270 MB at 1M bonded
         try:
             scene_to_liggghts.write_deck(sc, os.path.join(dd, "resolved.yaml"), deck, os.path.join(dd, "out.h5"),
                                          builtin=engine == "liggghts")
@@ -584,6 +598,7 @@ def calibrate_liggghts(deck, engine):
         f.write(re.sub(r"(?m)^run\s+\d+\s*$", "run             1", text))
     exe = LIGGGHTS_JDEM if engine == "liggghts-jdem" else LIGGGHTS
     w, c, rss, so, se, rc = timed([exe, "-in", "in.bench1", "-log", "log.calib", "-screen", "none"], d)
+    remove_files(os.path.join(d, "out.h5"))
     if rc:
         raise RuntimeError("%s 1-step calibration failed:\n%s" % (engine, se[-2000:]))
     return dict(wall_s=w, cpu_s=c, peak_rss=rss)
@@ -601,8 +616,18 @@ def jdem_split(stderr):
     return {k: float(v) for k, v in (kv.split("=") for kv in m[-1].split())}
 
 
-def run_jdem(out, size, variant, scene, steps, n, threads=1, extra=(), tag=""):
-    """Time `jdem run SCENE --threads T [extra]` as run(S) - run(1); returns the record."""
+def remove_files(*paths):
+    """Delete the large files of a finished timing (at 1M a trajectory of two frames is ~240 MB, a
+    scene copy 125 MB: a full sweep would otherwise fill the disk)."""
+    for p in paths:
+        for q in (p, p[:-3] + ".xdmf" if p.endswith(".h5") else None):
+            if q and os.path.exists(q):
+                os.remove(q)
+
+
+def run_jdem(out, size, variant, scene, steps, n, threads=1, extra=(), tag="", keep_trajectory=False):
+    """Time `jdem run SCENE --threads T [extra]` as run(S) - run(1); returns the record.  The
+    trajectories and the 1-step scene are deleted once read unless keep_trajectory."""
     d = os.path.join(out, "runs", "%s_%s" % (size, variant), "jdem%s_t%d" % (tag, threads))
     os.makedirs(d, exist_ok=True)
     one = os.path.join(d, "one.yaml")
@@ -619,10 +644,13 @@ def run_jdem(out, size, variant, scene, steps, n, threads=1, extra=(), tag=""):
     if rc or rc1:
         raise RuntimeError("jdem failed:\n" + e + e1)
     fr = h5_last_frame(traj)
+    remove_files(one, os.path.join(d, "one.h5"))
+    if not keep_trajectory:
+        remove_files(traj)
     return dict(wall_s=w - w1, cpu_s=c - c1, total_wall_s=w, setup_wall_s=w1, peak_rss=rss,
                 contacts_per_particle=2.0 * fr["contacts"] / n, timing="run(S) - run(1)",
                 bonds_start=fr["bonds_start"], bonds_end=fr["bonds"],
-                jdem_split=jdem_split(e), trajectory=traj)
+                jdem_split=jdem_split(e), trajectory=traj if keep_trajectory else None)
 
 
 LOOP_RE = re.compile(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
@@ -645,6 +673,7 @@ def run_liggghts(out, size, variant, deck, engine, ranks, steps, n):
         fr = h5_last_frame(os.path.join(d, "out.h5"))
         cpp = 2.0 * fr["contacts"] / n
         bonds = (fr["bonds_start"], fr["bonds"])
+        remove_files(os.path.join(d, "out.h5"))
     else:  # thermo: step atoms ke c_csum  (contact/atom counts each contact at both atoms)
         rows = re.findall(r"(?m)^\s*(\d+)\s+(\d+)\s+\S+\s+(\S+)\s*$", logtext)
         cpp = float(rows[-1][2]) / n if rows else float("nan")
@@ -685,7 +714,8 @@ def feature_check(out, size, steps, repeats):
     n = int(np.load(make_bed(out, size, "mono"))["id"].shape[0])
     res = {}
     for tag, extra in (("specialised", []), ("general", ["--all-laws"])):
-        runs = [run_jdem(out, size, "soft_mono_plain", scene, steps, n, extra=extra, tag="_" + tag)
+        runs = [run_jdem(out, size, "soft_mono_plain", scene, steps, n, extra=extra, tag="_" + tag,
+                         keep_trajectory=True)
                 for _ in range(repeats)]
         res[tag] = dict(wall_s=[r["wall_s"] for r in runs], cpu_s=[r["cpu_s"] for r in runs],
                         wall_s_median=statistics.median(r["wall_s"] for r in runs),
@@ -842,6 +872,8 @@ def main():
                          "thread target on; keeps make bench short)")
     ap.add_argument("--timeout", type=float, default=RUN_TIMEOUT_S,
                     help="seconds after which one engine run is killed and recorded as failed")
+    ap.add_argument("--keep-files", action="store_true",
+                    help="keep the LIGGGHTS decks of the tiled sizes after their timings (~0.5 GB per variant at 1M)")
     ap.add_argument("--report-only", action="store_true")
     ap.add_argument("--prepare-only", action="store_true",
                     help="generate the beds, scenes and decks only (no timings, no report)")
@@ -935,11 +967,17 @@ def main():
                         key = (size, variant, engine + "/calib", 1, 1, steps)
                         if engine == "jdem" or engine not in decks or done.get(key, 0) > rep:
                             continue
-                        res = calibrate_liggghts(decks[engine], engine)
+                        try:
+                            res = calibrate_liggghts(decks[engine], engine)
+                        except RuntimeError as e:
+                            log("%s %s %s 1-step calibration FAILED: %s" % (size, variant, engine, str(e)[-2000:]))
+                            continue
                         res.update(size=size, variant=variant, engine=engine + "/calib", ranks=1, n=n,
                                    steps=steps, dt=dt, repeat=rep, load_average=os.getloadavg()[0])
                         with open(runs_path, "a") as f:
                             f.write(json.dumps(res) + "\n")
+                if size in TILES and not a.keep_files and os.path.isdir(deck_dir(out, size, variant)):
+                    shutil.rmtree(deck_dir(out, size, variant))  # ~0.5 GB per variant at 1M
     if a.prepare_only:
         return 0
     # the feature check and the profile on the smallest size run (callgrind is ~50x slower than

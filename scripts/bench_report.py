@@ -301,9 +301,12 @@ def write_report(out, rows, machine, feature_check=None, flat=None, beds=None, f
                 continue
             eng = (rr[0] or {}).get("jdem_split_seconds") or {}
             ok = rr[0].get("engine_memory_within_budget") if rr[0] else None
+            na = v.endswith("_bonded")  # stock LIGGGHTS has no parallel bonds
             L.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n" % (
-                s, v, *[fmt(r["peak_rss_bytes"] / 1e6 if r else None, ".0f") for r in rr],
-                *[fmt(r["bytes_per_particle"] if r else None, ".0f") for r in rr],
+                s, v, *["n/a" if na and e == 2 else fmt(r["peak_rss_bytes"] / 1e6 if r else None, ".0f")
+                        for e, r in enumerate(rr)],
+                *["n/a" if na and e == 2 else fmt(r["bytes_per_particle"] if r else None, ".0f")
+                  for e, r in enumerate(rr)],
                 fmt(eng["engine_bytes"] / 1e6 if eng.get("engine_bytes") else None, ".1f"),
                 fmt(rr[0].get("engine_bytes_per_particle") if rr[0] else None, ".0f"),
                 fmt(rr[0]["memory_budget_bytes"] / 1e6 if rr[0] and rr[0].get("memory_budget_bytes") else None, ".1f"),
