@@ -3,6 +3,7 @@
 
     scripts/bench.py [--sizes 5k,20k] [--variants all] [--engines jdem,liggghts-jdem,liggghts]
                      [--repeats 3] [--ranks-size 20k] [--out out/bench] [--fresh] [--report-only]
+                     [--prepare-only] [--timeout 3600] [--keep-files]
 
 Dense beds of spheres settled under gravity in an open box (reference_runs/bench/README.md):
 monodisperse R = 1 mm or bidisperse 1 mm / 2 mm (half and half by number), soft (E = 1e7 Pa) or
@@ -15,12 +16,18 @@ stiff (E = 7e10 Pa), with or without rolling resistance; nu = 0.3, rho = 2500, e
    contact overlaps by exactly 5e-10 m (damped Gauss-Newton least squares, CGLS, numpy only):
    the settled contact network with nearly zero forces, which gravity loads again in the timed
    run.  Soft and stiff variants start from the same bed (settling at the stiff time step would
-   take ~1e6 steps).
+   take ~1e6 steps).  80k, 320k and 1M are 2 x 2, 4 x 4 and 7 x 7 copies of the 20k bed side by
+   side (bench_tiling.py; settling 1M spheres would take ~1.5 h), checked against the
+   stepper's start-overlap rule.
+   The bonded variants (*_bonded) are the same beds with a parallel bond between every touching
+   pair, formed at step 0 by a bond rule; stock LIGGGHTS has no parallel bonds (n/a).
 2. Scenes: reference_runs/bench/bench.yaml.in + the bed as explicit particles at rest; dt is the
    stepper's largest safe dt (its guard at max_impact_speed 1 m/s), rounded down; frames only
    at step 0 and the last step.
 3. Timings, each repeated --repeats times (median reported):
    * jdem: a run of S steps minus a run of 1 step (set-up, parsing, the two frames cancel);
+     also jdem's own timer of the loop (--timing), the steadier figure at 320k and 1M where the
+     set-up is ~25 s of scene parsing;
    * liggghts-jdem and stock liggghts: LIGGGHTS' "Loop time of ..." (the run loop only).  The
      decks come from scene_to_liggghts.py (stock: --builtin, dump removed).
    Also the CPU time of the loop (GNU time's user+sys of the S-step run minus that of a 1-step
@@ -31,7 +38,9 @@ stiff (E = 7e10 Pa), with or without rolling resistance; nu = 0.3, rho = 2500, e
    Average contacts per particle = 2 x particle-particle contacts / N at the last step (jdem and
    liggghts-jdem: the trajectory's /observables/contacts; stock: compute contact/atom).
 4. A callgrind profile of a 200-step jdem run (if valgrind is installed; OUT/profile.json).
-5. OUT/summary.json, OUT/runs.jsonl (every single timing), OUT/report.md with plots.
+5. OUT/summary.json, OUT/runs.jsonl (every single timing), OUT/report.md with plots; with the
+   flatness of jdem's cost per particle-step over N (max/min, target 1.25), its engine memory
+   against 300 B/particle + 100 B/contact, and ns per bond-step of the bonded variants.
 
 Timing results are appended to OUT/runs.jsonl and reused (a run already measured is not run
 again) unless --fresh; so an interrupted bench continues where it stopped.
@@ -151,10 +160,6 @@ def safe_dt(scene_path):
     v = guard_dt(scene_path)
     e = math.floor(math.log10(v)) - 1
     return math.floor(v / 10.0 ** e) * 10.0 ** e
-
-
-def round_sig(v):
-    return float("%.2g" % v)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -555,21 +560,20 @@ def make_decks(out, size, variant, scene, bed_path, steps, engines=ENGINES):
 # ---------------------------------------------------------------------------------------------
 # Timed runs
 
-def timed(cmd, cwd, timeout=None):
+def timed(cmd, cwd):
     """Run cmd under GNU time; returns (wall s, cpu s, peak RSS bytes, stdout, stderr, rc).  After
-    `timeout` seconds (default RUN_TIMEOUT_S) the whole process group (GNU time, mpirun, the
-    engine) is killed and RuntimeError raised."""
+    RUN_TIMEOUT_S (--timeout) the whole process group (GNU time, mpirun, the engine) is killed and
+    RuntimeError raised."""
     tf = os.path.join(cwd, ".time")
     full = [GNU_TIME, "-o", tf, "-f", "%e %U %S %M"] + cmd
-    timeout = RUN_TIMEOUT_S if timeout is None else timeout
     p = subprocess.Popen(full, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                          start_new_session=True)
     try:
-        so, se = p.communicate(timeout=timeout)
+        so, se = p.communicate(timeout=RUN_TIMEOUT_S)
     except subprocess.TimeoutExpired:
         os.killpg(p.pid, signal.SIGKILL)
         p.communicate()
-        raise RuntimeError("no result after %.0f s (--timeout), killed: %s" % (timeout, " ".join(cmd)))
+        raise RuntimeError("no result after %.0f s (--timeout), killed: %s" % (RUN_TIMEOUT_S, " ".join(cmd)))
     r = subprocess.CompletedProcess(full, p.returncode, so, se)
     try:
         e, u, s, m = open(tf).read().split()[-4:]
