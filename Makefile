@@ -146,10 +146,13 @@ demo: deps
 	@echo "reports: out/chung_ooi/report.md out/stability/report.md"
 
 # Performance benchmark (reference_runs/bench/README.md): settled beds, 3 engines, medians of 3.
-#   make bench [BENCH_SIZES=5k,20k,80k] [BENCH_REPEATS=3]     report: out/bench/report.md
+#   make bench [BENCH_SIZES=5k,20k,80k,320k,1M] [BENCH_VARIANTS=soft_mono,soft_mono_bonded]
+#              [BENCH_REPEATS=3]                              report: out/bench/report.md
+# 80k, 320k and 1M are tiled from the 20k bed; every variant at every size takes hours.
 .PHONY: bench
 bench: all
-	$(PY) scripts/bench.py $(if $(BENCH_SIZES),--sizes $(BENCH_SIZES)) $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
+	$(PY) scripts/bench.py $(if $(BENCH_SIZES),--sizes $(BENCH_SIZES)) $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS)) \
+	    $(if $(BENCH_VARIANTS),--variants $(BENCH_VARIANTS))
 	$(PY) scripts/bond_bench.py --engines jdem,liggghts-jdem --out out/bench/bonds $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
 
 # Parallel bonds (issue 4): every check of scripts/bond_checks.py in full length, in the engines

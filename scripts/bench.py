@@ -3,6 +3,7 @@
 
     scripts/bench.py [--sizes 5k,20k] [--variants all] [--engines jdem,liggghts-jdem,liggghts]
                      [--repeats 3] [--ranks-size 20k] [--out out/bench] [--fresh] [--report-only]
+                     [--prepare-only] [--timeout 3600] [--keep-files]
 
 Dense beds of spheres settled under gravity in an open box (reference_runs/bench/README.md):
 monodisperse R = 1 mm or bidisperse 1 mm / 2 mm (half and half by number), soft (E = 1e7 Pa) or
@@ -15,12 +16,18 @@ stiff (E = 7e10 Pa), with or without rolling resistance; nu = 0.3, rho = 2500, e
    contact overlaps by exactly 5e-10 m (damped Gauss-Newton least squares, CGLS, numpy only):
    the settled contact network with nearly zero forces, which gravity loads again in the timed
    run.  Soft and stiff variants start from the same bed (settling at the stiff time step would
-   take ~1e6 steps).
+   take ~1e6 steps).  80k, 320k and 1M are 2 x 2, 4 x 4 and 7 x 7 copies of the 20k bed side by
+   side (bench_tiling.py; settling 1M spheres would take ~1.5 h), checked against the
+   stepper's start-overlap rule.
+   The bonded variants (*_bonded) are the same beds with a parallel bond between every touching
+   pair, formed at step 0 by a bond rule; stock LIGGGHTS has no parallel bonds (n/a).
 2. Scenes: reference_runs/bench/bench.yaml.in + the bed as explicit particles at rest; dt is the
    stepper's largest safe dt (its guard at max_impact_speed 1 m/s), rounded down; frames only
    at step 0 and the last step.
 3. Timings, each repeated --repeats times (median reported):
    * jdem: a run of S steps minus a run of 1 step (set-up, parsing, the two frames cancel);
+     also jdem's own timer of the loop (--timing), the steadier figure at 320k and 1M where the
+     set-up is ~25 s of scene parsing;
    * liggghts-jdem and stock liggghts: LIGGGHTS' "Loop time of ..." (the run loop only).  The
      decks come from scene_to_liggghts.py (stock: --builtin, dump removed).
    Also the CPU time of the loop (GNU time's user+sys of the S-step run minus that of a 1-step
@@ -31,7 +38,9 @@ stiff (E = 7e10 Pa), with or without rolling resistance; nu = 0.3, rho = 2500, e
    Average contacts per particle = 2 x particle-particle contacts / N at the last step (jdem and
    liggghts-jdem: the trajectory's /observables/contacts; stock: compute contact/atom).
 4. A callgrind profile of a 200-step jdem run (if valgrind is installed; OUT/profile.json).
-5. OUT/summary.json, OUT/runs.jsonl (every single timing), OUT/report.md with plots.
+5. OUT/summary.json, OUT/runs.jsonl (every single timing), OUT/report.md with plots; with the
+   flatness of jdem's cost per particle-step over N (max/min, target 1.25), its engine memory
+   against 300 B/particle + 100 B/contact, and ns per bond-step of the bonded variants.
 
 Timing results are appended to OUT/runs.jsonl and reused (a run already measured is not run
 again) unless --fresh; so an interrupted bench continues where it stopped.
@@ -42,6 +51,7 @@ import math
 import os
 import re
 import shutil
+import signal
 import statistics
 import string
 import subprocess
@@ -64,12 +74,38 @@ LAYERS = 20                       # lattice layers before settling
 TOUCH = 5e-7                      # contact overlap of the bench beds, fraction of the smallest radius
 ETA_ROLL = 0.1                    # rolling-friction coefficient of the "roll" variants
 SIZES = {"5k": 5000, "20k": 20000, "80k": 80000, "320k": 320000, "1M": 1000000}
+# The large beds are k x k lateral copies of the settled, relaxed 20k bed (bench_tiling.py):
+# settling 1M spheres would take ~1.5 h.  N: 81 920, 327 680 and 1 003 520.
+TILES = {"80k": ("20k", 2), "320k": ("20k", 4), "1M": ("20k", 7)}
 STEPS = {"5k": 2000, "20k": 500, "80k": 200, "320k": 100, "1M": 50}
 SETTLE_TIME = {"mono": 0.12, "bi": 0.15}
 VARIANTS = [(stiff, disp, roll) for stiff in ("soft", "stiff") for disp in ("mono", "bi")
             for roll in ("", "_roll")]
-VARIANT_NAMES = ["%s_%s%s" % v for v in VARIANTS]
+# The bonded beds: the same beds with a parallel bond between every touching pair, formed at
+# step 0 (no rolling resistance; stock LIGGGHTS has no parallel bonds: jdem and liggghts-jdem only)
+BONDED_VARIANTS = ["%s_%s_bonded" % (stiff, disp) for stiff in ("soft", "stiff") for disp in ("mono", "bi")]
+VARIANT_NAMES = ["%s_%s%s" % v for v in VARIANTS] + BONDED_VARIANTS
 ENGINES = ("jdem", "liggghts-jdem", "liggghts")
+# Bonds of the bonded variants: axial stiffness per area kn = E / (2 R_small) (a bond as stiff as
+# a column of the grains' material between the two centres), kt = kn / (2 (1 + nu)) (the shear
+# modulus' ratio), strengths 1e9 Pa: ~1e5 x the stresses a 4 cm bed's weight puts on a bond, so
+# the bed stays intact while the failure test is still evaluated every step.  The bond rule
+# bonds pairs whose surfaces are at most BOND_MAX_GAP x the smaller radius apart: the relaxed
+# beds' contacts all overlap (by TOUCH), so these are exactly the pairs in contact at step 0.
+BOND_STRENGTH = 1.0e9
+BOND_MAX_GAP = 1.0e-9
+# A single engine run that takes longer than this is reported as failed (and the bench goes on)
+RUN_TIMEOUT_S = 3600.0
+PROFILE_MAX_SIZE = "20k"          # the callgrind profile runs on the smallest size, if not above this
+FLATNESS_TARGET = 1.25            # issue 6: jdem's cost per particle-step within 1.25x from 5k to 1M
+
+
+def is_bonded(variant):
+    return variant.endswith("_bonded")
+
+
+def variant_dispersity(variant):
+    return variant.split("_")[1]
 
 
 def log(msg):
@@ -126,10 +162,6 @@ def safe_dt(scene_path):
     return math.floor(v / 10.0 ** e) * 10.0 ** e
 
 
-def round_sig(v):
-    return float("%.2g" % v)
-
-
 # ---------------------------------------------------------------------------------------------
 # Beds
 
@@ -137,9 +169,13 @@ def h5_last_frame(path):
     import h5py
     with h5py.File(path, "r") as f:
         p = f["particles/all"]
+        obs = f["observables"]
         return dict(id=p["id"][...].astype(np.int64), radius=p["radius"][...].astype(float),
                     x=p["position/value"][-1].astype(float),
-                    contacts=float(f["observables/contacts/value"][-1]),
+                    contacts=float(obs["contacts/value"][-1]),
+                    # intact bonds at the first and the last frame (None without bonds)
+                    bonds_start=int(obs["bonds/value"][0]) if "bonds" in obs else None,
+                    bonds=int(obs["bonds/value"][-1]) if "bonds" in obs else None,
                     wall_contacts=float(f["observables/wall_contacts/value"][-1]),
                     kinetic_energy=float(f["observables/kinetic_energy/value"][-1]))
 
@@ -295,6 +331,8 @@ def make_bed(out, size, disp):
     path = base + ".npz"
     if os.path.exists(path):
         return path
+    if size in TILES:
+        return make_tiled_bed(out, size, disp, path)
     g = bed_geometry(size, disp)
     radius_line = ("radii: {values: [%s, %s], fractions: [0.5, 0.5]}" % (num(R_SMALL), num(R_LARGE))
                    if disp == "bi" else "radius: %s" % num(R_SMALL))
@@ -329,6 +367,49 @@ def make_bed(out, size, disp):
     return path
 
 
+def contact_counts(x, r, side):
+    """Pair and wall contacts per particle of a bed (every overlapping pair / wall contact), and
+    the contacts themselves."""
+    c = find_contacts(x, r, side)
+    return dict(pairs_per_particle=2.0 * len(c[0]) / len(r), wall_contacts_per_particle=len(c[4]) / len(r)), c
+
+
+def make_tiled_bed(out, size, disp, path):
+    """OUT/beds/SIZE_DISP.npz for the sizes of TILES: k x k copies of the base bed side by side,
+    the seams spaced by bench_tiling.seam_gap (no pair across a seam overlaps by more than the
+    bed's contact overlap), in a box of side k side + (k - 1) gap.  The whole tiled bed is then
+    checked against the stepper's start-overlap rule (every pair and wall contact, cell search)
+    and its contacts per particle compared with the base bed's.  Returns its path."""
+    import bench_tiling
+    base_size, k = TILES[size]
+    base = np.load(make_bed(out, base_size, disp))
+    binfo = json.loads(str(base["info"]))
+    t0 = time.time()
+    target = TOUCH * base["radius"].min()
+    gap = bench_tiling.seam_gap(base["x"], base["radius"], binfo["side"], target)
+    x, r, ids, side = bench_tiling.tile(base["x"], base["radius"], base["id"], binfo["side"], k, gap)
+    stats_base, _ = contact_counts(base["x"], base["radius"], binfo["side"])
+    stats, (I, J, _, ov, WI, _, WO) = contact_counts(x, r, side)
+    bad, badw = bench_tiling.start_overlap_violations(r, I, J, ov, WI, WO)
+    if bad or badw:
+        raise RuntimeError("tiled bed %s %s: %d pairs and %d wall contacts overlap by more than %g of the "
+                           "radius (worst: %s %s); build/jdem would refuse it"
+                           % (size, disp, len(bad), len(badw), bench_tiling.START_OVERLAP_TOL, bad[:1], badw[:1]))
+    info = dict(size=size, dispersity=disp, n=len(r), side=side, height=binfo["height"],
+                tiled_from=base_size, tiles=[k, k], seam_gap=gap, base_side=binfo["side"],
+                base=stats_base, tiled=stats,
+                pairs_per_particle_ratio=stats["pairs_per_particle"] / stats_base["pairs_per_particle"],
+                contacts_per_particle_ratio=(stats["pairs_per_particle"] + stats["wall_contacts_per_particle"])
+                / (stats_base["pairs_per_particle"] + stats_base["wall_contacts_per_particle"]),
+                max_overlap=float(max(ov.max(), WO.max())), generation_seconds=time.time() - t0)
+    log("bed %s %s: %d x %d tiles of %s, seam gap %.3g m, %d spheres: %s"
+        % (size, disp, k, k, base_size, gap, len(r), json.dumps(info)))
+    tmp = path[:-4] + ".part.npz"
+    np.savez(tmp, id=ids, radius=r, x=x, info=json.dumps(info))
+    os.replace(tmp, path)
+    return path
+
+
 # ---------------------------------------------------------------------------------------------
 # Scenes
 
@@ -336,15 +417,25 @@ def scene_path(out, size, variant):
     return os.path.join(out, "scenes", "%s_%s.yaml" % (size, variant))
 
 
+def bonds_yaml(E, r_small):
+    """The bonded variants' bond type and the rule that bonds every touching pair at step 0."""
+    kn = E / (2.0 * r_small)
+    return ("bond_types:\n  bench: {normal_stiffness: %s, shear_stiffness: %s, tensile_strength: %s, "
+            "shear_strength: %s}\nbond_rules:\n  - {type: bench, time: 0.0, max_gap: %s}\n"
+            % (num(kn), num(kn / (2.0 * (1.0 + 0.3))), num(BOND_STRENGTH), num(BOND_STRENGTH), num(BOND_MAX_GAP)))
+
+
 def make_scene(out, size, variant, bed_path, steps):
-    stiff, disp, roll = variant.split("_")[0], variant.split("_")[1], variant.endswith("_roll")
+    """The bench scene of a variant on a bed; dt is the guard's (rounded down): for the bonded
+    variants that includes the bonds' bound."""
+    stiff, roll = variant.split("_")[0], variant.endswith("_roll")
     path = scene_path(out, size, variant)
     bed = np.load(bed_path)
     info = json.loads(str(bed["info"]))
-    g = bed_geometry(size, disp)
+    E = E_STIFF if stiff == "stiff" else E_SOFT
     kw = dict(name="bench_%s_%s" % (size, variant), variant=variant, n=len(bed["id"]),
-              E=num(E_STIFF if stiff == "stiff" else E_SOFT), eta=num(ETA_ROLL if roll else 0.0),
-              walls=walls_yaml(info["side"], g["height"]))
+              E=num(E), eta=num(ETA_ROLL if roll else 0.0), walls=walls_yaml(info["side"], info["height"]),
+              bonds=bonds_yaml(E, float(bed["radius"].min())) if is_bonded(variant) else "")
     os.makedirs(os.path.dirname(path), exist_ok=True)
     head = fill("bench.yaml.in", dt=1.0, steps=1, **kw)
     lines = ["  - {id: %d, material: grain, radius: %s, position: [%s, %s, %s]}\n"
@@ -358,36 +449,108 @@ def make_scene(out, size, variant, bed_path, steps):
     return path, dt
 
 
-def make_decks(out, size, variant, scene, steps):
-    """Resolved scene and the two LIGGGHTS decks (ours and stock) in OUT/decks/SIZE_VARIANT/."""
-    d = os.path.join(out, "decks", "%s_%s" % (size, variant))
+def resolved_scene(scene, bed_path, d):
+    """The resolved scene of `scene` (what `jdem resolve` prints) as the dict that
+    scene_to_liggghts.write_deck reads, without loading the resolved YAML of every particle and
+    bond: at 1M that is ~25 million YAML nodes, ~14 GB and minutes per deck.  The full resolved
+    text still goes to D/resolved.yaml (the LIGGGHTS trajectory keeps it in /parameters).  Parsed
+    as YAML: `jdem resolve` of the scene cut to its first particle (materials, walls, time, bond
+    types: everything but the particles and bonds).  The particles are the bed's, the values the
+    scene lists, in the resolved schema of that first particle; the bonds are those jdem forms at
+    step 0 (/connectivity/bonds of a 1-step run), so the deck gets exactly jdem's.
+    tests/engine/test_bench_tiling.py checks that the decks equal those scene_to_liggghts.py
+    writes from the whole resolved YAML."""
+    import h5py
+    import yaml
     os.makedirs(d, exist_ok=True)
-    resolved = os.path.join(d, "resolved.yaml")
-    r = subprocess.run([JDEM, "resolve", scene], capture_output=True, text=True)
+    with open(os.path.join(d, "resolved.yaml"), "w") as f:
+        r = subprocess.run([JDEM, "resolve", scene], stdout=f, stderr=subprocess.PIPE, text=True)
     if r.returncode != 0:
-        raise RuntimeError(r.stderr)
-    with open(resolved, "w") as f:
-        f.write(r.stdout)
+        raise RuntimeError("jdem resolve %s failed:\n%s" % (scene, r.stderr))
+    with open(scene) as f:
+        text = f.read()
+    first = text.index("\nparticles:\n") + len("\nparticles:\n")
+    head = os.path.join(d, "first_particle.yaml")
+    with open(head, "w") as f:
+        f.write(text[:text.index("\n", first) + 1])
+    r = subprocess.run([JDEM, "resolve", head], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError("jdem resolve %s failed:\n%s" % (head, r.stderr))
+    sc = yaml.load(r.stdout, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    p0 = sc["particles"][0]
+    bed = np.load(bed_path)
+    sc["particles"] = [dict(p0, id=int(i), radius=float(rad), position=[float(c) for c in x])
+                       for i, rad, x in zip(bed["id"], bed["radius"], bed["x"])]
+    if sc.get("bond_types"):
+        one = os.path.join(d, "bonds_step0.yaml")
+        with open(one, "w") as f:
+            f.write(re.sub(r"(?m)^  steps: \d+", "  steps: 1", text))
+        h5 = os.path.join(d, "bonds_step0.h5")
+        r = subprocess.run([JDEM, "run", one, "-o", h5, "--quiet", "--force"], capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError("jdem run %s failed:\n%s" % (one, r.stderr))
+        names = list(sc["bond_types"])
+        with h5py.File(h5, "r") as f:
+            g = f["connectivity"]
+            step0 = g["bond_formed_step"][...] == 0
+            ids, types = g["bonds"][...][step0], g["bond_type"][...][step0]
+        sc["bonds"] = [{"ids": [int(a), int(b)], "type": names[t]} for (a, b), t in zip(ids.tolist(), types.tolist())]
+        for f in (one, h5, h5[:-3] + ".xdmf"):
+            os.remove(f)
+    return sc
+
+
+def link_or_copy(src, dst):
+    if os.path.exists(dst):
+        os.remove(dst)
+    try:
+        os.link(src, dst)
+    except OSError:
+        shutil.copyfile(src, dst)
+
+
+def adapt_deck(text, engine, steps):
+    """The bench's edits of a deck from scene_to_liggghts: thermo at the last step only, no
+    domain split along z, and for stock LIGGGHTS its own contact count instead of our dump."""
+    text = re.sub(r"(?m)^thermo\s+\d+\s*$", "thermo          %d" % steps, text)
+    # the box reaches twice the bed's height (the walls' extent): never split it along z,
+    # or one rank would own every particle
+    text = re.sub(r"(?m)^(boundary .*)$", r"\1\nprocessors      * * 1", text, count=1)
+    if engine == "liggghts":
+        # stock LIGGGHTS has no dump h5md/jdem: count contacts with its own computes instead
+        text = re.sub(r"(?m)^dump .*$\n", "", text)
+        text = text.replace("\nrun ", "\ncompute cc all contact/atom\ncompute csum all reduce sum c_cc\n"
+                            "thermo_style    custom step atoms ke c_csum\nrun ", 1)
+    return text
+
+
+def deck_dir(out, size, variant):
+    return os.path.join(out, "decks", "%s_%s" % (size, variant))
+
+
+def make_decks(out, size, variant, scene, bed_path, steps, engines=ENGINES):
+    """The LIGGGHTS decks (ours and stock) of `engines` in OUT/decks/SIZE_VARIANT/ENGINE/in.bench,
+    from resolved_scene() of the bench scene on its bed."""
+    import scene_to_liggghts
+    d = deck_dir(out, size, variant)
+    wanted = [e for e in ("liggghts-jdem", "liggghts") if e in engines
+              and not (e == "liggghts" and is_bonded(variant))]  # stock LIGGGHTS has no parallel bonds
+    if not wanted:
+        return {}
+    sc = resolved_scene(scene, bed_path, d)
     decks = {}
-    for engine, extra in (("liggghts-jdem", []), ("liggghts", ["--builtin"])):
+    for engine in wanted:
         dd = os.path.join(d, engine)
         os.makedirs(dd, exist_ok=True)
         deck = os.path.join(dd, "in.bench")
-        r = subprocess.run([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), resolved, "-o", deck,
-                            "--trajectory", os.path.join(dd, "out.h5")] + extra, capture_output=True, text=True)
-        if r.returncode != 0:
-            raise RuntimeError("deck generation failed:\n" + r.stderr)
+        link_or_copy(os.path.join(d, "resolved.yaml"), os.path.join(dd, "resolved.yaml"))  # 270 MB at 1M bonded
+        try:
+            scene_to_liggghts.write_deck(sc, os.path.join(dd, "resolved.yaml"), deck, os.path.join(dd, "out.h5"),
+                                         builtin=engine == "liggghts")
+        except SystemExit:  # scene_to_liggghts.fail() has printed the reason
+            raise RuntimeError("deck generation failed for %s (%s)" % (scene, engine))
         with open(deck) as f:
-            text = f.read()
-        text = re.sub(r"(?m)^thermo\s+\d+\s*$", "thermo          %d" % steps, text)
-        # the box reaches twice the bed's height (the walls' extent): never split it along z,
-        # or one rank would own every particle
-        text = re.sub(r"(?m)^(boundary .*)$", r"\1\nprocessors      * * 1", text, count=1)
-        if engine == "liggghts":
-            # stock LIGGGHTS has no dump h5md/jdem: count contacts with its own computes instead
-            text = re.sub(r"(?m)^dump .*$\n", "", text)
-            text = text.replace("\nrun ", "\ncompute cc all contact/atom\ncompute csum all reduce sum c_cc\n"
-                                "thermo_style    custom step atoms ke c_csum\nrun ", 1)
+            text = adapt_deck(f.read(), engine, steps)
         with open(deck, "w") as f:
             f.write(text)
         decks[engine] = deck
@@ -398,10 +561,20 @@ def make_decks(out, size, variant, scene, steps):
 # Timed runs
 
 def timed(cmd, cwd):
-    """Run cmd under GNU time; returns (wall s, cpu s, peak RSS bytes, stdout, stderr, rc)."""
+    """Run cmd under GNU time; returns (wall s, cpu s, peak RSS bytes, stdout, stderr, rc).  After
+    RUN_TIMEOUT_S (--timeout) the whole process group (GNU time, mpirun, the engine) is killed and
+    RuntimeError raised."""
     tf = os.path.join(cwd, ".time")
     full = [GNU_TIME, "-o", tf, "-f", "%e %U %S %M"] + cmd
-    r = subprocess.run(full, cwd=cwd, capture_output=True, text=True)
+    p = subprocess.Popen(full, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    try:
+        so, se = p.communicate(timeout=RUN_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        p.communicate()
+        raise RuntimeError("no result after %.0f s (--timeout), killed: %s" % (RUN_TIMEOUT_S, " ".join(cmd)))
+    r = subprocess.CompletedProcess(full, p.returncode, so, se)
     try:
         e, u, s, m = open(tf).read().split()[-4:]
         wall, cpu, rss = float(e), float(u) + float(s), int(m) * 1024
@@ -429,12 +602,14 @@ def calibrate_liggghts(deck, engine):
         f.write(re.sub(r"(?m)^run\s+\d+\s*$", "run             1", text))
     exe = LIGGGHTS_JDEM if engine == "liggghts-jdem" else LIGGGHTS
     w, c, rss, so, se, rc = timed([exe, "-in", "in.bench1", "-log", "log.calib", "-screen", "none"], d)
+    remove_files(os.path.join(d, "out.h5"))
     if rc:
         raise RuntimeError("%s 1-step calibration failed:\n%s" % (engine, se[-2000:]))
     return dict(wall_s=w, cpu_s=c, peak_rss=rss)
 
 
 TIMING_RE = re.compile(r"jdem-timing: (.*)")
+LOOP_PARTS = ("neighbour", "pairs", "walls", "integration", "output")  # jdem --timing's parts of the loop
 
 
 def jdem_split(stderr):
@@ -445,8 +620,18 @@ def jdem_split(stderr):
     return {k: float(v) for k, v in (kv.split("=") for kv in m[-1].split())}
 
 
-def run_jdem(out, size, variant, scene, steps, n, threads=1, extra=(), tag=""):
-    """Time `jdem run SCENE --threads T [extra]` as run(S) - run(1); returns the record."""
+def remove_files(*paths):
+    """Delete the large files of a finished timing (at 1M a trajectory of two frames is ~240 MB, a
+    scene copy 125 MB: a full sweep would otherwise fill the disk)."""
+    for p in paths:
+        for q in (p, p[:-3] + ".xdmf" if p.endswith(".h5") else None):
+            if q and os.path.exists(q):
+                os.remove(q)
+
+
+def run_jdem(out, size, variant, scene, steps, n, threads=1, extra=(), tag="", keep_trajectory=False):
+    """Time `jdem run SCENE --threads T [extra]` as run(S) - run(1); returns the record.  The
+    trajectories and the 1-step scene are deleted once read unless keep_trajectory."""
     d = os.path.join(out, "runs", "%s_%s" % (size, variant), "jdem%s_t%d" % (tag, threads))
     os.makedirs(d, exist_ok=True)
     one = os.path.join(d, "one.yaml")
@@ -463,9 +648,13 @@ def run_jdem(out, size, variant, scene, steps, n, threads=1, extra=(), tag=""):
     if rc or rc1:
         raise RuntimeError("jdem failed:\n" + e + e1)
     fr = h5_last_frame(traj)
+    remove_files(one, os.path.join(d, "one.h5"))
+    if not keep_trajectory:
+        remove_files(traj)
     return dict(wall_s=w - w1, cpu_s=c - c1, total_wall_s=w, setup_wall_s=w1, peak_rss=rss,
                 contacts_per_particle=2.0 * fr["contacts"] / n, timing="run(S) - run(1)",
-                jdem_split=jdem_split(e), trajectory=traj)
+                bonds_start=fr["bonds_start"], bonds_end=fr["bonds"],
+                jdem_split=jdem_split(e), trajectory=traj if keep_trajectory else None)
 
 
 LOOP_RE = re.compile(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
@@ -483,9 +672,12 @@ def run_liggghts(out, size, variant, deck, engine, ranks, steps, n):
     loop, procs, nsteps, natoms = m[-1]
     if int(natoms) != n:
         raise RuntimeError("%s lost atoms: %s of %d" % (engine, natoms, n))
+    bonds = (None, None)
     if engine == "liggghts-jdem":
         fr = h5_last_frame(os.path.join(d, "out.h5"))
         cpp = 2.0 * fr["contacts"] / n
+        bonds = (fr["bonds_start"], fr["bonds"])
+        remove_files(os.path.join(d, "out.h5"))
     else:  # thermo: step atoms ke c_csum  (contact/atom counts each contact at both atoms)
         rows = re.findall(r"(?m)^\s*(\d+)\s+(\d+)\s+\S+\s+(\S+)\s*$", logtext)
         cpp = float(rows[-1][2]) / n if rows else float("nan")
@@ -493,6 +685,7 @@ def run_liggghts(out, size, variant, deck, engine, ranks, steps, n):
     split = {k.strip().lower(): float(v) for k, v in
              re.findall(r"(?m)^(Pair|Neigh|Comm|Outpt|Other|Modify)\s+time \(%\) = \S+ \(([0-9.eE+-]+)\)", tail)}
     return dict(wall_s=float(loop), cpu_s=c, total_wall_s=w, peak_rss=rss, contacts_per_particle=cpp,
+                bonds_start=bonds[0], bonds_end=bonds[1],
                 timing="LIGGGHTS loop time", liggghts_split_percent=split)
 
 
@@ -525,7 +718,8 @@ def feature_check(out, size, steps, repeats):
     n = int(np.load(make_bed(out, size, "mono"))["id"].shape[0])
     res = {}
     for tag, extra in (("specialised", []), ("general", ["--all-laws"])):
-        runs = [run_jdem(out, size, "soft_mono_plain", scene, steps, n, extra=extra, tag="_" + tag)
+        runs = [run_jdem(out, size, "soft_mono_plain", scene, steps, n, extra=extra, tag="_" + tag,
+                         keep_trajectory=True)
                 for _ in range(repeats)]
         res[tag] = dict(wall_s=[r["wall_s"] for r in runs], cpu_s=[r["cpu_s"] for r in runs],
                         wall_s_median=statistics.median(r["wall_s"] for r in runs),
@@ -584,6 +778,13 @@ def summarise(runs):
         cpp = statistics.median(r["contacts_per_particle"] for r in rs)
         splits = [r["jdem_split"] for r in rs if r.get("jdem_split")]
         split = ({k: statistics.median(s[k] for s in splits) for k in splits[0]} if splits else None)
+        engine_bytes = split.get("engine_bytes") if split else None
+        # jdem's own timer of the loop (the sum of its --timing parts; leaves out only the
+        # watchdog's per-step scan): immune to the noise of the set-up that run(S) - run(1)
+        # subtracts, which at 1M is ~25 s of scene parsing against a loop of ~10 s
+        timer = sum(split[k] for k in LOOP_PARTS) if split else None
+        budget = 300.0 * n + 100.0 * 0.5 * cpp * n
+        bonds = rs[0].get("bonds_start")
         rows.append(dict(scene="%s_%s" % (size, variant), size=size, variant=variant, engine=engine,
                          threads=threads, ranks=ranks, N=n, steps=steps, dt=rs[0]["dt"], repeats=len(rs),
                          wall_seconds=wall, wall_seconds_all=[r["wall_s"] for r in rs],
@@ -591,15 +792,71 @@ def summarise(runs):
                          particle_steps_per_cpu_second=(n * steps / cpu_loop) if cpu_loop and cpu_loop > 0 else None,
                          particle_steps_per_second=n * steps / wall if wall > 0 else float("nan"),
                          contacts_per_particle=cpp,
+                         ns_per_particle_step=1e9 * wall / (n * steps),
+                         jdem_timer_seconds=timer,
+                         ns_per_particle_step_timer=1e9 * timer / (n * steps) if timer else None,
+                         bonds=bonds, bonds_intact_end=min((r.get("bonds_end") for r in rs), default=None)
+                         if bonds is not None else None,
+                         ns_per_bond_step=1e9 * wall / (bonds * steps) if bonds else None,
                          peak_rss_bytes=rss, bytes_per_particle=rss * ranks / n,
-                         memory_budget_bytes=300.0 * n + 100.0 * 0.5 * cpp * n,
+                         memory_budget_bytes=budget,
+                         engine_bytes=engine_bytes,
+                         engine_bytes_per_particle=engine_bytes / n if engine_bytes else None,
+                         engine_memory_within_budget=engine_bytes <= budget if engine_bytes else None,
                          timing=rs[0]["timing"], jdem_split_seconds=split,
                          liggghts_split_percent=rs[0].get("liggghts_split_percent"),
                          load_average=statistics.median(r.get("load_average", 0.0) for r in rs)))
+    # the bonds' own cost: the bonded row against the same bed, engine and threads without bonds
+    # (same steps; the bonded dt may be shorter, which does not change the work per step)
+    ix = {(r["size"], r["variant"], r["engine"], r["ranks"], r["threads"]): r for r in rows}
+    for r in rows:
+        plain = ix.get((r["size"], r["variant"][:-len("_bonded")], r["engine"], r["ranks"], r["threads"]))
+        if r["bonds"] and is_bonded(r["variant"]) and plain:
+            r["bond_marginal_ns_per_bond_step"] = (1e9 * (r["wall_seconds"] - plain["wall_seconds"])
+                                                   / (r["bonds"] * r["steps"]))
     return rows
 
 
+def flatness(rows):
+    """Issue 6's scaling target: jdem's ns per particle-step, max / min over the sizes run, per
+    variant and thread count (1 process), from wall time and (1 thread) from CPU time."""
+    groups = {}
+    for r in rows:
+        if r["engine"] == "jdem" and r["ranks"] == 1:
+            groups.setdefault((r["variant"], r["threads"]), []).append(r)
+    out = []
+    for (variant, threads), rs in groups.items():
+        if len(rs) < 2:
+            continue
+        rs.sort(key=lambda r: r["N"])
+        wall = [r["ns_per_particle_step"] for r in rs]
+        timer = [r["ns_per_particle_step_timer"] for r in rs if r.get("ns_per_particle_step_timer")]
+        cpu = [1e9 / r["particle_steps_per_cpu_second"] for r in rs if r.get("particle_steps_per_cpu_second")]
+        out.append(dict(variant=variant, threads=threads, sizes=[r["size"] for r in rs], N=[r["N"] for r in rs],
+                        ns_per_particle_step=wall, ratio_wall=max(wall) / min(wall),
+                        timer_ns_per_particle_step=timer if len(timer) == len(rs) else None,
+                        ratio_timer=max(timer) / min(timer) if len(timer) == len(rs) else None,
+                        cpu_ns_per_particle_step=cpu if len(cpu) == len(rs) else None,
+                        ratio_cpu=max(cpu) / min(cpu) if len(cpu) == len(rs) else None,
+                        target=FLATNESS_TARGET, met_wall=max(wall) / min(wall) <= FLATNESS_TARGET,
+                        met_timer=max(timer) / min(timer) <= FLATNESS_TARGET if len(timer) == len(rs) else None))
+    out.sort(key=lambda f: (VARIANT_NAMES.index(f["variant"]) if f["variant"] in VARIANT_NAMES else 99, f["threads"]))
+    return out
+
+
+def bed_infos(out):
+    """The generation record of every bed in OUT/beds (tiling: seam gap, contacts per particle
+    against the base bed's, generation seconds)."""
+    d = os.path.join(out, "beds")
+    infos = {}
+    for name in sorted(os.listdir(d)) if os.path.isdir(d) else []:
+        if name.endswith(".npz") and not name.endswith(".part.npz"):
+            infos[name[:-4]] = json.loads(str(np.load(os.path.join(d, name))["info"]))
+    return infos
+
+
 def main():
+    global RUN_TIMEOUT_S
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sizes", default=os.environ.get("BENCH_SIZES", "5k,20k"))
     ap.add_argument("--variants", default=os.environ.get("BENCH_VARIANTS", "all"))
@@ -617,9 +874,16 @@ def main():
                     help="variants whose jdem runs use every --threads count ('all' for every variant); "
                          "the others run on 1 thread (default soft_mono: the beds issue 6 sets the "
                          "thread target on; keeps make bench short)")
+    ap.add_argument("--timeout", type=float, default=RUN_TIMEOUT_S,
+                    help="seconds after which one engine run is killed and recorded as failed")
+    ap.add_argument("--keep-files", action="store_true",
+                    help="keep the LIGGGHTS decks of the tiled sizes after their timings (~0.5 GB per variant at 1M)")
     ap.add_argument("--report-only", action="store_true")
+    ap.add_argument("--prepare-only", action="store_true",
+                    help="generate the beds, scenes and decks only (no timings, no report)")
     ap.add_argument("--no-profile", action="store_true", help="skip the callgrind profile of jdem")
     a = ap.parse_args()
+    RUN_TIMEOUT_S = a.timeout
     out = os.path.abspath(a.out)
     os.makedirs(out, exist_ok=True)
     runs_path = os.path.join(out, "runs.jsonl")
@@ -634,29 +898,42 @@ def main():
         if s not in SIZES:
             ap.error("unknown size %s (valid: %s)" % (s, ", ".join(SIZES)))
     variants = VARIANT_NAMES if a.variants == "all" else a.variants.split(",")
+    for v in variants:
+        if v not in VARIANT_NAMES:
+            ap.error("unknown variant %s (valid: all, %s)" % (v, ", ".join(VARIANT_NAMES)))
     engines = a.engines.split(",")
     threads = [int(t) for t in a.threads.split(",") if t]
 
     if not a.report_only:
         done = {}
         for r in load_runs(runs_path):
+            if r.get("failed"):
+                continue  # a failed run is tried again
             key = (r["size"], r["variant"], r["engine"], r["ranks"], r.get("threads", 1), r["steps"])
             done[key] = done.get(key, 0) + 1
         for size in sizes:
             beds = {disp: make_bed(out, size, disp) for disp in ("mono", "bi")
-                    if any(v.split("_")[1] == disp for v in variants)}
+                    if any(variant_dispersity(v) == disp for v in variants)}
             steps = steps_of[size]
             for variant in variants:
-                disp = variant.split("_")[1]
+                disp = variant_dispersity(variant)
+                t0 = time.time()
                 scene, dt = make_scene(out, size, variant, beds[disp], steps)
+                t_scene = time.time() - t0
                 n = int(np.load(beds[disp])["id"].shape[0])
-                decks = make_decks(out, size, variant, scene, steps)
+                t0 = time.time()
+                decks = make_decks(out, size, variant, scene, beds[disp], steps, engines)
+                log("%s %s: scene and decks ready (%.0f s)" % (size, variant, time.time() - t0 + t_scene))
+                if a.prepare_only:
+                    continue
                 jobs = []
                 for engine in engines:
                     if engine == "jdem":
                         many = a.threads_variants == "all" or variant in a.threads_variants.split(",")
                         jobs += [(engine, 1, t) for t in (threads if many else [1])]
                         continue
+                    if engine not in decks:
+                        continue  # bonded variant: stock LIGGGHTS has no parallel bonds (n/a)
                     jobs.append((engine, 1, 1))
                     if size == a.ranks_size:
                         jobs.append((engine, 2, 1))
@@ -665,10 +942,19 @@ def main():
                         key = (size, variant, engine, ranks, nt, steps)
                         if done.get(key, 0) > rep:
                             continue
-                        if engine == "jdem":
-                            res = run_jdem(out, size, variant, scene, steps, n, threads=nt)
-                        else:
-                            res = run_liggghts(out, size, variant, decks[engine], engine, ranks, steps, n)
+                        try:
+                            if engine == "jdem":
+                                res = run_jdem(out, size, variant, scene, steps, n, threads=nt)
+                            else:
+                                res = run_liggghts(out, size, variant, decks[engine], engine, ranks, steps, n)
+                        except RuntimeError as e:  # timeouts, crashes: recorded, the bench goes on
+                            log("%s %s %s np=%d threads=%d rep %d FAILED: %s"
+                                % (size, variant, engine, ranks, nt, rep, str(e)[-2000:]))
+                            with open(runs_path, "a") as f:
+                                f.write(json.dumps(dict(size=size, variant=variant, engine=engine, ranks=ranks,
+                                                        threads=nt, n=n, steps=steps, repeat=rep,
+                                                        failed=str(e)[-2000:])) + "\n")
+                            continue
                         res.update(size=size, variant=variant, engine=engine, ranks=ranks, threads=nt,
                                    n=n, steps=steps, dt=dt, repeat=rep, when=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                                    load_average=os.getloadavg()[0],
@@ -683,29 +969,46 @@ def main():
                 for rep in range(a.repeats):  # CPU-time calibration of the LIGGGHTS engines (1 rank)
                     for engine in engines:
                         key = (size, variant, engine + "/calib", 1, 1, steps)
-                        if engine == "jdem" or done.get(key, 0) > rep:
+                        if engine == "jdem" or engine not in decks or done.get(key, 0) > rep:
                             continue
-                        res = calibrate_liggghts(decks[engine], engine)
+                        try:
+                            res = calibrate_liggghts(decks[engine], engine)
+                        except RuntimeError as e:
+                            log("%s %s %s 1-step calibration FAILED: %s" % (size, variant, engine, str(e)[-2000:]))
+                            continue
                         res.update(size=size, variant=variant, engine=engine + "/calib", ranks=1, n=n,
                                    steps=steps, dt=dt, repeat=rep, load_average=os.getloadavg()[0])
                         with open(runs_path, "a") as f:
                             f.write(json.dumps(res) + "\n")
+                if size in TILES and not a.keep_files and os.path.isdir(deck_dir(out, size, variant)):
+                    shutil.rmtree(deck_dir(out, size, variant))  # ~0.5 GB per variant at 1M
+    if a.prepare_only:
+        return 0
+    # the feature check and the profile on the smallest size run (callgrind is ~50x slower than
+    # the run itself: never above PROFILE_MAX_SIZE)
+    small = min(sizes, key=SIZES.get)
     if not a.report_only and "jdem" in engines and "soft_mono" in variants:
-        feature_check(out, sizes[0], steps_of[sizes[0]], a.repeats)
+        feature_check(out, small, steps_of[small], a.repeats)
     if not a.report_only and not a.no_profile and not os.path.exists(os.path.join(out, "profile.json")):
         import bench_report
-        sc = scene_path(out, sizes[0], "soft_mono")
-        if os.path.exists(sc):
+        sc = scene_path(out, small, "soft_mono")
+        if SIZES[small] > SIZES[PROFILE_MAX_SIZE]:
+            log("no callgrind profile: the smallest size run (%s) is above %s" % (small, PROFILE_MAX_SIZE))
+        elif os.path.exists(sc):
             log("profiling jdem (callgrind) on %s" % sc)
-            bench_report.profile_jdem(out, sc, int(np.load(make_bed(out, sizes[0], "mono"))["id"].shape[0]))
-    rows = summarise(load_runs(runs_path))
+            bench_report.profile_jdem(out, sc, int(np.load(make_bed(out, small, "mono"))["id"].shape[0]))
+    all_runs = load_runs(runs_path)
+    rows = summarise([r for r in all_runs if not r.get("failed")])
+    failures = [r for r in all_runs if r.get("failed")]
     fc_path = os.path.join(out, "feature_check.json")
     fc = json.load(open(fc_path)) if os.path.exists(fc_path) else None
+    beds = bed_infos(out)
     with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump(dict(generated=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-                       machine=machine_info(), runs=rows, feature_check=fc), f, indent=1)
+                       machine=machine_info(), runs=rows, flatness=flatness(rows), beds=beds,
+                       failures=failures, feature_check=fc), f, indent=1)
     import bench_report
-    bench_report.write_report(out, rows, machine_info(), fc)
+    bench_report.write_report(out, rows, machine_info(), fc, flatness(rows), beds, failures)
     log("wrote %s and %s" % (os.path.join(out, "summary.json"), os.path.join(out, "report.md")))
     return 0
 

@@ -1,5 +1,6 @@
 """bench_report.py — OUT/report.md and its plots from the summary rows of scripts/bench.py."""
 import json
+import math
 import os
 import re
 import subprocess
@@ -29,7 +30,10 @@ def plots(out, rows, variants, sizes):
     import matplotlib.pyplot as plt
     ix = index(rows)
     files = []
-    fig, axes = plt.subplots(2, 4, figsize=(16, 7.5), sharey=True)
+    nrow = max(1, math.ceil(len(variants) / 4))
+    fig, axes = plt.subplots(nrow, 4, figsize=(16, 3.75 * nrow), sharey=True, squeeze=False)
+    for ax in axes.flat[len(variants):]:
+        ax.set_visible(False)
     for ax, v in zip(axes.flat, variants):
         for e, mk in (("jdem", "o-"), ("jdem/2t", "o-."), ("liggghts-jdem", "s--"), ("liggghts", "^:")):
             pts = [(ix[(s, v, e, 1)]["N"], ix[(s, v, e, 1)]["particle_steps_per_second"])
@@ -40,8 +44,8 @@ def plots(out, rows, variants, sizes):
         ax.set_title(v)
         ax.set_xlabel("N")
         ax.grid(alpha=0.3)
-    axes[0, 0].set_ylabel("particle-steps / s (1 rank)")
-    axes[1, 0].set_ylabel("particle-steps / s (1 rank)")
+    for row in axes:
+        row[0].set_ylabel("particle-steps / s (1 rank)")
     axes[0, 0].legend(fontsize=8)
     fig.tight_layout()
     p = os.path.join(out, "throughput.png")
@@ -139,7 +143,86 @@ def feature_section(fc):
             % (fc["speed_ratio_wall"], fc["speed_ratio_cpu"], "yes" if fc["identical_trajectory"] else "NO")]
 
 
-def write_report(out, rows, machine, feature_check=None):
+def flatness_section(flat):
+    if not flat:
+        return []
+    L = ["## Cost per particle-step against N (jdem)\n\n",
+         "Nanoseconds per particle-step of jdem at each size run, and the flatness ratio max / min over the "
+         "sizes (issue 6: <= %.2f from 5k to 1M), from three measures of the loop: wall time as run(S) - run(1) "
+         "(the throughput tables' measure), jdem's own timer of the loop (`--timing`: the sum of its parts; "
+         "immune to the noise of the set-up that run(S) - run(1) subtracts, ~25 s of scene parsing at 1M, so the "
+         "figure to use from 320k up), and CPU time (1 thread; least disturbed by other jobs). On a loaded "
+         "machine the wall-time ratios measure the load as much as the code.\n\n" % flat[0]["target"],
+         "| variant | threads | sizes | ns/particle-step: wall | timer | CPU | ratio: wall | timer | CPU | "
+         "target met (timer) |\n|---|---:|---|---|---|---|---:|---:|---:|---|\n"]
+    for f in flat:
+        cpu, timer = f.get("cpu_ns_per_particle_step"), f.get("timer_ns_per_particle_step")
+        L.append("| %s | %d | %s | %s | %s | %s | %.2f | **%s** | %s | %s |\n" % (
+            f["variant"], f["threads"], ", ".join(f["sizes"]), ", ".join("%.0f" % v for v in f["ns_per_particle_step"]),
+            ", ".join("%.0f" % v for v in timer) if timer else "–", ", ".join("%.0f" % v for v in cpu) if cpu else "–",
+            f["ratio_wall"], fmt(f.get("ratio_timer"), ".2f"), fmt(f.get("ratio_cpu"), ".2f"),
+            "–" if f.get("met_timer") is None else "yes" if f["met_timer"] else "no"))
+    L.append("\n")
+    return L
+
+
+def bonded_section(rows):
+    """ns per particle-step and per bond-step of the bonded variants."""
+    br = [r for r in rows if r.get("bonds")]
+    if not br:
+        return []
+    L = ["## Bonded beds\n\n",
+         "The same beds with a parallel bond between every touching pair (formed at step 0), at the guard's dt "
+         "with the bonds' bound. Stock LIGGGHTS has no parallel-bond model: **n/a**. Per bond-step: the whole "
+         "loop divided by bonds x steps, and the bonds' own share (bonded minus the same bed without bonds, same "
+         "engine and threads, divided by bonds x steps; comparable with `make bonds`' ns per bond-step).\n\n",
+         "| size | variant | engine | threads | ranks | N | bonds (start / end) | dt [s] | ns/particle-step | "
+         "ns/bond-step (whole loop) | ns/bond-step (bonds' share) | stock liggghts |\n"
+         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n"]
+    for r in br:
+        L.append("| %s | %s | %s | %d | %d | %d | %d / %s | %.2g | %.0f | %s | %s | n/a |\n" % (
+            r["size"], r["variant"], r["engine"], r["threads"], r["ranks"], r["N"], r["bonds"],
+            r["bonds_intact_end"] if r.get("bonds_intact_end") is not None else "–", r["dt"],
+            r["ns_per_particle_step"], fmt(r.get("ns_per_bond_step"), ".0f"),
+            fmt(r.get("bond_marginal_ns_per_bond_step"), ".0f")))
+    L.append("\n")
+    return L
+
+
+def beds_section(beds):
+    tiled = {k: v for k, v in (beds or {}).items() if v.get("tiled_from")}
+    if not tiled:
+        return []
+    L = ["## Tiled beds\n\n",
+         "80k, 320k and 1M are k x k copies of the settled, relaxed 20k bed side by side (reference_runs/bench/"
+         "README.md). Contacts per particle of the generated bed (every contact at the bed's touch overlap) "
+         "against the base bed's.\n\n",
+         "| bed | tiles | N | seam gap [m] | pairs/particle (base / tiled) | wall contacts/particle (base / tiled) | "
+         "all contacts, tiled / base | max start overlap [m] | generation [s] |\n"
+         "|---|---|---:|---:|---|---|---:|---:|---:|\n"]
+    for name, b in sorted(tiled.items(), key=lambda kv: kv[1]["n"]):
+        L.append("| %s | %d x %d of %s | %d | %.3g | %.3f / %.3f | %.3f / %.3f | %.4f | %.3g | %.1f |\n" % (
+            name, b["tiles"][0], b["tiles"][1], b["tiled_from"], b["n"], b["seam_gap"],
+            b["base"]["pairs_per_particle"], b["tiled"]["pairs_per_particle"],
+            b["base"]["wall_contacts_per_particle"], b["tiled"]["wall_contacts_per_particle"],
+            b["contacts_per_particle_ratio"], b["max_overlap"], b["generation_seconds"]))
+    L.append("\n")
+    return L
+
+
+def failures_section(failures):
+    if not failures:
+        return []
+    L = ["## Failed runs\n\n| size | variant | engine | ranks | threads | repeat | message |\n|---|---|---|---:|---:|---:|---|\n"]
+    for f in failures:
+        L.append("| %s | %s | %s | %d | %d | %d | %s |\n" % (f["size"], f["variant"], f["engine"], f["ranks"],
+                                                           f["threads"], f["repeat"],
+                                                           f["failed"].strip().splitlines()[-1][:200].replace("|", "/")))
+    L.append("\n")
+    return L
+
+
+def write_report(out, rows, machine, feature_check=None, flat=None, beds=None, failures=None):
     ix = index(rows)
     sizes = [s for s in SIZE_ORDER if any(r["size"] == s for r in rows)]
     variants = []
@@ -184,11 +267,14 @@ def write_report(out, rows, machine, feature_check=None):
                     continue
                 tp = lambda r: r[key] / 1e6 if r and r.get(key) else None
                 ratio = lambda x, y: x[key] / y[key] if x and y and x.get(key) and y.get(key) else None
+                na = v.endswith("_bonded")  # stock LIGGGHTS has no parallel bonds
                 L.append("| %s | %s | %d | %d | %.2g | %s / %s | %s | %s | %s | %s | %s | %s | %s |\n" % (
                     s, v, base["N"], base["steps"], base["dt"],
-                    fmt(a["contacts_per_particle"] if a else None, ".2f"), fmt(c["contacts_per_particle"] if c else None, ".2f"),
-                    fmt(tp(a), ".2f"), fmt(tp(a2), ".2f"), fmt(tp(b), ".2f"), fmt(tp(c), ".2f"), fmt(ratio(a, c), ".2f"),
-                    fmt(ratio(a2, a), ".2f"), fmt(ratio(b, c), ".2f")))
+                    fmt(a["contacts_per_particle"] if a else None, ".2f"),
+                    "n/a" if na else fmt(c["contacts_per_particle"] if c else None, ".2f"),
+                    fmt(tp(a), ".2f"), fmt(tp(a2), ".2f"), fmt(tp(b), ".2f"), "n/a" if na else fmt(tp(c), ".2f"),
+                    "n/a" if na else fmt(ratio(a, c), ".2f"),
+                    fmt(ratio(a2, a), ".2f"), "n/a" if na else fmt(ratio(b, c), ".2f")))
         L.append("\n")
     for p in pngs:
         L.append("![%s](%s)\n\n" % (os.path.basename(p), os.path.basename(p)))
@@ -205,25 +291,34 @@ def write_report(out, rows, machine, feature_check=None):
                     r["particle_steps_per_second"] / one["particle_steps_per_second"]))
         L.append("\njdem runs on one process; its OpenMP threads are in the throughput tables.\n\n")
     L.append("## Memory (peak resident set, largest process)\n\n| size | variant | jdem [MB] | liggghts-jdem [MB] | liggghts [MB] | "
-             "bytes/particle jdem | liggghts-jdem | liggghts | jdem engine [MB] | jdem budget [MB] (300 B/particle + 100 B/contact) |\n"
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n")
+             "bytes/particle jdem | liggghts-jdem | liggghts | jdem engine [MB] | jdem engine B/particle | "
+             "jdem budget [MB] (300 B/particle + 100 B/contact) | engine within budget |\n"
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n")
     for s in sizes:
         for v in variants:
             rr = [ix.get((s, v, e, 1)) for e in ("jdem", "liggghts-jdem", "liggghts")]
             if not any(rr):
                 continue
             eng = (rr[0] or {}).get("jdem_split_seconds") or {}
-            L.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n" % (
-                s, v, *[fmt(r["peak_rss_bytes"] / 1e6 if r else None, ".0f") for r in rr],
-                *[fmt(r["bytes_per_particle"] if r else None, ".0f") for r in rr],
+            ok = rr[0].get("engine_memory_within_budget") if rr[0] else None
+            na = v.endswith("_bonded")  # stock LIGGGHTS has no parallel bonds
+            L.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n" % (
+                s, v, *["n/a" if na and e == 2 else fmt(r["peak_rss_bytes"] / 1e6 if r else None, ".0f")
+                        for e, r in enumerate(rr)],
+                *["n/a" if na and e == 2 else fmt(r["bytes_per_particle"] if r else None, ".0f")
+                  for e, r in enumerate(rr)],
                 fmt(eng["engine_bytes"] / 1e6 if eng.get("engine_bytes") else None, ".1f"),
-                fmt(rr[0]["memory_budget_bytes"] / 1e6 if rr[0] and rr[0].get("memory_budget_bytes") else None, ".1f")))
+                fmt(rr[0].get("engine_bytes_per_particle") if rr[0] else None, ".0f"),
+                fmt(rr[0]["memory_budget_bytes"] / 1e6 if rr[0] and rr[0].get("memory_budget_bytes") else None, ".1f"),
+                "–" if ok is None else "yes" if ok else "NO"))
     L.append("\nPeak RSS includes the executable and its libraries (LIGGGHTS: ~35–55 MB before any atom), "
              "so bytes/particle is meaningful only at the larger sizes. jdem's peak also holds the parsed "
              "scene: the bench scenes list every particle in YAML, and libyaml's document tree of them is "
              "the largest single item; \"jdem engine\" is what the engine itself holds during the run "
              "(particle arrays, contact lists at capacity, cells; `jdem run --timing`), the figure to hold "
-             "against the budget.\n\n")
+             "against the budget. The budget counts as contacts the particle-particle contacts at the last step "
+             "(contacts/particle x N / 2, from the trajectory's /observables/contacts); wall contacts and bonds "
+             "are not in it.\n\n")
     L.append("## LIGGGHTS' own time split (median run, % of loop time)\n\n| size | variant | engine | ranks | Pair | Neigh | Comm | Other (fixes: walls, integration, gravity) |\n|---|---|---|---:|---:|---:|---:|---:|\n")
     for r in rows:
         sp = r.get("liggghts_split_percent")
@@ -232,6 +327,10 @@ def write_report(out, rows, machine, feature_check=None):
                 r["size"], r["variant"], r["engine"], r["ranks"], fmt(sp.get("pair"), ".0f"), fmt(sp.get("neigh"), ".0f"),
                 fmt(sp.get("comm"), ".0f"), fmt(sp.get("other"), ".0f")))
     L.append("\n")
+    L += flatness_section(flat)
+    L += bonded_section(rows)
+    L += beds_section(beds)
+    L += failures_section(failures)
     L += split_section(rows, sizes, variants)
     L += feature_section(feature_check)
     L += profile_section(out)
