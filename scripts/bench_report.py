@@ -4,6 +4,7 @@ import math
 import os
 import re
 import subprocess
+import sys
 
 ENGINE_LABEL = {"jdem": "jdem", "jdem/2t": "jdem, 2 threads", "liggghts-jdem": "liggghts-jdem (gran/jiang)",
                 "liggghts": "stock liggghts (hertz/history)"}
@@ -342,7 +343,7 @@ def write_report(out, rows, machine, feature_check=None, flat=None, beds=None, f
 
 def profile_jdem(out, scene, n, steps=200):
     """Callgrind on a short run of `scene`; writes OUT/profile.json.  Returns False when valgrind
-    is missing."""
+    is missing or cannot decode the build."""
     import shutil
     if not shutil.which("valgrind") or not shutil.which("callgrind_annotate"):
         return False
@@ -356,8 +357,13 @@ def profile_jdem(out, scene, n, steps=200):
     cg = os.path.join(d, "callgrind.out")
     jdem = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "build", "jdem")
     # only the time loop (sim_step and what it calls) is collected; 1 thread
-    subprocess.run(["valgrind", "--tool=callgrind", "--toggle-collect=sim_step", "--callgrind-out-file=" + cg,
-                    jdem, "run", sc, "-o", os.path.join(d, "p.h5"), "--quiet", "--threads", "1"], capture_output=True)
+    r = subprocess.run(["valgrind", "--tool=callgrind", "--toggle-collect=sim_step", "--callgrind-out-file=" + cg,
+                        jdem, "run", sc, "-o", os.path.join(d, "p.h5"), "--quiet", "--threads", "1"],
+                       capture_output=True, text=True)
+    if "unhandled instruction" in r.stderr:  # valgrind decodes at most AVX2
+        sys.stderr.write("bench: no callgrind profile: valgrind cannot decode this build's AVX-512 "
+                         "instructions (profile a build made with `make ARCH=-march=x86-64-v3`)\n")
+        return False
     ann = subprocess.run(["callgrind_annotate", "--inclusive=no", "--threshold=100", cg],
                          capture_output=True, text=True).stdout
     # exclusive counts per "file:function": inlined code is attributed to the file it comes
