@@ -30,11 +30,15 @@ using namespace LAMMPS_NS;
 FixJdemWatchdog::FixJdemWatchdog(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), energy_every(1), max_overlap(0.5), max_energy_jump(0.05),
       has_ref(false), ref(), ref_step(0) {
-  if (narg < 4) error->all(FLERR, "Illegal fix jdem/watchdog command: fix ID group jdem/watchdog N [overlap F] [energy J]");
+  if (narg < 4) error->all(FLERR, "Illegal fix jdem/watchdog command: fix ID group jdem/watchdog N [overlap F] [energy J|off]");
   energy_every = force->inumeric(FLERR, arg[3]);
   if (energy_every < 1) error->all(FLERR, "fix jdem/watchdog: N must be >= 1");
   for (int i = 4; i < narg; i += 2) {
     if (i + 1 >= narg) error->all(FLERR, "fix jdem/watchdog: keyword without a value");
+    if (std::strcmp(arg[i], "energy") == 0 && std::strcmp(arg[i + 1], "off") == 0) {
+      max_energy_jump = 0.0;
+      continue;
+    }
     const double value = force->numeric(FLERR, arg[i + 1]);
     if (!(value > 0.0)) error->all(FLERR, "fix jdem/watchdog: limits must be > 0");
     if (std::strcmp(arg[i], "overlap") == 0) max_overlap = value;
@@ -107,7 +111,8 @@ void FixJdemWatchdog::check() {
   if (any[0] > 0.0 && nonfinite(msg)) trip(msg, false);
   if (any[1] > 0.0 && overlap(msg)) trip(msg, true);
   const bigint step = update->ntimestep;
-  if ((step % energy_every == 0 || step == update->laststep) && energy(msg)) trip(msg, true);
+  if (checks_energy() && (step % energy_every == 0 || step == update->laststep) && energy(msg))
+    trip(msg, true);
 }
 
 static std::string format(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
