@@ -151,8 +151,7 @@ void PairGranJiang::init_granular() {
   const std::string user = jdem_contact_energy_user(lmp);
   if (!energy_accounts && !user.empty())
     error->all(FLERR, ("pair_style gran/jiang energy no keeps no energy accounts, but " + user +
-                       " needs them: give it the option shown, or use pair_style gran/jiang "
-                       "energy yes").c_str());
+                       ", or use pair_style gran/jiang energy yes").c_str());
   energy = !user.empty();
 
   features_ = 0u;
