@@ -42,8 +42,8 @@ static_assert(offsetof(jd_rolling_state, theta) == 0 &&
 
 PairGranJiang::PairGranJiang(LAMMPS *lmp)
     : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
-      xi_limit(JD_XI_COULOMB), mu_r(1.0), rolling(false), energy_accounts(true), energy(false), e_damp_cum(0.0),
-      e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
+      xi_limit(JD_XI_COULOMB), mu_r(1.0), rolling(false), energy_accounts(true), energy(false),
+      e_damp_cum(0.0), e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
       features_(0), ntypes_(0), kp_ncalls_(-1), kp_nall_(-1) {}
 
 /* ---------------------------------------------------------------------------------------- */
@@ -253,7 +253,7 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
       jd_copy3(k.wa, omega[i]);
       jd_copy3(k.vb, v[j]);
       jd_copy3(k.wb, omega[j]);
-      /* the kernel advances the stored history in place; the set-up evaluation on a copy */
+      /* the stored history itself or a local copy (jdem_history.h) */
       JdHistory<F> h(hist, roll_at, commit);
       jd_contact_result out;
       const int carries = jd_contact(F, &coeffs_i[type[j]], &g, &k,
