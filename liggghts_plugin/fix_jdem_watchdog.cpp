@@ -40,7 +40,7 @@ FixJdemWatchdog::FixJdemWatchdog(LAMMPS *lmp, int narg, char **arg)
       continue;
     }
     const double value = force->numeric(FLERR, arg[i + 1]);
-    if (!(value > 0.0)) error->all(FLERR, "fix jdem/watchdog: limits must be > 0");
+    if (!(value > 0.0)) error->all(FLERR, "fix jdem/watchdog: limits must be > 0 (energy: > 0 or off)");
     if (std::strcmp(arg[i], "overlap") == 0) max_overlap = value;
     else if (std::strcmp(arg[i], "energy") == 0) max_energy_jump = value;
     else error->all(FLERR, "fix jdem/watchdog: unknown keyword (valid: overlap, energy)");
