@@ -31,7 +31,7 @@ enum { COL_ID = 0, COL_TYPE, COL_R, COL_M, COL_X, COL_V = COL_X + 3, COL_W = COL
        COL_F = COL_W + 3, COL_T = COL_F + 3, NCOL = COL_T + 3 };
 
 DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
-    : Dump(lmp, narg, arg), h5(NULL), natoms0(-1), last_step(-1) {
+    : Dump(lmp, narg, arg), h5(NULL), energy(true), natoms0(-1), last_step(-1) {
   if (narg < 5) error->all(FLERR, "Illegal dump h5md/jdem command: dump ID group h5md/jdem N FILE.h5");
   path = arg[4];
   if (path.find('*') != std::string::npos || path.find('%') != std::string::npos)
@@ -49,8 +49,12 @@ DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
         ss << in.rdbuf();
         scene_yaml = ss.str();
       }
+    } else if (k == "energy") {
+      if (std::strcmp(arg[i + 1], "yes") == 0) energy = true;
+      else if (std::strcmp(arg[i + 1], "no") == 0) energy = false;
+      else error->all(FLERR, "dump h5md/jdem: energy must be yes or no");
     } else {
-      error->all(FLERR, "dump h5md/jdem: unknown keyword (valid: scene, case, scene_yaml)");
+      error->all(FLERR, "dump h5md/jdem: unknown keyword (valid: scene, case, scene_yaml, energy)");
     }
   }
   size_one = NCOL;
@@ -184,11 +188,11 @@ void DumpH5mdJdem::write() {
     struct { const char *name; double value; bool on; } o[] = {
         {"kinetic_energy", all_obs[JDO_KINETIC], true},
         {"rotational_energy", all_obs[JDO_ROTATIONAL], true},
-        {"elastic_energy", all_obs[JDO_ELASTIC], pair != NULL},
+        {"elastic_energy", all_obs[JDO_ELASTIC], pair != NULL && energy},
         {"gravitational_energy", all_obs[JDO_GRAVITATIONAL], true},
-        {"damping_dissipation", all_obs[JDO_DAMPING], pair != NULL && pair->energy},
-        {"friction_dissipation", all_obs[JDO_FRICTION], pair != NULL && pair->energy},
-        {"wall_work", all_obs[JDO_WALL_WORK], pair != NULL},
+        {"damping_dissipation", all_obs[JDO_DAMPING], pair != NULL && energy},
+        {"friction_dissipation", all_obs[JDO_FRICTION], pair != NULL && energy},
+        {"wall_work", all_obs[JDO_WALL_WORK], pair != NULL && energy},
         {"contacts", all_obs[JDO_CONTACTS], pair != NULL},
         {"wall_contacts", all_obs[JDO_WALL_CONTACTS], pair != NULL},
     };

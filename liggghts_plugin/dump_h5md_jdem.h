@@ -1,6 +1,6 @@
 /* dump_h5md_jdem.h — `dump ID group h5md/jdem N FILE.h5 [scene NAME] [case NAME]
- *                    [scene_yaml PATH]`: jdem's H5MD trajectory (io/h5md.h), written on rank 0
- * through the shared C writer.
+ *                    [scene_yaml PATH] [energy yes|no]`: jdem's H5MD trajectory (io/h5md.h),
+ * written on rank 0 through the shared C writer.
  *
  * Every N steps: position, velocity, angular velocity, force, torque of the group's atoms,
  * sorted by id (species = type - 1), and the observables kinetic_energy, rotational_energy,
@@ -10,8 +10,11 @@
  * observables bonds, fragments, bond_elastic_energy, bond_damping_dissipation,
  * bond_breakage_energy (jdem_bond_output.h); also the last step of a run that is not a multiple of N (runs of at least N
  * steps), like build/jdem.  The file is FILE.h5.part while the run goes on and is renamed to FILE.h5
- * when LIGGGHTS ends normally or at `undump`; after an error it stays FILE.h5.part.  The optional keywords only annotate
- * /parameters.  The particle set must not change during the run. */
+ * when LIGGGHTS ends normally or at `undump`; after an error it stays FILE.h5.part.  The optional keywords scene, case
+ * and scene_yaml only annotate /parameters.  energy no (build/jdem's output.energy: false)
+ * leaves out elastic_energy, damping_dissipation, friction_dissipation and wall_work, so that
+ * pair_style gran/jiang can run without energy accounts (energy no).  The particle set must not
+ * change during the run. */
 #ifndef JDEM_DUMP_H5MD_JDEM_H
 #define JDEM_DUMP_H5MD_JDEM_H
 
@@ -44,6 +47,7 @@ class DumpH5mdJdem : public Dump {
     if (step != last_step) write();
   }
   bigint last_frame_step() const { return last_step; } /* -1: no frame yet */
+  bool writes_energy() const { return energy; }         /* keyword energy (default yes) */
 
  protected:
   virtual void init_style();
@@ -54,6 +58,7 @@ class DumpH5mdJdem : public Dump {
  private:
   struct jd_h5md *h5;
   std::string path, scene_name, case_name, scene_yaml;
+  bool energy;
   bigint natoms0;
   bigint last_step; /* of the last frame written; -1: none */
   JdemBondOutput bonds;

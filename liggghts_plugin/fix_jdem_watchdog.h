@@ -1,4 +1,4 @@
-/* fix_jdem_watchdog.h — `fix ID group jdem/watchdog N [overlap F] [energy J]`: the run-time
+/* fix_jdem_watchdog.h — `fix ID group jdem/watchdog N [overlap F] [energy J|off]`: the run-time
  * watchdog of docs/scenes.md ("Watchdog") in LIGGGHTS, with the stepper's limits
  * (kernel/jdem_watchdog.h) and message text.
  *
@@ -6,7 +6,8 @@
  * or angular velocity of an atom of the group; an overlap beyond F (default 0.5) of the smaller
  * radius in pair_style gran/jiang or any fix wall/jiang.  Every N steps, and at the last step:
  * a jump of the total energy (the observables of dump h5md/jdem, bonds included) beyond J (default 0.05)
- * relative to the energy in play, since the previous check.  On a trip the dumps write the
+ * relative to the energy in play, since the previous check (energy off: no energy check, as
+ * build/jdem with output.energy: false).  On a trip the dumps write the
  * frame of this step (not for a non-finite state) and the run ends through error->all with
  * "jdem: watchdog: step S: QUANTITY VALUE for particle(s) IDS exceeds LIMIT ...": dump
  * h5md/jdem then keeps its file, closed, as FILE.part.
@@ -31,6 +32,7 @@ class FixJdemWatchdog : public Fix {
   void init();
   void setup(int);
   void end_of_step();
+  bool checks_energy() const { return max_energy_jump > 0.0; }
 
  private:
   void check();
@@ -41,7 +43,7 @@ class FixJdemWatchdog : public Fix {
   void trip(const std::string &msg, bool write_frame);
 
   int energy_every;
-  double max_overlap, max_energy_jump;
+  double max_overlap, max_energy_jump; /* max_energy_jump 0: energy off */
   bool has_ref;
   jd_energy_terms ref;
   bigint ref_step;

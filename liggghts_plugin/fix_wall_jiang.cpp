@@ -106,7 +106,7 @@ void FixWallJiang::init() {
   pair = dynamic_cast<PairGranJiang *>(force->pair);
   if (!pair) error->all(FLERR, "fix wall/jiang requires pair_style gran/jiang");
   if (pair->state_len() != slen)
-    error->all(FLERR, "fix wall/jiang: pair_style gran/jiang changed its rolling option after the wall was defined");
+    error->all(FLERR, "fix wall/jiang: pair_style gran/jiang changed its rolling or energy option after the wall was defined");
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
     error->all(FLERR, "fix wall/jiang requires atom_style granular (sphere)");
   /* The candidate list relies on LIGGGHTS' guarantee that no atom has moved more than skin/2
@@ -186,6 +186,7 @@ void FixWallJiang::loop(bool commit) {
   const int *type = atom->type, *mask = atom->mask;
   const int nlocal = atom->nlocal;
   const double dt = update->dt;
+  const int roll_at = pair->rolling_at();
   pair->refresh_prefactors();
   const double *kw = pair->wall_prefactors();
   double e_damp = 0.0, e_fric = 0.0, e_el = 0.0, ncontacts = 0.0, work = 0.0;
@@ -217,12 +218,14 @@ void FixWallJiang::loop(bool commit) {
     jd_copy3(k.wa, omega[i]);
     jd_copy3(k.vb, vel);
     k.wb[0] = k.wb[1] = k.wb[2] = 0.0;
-    JdHistory hs(h, F & JD_F_ROLLING, commit);
+    JdHistory<F> hs(h, roll_at, commit);
     jd_contact_result out;
-    const double f_prev[3] = {hs.st->f_prev[0], hs.st->f_prev[1], hs.st->f_prev[2]};
+    double f_prev[3] = {0.0, 0.0, 0.0};
+    if (F & JD_F_ENERGY) jd_copy3(f_prev, hs.st->f_prev);
     const int carries = jd_contact(F, &pair->coeffs(type[i], wtype), &g, &k, dt, hs.st, hs.rs, &out);
-    work += jd_wall_work(f_prev, out.f, vel, dt); /* also over the step a contact ends */
     if (F & JD_F_ENERGY) {
+      /* f_prev is booked only with the energies; the work also over the step a contact ends */
+      work += jd_wall_work(f_prev, out.f, vel, dt);
       e_damp += hs.st->e_damp;
       e_fric += hs.st->e_fric;
       hs.st->e_damp = hs.st->e_fric = 0.0;

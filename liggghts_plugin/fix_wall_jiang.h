@@ -13,7 +13,8 @@
  * walls translate at the given velocity (x += v dt every step, as the standalone engine).
  * Requires pair_style gran/jiang defined before the fix.  Geometry: kernel/jdem_geometry.h.
  *
- * History: one jd_contact_state (+ jd_rolling_state with rolling on) per atom, migrating with
+ * History: one contact record per atom in gran/jiang's layout (jdem_history.h: jd_contact_state,
+ * + jd_rolling_state with rolling on, or only their law fields with energy no), migrating with
  * the atom; reset when the particle leaves the wall.
  *
  * Cost: each step only the particles found near the wall at the last neighbour build are

@@ -1,6 +1,18 @@
 /* jdem_history.h — moves a contact's kernel state (jd_contact_state, and jd_rolling_state when
  * the run has rolling) between LIGGGHTS' flat per-contact history arrays and the kernel.  Shared
- * by the pair style and the wall fix. */
+ * by the pair style and the wall fix.
+ *
+ * Two layouts of the stored history (doubles per contact):
+ *  - with the energy accounts (pair_style gran/jiang energy yes): the whole jd_contact_state
+ *    (JD_CONTACT_STATE_LEN), then the whole jd_rolling_state when rolling is on;
+ *  - without them (energy no): only what the laws carry from one step to the next, xi[3] and
+ *    flags (JD_HISTORY_LAWS_LEN), then theta[3] with rolling (JD_ROLLING_LAWS_LEN): 4 or 7
+ *    doubles instead of 11 or 17.  LIGGGHTS' fix contacthistory copies the history of every
+ *    neighbour pair at each neighbour build and the pair loop streams all of it every step, so
+ *    the shorter record is less memory traffic (docs/liggghts.md, "Cost").
+ * jd_contact() reads and writes the energy fields only under JD_F_ENERGY (jd_contact_separate
+ * zeroes them always), so a loop without JD_F_ENERGY evaluates a local jd_contact_state filled
+ * from the law fields and stores those back: the same arithmetic on the same values. */
 #ifndef JDEM_PLUGIN_HISTORY_H
 #define JDEM_PLUGIN_HISTORY_H
 
@@ -8,15 +20,36 @@
 
 #include "jdem_kernel.h"
 
-/* Read the state stored at h (rs: NULL without rolling). */
+/* Law fields at the start of the kernel's states (their layout is checked in
+ * pair_gran_jiang.cpp): jd_contact_state's xi[3], flags; jd_rolling_state's theta[3]. */
+#define JD_HISTORY_LAWS_LEN 4
+#define JD_ROLLING_LAWS_LEN 3
+
+/* Doubles of the contact record, and where the rolling part starts in it. */
+static inline int jd_history_contact_len(bool energy) {
+  return energy ? JD_CONTACT_STATE_LEN : JD_HISTORY_LAWS_LEN;
+}
+static inline int jd_history_len(bool energy, bool rolling) {
+  return jd_history_contact_len(energy) +
+         (rolling ? (energy ? JD_ROLLING_STATE_LEN : JD_ROLLING_LAWS_LEN) : 0);
+}
+/* LIGGGHTS' sign-flip flag of entry k of the record (1: a vector component that changes sign
+ * when i and j swap): the kernel's jd_contact_state_newton / jd_rolling_state_newton, whose
+ * first entries are those of the law fields. */
+static inline int jd_history_newton(bool energy, int k) {
+  const int nc = jd_history_contact_len(energy);
+  return k < nc ? jd_contact_state_newton[k] : jd_rolling_state_newton[k - nc];
+}
+
+/* Read the full state stored at h (rs: NULL without rolling; energy-accounts layout). */
 static inline void jd_load_history(const double *h, jd_contact_state &st, jd_rolling_state *rs) {
   std::memcpy(&st, h, sizeof st);
   if (rs) std::memcpy(rs, h + JD_CONTACT_STATE_LEN, sizeof *rs);
 }
 
-/* Write an evaluated state back to h: all of it after a time step; after LIGGGHTS' set-up
- * evaluation (commit false), which must not advance the history, only the energy reference
- * (jd_contact_keep_reference). */
+/* Write an evaluated state back to h (energy-accounts layout): all of it after a time step;
+ * after LIGGGHTS' set-up evaluation (commit false), which must not advance the history, only
+ * the energy reference (jd_contact_keep_reference). */
 static inline void jd_store_history(double *h, const jd_contact_state &st,
                                     const jd_rolling_state *rs, bool commit) {
   jd_contact_state out = st;
@@ -28,31 +61,64 @@ static inline void jd_store_history(double *h, const jd_contact_state &st,
   if (rs) std::memcpy(h + JD_CONTACT_STATE_LEN, &rout, sizeof rout);
 }
 
-/* The state of one contact during an evaluation: in a time step, the stored history itself
- * (the kernel advances it in place; jd_contact_state and jd_rolling_state are plain doubles,
- * laid out as LIGGGHTS' history array, see the static_asserts in pair_gran_jiang.cpp); in
- * LIGGGHTS' set-up evaluation (commit false), a copy, of which finish() stores back only the
- * energy reference (jd_store_history). */
+/* The state of one contact during an evaluation by a loop with feature bits F.
+ *  - With JD_F_ENERGY (energy-accounts layout): in a time step, the stored history itself (the
+ *    kernel advances it in place; the states are plain doubles laid out as LIGGGHTS' history
+ *    array); in LIGGGHTS' set-up evaluation (commit false), a copy, of which finish() stores
+ *    back only the energy reference (jd_store_history).
+ *  - Without: a local state holding the law fields of the record (either layout: the rolling
+ *    part starts at roll_at), the energy fields zero; finish() stores the law fields back after
+ *    a time step, nothing after the set-up evaluation. */
+template <unsigned F>
 struct JdHistory {
   jd_contact_state *st;
   jd_rolling_state *rs; /* NULL without rolling */
 
-  JdHistory(double *h, bool rolling, bool commit) : st(NULL), rs(NULL), h_(h), commit_(commit) {
-    if (commit) {
-      st = reinterpret_cast<jd_contact_state *>(h);
-      if (rolling) rs = reinterpret_cast<jd_rolling_state *>(h + JD_CONTACT_STATE_LEN);
-    } else {
-      st = &st_copy_;
-      if (rolling) rs = &rs_copy_;
-      jd_load_history(h, st_copy_, rs);
+  /* h: the record; roll_at: offset of its rolling part (unused with JD_F_ENERGY) */
+  JdHistory(double *h, int roll_at, bool commit)
+      : st(&st_copy_), rs((F & JD_F_ROLLING) ? &rs_copy_ : NULL), h_(h), roll_at_(roll_at),
+        commit_(commit) {
+    if (F & JD_F_ENERGY) {
+      if (commit) {
+        st = reinterpret_cast<jd_contact_state *>(h);
+        if (F & JD_F_ROLLING) rs = reinterpret_cast<jd_rolling_state *>(h + JD_CONTACT_STATE_LEN);
+      } else {
+        jd_load_history(h, st_copy_, rs);
+      }
+      return;
+    }
+    std::memset(&st_copy_, 0, sizeof st_copy_);
+    st_copy_.xi[0] = h[0];
+    st_copy_.xi[1] = h[1];
+    st_copy_.xi[2] = h[2];
+    st_copy_.flags = h[3];
+    if (F & JD_F_ROLLING) {
+      std::memset(&rs_copy_, 0, sizeof rs_copy_);
+      rs_copy_.theta[0] = h[roll_at];
+      rs_copy_.theta[1] = h[roll_at + 1];
+      rs_copy_.theta[2] = h[roll_at + 2];
     }
   }
   void finish() {
-    if (!commit_) jd_store_history(h_, st_copy_, rs, false);
+    if (F & JD_F_ENERGY) {
+      if (!commit_) jd_store_history(h_, st_copy_, rs, false);
+      return;
+    }
+    if (!commit_) return;
+    h_[0] = st_copy_.xi[0];
+    h_[1] = st_copy_.xi[1];
+    h_[2] = st_copy_.xi[2];
+    h_[3] = st_copy_.flags;
+    if (F & JD_F_ROLLING) {
+      h_[roll_at_] = rs_copy_.theta[0];
+      h_[roll_at_ + 1] = rs_copy_.theta[1];
+      h_[roll_at_ + 2] = rs_copy_.theta[2];
+    }
   }
 
  private:
   double *h_;
+  int roll_at_;
   bool commit_;
   jd_contact_state st_copy_;
   jd_rolling_state rs_copy_;

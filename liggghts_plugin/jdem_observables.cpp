@@ -10,9 +10,9 @@
 #include "dump.h"
 #include "fix.h"
 
-#include <cstring>
-
+#include "dump_h5md_jdem.h"
 #include "fix_bond_jiang.h"
+#include "fix_jdem_watchdog.h"
 #include "fix_jdem_loads.h"
 #include "fix_wall_jiang.h"
 #include "jdem_kernel.h"
@@ -75,10 +75,28 @@ void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]) {
 
 bool jdem_wants_energy(LAMMPS *lmp) {
   for (int k = 0; k < lmp->output->ndump; k++)
-    if (std::strcmp(lmp->output->dump[k]->style, "h5md/jdem") == 0) return true;
-  for (int k = 0; k < lmp->modify->nfix; k++)
-    if (std::strcmp(lmp->modify->fix[k]->style, "jdem/watchdog") == 0) return true;
+    if (dynamic_cast<DumpH5mdJdem *>(lmp->output->dump[k])) return true;
+  for (int k = 0; k < lmp->modify->nfix; k++) {
+    FixJdemWatchdog *w = dynamic_cast<FixJdemWatchdog *>(lmp->modify->fix[k]);
+    if (w && w->checks_energy()) return true;
+  }
   return false;
+}
+
+std::string jdem_contact_energy_user(LAMMPS *lmp) {
+  for (int k = 0; k < lmp->output->ndump; k++) {
+    DumpH5mdJdem *d = dynamic_cast<DumpH5mdJdem *>(lmp->output->dump[k]);
+    if (d && d->writes_energy())
+      return std::string("dump ") + d->id + " (h5md/jdem) writes the energy observables: add "
+             "'energy no' to the dump";
+  }
+  for (int k = 0; k < lmp->modify->nfix; k++) {
+    FixJdemWatchdog *w = dynamic_cast<FixJdemWatchdog *>(lmp->modify->fix[k]);
+    if (w && w->checks_energy())
+      return std::string("fix ") + w->id + " (jdem/watchdog) checks the energy balance: add "
+             "'energy off' to the fix";
+  }
+  return std::string();
 }
 
 }  // namespace LAMMPS_NS

@@ -5,6 +5,8 @@
 #ifndef JDEM_OBSERVABLES_H
 #define JDEM_OBSERVABLES_H
 
+#include <string>
+
 namespace LAMMPS_NS {
 class LAMMPS;
 
@@ -18,9 +20,15 @@ enum { JDO_KINETIC = 0, JDO_ROTATIONAL, JDO_GRAVITATIONAL, JDO_ELASTIC, JDO_DAMP
  * terms stay 0 without pair_style gran/jiang, the bond terms without fix bond/jiang. */
 void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]);
 
-/* True when some consumer of the energies is defined (a dump h5md/jdem, which writes them, or a
- * fix jdem/watchdog, which checks their balance): the force loops then book them. */
+/* True when some consumer of the bond energies is defined (a dump h5md/jdem, which writes them,
+ * or a fix jdem/watchdog that checks the energy balance): fix bond/jiang then books them. */
 bool jdem_wants_energy(LAMMPS *lmp);
+
+/* The first consumer of the contact energies (a dump h5md/jdem without `energy no`, a fix
+ * jdem/watchdog without `energy off`), described for an error message with the option that
+ * turns it off, e.g. "dump d (h5md/jdem) writes the energy observables: add 'energy no' to
+ * the dump"; empty when there is none.  pair_style gran/jiang books the energies only then. */
+std::string jdem_contact_energy_user(LAMMPS *lmp);
 
 }  // namespace LAMMPS_NS
 

@@ -147,12 +147,14 @@ static const char *jdem_help =
     "\nStyles added by liggghts-jdem (jdem's C contact kernel; see docs/liggghts.md):\n"
     "* Pair styles:  gran/jiang   [wall_rule hertz|jiang2021] [damping jiang2021|exact_restitution]\n"
     "                             [tangential_limit coulomb|unconstrained] [mu_r X] [rolling on|off]\n"
+    "                             [energy yes|no]   (no: no energy accounts, a shorter history)\n"
     "* Fix styles:   wall/jiang   plane corners x1 y1 z1 ... x4 y4 z4 type T [velocity vx vy vz]\n"
     "                             cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T\n"
     "                                 [velocity vx vy vz]\n"
-    "                jdem/watchdog N [overlap F] [energy J]   (stop a run that goes wrong)\n"
+    "                jdem/watchdog N [overlap F] [energy J|off]   (stop a run that goes wrong)\n"
     "                jdem/guard vmax V [coordination C] [force]   (refuse an unsafe timestep)\n"
     "* Dump styles:  h5md/jdem    N FILE.h5 [scene NAME] [case NAME] [scene_yaml PATH]\n"
+    "                             [energy yes|no]\n"
     "(gran/jiang presents itself as \"gran\" to LIGGGHTS; do not use `clear` or restart files.)\n\n";
 
 int main(int argc, char **argv) {

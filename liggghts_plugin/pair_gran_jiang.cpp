@@ -3,6 +3,7 @@
 #include "pair_gran_jiang.h"
 
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -31,11 +32,18 @@ static_assert(sizeof(jd_contact_state) == JD_CONTACT_STATE_LEN * sizeof(double),
               "jd_contact_state must be JD_CONTACT_STATE_LEN doubles");
 static_assert(sizeof(jd_rolling_state) == JD_ROLLING_STATE_LEN * sizeof(double),
               "jd_rolling_state must be JD_ROLLING_STATE_LEN doubles");
+/* Without energy accounts the record holds the law fields only (jdem_history.h): they must be
+ * the first entries of the states, so that the kernel's sign-flip flags apply to them. */
+static_assert(offsetof(jd_contact_state, flags) == (JD_HISTORY_LAWS_LEN - 1) * sizeof(double),
+              "jd_contact_state must start with xi[3], flags");
+static_assert(offsetof(jd_rolling_state, theta) == 0 &&
+                  sizeof(((jd_rolling_state *)0)->theta) == JD_ROLLING_LAWS_LEN * sizeof(double),
+              "jd_rolling_state must start with theta[3]");
 
 PairGranJiang::PairGranJiang(LAMMPS *lmp)
     : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
-      xi_limit(JD_XI_COULOMB), mu_r(1.0), rolling(false), energy(false), e_damp_cum(0.0),
-      e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
+      xi_limit(JD_XI_COULOMB), mu_r(1.0), rolling(false), energy_accounts(true), energy(false),
+      e_damp_cum(0.0), e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
       features_(0), ntypes_(0), kp_ncalls_(-1), kp_nall_(-1) {}
 
 /* ---------------------------------------------------------------------------------------- */
@@ -63,26 +71,27 @@ void PairGranJiang::settings(int narg, char **arg) {
       if (val == "on") rolling = true;
       else if (val == "off") rolling = false;
       else error->all(FLERR, "pair_style gran/jiang: rolling must be on or off");
+    } else if (k == "energy") {
+      if (val == "yes") energy_accounts = true;
+      else if (val == "no") energy_accounts = false;
+      else error->all(FLERR, "pair_style gran/jiang: energy must be yes or no");
     } else {
       error->all(FLERR, ("pair_style gran/jiang: unknown option '" + k +
-                         "' (valid: wall_rule, damping, tangential_limit, mu_r, rolling)").c_str());
+                         "' (valid: wall_rule, damping, tangential_limit, mu_r, rolling, energy)").c_str());
     }
   }
 
-  /* Per-contact history: jd_contact_state, then jd_rolling_state when rolling is on, with the
-   * kernel's sign-flip flags.  (settings() may run again for a repeated pair_style line.) */
+  /* Per-contact history (jdem_history.h): jd_contact_state, then jd_rolling_state when rolling
+   * is on, or only their law fields without energy accounts, with the kernel's sign-flip flags.
+   * (settings() may run again for a repeated pair_style line.) */
   history_arg.clear();
   dnum_pairgran = 0;
   char name[32];
-  for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) {
-    std::snprintf(name, sizeof name, "jd_state_%d", k);
-    add_history_value(name, jd_contact_state_newton[k] ? "1" : "0");
+  for (int k = 0; k < state_len(); k++) {
+    std::snprintf(name, sizeof name, k < rolling_at() ? "jd_state_%d" : "jd_rolling_%d",
+                  k < rolling_at() ? k : k - rolling_at());
+    add_history_value(name, jd_history_newton(energy_accounts, k) ? "1" : "0");
   }
-  if (rolling)
-    for (int k = 0; k < JD_ROLLING_STATE_LEN; k++) {
-      std::snprintf(name, sizeof name, "jd_rolling_%d", k);
-      add_history_value(name, jd_rolling_state_newton[k] ? "1" : "0");
-    }
 
   /* FixContactHistory and check/timestep/gran find the pair by the exact name "gran". */
   if (force->pair == this && std::strcmp(force->pair_style, "gran") != 0) {
@@ -138,8 +147,12 @@ void PairGranJiang::init_granular() {
     }
 
   /* Energies only when a dump h5md/jdem records the observables or fix jdem/watchdog checks
-   * their balance. */
-  energy = jdem_wants_energy(lmp);
+   * their balance; without energy accounts in the history neither may ask for them. */
+  const std::string user = jdem_contact_energy_user(lmp);
+  if (!energy_accounts && !user.empty())
+    error->all(FLERR, ("pair_style gran/jiang energy no keeps no energy accounts, but " + user +
+                       ", or use pair_style gran/jiang energy yes").c_str());
+  energy = !user.empty();
 
   features_ = 0u;
   if (any_damp) features_ |= JD_F_DAMPING;
@@ -191,7 +204,7 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
   int **firsttouch = listgranhistory->firstneigh;
   double **firsthist = listgranhistory->firstdouble;
   const int dn = dnum();
-  const int slen = state_len();
+  const int slen = state_len(), roll_at = rolling_at();
   const double dt_run = update->dt;
   /* LIGGGHTS evaluates forces without advancing the history at set-up (shearupdate 0) and for
    * compute pair/gran/local (computeflag 0): evaluate on a copy then. */
@@ -240,8 +253,8 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
       jd_copy3(k.wa, omega[i]);
       jd_copy3(k.vb, v[j]);
       jd_copy3(k.wb, omega[j]);
-      /* the kernel advances the stored history in place; the set-up evaluation on a copy */
-      JdHistory h(hist, F & JD_F_ROLLING, commit);
+      /* the stored history itself or a local copy (jdem_history.h) */
+      JdHistory<F> h(hist, roll_at, commit);
       jd_contact_result out;
       const int carries = jd_contact(F, &coeffs_i[type[j]], &g, &k,
                                      dt_run, h.st, h.rs, &out);

@@ -3,7 +3,12 @@
  *
  *   pair_style gran/jiang [wall_rule hertz|jiang2021] [damping jiang2021|exact_restitution]
  *                         [tangential_limit coulomb|unconstrained] [mu_r X] [rolling on|off]
+ *                         [energy yes|no]
  *   pair_coeff * *
+ *
+ * energy no: the contact history keeps no energy accounts (4 doubles per contact instead of 11,
+ * jdem_history.h); then no dump h5md/jdem or fix jdem/watchdog may ask for the energies (their
+ * own keyword `energy no` / `energy off`), or init stops with a message naming them.
  *
  * Materials come from fix property/global youngsModulus, poissonsRatio (peratomtype) and
  * coefficientRestitution, coefficientFriction, coefficientRollingFriction (peratomtypepair; the
@@ -20,6 +25,7 @@
 #include "pair_gran.h"
 
 #include "jdem_dispatch.h"
+#include "jdem_history.h"
 #include "jdem_overlap.h"
 
 namespace LAMMPS_NS {
@@ -39,7 +45,8 @@ class PairGranJiang : public PairGran {
   int wall_rule, damping_map, xi_limit;
   double mu_r;
   bool rolling;
-  bool energy; /* JD_F_ENERGY: set when a dump h5md/jdem wants the observables */
+  bool energy_accounts; /* keyword energy: the history has room for the energy bookkeeping */
+  bool energy; /* JD_F_ENERGY: set when a dump h5md/jdem or fix jdem/watchdog wants energies */
   unsigned features() const { return features_; }
 
   /* Per-type data (types 1..ntypes), valid after init. */
@@ -53,8 +60,10 @@ class PairGranJiang : public PairGran {
   void refresh_prefactors();
   const double *pair_prefactors() const { return &kp_[0]; }
   const double *wall_prefactors() const { return &kw_[0]; }
-  /* Pair-history layout: jd_contact_state first, then jd_rolling_state when rolling is on. */
-  int state_len() const { return JD_CONTACT_STATE_LEN + (rolling ? JD_ROLLING_STATE_LEN : 0); }
+  /* Contact-history layout (jdem_history.h): doubles per contact, and where the rolling part
+   * starts; the same for the pair and the wall records. */
+  int state_len() const { return jd_history_len(energy_accounts, rolling); }
+  int rolling_at() const { return jd_history_contact_len(energy_accounts); }
 
   /* Observables of this rank (pairs with a ghost partner count 1/2, so that the sums over ranks
    * count every pair once): cumulative dissipation [J], and at the last force evaluation the

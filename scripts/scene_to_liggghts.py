@@ -126,16 +126,26 @@ def primitive_wall(w):
     return "%scylinder %s %s %s" % ("xyz"[d], num(w["radius"]), num(a[(d + 1) % 3]), num(a[(d + 2) % 3]))
 
 
+def energy_bookkeeping(scene):
+    """The scene's output.energy (default true).  Without it build/jdem keeps no energy
+    accounts, writes no energy observables and skips the watchdog's energy check; the deck does
+    the same: `energy no` for gran/jiang (a 4-double contact history instead of 11) and for the
+    dump, `energy off` for the watchdog."""
+    return bool((scene.get("output") or {}).get("energy", True))
+
+
 def watchdog_lines(scene, builtin):
     """`fix jdem/watchdog` with the scene's limits (docs/scenes.md "Watchdog"), energy checked at
-    the observable samples as build/jdem does.  It needs gran/jiang: none with --builtin."""
+    the observable samples as build/jdem does (not without energy bookkeeping).  It needs
+    gran/jiang: none with --builtin."""
     wd = scene.get("watchdog") or {}
     if builtin or not wd.get("enabled", True):
         return []
     out = scene.get("output") or {}
     every = int(out.get("observables_every", out.get("every", 1)))
+    energy = num(wd.get("max_energy_jump", 0.05)) if energy_bookkeeping(scene) else "off"
     return ["fix watchdog all jdem/watchdog %d overlap %s energy %s\n" % (
-        every, num(wd.get("max_overlap_fraction", 0.5)), num(wd.get("max_energy_jump", 0.05)))]
+        every, num(wd.get("max_overlap_fraction", 0.5)), energy)]
 
 
 BENDING = {"potyondy_cundall": "I", "jiang2021_literal": "J_literal"}
@@ -311,9 +321,10 @@ def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=
         L.append("\n# LIGGGHTS' built-in contact law (--builtin), not jdem's\n")
         L.append("pair_style      gran %s\n" % builtin_model)
     else:
-        L.append("\npair_style      gran/jiang wall_rule %s damping %s tangential_limit %s mu_r %s rolling %s\n" % (
+        L.append("\npair_style      gran/jiang wall_rule %s damping %s tangential_limit %s mu_r %s rolling %s%s\n" % (
             model.get("wall_rule", "hertz"), model.get("damping", "jiang2021"),
-            model.get("tangential_limit", "coulomb"), num(model.get("mu_r", 1.0)), "on" if rolling else "off"))
+            model.get("tangential_limit", "coulomb"), num(model.get("mu_r", 1.0)), "on" if rolling else "off",
+            "" if energy_bookkeeping(scene) else " energy no"))
     L.append("pair_coeff      * *\n")
     L.append("neighbor        %s bin\n" % num(skin))
     L.append("neigh_modify    delay 0\n")
@@ -356,9 +367,9 @@ def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=
     L.extend(guard_lines(scene, builtin, force))
     L.append("\ntimestep        %s\n" % num(dt))
     L.append("thermo          %d\n" % max(1, steps // 10))
-    L.append("dump d all h5md/jdem %d %s scene %s case %s scene_yaml %s\n" % (
+    L.append("dump d all h5md/jdem %d %s scene %s case %s scene_yaml %s%s\n" % (
         every, os.path.abspath(traj_path), scene.get("name", "scene"), scene.get("case", scene.get("name", "case")),
-        os.path.abspath(resolved_path)))
+        os.path.abspath(resolved_path), "" if energy_bookkeeping(scene) else " energy no"))
     L.append("run             %d\n" % steps)
     with open(deck_path, "w") as f:
         f.write("".join(L))

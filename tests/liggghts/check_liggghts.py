@@ -8,7 +8,11 @@ standalone engine (build/jdem run) and LIGGGHTS (scripts/liggghts_run.py) and co
 trajectories with scripts/compare_trajectories.py (tolerance: the scene's output.compare_tolerance,
 default 1e-10, scaled as documented there);
 the scenes named mpi_*.yaml are also run on 2 MPI ranks and compared with the 1-rank LIGGGHTS
-run.  With
+run.  Both engines must write the same observables.  A scene with output.energy: false (gran/jiang
+`energy no`: the short contact history) is also run in LIGGGHTS with the energy bookkeeping on
+(the full history, the reference path): the trajectories must be identical bit for bit; and its
+deck, with the dump or the watchdog asking for energies, must stop at init with a message naming
+them and leave no trajectory.  With
 --chung-ooi the cases of reference_runs/chung_ooi/test*/scene.yaml are checked too.
 Prints one PASS/FAIL line per check and exits 1 if any check fails.
 """
@@ -19,6 +23,9 @@ import shutil
 import subprocess
 import sys
 import tempfile
+
+import h5py
+import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -45,10 +52,72 @@ def indented(text):
     return "".join("    " + l + "\n" for l in text.rstrip().splitlines())
 
 
-def compare(a, b):
-    # the tolerance is each scene's output.compare_tolerance (default 1e-10)
-    rc, out = run([PY, os.path.join(ROOT, "scripts", "compare_trajectories.py"), a, b])
+def compare(a, b, tol=None):
+    # the tolerance is each scene's output.compare_tolerance (default 1e-10), unless given
+    rc, out = run([PY, os.path.join(ROOT, "scripts", "compare_trajectories.py"), a, b] +
+                  ([] if tol is None else ["--tol", repr(tol)]))
     return rc == 0, last_line(out), out
+
+
+def observable_names(path):
+    with h5py.File(path, "r") as f:
+        return sorted(f["observables"]) if "observables" in f else []
+
+
+def energy_off_checks(scene, stem, label):
+    """The scene has output.energy: false.  Returns the number of failed checks."""
+    failures = 0
+    # reference path: the same scene with the energy bookkeeping (full contact history)
+    with open(scene) as f:
+        doc = yaml.safe_load(f)
+    doc.setdefault("output", {})["energy"] = True
+    full = stem + ".energy_on.yaml"
+    with open(full, "w") as f:
+        yaml.safe_dump(doc, f)
+    rc, out = run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), full, "-o", stem + ".energy_on.h5"])
+    if rc != 0:
+        print("FAIL %s: liggghts_run.py with energy on:\n%s" % (label, indented(out.strip()[-1500:])))
+        return 1
+    ok, summary, text = compare(stem + ".energy_on.h5", stem + ".lig.h5", tol=0.0)
+    print("%s %s: liggghts-jdem short history (energy no) vs full history: %s" % (
+        "PASS" if ok else "FAIL", label, summary))
+    if not ok:
+        failures += 1
+        sys.stdout.write(indented(text))
+    # a consumer of the energies in a deck whose pair style keeps none: a clear error at init
+    deck_dir = os.path.abspath(stem + ".lig.deck")
+    with open(os.path.join(deck_dir, "in.jdem")) as f:
+        deck = f.read()
+    for what, old, new, expect in (
+            ("dump", " energy no\nrun", "\nrun",
+             "dump d (h5md/jdem) writes the energy observables: add 'energy no' to the dump"),
+            ("watchdog", "energy off", "energy 0.05",
+             "fix watchdog (jdem/watchdog) checks the energy balance: add 'energy off' to the fix")):
+        if old not in deck:
+            print("FAIL %s: the generated deck has no '%s'" % (label, old))
+            failures += 1
+            continue
+        bad = os.path.join(deck_dir, "in.%s_wants_energy" % what)
+        traj = os.path.join(deck_dir, "%s_wants_energy.h5" % what)
+        text = deck.replace(old, new, 1).replace(os.path.abspath(stem + ".lig.h5"), traj)
+        with open(bad, "w") as f:
+            f.write(text)
+        log = os.path.join(deck_dir, "log.%s_wants_energy" % what)
+        for p in (traj, traj + ".part", log):  # from an earlier run in the same --out
+            if os.path.exists(p):
+                os.remove(p)
+        r = subprocess.run([LIG, "-in", bad, "-log", log, "-screen", "none"], cwd=deck_dir,
+                           capture_output=True, text=True)
+        with open(log, errors="replace") as f:  # the screen of an aborted run is not flushed
+            said = f.read()
+        left = [p for p in (traj, traj + ".part") if os.path.exists(p)]
+        ok = r.returncode != 0 and "pair_style gran/jiang energy no" in said and expect in said and not left
+        print("%s %s: energy no with the %s asking for energies: %s" % (
+            "PASS" if ok else "FAIL", label, what,
+            "exit %d, clear message, no trajectory" % r.returncode if ok else
+            "exit %d, files left %s, output:\n%s" % (r.returncode, left, indented(said.strip()[-800:]))))
+        failures += 0 if ok else 1
+    return failures
 
 
 def main():
@@ -93,10 +162,17 @@ def main():
             failures += 1
             continue
         ok, summary, full = compare(stem + ".jdem.h5", stem + ".lig.h5")
+        names = (observable_names(stem + ".jdem.h5"), observable_names(stem + ".lig.h5"))
+        if ok and names[0] != names[1]:
+            ok, summary = False, "observables differ: jdem %s, liggghts-jdem %s" % names
         print("%s %s: jdem vs liggghts-jdem: %s" % ("PASS" if ok else "FAIL", label, summary))
         if not ok:
             failures += 1
             sys.stdout.write(indented(full))
+        with open(scene) as f:
+            energy = ((yaml.safe_load(f) or {}).get("output") or {}).get("energy", True)
+        if not energy and case is None:
+            failures += energy_off_checks(scene, stem, label)
         if name.startswith("mpi_"):
             rc, out = run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene] + caseopt +
                           ["-o", stem + ".np2.h5", "--np", "2"])
