@@ -35,7 +35,10 @@ ARCH     ?= -march=native
 OPT      := -O3 $(ARCH) -fno-trapping-math -ffp-contract=off
 CFLAGS   := -std=c11 $(OPT) -g $(WARN) -D_POSIX_C_SOURCE=200809L -DJDEM_VERSION=\"$(VERSION)\" \
             -Ikernel -Iio -Istepper $(PKG_CFLAGS)
-SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+# The sanitizer build compiles the force loops once, with the feature set as a run-time value
+# (stepper/forces.c, JD_ONE_FORCE_LOOP): 32 inlined copies of the law take minutes under ASan+UBSan.
+SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer \
+            -DJD_ONE_FORCE_LOOP
 # OpenMP threads in the standalone engine's force and integration loops (stepper/ only: the
 # kernel and the H5MD writer stay free of it, and clang's fuzz build needs no OpenMP runtime).
 # Threads: `jdem run --threads N` or OMP_NUM_THREADS (docs/scenes.md, "Threads").

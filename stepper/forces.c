@@ -346,10 +346,17 @@ static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
     _Static_assert(JD_F_DAMPING == 1 && JD_F_FRICTION == 2 && JD_F_ROLLING == 4 && JD_F_MU_R == 8 &&
                        JD_F_ENERGY == 16,
                    "the dispatch below enumerates the four optional laws as bits 0-3, energy as 4");
+#ifdef JD_ONE_FORCE_LOOP
+    /* one copy of the loops, with the features as a run-time value: the sanitizer build
+     * (Makefile), where 32 inlined copies of the law under ASan+UBSan take minutes to compile;
+     * the same source, hence the same checks */
+    work = contact_loops(s, s->features & 31u, tid, nt, &t_pairs_end);
+#else
     switch (s->features & 31u) {
         JD_FORCE_CASES(0)
         JD_FORCE_CASES(16)
     }
+#endif
     if (tid == 0) *t_pairs_end_out = t_pairs_end;
     return work;
 }
