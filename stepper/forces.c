@@ -75,13 +75,15 @@ static JD_ALWAYS_INLINE void hist_store(jd_contact_list *L, const unsigned F, si
     for (int k = 0; k < RW(F); k++) L->rhist[RW(F) * c + (size_t)k] = b[k];
 }
 
-/* The pair or wall entry c no longer overlaps: jd_contact_separate on its history. */
+/* The pair or wall entry c no longer overlaps: its history as jd_contact_separate leaves it
+ * (every field zero but the dissipation accumulators e_damp and e_fric, which the engine sums
+ * per entry; test_kernel checks the kernel keeps exactly those), written in place: the list
+ * holds many such entries every step. */
 static JD_ALWAYS_INLINE void hist_separate(jd_contact_list *L, const unsigned F, size_t c) {
-    jd_contact_state st;
-    jd_rolling_state rs;
-    hist_load(L, F, c, &st, &rs);
-    jd_contact_separate(&st, &rs);
-    hist_store(L, F, c, &st, &rs);
+    double *h = L->hist + (size_t)HW(F) * c, *r = L->rhist + (size_t)RW(F) * c;
+    for (int k = 0; k < HW(F); k++)
+        if (k != AT(jd_contact_state, e_damp) && k != AT(jd_contact_state, e_fric)) h[k] = 0.0;
+    for (int k = 0; k < RW(F); k++) r[k] = 0.0;
 }
 
 /* Contacts per batch of the pair loop: a multiple of the widest SIMD vector, few enough that
@@ -182,13 +184,19 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, b
 
 /* Lanes [0, nb) back: the history into the list, the forces and torques added in list order,
  * overlaps beyond the watchdog's limit.  The list is sorted by i, so consecutive lanes mostly
- * share particle i: its force and torque are summed in registers over the run of lanes and added
- * once (the sums differ from one addition per contact by round-off only). */
+ * share particle i: its force and torque are loaded once per run of lanes, updated in registers
+ * and stored once.  No other entry of the run touches particle i (they add to j > i), so every
+ * sum is exactly that of a plain loop over the list, one contact at a time. */
 static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const unsigned F, const batch *B, int nb,
                                            acc a, jd_overlap_trip *trip) {
     jd_contact_list *L = &s->pairs;
-    int32_t run_i = nb ? B->i[0] : 0;
-    double fi[3] = {0.0, 0.0, 0.0}, ti[3] = {0.0, 0.0, 0.0};
+    if (nb == 0) return;
+    int32_t run_i = B->i[0];
+    double fi[3], ti[3];
+    for (int d = 0; d < 3; d++) {
+        fi[d] = a.f[3 * (size_t)run_i + d];
+        ti[d] = a.t[3 * (size_t)run_i + d];
+    }
     for (int b = 0; b < nb; b++) {
         const size_t c = (size_t)B->c[b];
         const int32_t i = B->i[b], j = B->j[b];
@@ -210,11 +218,11 @@ static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const unsigned F, const ba
         if (B->excessive[b])
             sim_watchdog_overlap(trip, i, j, B->delta[b], fmin(s->radius[i], s->radius[j]));
         if (i != run_i) {
-            double *fa = a.f + 3 * (size_t)run_i, *ta = a.t + 3 * (size_t)run_i;
             for (int d = 0; d < 3; d++) {
-                fa[d] += fi[d];
-                ta[d] += ti[d];
-                fi[d] = ti[d] = 0.0;
+                a.f[3 * (size_t)run_i + d] = fi[d];
+                a.t[3 * (size_t)run_i + d] = ti[d];
+                fi[d] = a.f[3 * (size_t)i + d];
+                ti[d] = a.t[3 * (size_t)i + d];
             }
             run_i = i;
         }
@@ -227,12 +235,9 @@ static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const unsigned F, const ba
             tb[d] += B->tb[d][b];
         }
     }
-    if (nb) {
-        double *fa = a.f + 3 * (size_t)run_i, *ta = a.t + 3 * (size_t)run_i;
-        for (int d = 0; d < 3; d++) {
-            fa[d] += fi[d];
-            ta[d] += ti[d];
-        }
+    for (int d = 0; d < 3; d++) {
+        a.f[3 * (size_t)run_i + d] = fi[d];
+        a.t[3 * (size_t)run_i + d] = ti[d];
     }
 }
 

@@ -230,6 +230,24 @@ static void luding_end_of_collision(void **state) {
     assert_true(s.e_damp >= restored && s.e_damp <= restored + dashpot_step);
 }
 
+
+/* What separation keeps: the stepper resets entries that stopped overlapping in place, every
+ * field zero but e_damp and e_fric (stepper/forces.c, hist_separate), relying on exactly this. */
+static void separate_keeps_only_the_dissipation_accumulators(void **state) {
+    (void)state;
+    jd_contact_state s;
+    jd_rolling_state r;
+    double *a = (double *)&s, *b = (double *)&r;
+    for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) a[k] = k + 1.0;
+    for (int k = 0; k < JD_ROLLING_STATE_LEN; k++) b[k] = k + 1.0;
+    jd_contact_separate(&s, &r);
+    for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) {
+        const int kept = a + k == &s.e_damp || a + k == &s.e_fric;
+        assert_true(a[k] == (kept ? k + 1.0 : 0.0));
+    }
+    for (int k = 0; k < JD_ROLLING_STATE_LEN; k++) assert_true(b[k] == 0.0);
+}
+
 int run_kernel_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(hertz_pair_identical_spheres_is_exact_hertz),
@@ -248,6 +266,7 @@ int run_kernel_tests(void) {
         cmocka_unit_test(rolling_cap),
         cmocka_unit_test(angular_momentum_balance),
         cmocka_unit_test(luding_end_of_collision),
+        cmocka_unit_test(separate_keeps_only_the_dissipation_accumulators),
     };
     return cmocka_run_group_tests_name("kernel", tests, NULL, NULL);
 }
