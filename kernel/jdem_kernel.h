@@ -419,16 +419,16 @@ JD_CONTACT_INLINE int jd_contact(const unsigned features, const jd_pair_coeffs *
          * dissipated is -W less the change of its stored energy.  The normal dashpot's share is
          * the same trapezoid on its own force; the remainder is the sliders' (friction), or the
          * dashpot's too when there are no sliders. */
-        double w_prev = jd_dot(f_prev, vrel);
+        double w = jd_dot(f_prev, vrel) + jd_dot(f, vrel);
+        if (rolling) w += jd_dot(m_prev, wrel) + jd_dot(m_roll, wrel);
+        double w_prev = jd_dot(f_prev, vrel); /* the previous step's force alone (Luding's end) */
         if (rolling) w_prev += jd_dot(m_prev, wrel);
-        double w = w_prev + jd_dot(f, vrel);
-        if (rolling) w += jd_dot(m_roll, wrel);
         fd = Cn * ddelta;
         dash += 0.5 * (fd_prev + fd) * ddelta * dt;
         const double diss = -0.5 * w * dt - (u_new - u_prev);
         if (friction | rolling) {
             e_damp_new = e_damp + dash;
-            e_fric_new = e_fric + diss - dash;
+            e_fric_new = e_fric + (diss - dash);
         } else {
             e_damp_new = e_damp + diss; /* no sliders: all of it is the dashpot's (to O(dt^2)) */
         }

@@ -102,8 +102,68 @@ struct jd_batch {
         e_fric[JD_BATCH], m_prev[3][JD_BATCH];
     double delta[JD_BATCH];
     int carries[JD_BATCH], excessive[JD_BATCH];
+    /* wall batches: the geometry from the wall's test, the wall's velocity, the coefficients'
+     * row, and (energy bookkeeping) the force on the wall before the step */
+    double n[3][JD_BATCH], ra[3][JD_BATCH], vw[3][JD_BATCH], f_before[3][JD_BATCH];
+    int32_t k_co[JD_BATCH];
 };
 typedef struct jd_batch batch;
+
+/* Lane b of a batch: the law on geometry g (touch: the bodies overlap; if not, the history is
+ * reset as by jd_contact_separate), kinematics k and coefficients co, starting from the history
+ * of list entry c (hist, rhist: the list's arrays); history, force and torques into the lanes. */
+static JD_ALWAYS_INLINE void lane_law(const unsigned F, batch *restrict B, int b,
+                                      const double *restrict hist, const double *restrict rhist,
+                                      int32_t c, const jd_contact_geom *g, const jd_kinematics *k,
+                                      const jd_pair_coeffs *co, int touch, double dt) {
+    jd_contact_state st;
+    jd_rolling_state rs;
+    double *sa = (double *)&st, *ra = (double *)&rs;
+    for (int q = 0; q < JD_CONTACT_STATE_LEN; q++) sa[q] = q < HW(F) ? hist[HW(F) * c + q] : 0.0;
+    for (int q = 0; q < JD_ROLLING_STATE_LEN; q++) ra[q] = q < RW(F) ? rhist[RW(F) * c + q] : 0.0;
+    const double e_damp_in = st.e_damp, e_fric_in = st.e_fric;
+    if (F & JD_F_ENERGY)
+        for (int d = 0; d < 3; d++) B->f_before[d][b] = st.f_prev[d];
+    jd_contact_result out;
+    const int carries = jd_contact(F, co, g, k, dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
+    for (int d = 0; d < 3; d++) {
+        B->xi[d][b] = touch ? st.xi[d] : 0.0;
+        if (F & JD_F_ENERGY) B->f_prev[d][b] = touch ? st.f_prev[d] : 0.0;
+        if (F & JD_F_ROLLING) B->theta[d][b] = touch ? rs.theta[d] : 0.0;
+        if ((F & JD_F_ROLLING) && (F & JD_F_ENERGY)) B->m_prev[d][b] = touch ? rs.m_prev[d] : 0.0;
+        B->f[d][b] = out.f[d];
+        B->ta[d][b] = out.ta[d];
+        B->tb[d][b] = out.tb[d];
+    }
+    B->flags[b] = touch ? st.flags : 0.0;
+    if (F & JD_F_ENERGY) {
+        B->fd_prev[b] = touch ? st.fd_prev : 0.0;
+        B->u_prev[b] = touch ? st.u_prev : 0.0;
+        B->e_damp[b] = touch ? st.e_damp : e_damp_in;
+        B->e_fric[b] = touch ? st.e_fric : e_fric_in;
+    }
+    B->carries[b] = touch & carries;
+}
+
+/* Lane b's history back into entry c of list L. */
+static JD_ALWAYS_INLINE void lane_history_store(const unsigned F, const batch *B, int b,
+                                                jd_contact_list *L, size_t c) {
+    double *h = L->hist + (size_t)HW(F) * c, *r = L->rhist + (size_t)RW(F) * c;
+    for (int d = 0; d < 3; d++) h[AT(jd_contact_state, xi) + d] = B->xi[d][b];
+    h[AT(jd_contact_state, flags)] = B->flags[b];
+    if (F & JD_F_ENERGY) {
+        for (int d = 0; d < 3; d++) h[AT(jd_contact_state, f_prev) + d] = B->f_prev[d][b];
+        h[AT(jd_contact_state, fd_prev)] = B->fd_prev[b];
+        h[AT(jd_contact_state, u_prev)] = B->u_prev[b];
+        h[AT(jd_contact_state, e_damp)] = B->e_damp[b];
+        h[AT(jd_contact_state, e_fric)] = B->e_fric[b];
+    }
+    if (F & JD_F_ROLLING)
+        for (int d = 0; d < 3; d++) {
+            r[AT(jd_rolling_state, theta) + d] = B->theta[d][b];
+            if (F & JD_F_ENERGY) r[AT(jd_rolling_state, m_prev) + d] = B->m_prev[d][b];
+        }
+}
 
 /* The force loops' buffers (sim_init). */
 int sim_forces_init(jd_sim *s) {
@@ -142,42 +202,14 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, b
         const jd_pair_coeffs co = {coeffs[k_co].gamma, coeffs[k_co].mu, coeffs[k_co].eta,
                                    coeffs[k_co].mu_r, coeffs[k_co].xi_limit};
         jd_kinematics k;
-        jd_contact_state st;
-        jd_rolling_state rs;
-        double *sa = (double *)&st, *ra = (double *)&rs;
-        for (int q = 0; q < JD_CONTACT_STATE_LEN; q++) sa[q] = q < HW(F) ? hist[HW(F) * c + q] : 0.0;
-        for (int q = 0; q < JD_ROLLING_STATE_LEN; q++) ra[q] = q < RW(F) ? rhist[RW(F) * c + q] : 0.0;
         for (int d = 0; d < 3; d++) {
             k.va[d] = v[3 * i + d];
             k.wa[d] = w[3 * i + d];
             k.vb[d] = v[3 * j + d];
             k.wb[d] = w[3 * j + d];
         }
-        const double e_damp_in = st.e_damp, e_fric_in = st.e_fric;
-        jd_contact_result out;
-        const int carries =
-            jd_contact(F, &co, &g, &k, dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
-        /* a candidate that does not overlap after all (delta <= 0, or r = 0) is separated
-         * (as jd_contact_separate: everything but the dissipation accumulators to zero) */
-        for (int d = 0; d < 3; d++) {
-            B->xi[d][b] = touch ? st.xi[d] : 0.0;
-            if (F & JD_F_ENERGY) B->f_prev[d][b] = touch ? st.f_prev[d] : 0.0;
-            if (F & JD_F_ROLLING) B->theta[d][b] = touch ? rs.theta[d] : 0.0;
-            if ((F & JD_F_ROLLING) && (F & JD_F_ENERGY))
-                B->m_prev[d][b] = touch ? rs.m_prev[d] : 0.0;
-            B->f[d][b] = out.f[d];
-            B->ta[d][b] = out.ta[d];
-            B->tb[d][b] = out.tb[d];
-        }
-        B->flags[b] = touch ? st.flags : 0.0;
-        if (F & JD_F_ENERGY) {
-            B->fd_prev[b] = touch ? st.fd_prev : 0.0;
-            B->u_prev[b] = touch ? st.u_prev : 0.0;
-            B->e_damp[b] = touch ? st.e_damp : e_damp_in;
-            B->e_fric[b] = touch ? st.e_fric : e_fric_in;
-        }
+        lane_law(F, B, b, hist, rhist, c, &g, &k, &co, touch, dt);
         B->delta[b] = g.delta;
-        B->carries[b] = touch & carries;
         B->excessive[b] = touch & jd_overlap_excessive(g.delta, rad[i], rad[j], max_overlap);
     }
 }
@@ -200,21 +232,7 @@ static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const unsigned F, const ba
     for (int b = 0; b < nb; b++) {
         const size_t c = (size_t)B->c[b];
         const int32_t i = B->i[b], j = B->j[b];
-        double *h = L->hist + (size_t)HW(F) * c, *r = L->rhist + (size_t)RW(F) * c;
-        for (int d = 0; d < 3; d++) h[AT(jd_contact_state, xi) + d] = B->xi[d][b];
-        h[AT(jd_contact_state, flags)] = B->flags[b];
-        if (F & JD_F_ENERGY) {
-            for (int d = 0; d < 3; d++) h[AT(jd_contact_state, f_prev) + d] = B->f_prev[d][b];
-            h[AT(jd_contact_state, fd_prev)] = B->fd_prev[b];
-            h[AT(jd_contact_state, u_prev)] = B->u_prev[b];
-            h[AT(jd_contact_state, e_damp)] = B->e_damp[b];
-            h[AT(jd_contact_state, e_fric)] = B->e_fric[b];
-        }
-        if (F & JD_F_ROLLING)
-            for (int d = 0; d < 3; d++) {
-                r[AT(jd_rolling_state, theta) + d] = B->theta[d][b];
-                if (F & JD_F_ENERGY) r[AT(jd_rolling_state, m_prev) + d] = B->m_prev[d][b];
-            }
+        lane_history_store(F, B, b, L, c);
         if (B->excessive[b])
             sim_watchdog_overlap(trip, i, j, B->delta[b], fmin(s->radius[i], s->radius[j]));
         if (i != run_i) {
@@ -277,12 +295,80 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, size_t c0, s
     batch_scatter(s, F, B, nb, a, trip);
 }
 
-/* Returns the work the walls did on the particles of the chunk. */
+/* Geometry lanes of a wall batch: the law for lanes [0, nb), vectorised like the pairs'. */
+static JD_ALWAYS_INLINE void wall_batch_evaluate(const jd_sim *s, const unsigned F,
+                                                 batch *restrict B, int nb) {
+    const jd_contact_list *L = &s->wall_pairs;
+    const double *restrict v = s->v, *restrict w = s->omega, *restrict rad = s->radius;
+    const double *restrict kw = s->kw, *restrict mass = s->mass, *restrict inertia = s->inertia;
+    const double *restrict hist = L->hist, *restrict rhist = L->rhist;
+    const jd_pair_coeffs *restrict coeffs = s->coeffs;
+    const double dt = s->dt;
+    for (int b = 0; b < nb; b++) {
+        const int32_t c = B->c[b], i = B->i[b];
+        jd_contact_geom g;
+        for (int d = 0; d < 3; d++) {
+            g.n[d] = B->n[d][b];
+            g.ra[d] = B->ra[d][b];
+            g.rb[d] = 0.0;
+        }
+        g.delta = B->delta[b];
+        g.r_roll = rad[i];
+        jd_geom_wall_material(F, &g, kw[i], mass[i], inertia[i]);
+        const int32_t k_co = B->k_co[b];
+        const jd_pair_coeffs co = {coeffs[k_co].gamma, coeffs[k_co].mu, coeffs[k_co].eta,
+                                   coeffs[k_co].mu_r, coeffs[k_co].xi_limit};
+        jd_kinematics k;
+        for (int d = 0; d < 3; d++) {
+            k.va[d] = v[3 * i + d];
+            k.wa[d] = w[3 * i + d];
+            k.vb[d] = B->vw[d][b];
+            k.wb[d] = 0.0;
+        }
+        lane_law(F, B, b, hist, rhist, c, &g, &k, &co, 1, dt);
+    }
+}
+
+/* Lanes [0, nb) of a wall batch back: history, watchdog, the walls' work (energy bookkeeping:
+ * also over the step a contact ends) and the forces on the particles, in list order.  Returns
+ * the work. */
+static JD_ALWAYS_INLINE double wall_batch_scatter(jd_sim *s, const unsigned F, const batch *B,
+                                                  int nb, acc a, jd_overlap_trip *trip) {
+    jd_contact_list *L = &s->wall_pairs;
+    double work = 0.0;
+    for (int b = 0; b < nb; b++) {
+        const size_t c = (size_t)B->c[b];
+        const int32_t i = B->i[b];
+        lane_history_store(F, B, b, L, c);
+        if (jd_overlap_excessive(B->delta[b], s->radius[i], INFINITY, s->max_overlap))
+            sim_watchdog_overlap(trip, i, -1 - B->j[b], B->delta[b], s->radius[i]);
+        if (F & JD_F_ENERGY) {
+            const double f_before[3] = {B->f_before[0][b], B->f_before[1][b], B->f_before[2][b]};
+            const double f[3] = {B->f[0][b], B->f[1][b], B->f[2][b]};
+            const double vw[3] = {B->vw[0][b], B->vw[1][b], B->vw[2][b]};
+            work += jd_wall_work(f_before, f, vw, s->dt);
+        }
+        if (!B->carries[b]) continue;
+        double *fa = a.f + 3 * (size_t)i, *ta = a.t + 3 * (size_t)i;
+        for (int d = 0; d < 3; d++) {
+            fa[d] -= B->f[d][b];
+            ta[d] += B->ta[d][b];
+        }
+    }
+    return work;
+}
+
+/* The wall loop over entries [c0, c1), in batches like the pair loop: the wall's own test
+ * (plane or cylinder) decides the touching entries and fills their geometry lanes.  Returns
+ * the work the walls did on the particles of the chunk. */
 static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
                                          jd_overlap_trip *trip) {
     jd_contact_list *L = &s->wall_pairs;
-    const size_t nm = s->n_materials;
+    const int32_t nm = (int32_t)s->n_materials;
+    batch lanes;
+    batch *B = &lanes;
     double work = 0.0;
+    int nb = 0;
     for (size_t c = c0; c < c1; c++) {
         const int32_t i = L->i[c];
         const jd_sim_wall *w = &s->walls[L->j[c]];
@@ -291,33 +377,24 @@ static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0,
             hist_separate(L, F, c);
             continue;
         }
-        if (jd_overlap_excessive(g.delta, s->radius[i], INFINITY, s->max_overlap))
-            sim_watchdog_overlap(trip, i, -1 - L->j[c], g.delta, s->radius[i]);
-        jd_kinematics k;
+        B->c[nb] = (int32_t)c;
+        B->i[nb] = i;
+        B->j[nb] = L->j[c];
+        B->delta[nb] = g.delta;
+        B->k_co[nb] = s->species[i] * nm + (int32_t)w->material;
         for (int d = 0; d < 3; d++) {
-            k.va[d] = s->v[3 * (size_t)i + d];
-            k.wa[d] = s->omega[3 * (size_t)i + d];
-            k.vb[d] = w->v[d];
-            k.wb[d] = 0.0;
+            B->n[d][nb] = g.n[d];
+            B->ra[d][nb] = g.ra[d];
+            B->vw[d][nb] = w->v[d];
         }
-        const jd_pair_coeffs *co = &s->coeffs[(size_t)s->species[i] * nm + (size_t)w->material];
-        jd_contact_state st;
-        jd_rolling_state rs;
-        hist_load(L, F, c, &st, &rs);
-        jd_contact_result out;
-        const double f_prev[3] = {st.f_prev[0], st.f_prev[1], st.f_prev[2]};
-        const int carries = jd_contact(F, co, &g, &k, s->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
-        hist_store(L, F, c, &st, &rs);
-        if (F & JD_F_ENERGY) /* also over the step a contact ends */
-            work += jd_wall_work(f_prev, out.f, w->v, s->dt);
-        if (!carries) continue;
-        double *fa = a.f + 3 * (size_t)i, *ta = a.t + 3 * (size_t)i;
-        for (int d = 0; d < 3; d++) {
-            fa[d] -= out.f[d];
-            ta[d] += out.ta[d];
+        if (++nb == JD_BATCH) {
+            wall_batch_evaluate(s, F, B, nb);
+            work += wall_batch_scatter(s, F, B, nb, a, trip);
+            nb = 0;
         }
     }
-    return work;
+    wall_batch_evaluate(s, F, B, nb);
+    return work + wall_batch_scatter(s, F, B, nb, a, trip);
 }
 
 /* This thread's share of the contact loops; returns its wall work.  *t_pairs_end: when thread 0
