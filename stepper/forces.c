@@ -397,6 +397,101 @@ static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0,
     return work + wall_batch_scatter(s, F, B, nb, a, trip);
 }
 
+/* The reference path (--plain-loops): one contact at a time, as the loops were before they
+ * were batched, with the features as a run-time value.  The batched loops must give the same
+ * bits (tests/engine/test_fastpaths.py). */
+static void plain_pair_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
+                            jd_overlap_trip *trip) {
+    jd_contact_list *L = &s->pairs;
+    const size_t nm = s->n_materials;
+    for (size_t c = c0; c < c1; c++) {
+        const int32_t i = L->i[c], j = L->j[c];
+        jd_contact_geom g;
+        if (!sim_pair_geom(s, F, c, i, j, &g)) {
+            hist_separate(L, F, c);
+            continue;
+        }
+        if (jd_overlap_excessive(g.delta, s->radius[i], s->radius[j], s->max_overlap))
+            sim_watchdog_overlap(trip, i, j, g.delta, fmin(s->radius[i], s->radius[j]));
+        jd_kinematics k;
+        for (int d = 0; d < 3; d++) {
+            k.va[d] = s->v[3 * (size_t)i + d];
+            k.wa[d] = s->omega[3 * (size_t)i + d];
+            k.vb[d] = s->v[3 * (size_t)j + d];
+            k.wb[d] = s->omega[3 * (size_t)j + d];
+        }
+        const jd_pair_coeffs *co = &s->coeffs[(size_t)s->species[i] * nm + (size_t)s->species[j]];
+        jd_contact_state st;
+        jd_rolling_state rs;
+        hist_load(L, F, c, &st, &rs);
+        jd_contact_result out;
+        const int carries = jd_contact(F, co, &g, &k, s->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
+        hist_store(L, F, c, &st, &rs);
+        if (!carries) continue;
+        double *fa = a.f + 3 * (size_t)i, *fb = a.f + 3 * (size_t)j;
+        double *ta = a.t + 3 * (size_t)i, *tb = a.t + 3 * (size_t)j;
+        for (int d = 0; d < 3; d++) {
+            fa[d] -= out.f[d];
+            fb[d] += out.f[d];
+            ta[d] += out.ta[d];
+            tb[d] += out.tb[d];
+        }
+    }
+}
+
+static double plain_wall_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
+                              jd_overlap_trip *trip) {
+    jd_contact_list *L = &s->wall_pairs;
+    const size_t nm = s->n_materials;
+    double work = 0.0;
+    for (size_t c = c0; c < c1; c++) {
+        const int32_t i = L->i[c];
+        const jd_sim_wall *w = &s->walls[L->j[c]];
+        jd_contact_geom g;
+        if (!sim_wall_geom(s, i, w, &g)) {
+            hist_separate(L, F, c);
+            continue;
+        }
+        if (jd_overlap_excessive(g.delta, s->radius[i], INFINITY, s->max_overlap))
+            sim_watchdog_overlap(trip, i, -1 - L->j[c], g.delta, s->radius[i]);
+        jd_kinematics k;
+        for (int d = 0; d < 3; d++) {
+            k.va[d] = s->v[3 * (size_t)i + d];
+            k.wa[d] = s->omega[3 * (size_t)i + d];
+            k.vb[d] = w->v[d];
+            k.wb[d] = 0.0;
+        }
+        const jd_pair_coeffs *co = &s->coeffs[(size_t)s->species[i] * nm + (size_t)w->material];
+        jd_contact_state st;
+        jd_rolling_state rs;
+        hist_load(L, F, c, &st, &rs);
+        jd_contact_result out;
+        const double f_prev[3] = {st.f_prev[0], st.f_prev[1], st.f_prev[2]};
+        const int carries = jd_contact(F, co, &g, &k, s->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
+        hist_store(L, F, c, &st, &rs);
+        if (F & JD_F_ENERGY) work += jd_wall_work(f_prev, out.f, w->v, s->dt);
+        if (!carries) continue;
+        for (int d = 0; d < 3; d++) {
+            a.f[3 * (size_t)i + d] -= out.f[d];
+            a.t[3 * (size_t)i + d] += out.ta[d];
+        }
+    }
+    return work;
+}
+
+/* contact_loops on the reference path, compiled once (the features a run-time value). */
+static double plain_contact_loops(jd_sim *s, int tid, int nt, double *t_pairs_end) {
+    const unsigned F = s->features;
+    const acc a = acc_of(s, tid);
+    jd_overlap_trip *trip = &s->trips[tid];
+    size_t lo, hi;
+    chunk(s->pairs.n, tid, nt, &lo, &hi);
+    plain_pair_loop(s, F, lo, hi, a, trip);
+    if (tid == 0) *t_pairs_end = sim_clock();
+    chunk(s->wall_pairs.n, tid, nt, &lo, &hi);
+    return plain_wall_loop(s, F, lo, hi, a, trip);
+}
+
 /* This thread's share of the contact loops; returns its wall work.  *t_pairs_end: when thread 0
  * finished its share of the pairs (with threads, the split of the timing is thread 0's). */
 static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int tid, int nt,
@@ -428,6 +523,11 @@ static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
     _Static_assert(JD_F_DAMPING == 1 && JD_F_FRICTION == 2 && JD_F_ROLLING == 4 && JD_F_MU_R == 8 &&
                        JD_F_ENERGY == 16,
                    "the dispatch below enumerates the four optional laws as bits 0-3, energy as 4");
+    if (s->opt.plain_loops) {
+        work = plain_contact_loops(s, tid, nt, &t_pairs_end);
+        if (tid == 0) *t_pairs_end_out = t_pairs_end;
+        return work;
+    }
 #ifdef JD_ONE_FORCE_LOOP
     /* one copy of the loops, with the features as a run-time value: the sanitizer build
      * (Makefile), where 32 inlined copies of the law under ASan+UBSan take minutes to compile;

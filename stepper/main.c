@@ -59,6 +59,8 @@ static const char usage_text[] =
     "  --all-laws               evaluate every contact law even where the scene's\n"
     "                           coefficients switch it off (run; the general force loop, a\n"
     "                           reference for the scene-specialised ones: same trajectory)\n"
+    "  --plain-loops            evaluate one contact at a time instead of in SIMD batches\n"
+    "                           (run; the reference for the batched loops: same trajectory)\n"
     "\n"
     "time-step guard (run): dt must not exceed 20 % of the Rayleigh time step of the smallest\n"
     "sphere, nor 1/50 of the shortest Hertz contact time at time.max_impact_speed, nor the\n"
@@ -83,7 +85,7 @@ static const char usage_text[] =
 
 typedef struct cli {
     const char *command, *scene, *case_name, *output;
-    int force, quiet, timing, no_sort, all_laws, threads;
+    int force, quiet, timing, no_sort, all_laws, plain_loops, threads;
 } cli;
 
 /* A positive thread count from s (option or environment), or 0. */
@@ -122,6 +124,8 @@ static int parse(int argc, char **argv, cli *c) {
             c->no_sort = 1;
         } else if (!strcmp(a, "--all-laws")) {
             c->all_laws = 1;
+        } else if (!strcmp(a, "--plain-loops")) {
+            c->plain_loops = 1;
         } else if (!strcmp(a, "--threads")) {
             if (!has_value) return usage_error("--threads needs a value", NULL);
             if (!(c->threads = thread_count(argv[++k])))
@@ -141,9 +145,10 @@ static int parse(int argc, char **argv, cli *c) {
         return usage_error("unknown command", c->command);
     if (!c->scene) return usage_error("missing SCENE", NULL);
     if (strcmp(c->command, "run") &&
-        (c->output || c->force || c->quiet || c->timing || c->no_sort || c->all_laws || c->threads))
-        return usage_error("-o, --force, --quiet, --threads, --timing, --no-sort and --all-laws "
-                           "apply to 'run' only", NULL);
+        (c->output || c->force || c->quiet || c->timing || c->no_sort || c->all_laws ||
+         c->plain_loops || c->threads))
+        return usage_error("-o, --force, --quiet, --threads, --timing, --no-sort, --all-laws and "
+                           "--plain-loops apply to 'run' only", NULL);
     if (!c->threads && getenv("OMP_NUM_THREADS")) {
         if (!(c->threads = thread_count(getenv("OMP_NUM_THREADS"))))
             return usage_error("OMP_NUM_THREADS must be a whole number from 1 to 1024",
@@ -322,7 +327,8 @@ static int cmd_run(const cli *c) {
     if (make_parent_dirs(out, err, sizeof err) != 0) goto fail;
     const jd_sim_options opt = {
         .allpairs = getenv("JDEM_NEIGHBOUR") && !strcmp(getenv("JDEM_NEIGHBOUR"), "allpairs"),
-        .no_sort = c->no_sort, .all_laws = c->all_laws, .threads = c->threads ? c->threads : 1};
+        .no_sort = c->no_sort, .all_laws = c->all_laws, .plain_loops = c->plain_loops,
+        .threads = c->threads ? c->threads : 1};
     if (sim_init(&sim, &sc, &opt, err, sizeof err) != 0) goto fail;
     sim_ok = 1;
     yaml = scene_yaml_string(&sc);

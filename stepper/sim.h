@@ -73,6 +73,7 @@ typedef struct jd_sim_options {
     int no_sort;      /* keep the scene's particle order (reference for the sorted path) */
     int all_laws;     /* evaluate every law even where its coefficient makes it vanish (the
                          general loop; reference for the feature-specialised ones) */
+    int plain_loops;  /* one contact at a time instead of SIMD batches (reference for them) */
     int threads;      /* OpenMP threads of the force and integration loops; <= 0: 1 */
 } jd_sim_options;
 

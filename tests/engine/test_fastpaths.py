@@ -8,6 +8,9 @@ a cylinder, damping, friction, rolling resistance, ~50 neighbour rebuilds).
   the trajectories agree to round-off (differences start at 1e-17 and grow through the
   collisions; the bounds below are 1e-12 relative, far below any physical effect: one missed
   contact step changes velocities by ~1e-3 relative) and the contact counts are identical;
+* the force loops in SIMD batches against one contact at a time (--plain-loops): each contact's
+  arithmetic and the order of the force sums are the same, so the trajectories and every
+  observable (energies included) are identical bit for bit;
 * 2 OpenMP threads against 1: the same round-off bounds; two 2-thread runs are identical bit
   for bit (the summation order is fixed for a given thread count);
 * the scene-specialised force loop against the general one (--all-laws) on the scene without
@@ -93,6 +96,14 @@ srt, _, _ = run_file(base)
 c.check("sorting_changes_summation_order", not identical(ref, srt),
         "sorted and unsorted runs are identical: was anything renumbered?")
 roundoff_equal(c, "sorted_vs_unsorted", srt, ref)
+
+plain, _, _ = run_file(base, "--plain-loops")
+c.check("batched_vs_plain_loops_identical", identical(srt, plain),
+        "the SIMD-batched force loops differ from the one-contact-at-a-time loops: position "
+        f"{rel_diff(srt, plain, 'position'):.3g}")
+c.check("batched_vs_plain_loops_same_observables",
+        all(np.array_equal(srt["obs"][k], plain["obs"][k]) for k in srt["obs"]),
+        "observables differ between the batched and the plain force loops")
 
 two, _, nt = run_file(base, "--threads", "2")
 c.check("two_threads_used", nt == 2, f"{nt} threads")
