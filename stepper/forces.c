@@ -94,7 +94,6 @@ static JD_ALWAYS_INLINE void hist_separate(jd_contact_list *L, const unsigned F,
  * and particles, and what the law returns. */
 struct jd_batch {
     int32_t c[JD_BATCH], i[JD_BATCH], j[JD_BATCH]; /* list entry and its particles */
-    double dx[3][JD_BATCH];                        /* x_j - x_i [m] */
     /* results: force on j, torques on i and j, history after the step */
     double f[3][JD_BATCH], ta[3][JD_BATCH], tb[3][JD_BATCH];
     double xi[3][JD_BATCH], flags[JD_BATCH], theta[3][JD_BATCH];
@@ -145,10 +144,10 @@ static JD_ALWAYS_INLINE void lane_law(const unsigned F, batch *restrict B, int b
     B->carries[b] = touch & carries;
 }
 
-/* Lane b's history back into entry c of list L. */
-static JD_ALWAYS_INLINE void lane_history_store(const unsigned F, const batch *B, int b,
-                                                jd_contact_list *L, size_t c) {
-    double *h = L->hist + (size_t)HW(F) * c, *r = L->rhist + (size_t)RW(F) * c;
+/* Lane b's history into entry c of a list's history arrays. */
+static JD_ALWAYS_INLINE void lane_history_write(const unsigned F, const batch *B, int b,
+                                                double *hist, double *rhist, size_t c) {
+    double *h = hist + (size_t)HW(F) * c, *r = rhist + (size_t)RW(F) * c;
     for (int d = 0; d < 3; d++) h[AT(jd_contact_state, xi) + d] = B->xi[d][b];
     h[AT(jd_contact_state, flags)] = B->flags[b];
     if (F & JD_F_ENERGY) {
@@ -173,32 +172,39 @@ int sim_forces_init(jd_sim *s) {
     return (nb && !s->tbuf) || !s->trips ? -1 : 0;
 }
 
-/* Geometry and law for lanes [0, nb), reading the particles and the history through the lanes'
- * indices and writing the results into the lanes.  The compiler vectorises this loop: the
- * kernel's geometry and law have no data-dependent branches, and a lane writes only its own
- * fields. */
-static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, batch *restrict B,
-                                            int nb) {
+/* Geometry and law for list entries [c0, c0 + nb), one lane each, every candidate: the sphere
+ * test (LIGGGHTS' rsq < radsum^2, then jd_geom_spheres_fill's) is a lane mask, not a branch.  A
+ * lane that does not touch computes the law on a meaningless geometry and then selects what
+ * jd_contact_separate leaves and a zero force, so a candidate's history is exactly the plain
+ * loop's either way.  Each lane writes its own entry's history, so that is done here too (no
+ * two lanes share an entry); the forces go into the lanes for batch_scatter.  The compiler vectorises this loop: the kernel's
+ * geometry and law have no data-dependent branches. */
+static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, const int one_row,
+                                            batch *restrict B, size_t c0, int nb) {
     const jd_contact_list *L = &s->pairs;
-    const double *restrict v = s->v, *restrict w = s->omega, *restrict rad = s->radius;
-    const double *restrict hist = L->hist, *restrict rhist = L->rhist;
-    const jd_pair_const *restrict pc = L->pc;
-    const jd_pair_const_roll *restrict pcr = L->pcr;
+    const double *restrict x = s->x, *restrict v = s->v, *restrict w = s->omega,
+                           *restrict rad = s->radius;
+    double *hist = L->hist, *rhist = L->rhist;
+    const int32_t *restrict li = L->i + c0, *restrict lj = L->j + c0;
+    const jd_pair_const *restrict pc = L->pc + c0;
+    const jd_pair_const_roll *restrict pcr = L->pcr ? L->pcr + c0 : NULL;
     const size_t nm = s->n_materials;
     const jd_pair_coeffs *restrict coeffs = s->coeffs;
     const int32_t *restrict species = s->species;
     const double dt = s->dt, max_overlap = s->max_overlap;
     for (int b = 0; b < nb; b++) {
         /* int indices (vectorisable arithmetic; 3 n < 2^31 is checked at set-up) */
-        const int32_t c = B->c[b], i = B->i[b], j = B->j[b];
-        const double dx[3] = {B->dx[0][b], B->dx[1][b], B->dx[2][b]};
+        const int32_t c = (int32_t)c0 + b, i = li[b], j = lj[b];
+        const double dx[3] = {x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
+        const double rsq = jd_dot(dx, dx), radsum = rad[i] + rad[j];
         jd_contact_geom g;
-        const int touch = jd_geom_spheres_fill(dx, jd_dot(dx, dx), rad[i], rad[j], &g);
-        g.k_n = pc[c].k_n;
-        g.m_eff = pc[c].m_eff;
-        g.i_eff = (F & JD_F_ROLLING) ? pcr[c].i_eff : 0.0;
-        g.r_roll = (F & JD_F_ROLLING) ? pcr[c].r_roll : 0.0;
-        const int32_t k_co = species[i] * (int32_t)nm + species[j];
+        const int touch = (rsq < radsum * radsum) & jd_geom_spheres_fill(dx, rsq, rad[i], rad[j], &g);
+        g.k_n = pc[b].k_n;
+        g.m_eff = pc[b].m_eff;
+        g.i_eff = (F & JD_F_ROLLING) ? pcr[b].i_eff : 0.0;
+        g.r_roll = (F & JD_F_ROLLING) ? pcr[b].r_roll : 0.0;
+        /* one_row: the same row for every lane, loaded once (5 gathers fewer per lane) */
+        const int32_t k_co = one_row ? s->pair_row : species[i] * (int32_t)nm + species[j];
         const jd_pair_coeffs co = {coeffs[k_co].gamma, coeffs[k_co].mu, coeffs[k_co].eta,
                                    coeffs[k_co].mu_r, coeffs[k_co].xi_limit};
         jd_kinematics k;
@@ -209,32 +215,45 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, b
             k.wb[d] = w[3 * j + d];
         }
         lane_law(F, B, b, hist, rhist, c, &g, &k, &co, touch, dt);
+        B->i[b] = i;
+        B->j[b] = j;
         B->delta[b] = g.delta;
         B->excessive[b] = touch & jd_overlap_excessive(g.delta, rad[i], rad[j], max_overlap);
     }
+    /* a loop of its own: in the one above, stores to the list would be stores the compiler
+     * cannot tell apart from the particle arrays it gathers from */
+    for (int b = 0; b < nb; b++) lane_history_write(F, B, b, hist, rhist, c0 + (size_t)b);
 }
 
-/* Lanes [0, nb) back: the history into the list, the forces and torques added in list order,
- * overlaps beyond the watchdog's limit.  The list is sorted by i, so consecutive lanes mostly
- * share particle i: its force and torque are loaded once per run of lanes, updated in registers
- * and stored once.  No other entry of the run touches particle i (they add to j > i), so every
- * sum is exactly that of a plain loop over the list, one contact at a time. */
-static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const unsigned F, const batch *B, int nb,
-                                           acc a, jd_overlap_trip *trip) {
-    jd_contact_list *L = &s->pairs;
-    if (nb == 0) return;
-    int32_t run_i = B->i[0];
+/* Lanes [0, nb) back: overlaps beyond the watchdog's limit, and the forces and torques of the
+ * lanes that carry one added in list order.  The list is sorted by i, so consecutive lanes
+ * mostly share particle i: its force and torque are loaded once per run of lanes, updated in
+ * registers and stored once.  No other entry of the run touches particle i (they add to j > i),
+ * so every sum is exactly that of a plain loop over the list, one contact at a time.  The lanes
+ * that carry no force are dropped first without a branch (most candidates of a settled bed do
+ * not touch, in no predictable pattern). */
+static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const batch *B, int nb, acc a,
+                                           jd_overlap_trip *trip) {
+    int32_t live[JD_BATCH];
+    int m = 0;
+    for (int b = 0; b < nb; b++) {
+        live[m] = b;
+        m += B->carries[b];
+        if (B->excessive[b]) {
+            const int32_t i = B->i[b], j = B->j[b];
+            sim_watchdog_overlap(trip, i, j, B->delta[b], fmin(s->radius[i], s->radius[j]));
+        }
+    }
+    if (m == 0) return;
+    int32_t run_i = B->i[live[0]];
     double fi[3], ti[3];
     for (int d = 0; d < 3; d++) {
         fi[d] = a.f[3 * (size_t)run_i + d];
         ti[d] = a.t[3 * (size_t)run_i + d];
     }
-    for (int b = 0; b < nb; b++) {
-        const size_t c = (size_t)B->c[b];
+    for (int q = 0; q < m; q++) {
+        const int b = live[q];
         const int32_t i = B->i[b], j = B->j[b];
-        lane_history_store(F, B, b, L, c);
-        if (B->excessive[b])
-            sim_watchdog_overlap(trip, i, j, B->delta[b], fmin(s->radius[i], s->radius[j]));
         if (i != run_i) {
             for (int d = 0; d < 3; d++) {
                 a.f[3 * (size_t)run_i + d] = fi[d];
@@ -244,7 +263,6 @@ static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const unsigned F, const ba
             }
             run_i = i;
         }
-        if (!B->carries[b]) continue;
         double *fb = a.f + 3 * (size_t)j, *tb = a.t + 3 * (size_t)j;
         for (int d = 0; d < 3; d++) {
             fi[d] -= B->f[d][b];
@@ -259,40 +277,18 @@ static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const unsigned F, const ba
     }
 }
 
-/* The pair loop over list entries [c0, c1), in batches: candidates whose spheres overlap
- * (rsq < radsum^2, LIGGGHTS' test) go into the lanes of a batch, the others have their history
- * reset (jd_contact_separate); a full batch is evaluated (SIMD) and scattered back.  Each
- * contact's arithmetic is exactly that of a plain loop over the list calling
- * jd_geom_spheres_contact and jd_contact. */
-static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
-                                       jd_overlap_trip *trip) {
-    jd_contact_list *L = &s->pairs;
-    const double *x = s->x, *rad = s->radius;
+/* The pair loop over list entries [c0, c1), in batches of consecutive entries: each batch is
+ * evaluated (SIMD) and scattered back.  one_row: a literal, 1 when every pair uses the
+ * coefficient row s->pair_row (one particle material).  Each contact's arithmetic is exactly that of a plain
+ * loop over the list calling jd_geom_spheres_contact and jd_contact. */
+static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int one_row, size_t c0,
+                                       size_t c1, acc a, jd_overlap_trip *trip) {
     batch lanes; /* on the stack: the compiler then knows that no list or particle array aliases it */
-    batch *B = &lanes;
-    int nb = 0;
-    for (size_t c = c0; c < c1; c++) {
-        const int32_t i = L->i[c], j = L->j[c];
-        const double dx[3] = {x[3 * (size_t)j] - x[3 * (size_t)i],
-                              x[3 * (size_t)j + 1] - x[3 * (size_t)i + 1],
-                              x[3 * (size_t)j + 2] - x[3 * (size_t)i + 2]};
-        const double radsum = rad[i] + rad[j];
-        if (!(jd_dot(dx, dx) < radsum * radsum)) {
-            hist_separate(L, F, c);
-            continue;
-        }
-        B->c[nb] = (int32_t)c;
-        B->i[nb] = i;
-        B->j[nb] = j;
-        for (int d = 0; d < 3; d++) B->dx[d][nb] = dx[d];
-        if (++nb == JD_BATCH) {
-            batch_evaluate(s, F, B, nb);
-            batch_scatter(s, F, B, nb, a, trip);
-            nb = 0;
-        }
+    for (size_t c = c0; c < c1; c += JD_BATCH) {
+        const int nb = c1 - c < JD_BATCH ? (int)(c1 - c) : JD_BATCH;
+        batch_evaluate(s, F, one_row, &lanes, c, nb);
+        batch_scatter(s, &lanes, nb, a, trip);
     }
-    batch_evaluate(s, F, B, nb);
-    batch_scatter(s, F, B, nb, a, trip);
 }
 
 /* Geometry lanes of a wall batch: the law for lanes [0, nb), vectorised like the pairs'. */
@@ -339,7 +335,7 @@ static JD_ALWAYS_INLINE double wall_batch_scatter(jd_sim *s, const unsigned F, c
     for (int b = 0; b < nb; b++) {
         const size_t c = (size_t)B->c[b];
         const int32_t i = B->i[b];
-        lane_history_store(F, B, b, L, c);
+        lane_history_write(F, B, b, L->hist, L->rhist, c);
         if (jd_overlap_excessive(B->delta[b], s->radius[i], INFINITY, s->max_overlap))
             sim_watchdog_overlap(trip, i, -1 - B->j[b], B->delta[b], s->radius[i]);
         if (F & JD_F_ENERGY) {
@@ -500,14 +496,19 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
     jd_overlap_trip *trip = &s->trips[tid];
     size_t lo, hi;
     chunk(s->pairs.n, tid, nt, &lo, &hi);
-    pair_loop(s, F, lo, hi, a, trip);
+    if (s->pair_row >= 0)
+        pair_loop(s, F, 1, lo, hi, a, trip);
+    else
+        pair_loop(s, F, 0, lo, hi, a, trip);
     if (tid == 0) *t_pairs_end = sim_clock();
     chunk(s->wall_pairs.n, tid, nt, &lo, &hi);
     return wall_loop(s, F, lo, hi, a, trip);
 }
 
 /* One instantiation per combination of the four optional laws and the energy bookkeeping
- * (output.energy).  The switch maps the run-time bits to a literal constant. */
+ * (output.energy) that sim.c can select: mu_R modifies the tangential law only, so JD_F_MU_R
+ * comes with JD_F_FRICTION (12 of the 16 law sets).  The switch maps the run-time bits to a
+ * literal constant. */
 #define JD_FORCE_CASE(bits)                                                     \
     case (bits):                                                                \
         work = contact_loops(s, (bits), tid, nt, &t_pairs_end);                 \
@@ -515,8 +516,7 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
 #define JD_FORCE_CASES(e)                                                                     \
     JD_FORCE_CASE((e) | 0) JD_FORCE_CASE((e) | 1) JD_FORCE_CASE((e) | 2) JD_FORCE_CASE((e) | 3)     \
     JD_FORCE_CASE((e) | 4) JD_FORCE_CASE((e) | 5) JD_FORCE_CASE((e) | 6) JD_FORCE_CASE((e) | 7)     \
-    JD_FORCE_CASE((e) | 8) JD_FORCE_CASE((e) | 9) JD_FORCE_CASE((e) | 10) JD_FORCE_CASE((e) | 11)   \
-    JD_FORCE_CASE((e) | 12) JD_FORCE_CASE((e) | 13) JD_FORCE_CASE((e) | 14) JD_FORCE_CASE((e) | 15)
+    JD_FORCE_CASE((e) | 10) JD_FORCE_CASE((e) | 11) JD_FORCE_CASE((e) | 14) JD_FORCE_CASE((e) | 15)
 
 static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
     double work = 0.0, t_pairs_end = 0.0;
@@ -537,6 +537,8 @@ static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
     switch (s->features & 31u) {
         JD_FORCE_CASES(0)
         JD_FORCE_CASES(16)
+    default: /* a law set sim.c never selects: the reference path serves every set */
+        work = plain_contact_loops(s, tid, nt, &t_pairs_end);
     }
 #endif
     if (tid == 0) *t_pairs_end_out = t_pairs_end;

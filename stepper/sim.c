@@ -36,6 +36,9 @@ static int init_coeffs(jd_sim *s) {
     }
     free(e_seen);
     free(gamma_seen);
+    s->pair_row = s->n ? s->species[0] * (int32_t)(nm + 1) : -1;
+    for (size_t i = 1; i < s->n; i++)
+        if (s->species[i] != s->species[0]) s->pair_row = -1;
     return rc;
 }
 

@@ -173,6 +173,8 @@ typedef struct jd_sim {
 
     size_t n_materials;
     jd_pair_coeffs *coeffs; /* n_materials^2, row-major: coefficients of (material a, material b) */
+    int32_t pair_row;  /* the row of coeffs every particle pair uses when all particles share one
+                        * material (the pair loop then reads no species), else -1 */
     double g[3];
 
     size_t n_walls;

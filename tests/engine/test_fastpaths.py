@@ -10,7 +10,8 @@ a cylinder, damping, friction, rolling resistance, ~50 neighbour rebuilds).
   contact step changes velocities by ~1e-3 relative) and the contact counts are identical;
 * the force loops in SIMD batches against one contact at a time (--plain-loops): each contact's
   arithmetic and the order of the force sums are the same, so the trajectories and every
-  observable (energies included) are identical bit for bit;
+  observable (energies included) are identical bit for bit; also with two particle materials
+  (the coefficients read per pair instead of once);
 * 2 OpenMP threads against 1: the same round-off bounds; two 2-thread runs are identical bit
   for bit (the summation order is fixed for a given thread count);
 * the scene-specialised force loop against the general one (--all-laws) on the scene without
@@ -104,6 +105,29 @@ c.check("batched_vs_plain_loops_identical", identical(srt, plain),
 c.check("batched_vs_plain_loops_same_observables",
         all(np.array_equal(srt["obs"][k], plain["obs"][k]) for k in srt["obs"]),
         "observables differ between the batched and the plain force loops")
+
+# Two particle materials: the batches then read each pair's coefficient row through the
+# species (one material: the one row, read once per batch).
+lattice = "      counts: [6, 6, 6]\n"
+mixed_text = open(base).read()
+assert mixed_text.count(lattice) == 1
+mixed_text = mixed_text.replace(
+    "  steel:", "  sand: {youngs_modulus: 5.0e7, poisson_ratio: 0.25, density: 2000, restitution: 0.4,\n"
+    "         friction: 0.6, rolling_friction: 0.02}\n  steel:").replace(lattice, "      counts: [6, 6, 3]\n")
+mixed_text = mixed_text.replace("generate:", "interactions:\n  - {materials: [grain, sand], restitution: 0.5, "
+                                "friction: 0.5, rolling_friction: 0.03}\n"
+                                "  - {materials: [sand, steel], restitution: 0.5, friction: 0.5, "
+                                "rolling_friction: 0.03}\ngenerate:")
+second = mixed_text[mixed_text.index("  - lattice:"):mixed_text.index("walls:")]
+mixed_text = mixed_text.replace(second, second + second.replace("material: grain", "material: sand").replace(
+    "origin: [-0.00525, -0.00525, 0.00105]", "origin: [-0.00525, -0.00525, 0.00735]"))
+mixed = variant(mixed_text, "fastpaths_two_materials")
+mixed_batched, _, _ = run_file(mixed)
+mixed_plain, _, _ = run_file(mixed, "--plain-loops")
+c.check("two_materials_batched_vs_plain_identical", identical(mixed_batched, mixed_plain),
+        "with two particle materials the batched loops differ from the plain ones: position "
+        f"{rel_diff(mixed_batched, mixed_plain, 'position'):.3g}")
+c.check("two_materials_differ_from_one", not identical(mixed_batched, srt), "the second material changed nothing")
 
 two, _, nt = run_file(base, "--threads", "2")
 c.check("two_threads_used", nt == 2, f"{nt} threads")
