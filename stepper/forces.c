@@ -21,8 +21,10 @@
 
 #if defined(__GNUC__)
 #define JD_ALWAYS_INLINE inline __attribute__((always_inline))
+#define JD_NOINLINE __attribute__((noinline))
 #else
 #define JD_ALWAYS_INLINE inline
+#define JD_NOINLINE
 #endif
 /* one copy of the law per specialised loop (kernel/jdem_kernel.h, JD_CONTACT_INLINE) */
 #define JD_CONTACT_INLINE static JD_ALWAYS_INLINE
@@ -172,14 +174,20 @@ int sim_forces_init(jd_sim *s) {
     return (nb && !s->tbuf) || !s->trips ? -1 : 0;
 }
 
+/* How alike the particles of a scene are (sim.h: pair_row, alike), a compile-time constant of the
+ * pair loops: any mix; one material (one coefficient row); one material and one radius (the
+ * same constants for every pair). */
+enum { JD_KINDS_ANY, JD_KINDS_ONE_MATERIAL, JD_KINDS_ALIKE };
+
 /* Geometry and law for list entries [c0, c0 + nb), one lane each, every candidate: the sphere
  * test (LIGGGHTS' rsq < radsum^2, then jd_geom_spheres_fill's) is a lane mask, not a branch.  A
- * lane that does not touch computes the law on a meaningless geometry and then selects what
- * jd_contact_separate leaves and a zero force, so a candidate's history is exactly the plain
- * loop's either way.  Each lane writes its own entry's history, so that is done here too (no
- * two lanes share an entry); the forces go into the lanes for batch_scatter.  The compiler vectorises this loop: the kernel's
- * geometry and law have no data-dependent branches. */
-static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, const int one_row,
+ * lane that does not touch computes the law on a meaningless geometry, then keeps what
+ * jd_contact_separate leaves and carries no force, so every candidate's history is exactly the
+ * plain loop's.  The vectorised loop writes only the lanes (stores to the list there would be
+ * stores the compiler cannot tell apart from the particle arrays it gathers from); a second
+ * loop copies each lane's history to its entry.  The kernel's geometry and law have no
+ * data-dependent branches. */
+static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, const int kinds,
                                             batch *restrict B, size_t c0, int nb) {
     const jd_contact_list *L = &s->pairs;
     const double *restrict x = s->x, *restrict v = s->v, *restrict w = s->omega,
@@ -192,18 +200,23 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, c
     const jd_pair_coeffs *restrict coeffs = s->coeffs;
     const int32_t *restrict species = s->species;
     const double dt = s->dt, max_overlap = s->max_overlap;
+    /* what is the same for every lane, loaded once: saves gathers and the per-pair reads */
+    const int one_row = kinds != JD_KINDS_ANY, alike = kinds == JD_KINDS_ALIKE;
+    const jd_pair_const pc1 = s->pc_alike;
+    const jd_pair_const_roll pcr1 = s->pcr_alike;
+    const double r1 = s->r_alike;
     for (int b = 0; b < nb; b++) {
         /* int indices (vectorisable arithmetic; 3 n < 2^31 is checked at set-up) */
         const int32_t c = (int32_t)c0 + b, i = li[b], j = lj[b];
         const double dx[3] = {x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
-        const double rsq = jd_dot(dx, dx), radsum = rad[i] + rad[j];
+        const double ri = alike ? r1 : rad[i], rj = alike ? r1 : rad[j];
+        const double rsq = jd_dot(dx, dx), radsum = ri + rj;
         jd_contact_geom g;
-        const int touch = (rsq < radsum * radsum) & jd_geom_spheres_fill(dx, rsq, rad[i], rad[j], &g);
-        g.k_n = pc[b].k_n;
-        g.m_eff = pc[b].m_eff;
-        g.i_eff = (F & JD_F_ROLLING) ? pcr[b].i_eff : 0.0;
-        g.r_roll = (F & JD_F_ROLLING) ? pcr[b].r_roll : 0.0;
-        /* one_row: the same row for every lane, loaded once (5 gathers fewer per lane) */
+        const int touch = (rsq < radsum * radsum) & jd_geom_spheres_fill(dx, rsq, ri, rj, &g);
+        g.k_n = alike ? pc1.k_n : pc[b].k_n;
+        g.m_eff = alike ? pc1.m_eff : pc[b].m_eff;
+        g.i_eff = (F & JD_F_ROLLING) ? (alike ? pcr1.i_eff : pcr[b].i_eff) : 0.0;
+        g.r_roll = (F & JD_F_ROLLING) ? (alike ? pcr1.r_roll : pcr[b].r_roll) : 0.0;
         const int32_t k_co = one_row ? s->pair_row : species[i] * (int32_t)nm + species[j];
         const jd_pair_coeffs co = {coeffs[k_co].gamma, coeffs[k_co].mu, coeffs[k_co].eta,
                                    coeffs[k_co].mu_r, coeffs[k_co].xi_limit};
@@ -218,10 +231,8 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, c
         B->i[b] = i;
         B->j[b] = j;
         B->delta[b] = g.delta;
-        B->excessive[b] = touch & jd_overlap_excessive(g.delta, rad[i], rad[j], max_overlap);
+        B->excessive[b] = touch & jd_overlap_excessive(g.delta, ri, rj, max_overlap);
     }
-    /* a loop of its own: in the one above, stores to the list would be stores the compiler
-     * cannot tell apart from the particle arrays it gathers from */
     for (int b = 0; b < nb; b++) lane_history_write(F, B, b, hist, rhist, c0 + (size_t)b);
 }
 
@@ -230,10 +241,12 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, c
  * mostly share particle i: its force and torque are loaded once per run of lanes, updated in
  * registers and stored once.  No other entry of the run touches particle i (they add to j > i),
  * so every sum is exactly that of a plain loop over the list, one contact at a time.  The lanes
- * that carry no force are dropped first without a branch (most candidates of a settled bed do
- * not touch, in no predictable pattern). */
-static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const batch *B, int nb, acc a,
-                                           jd_overlap_trip *trip) {
+ * that carry no force are dropped first without a branch (a third of the candidates of a
+ * settled bed do not touch, in no predictable pattern).  One copy for every law set, not
+ * inlined: on its own the loop keeps its pointers in registers. */
+static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, int nb,
+                                      double *restrict f, double *restrict t,
+                                      jd_overlap_trip *trip) {
     int32_t live[JD_BATCH];
     int m = 0;
     for (int b = 0; b < nb; b++) {
@@ -248,22 +261,22 @@ static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const batch *B, int nb, ac
     int32_t run_i = B->i[live[0]];
     double fi[3], ti[3];
     for (int d = 0; d < 3; d++) {
-        fi[d] = a.f[3 * (size_t)run_i + d];
-        ti[d] = a.t[3 * (size_t)run_i + d];
+        fi[d] = f[3 * (size_t)run_i + d];
+        ti[d] = t[3 * (size_t)run_i + d];
     }
     for (int q = 0; q < m; q++) {
         const int b = live[q];
         const int32_t i = B->i[b], j = B->j[b];
         if (i != run_i) {
             for (int d = 0; d < 3; d++) {
-                a.f[3 * (size_t)run_i + d] = fi[d];
-                a.t[3 * (size_t)run_i + d] = ti[d];
-                fi[d] = a.f[3 * (size_t)i + d];
-                ti[d] = a.t[3 * (size_t)i + d];
+                f[3 * (size_t)run_i + d] = fi[d];
+                t[3 * (size_t)run_i + d] = ti[d];
+                fi[d] = f[3 * (size_t)i + d];
+                ti[d] = t[3 * (size_t)i + d];
             }
             run_i = i;
         }
-        double *fb = a.f + 3 * (size_t)j, *tb = a.t + 3 * (size_t)j;
+        double *fb = f + 3 * (size_t)j, *tb = t + 3 * (size_t)j;
         for (int d = 0; d < 3; d++) {
             fi[d] -= B->f[d][b];
             ti[d] += B->ta[d][b];
@@ -272,22 +285,21 @@ static JD_ALWAYS_INLINE void batch_scatter(jd_sim *s, const batch *B, int nb, ac
         }
     }
     for (int d = 0; d < 3; d++) {
-        a.f[3 * (size_t)run_i + d] = fi[d];
-        a.t[3 * (size_t)run_i + d] = ti[d];
+        f[3 * (size_t)run_i + d] = fi[d];
+        t[3 * (size_t)run_i + d] = ti[d];
     }
 }
 
 /* The pair loop over list entries [c0, c1), in batches of consecutive entries: each batch is
- * evaluated (SIMD) and scattered back.  one_row: a literal, 1 when every pair uses the
- * coefficient row s->pair_row (one particle material).  Each contact's arithmetic is exactly that of a plain
- * loop over the list calling jd_geom_spheres_contact and jd_contact. */
-static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int one_row, size_t c0,
+ * evaluated (SIMD) and scattered back.  kinds: a literal JD_KINDS_*.  Each contact's arithmetic
+ * is exactly that of a plain loop over the list calling jd_geom_spheres_contact and jd_contact. */
+static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int kinds, size_t c0,
                                        size_t c1, acc a, jd_overlap_trip *trip) {
     batch lanes; /* on the stack: the compiler then knows that no list or particle array aliases it */
     for (size_t c = c0; c < c1; c += JD_BATCH) {
         const int nb = c1 - c < JD_BATCH ? (int)(c1 - c) : JD_BATCH;
-        batch_evaluate(s, F, one_row, &lanes, c, nb);
-        batch_scatter(s, &lanes, nb, a, trip);
+        batch_evaluate(s, F, kinds, &lanes, c, nb);
+        batch_scatter(s, &lanes, nb, a.f, a.t, trip);
     }
 }
 
@@ -496,10 +508,12 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
     jd_overlap_trip *trip = &s->trips[tid];
     size_t lo, hi;
     chunk(s->pairs.n, tid, nt, &lo, &hi);
-    if (s->pair_row >= 0)
-        pair_loop(s, F, 1, lo, hi, a, trip);
+    if (s->alike)
+        pair_loop(s, F, JD_KINDS_ALIKE, lo, hi, a, trip);
+    else if (s->pair_row >= 0)
+        pair_loop(s, F, JD_KINDS_ONE_MATERIAL, lo, hi, a, trip);
     else
-        pair_loop(s, F, 0, lo, hi, a, trip);
+        pair_loop(s, F, JD_KINDS_ANY, lo, hi, a, trip);
     if (tid == 0) *t_pairs_end = sim_clock();
     chunk(s->wall_pairs.n, tid, nt, &lo, &hi);
     return wall_loop(s, F, lo, hi, a, trip);

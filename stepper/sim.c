@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry.h"
 #include "h5md.h"
 #include "sim.h"
 
@@ -37,8 +38,15 @@ static int init_coeffs(jd_sim *s) {
     free(e_seen);
     free(gamma_seen);
     s->pair_row = s->n ? s->species[0] * (int32_t)(nm + 1) : -1;
-    for (size_t i = 1; i < s->n; i++)
+    s->alike = s->n > 0;
+    for (size_t i = 1; i < s->n; i++) {
         if (s->species[i] != s->species[0]) s->pair_row = -1;
+        if (s->species[i] != s->species[0] || s->radius[i] != s->radius[0]) s->alike = 0;
+    }
+    if (s->alike) { /* the constants of any pair: those of particle 0 with itself */
+        s->r_alike = s->radius[0];
+        sim_pair_constants(s, 0, 0, &s->pc_alike, &s->pcr_alike);
+    }
     return rc;
 }
 

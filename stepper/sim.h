@@ -175,6 +175,12 @@ typedef struct jd_sim {
     jd_pair_coeffs *coeffs; /* n_materials^2, row-major: coefficients of (material a, material b) */
     int32_t pair_row;  /* the row of coeffs every particle pair uses when all particles share one
                         * material (the pair loop then reads no species), else -1 */
+    int alike;         /* 1 when all particles also share one radius: every pair then has the
+                        * constants pc_alike, pcr_alike and radii r_alike, which the pair loop
+                        * uses instead of reading them per pair */
+    double r_alike;            /* [m] */
+    jd_pair_const pc_alike;
+    jd_pair_const_roll pcr_alike;
     double g[3];
 
     size_t n_walls;

@@ -11,7 +11,8 @@ a cylinder, damping, friction, rolling resistance, ~50 neighbour rebuilds).
 * the force loops in SIMD batches against one contact at a time (--plain-loops): each contact's
   arithmetic and the order of the force sums are the same, so the trajectories and every
   observable (energies included) are identical bit for bit; also with two particle materials
-  (the coefficients read per pair instead of once);
+  (the coefficients read per pair instead of once) and with one radius (the pair constants
+  taken once instead of per pair);
 * 2 OpenMP threads against 1: the same round-off bounds; two 2-thread runs are identical bit
   for bit (the summation order is fixed for a given thread count);
 * the scene-specialised force loop against the general one (--all-laws) on the scene without
@@ -128,6 +129,19 @@ c.check("two_materials_batched_vs_plain_identical", identical(mixed_batched, mix
         "with two particle materials the batched loops differ from the plain ones: position "
         f"{rel_diff(mixed_batched, mixed_plain, 'position'):.3g}")
 c.check("two_materials_differ_from_one", not identical(mixed_batched, srt), "the second material changed nothing")
+
+# One material and one radius: every pair has the same constants, which the batches then take
+# once instead of per pair.
+radii = "radii: {values: [0.0008, 0.001], fractions: [0.5, 0.5]}"
+assert open(base).read().count(radii) == 1
+alike = variant(open(base).read().replace(radii, "radii: {values: [0.001], fractions: [1.0]}"),
+                "fastpaths_one_radius")
+alike_batched, _, _ = run_file(alike)
+alike_plain, _, _ = run_file(alike, "--plain-loops")
+c.check("one_radius_batched_vs_plain_identical", identical(alike_batched, alike_plain),
+        "with particles all alike the batched loops differ from the plain ones: position "
+        f"{rel_diff(alike_batched, alike_plain, 'position'):.3g}")
+c.check("one_radius_differs_from_two", not identical(alike_batched, srt), "the single radius changed nothing")
 
 two, _, nt = run_file(base, "--threads", "2")
 c.check("two_threads_used", nt == 2, f"{nt} threads")
