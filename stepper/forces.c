@@ -237,11 +237,12 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, c
 }
 
 /* Lanes [0, nb) back: overlaps beyond the watchdog's limit, and the forces and torques of the
- * lanes that carry one added in list order.  The list is sorted by i, so consecutive lanes
- * mostly share particle i: its force and torque are loaded once per run of lanes, updated in
- * registers and stored once.  No other entry of the run touches particle i (they add to j > i),
- * so every sum is exactly that of a plain loop over the list, one contact at a time.  The lanes
- * that carry no force are dropped first without a branch (a third of the candidates of a
+ * lanes that carry one added, first on the j particles, then on the i particles, each pass in
+ * list order.  That is exactly the order of a plain loop over the list, one contact at a time,
+ * for every particle p: p is j only in entries of particles i < p, all listed before p's own
+ * run as i, so its sums as j all precede those as i in the list, and each pass keeps their
+ * order.  Without the interleaving, neither pass has a data-dependent branch.  The lanes that
+ * carry no force are dropped first, also without a branch (a third of the candidates of a
  * settled bed do not touch, in no predictable pattern).  One copy for every law set, not
  * inlined: on its own the loop keeps its pointers in registers. */
 static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, int nb,
@@ -257,36 +258,21 @@ static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, 
             sim_watchdog_overlap(trip, i, j, B->delta[b], fmin(s->radius[i], s->radius[j]));
         }
     }
-    if (m == 0) return;
-    int32_t run_i = B->i[live[0]];
-    double fi[3], ti[3];
-    for (int d = 0; d < 3; d++) {
-        fi[d] = f[3 * (size_t)run_i + d];
-        ti[d] = t[3 * (size_t)run_i + d];
-    }
     for (int q = 0; q < m; q++) {
         const int b = live[q];
-        const int32_t i = B->i[b], j = B->j[b];
-        if (i != run_i) {
-            for (int d = 0; d < 3; d++) {
-                f[3 * (size_t)run_i + d] = fi[d];
-                t[3 * (size_t)run_i + d] = ti[d];
-                fi[d] = f[3 * (size_t)i + d];
-                ti[d] = t[3 * (size_t)i + d];
-            }
-            run_i = i;
-        }
-        double *fb = f + 3 * (size_t)j, *tb = t + 3 * (size_t)j;
+        double *fb = f + 3 * (size_t)B->j[b], *tb = t + 3 * (size_t)B->j[b];
         for (int d = 0; d < 3; d++) {
-            fi[d] -= B->f[d][b];
-            ti[d] += B->ta[d][b];
             fb[d] += B->f[d][b];
             tb[d] += B->tb[d][b];
         }
     }
-    for (int d = 0; d < 3; d++) {
-        f[3 * (size_t)run_i + d] = fi[d];
-        t[3 * (size_t)run_i + d] = ti[d];
+    for (int q = 0; q < m; q++) {
+        const int b = live[q];
+        double *fa = f + 3 * (size_t)B->i[b], *ta = t + 3 * (size_t)B->i[b];
+        for (int d = 0; d < 3; d++) {
+            fa[d] -= B->f[d][b];
+            ta[d] += B->ta[d][b];
+        }
     }
 }
 
