@@ -4,11 +4,11 @@
  * jd_contact() compiles away every law the scene does not use (DESIGN.md: "leave out what a
  * scene does not need").  Order as LIGGGHTS: pair forces in list order, wall forces, gravity.
  *
- * Threads (sim.h, "Threads"): each list is cut into one contiguous chunk per thread (the same
- * cut for a given list length and thread count); thread 0 adds into f and torque, every other
- * thread into its own buffer, and the reduction adds the buffers to f and torque per particle
- * in thread order (then gravity) and zeroes them for the next evaluation: one barrier per
- * evaluation, no atomics.  With one thread this is exactly the serial loop.
+ * Threads (sim.h, "Threads"): each thread evaluates the entries of the particles it owns and
+ * adds into f and torque, and into its overflow buffer for partners beyond its particles; after
+ * one barrier each thread adds the earlier threads' overflow into its particles in thread order
+ * (then gravity) and zeroes it for the next evaluation.  No atomics; with one thread this is
+ * exactly the serial loop.
  */
 #include <math.h>
 #include <stddef.h>
@@ -39,21 +39,16 @@ double sim_clock(void) {
 }
 
 
-/* Where thread `tid` adds its forces and torques. */
+/* Where a thread adds its forces and torques: f and torque for particles below hi, its
+ * overflow buffer (of, ot: index j - hi) for the partners j >= hi. */
 typedef struct acc {
-    double *f, *t;
+    double *f, *t, *of, *ot;
+    size_t hi;
 } acc;
 
 static acc acc_of(const jd_sim *s, int tid) {
-    if (tid == 0) return (acc){s->f, s->torque};
-    double *b = s->tbuf + (size_t)(tid - 1) * 6 * s->n;
-    return (acc){b, b + 3 * s->n};
-}
-
-/* [lo, hi) of thread tid's chunk of n items. */
-static void chunk(size_t n, int tid, int nt, size_t *lo, size_t *hi) {
-    *lo = n * (size_t)tid / (size_t)nt;
-    *hi = n * (size_t)(tid + 1) / (size_t)nt;
+    const jd_thread_share *h = &s->shares[tid];
+    return (acc){s->f, s->torque, h->ovf, h->ovf + 3 * h->cap, h->p_hi};
 }
 
 /* History widths of a feature set (sim.h, jd_contact_list), compile-time constants in the
@@ -166,12 +161,65 @@ static JD_ALWAYS_INLINE void lane_history_write(const unsigned F, const batch *B
         }
 }
 
-/* The force loops' buffers (sim_init). */
+/* The force loops' per-thread state (sim_init). */
 int sim_forces_init(jd_sim *s) {
-    const size_t nb = s->threads > 1 ? (size_t)(s->threads - 1) * 6 * s->n : 0;
-    s->tbuf = nb ? calloc(nb, sizeof *s->tbuf) : NULL;
+    s->shares = calloc((size_t)s->threads, sizeof *s->shares);
     s->trips = calloc((size_t)s->threads, sizeof *s->trips);
-    return (nb && !s->tbuf) || !s->trips ? -1 : 0;
+    return !s->shares || !s->trips ? -1 : 0;
+}
+
+void sim_forces_free(jd_sim *s) {
+    for (int t = 0; s->shares && t < s->threads; t++) free(s->shares[t].ovf);
+    free(s->shares);
+    free(s->trips);
+}
+
+/* First entry of list l with i >= p (the lists are sorted by i). */
+static size_t first_entry_of(const jd_contact_list *l, size_t p) {
+    size_t lo = 0, hi = l->n;
+    while (lo < hi) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if ((size_t)l->i[mid] < p)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* The threads' shares of the current lists (sim.h, "Threads"): about equal numbers of pair
+ * entries, never splitting a particle's run of entries; the walls of the same particles; and
+ * overflow buffers large enough for the partners past each share. */
+int sim_forces_partition(jd_sim *s) {
+    const int nt = s->threads;
+    const jd_contact_list *P = &s->pairs;
+    for (int t = 0; t < nt; t++) {
+        jd_thread_share *h = &s->shares[t];
+        const size_t before = t ? s->shares[t - 1].pair_lo : 0;
+        size_t e = P->n * (size_t)t / (size_t)nt;
+        while (e > before && e < P->n && P->i[e - 1] == P->i[e]) e--;
+        h->pair_lo = e;
+        h->p_lo = t == 0 ? 0 : e < P->n ? (size_t)P->i[e] : s->n;
+    }
+    for (int t = 0; t < nt; t++) {
+        jd_thread_share *h = &s->shares[t];
+        h->pair_hi = t + 1 < nt ? s->shares[t + 1].pair_lo : P->n;
+        h->p_hi = t + 1 < nt ? s->shares[t + 1].p_lo : s->n;
+        h->wall_lo = first_entry_of(&s->wall_pairs, h->p_lo);
+        h->wall_hi = first_entry_of(&s->wall_pairs, h->p_hi);
+        size_t reach = h->p_hi;
+        for (size_t c = h->pair_lo; c < h->pair_hi; c++)
+            if ((size_t)P->j[c] + 1 > reach) reach = (size_t)P->j[c] + 1;
+        h->win = reach - h->p_hi;
+        if (h->win > h->cap) {
+            double *o = calloc(6 * h->win, sizeof *o);
+            if (!o) return -1;
+            free(h->ovf);
+            h->ovf = o;
+            h->cap = h->win;
+        }
+    }
+    return 0;
 }
 
 /* How alike the particles of a scene are (sim.h: pair_row, alike), a compile-time constant of the
@@ -246,8 +294,8 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, c
  * settled bed do not touch, in no predictable pattern).  One copy for every law set, not
  * inlined: on its own the loop keeps its pointers in registers. */
 static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, int nb,
-                                      double *restrict f, double *restrict t,
-                                      jd_overlap_trip *trip) {
+                                      double *restrict f, double *restrict t, double *restrict of,
+                                      double *restrict ot, size_t hi, jd_overlap_trip *trip) {
     int32_t live[JD_BATCH];
     int m = 0;
     for (int b = 0; b < nb; b++) {
@@ -260,7 +308,8 @@ static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, 
     }
     for (int q = 0; q < m; q++) {
         const int b = live[q];
-        double *fb = f + 3 * (size_t)B->j[b], *tb = t + 3 * (size_t)B->j[b];
+        const size_t j = (size_t)B->j[b];
+        double *fb = j < hi ? f + 3 * j : of + 3 * (j - hi), *tb = j < hi ? t + 3 * j : ot + 3 * (j - hi);
         for (int d = 0; d < 3; d++) {
             fb[d] += B->f[d][b];
             tb[d] += B->tb[d][b];
@@ -285,7 +334,7 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int ki
     for (size_t c = c0; c < c1; c += JD_BATCH) {
         const int nb = c1 - c < JD_BATCH ? (int)(c1 - c) : JD_BATCH;
         batch_evaluate(s, F, kinds, &lanes, c, nb);
-        batch_scatter(s, &lanes, nb, a.f, a.t, trip);
+        batch_scatter(s, &lanes, nb, a.f, a.t, a.of, a.ot, a.hi, trip);
     }
 }
 
@@ -422,8 +471,9 @@ static void plain_pair_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, a
         const int carries = jd_contact(F, co, &g, &k, s->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
         hist_store(L, F, c, &st, &rs);
         if (!carries) continue;
-        double *fa = a.f + 3 * (size_t)i, *fb = a.f + 3 * (size_t)j;
-        double *ta = a.t + 3 * (size_t)i, *tb = a.t + 3 * (size_t)j;
+        const int own = (size_t)j < a.hi;
+        double *fa = a.f + 3 * (size_t)i, *fb = own ? a.f + 3 * (size_t)j : a.of + 3 * ((size_t)j - a.hi);
+        double *ta = a.t + 3 * (size_t)i, *tb = own ? a.t + 3 * (size_t)j : a.ot + 3 * ((size_t)j - a.hi);
         for (int d = 0; d < 3; d++) {
             fa[d] -= out.f[d];
             fb[d] += out.f[d];
@@ -474,35 +524,31 @@ static double plain_wall_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1,
 }
 
 /* contact_loops on the reference path, compiled once (the features a run-time value). */
-static double plain_contact_loops(jd_sim *s, int tid, int nt, double *t_pairs_end) {
+static double plain_contact_loops(jd_sim *s, int tid, double *t_pairs_end) {
     const unsigned F = s->features;
     const acc a = acc_of(s, tid);
+    const jd_thread_share *h = &s->shares[tid];
     jd_overlap_trip *trip = &s->trips[tid];
-    size_t lo, hi;
-    chunk(s->pairs.n, tid, nt, &lo, &hi);
-    plain_pair_loop(s, F, lo, hi, a, trip);
+    plain_pair_loop(s, F, h->pair_lo, h->pair_hi, a, trip);
     if (tid == 0) *t_pairs_end = sim_clock();
-    chunk(s->wall_pairs.n, tid, nt, &lo, &hi);
-    return plain_wall_loop(s, F, lo, hi, a, trip);
+    return plain_wall_loop(s, F, h->wall_lo, h->wall_hi, a, trip);
 }
 
 /* This thread's share of the contact loops; returns its wall work.  *t_pairs_end: when thread 0
  * finished its share of the pairs (with threads, the split of the timing is thread 0's). */
-static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int tid, int nt,
+static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int tid,
                                              double *t_pairs_end) {
     const acc a = acc_of(s, tid);
+    const jd_thread_share *h = &s->shares[tid];
     jd_overlap_trip *trip = &s->trips[tid];
-    size_t lo, hi;
-    chunk(s->pairs.n, tid, nt, &lo, &hi);
     if (s->alike)
-        pair_loop(s, F, JD_KINDS_ALIKE, lo, hi, a, trip);
+        pair_loop(s, F, JD_KINDS_ALIKE, h->pair_lo, h->pair_hi, a, trip);
     else if (s->pair_row >= 0)
-        pair_loop(s, F, JD_KINDS_ONE_MATERIAL, lo, hi, a, trip);
+        pair_loop(s, F, JD_KINDS_ONE_MATERIAL, h->pair_lo, h->pair_hi, a, trip);
     else
-        pair_loop(s, F, JD_KINDS_ANY, lo, hi, a, trip);
+        pair_loop(s, F, JD_KINDS_ANY, h->pair_lo, h->pair_hi, a, trip);
     if (tid == 0) *t_pairs_end = sim_clock();
-    chunk(s->wall_pairs.n, tid, nt, &lo, &hi);
-    return wall_loop(s, F, lo, hi, a, trip);
+    return wall_loop(s, F, h->wall_lo, h->wall_hi, a, trip);
 }
 
 /* One instantiation per combination of the four optional laws and the energy bookkeeping
@@ -511,20 +557,20 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
  * literal constant. */
 #define JD_FORCE_CASE(bits)                                                     \
     case (bits):                                                                \
-        work = contact_loops(s, (bits), tid, nt, &t_pairs_end);                 \
+        work = contact_loops(s, (bits), tid, &t_pairs_end);                     \
         break;
 #define JD_FORCE_CASES(e)                                                                     \
     JD_FORCE_CASE((e) | 0) JD_FORCE_CASE((e) | 1) JD_FORCE_CASE((e) | 2) JD_FORCE_CASE((e) | 3)     \
     JD_FORCE_CASE((e) | 4) JD_FORCE_CASE((e) | 5) JD_FORCE_CASE((e) | 6) JD_FORCE_CASE((e) | 7)     \
     JD_FORCE_CASE((e) | 10) JD_FORCE_CASE((e) | 11) JD_FORCE_CASE((e) | 14) JD_FORCE_CASE((e) | 15)
 
-static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
+static double dispatch(jd_sim *s, int tid, double *t_pairs_end_out) {
     double work = 0.0, t_pairs_end = 0.0;
     _Static_assert(JD_F_DAMPING == 1 && JD_F_FRICTION == 2 && JD_F_ROLLING == 4 && JD_F_MU_R == 8 &&
                        JD_F_ENERGY == 16,
                    "the dispatch below enumerates the four optional laws as bits 0-3, energy as 4");
     if (s->opt.plain_loops) {
-        work = plain_contact_loops(s, tid, nt, &t_pairs_end);
+        work = plain_contact_loops(s, tid, &t_pairs_end);
         if (tid == 0) *t_pairs_end_out = t_pairs_end;
         return work;
     }
@@ -532,29 +578,33 @@ static double dispatch(jd_sim *s, int tid, int nt, double *t_pairs_end_out) {
     /* one copy of the loops, with the features as a run-time value: the sanitizer build
      * (Makefile), where 32 inlined copies of the law under ASan+UBSan take minutes to compile;
      * the same source, hence the same checks */
-    work = contact_loops(s, s->features & 31u, tid, nt, &t_pairs_end);
+    work = contact_loops(s, s->features & 31u, tid, &t_pairs_end);
 #else
     switch (s->features & 31u) {
         JD_FORCE_CASES(0)
         JD_FORCE_CASES(16)
     default: /* a law set sim.c never selects: the reference path serves every set */
-        work = plain_contact_loops(s, tid, nt, &t_pairs_end);
+        work = plain_contact_loops(s, tid, &t_pairs_end);
     }
 #endif
     if (tid == 0) *t_pairs_end_out = t_pairs_end;
     return work;
 }
 
-/* With threads: f = the sum of the threads' buffers in thread order (zeroing them), for
- * particles [lo, hi). */
-static void reduce(jd_sim *s, size_t lo, size_t hi) {
-    const size_t n = s->n;
-    for (int t = 1; t < s->threads; t++) {
-        double *bf = s->tbuf + (size_t)(t - 1) * 6 * n, *bt = bf + 3 * n;
+/* With threads: thread tid adds the earlier threads' overflow into the particles it owns, in
+ * thread order, and zeroes it for the next evaluation. */
+static void reduce(jd_sim *s, int tid) {
+    const jd_thread_share *me = &s->shares[tid];
+    for (int u = 0; u < tid; u++) {
+        const jd_thread_share *h = &s->shares[u];
+        const size_t lo = h->p_hi > me->p_lo ? h->p_hi : me->p_lo;
+        const size_t hi = h->p_hi + h->win < me->p_hi ? h->p_hi + h->win : me->p_hi;
+        double *of = h->ovf, *ot = h->ovf + 3 * h->cap;
         for (size_t k = 3 * lo; k < 3 * hi; k++) {
-            s->f[k] += bf[k];
-            s->torque[k] += bt[k];
-            bf[k] = bt[k] = 0.0;
+            const size_t o = k - 3 * h->p_hi;
+            s->f[k] += of[o];
+            s->torque[k] += ot[o];
+            of[o] = ot[o] = 0.0;
         }
     }
 }
@@ -585,12 +635,10 @@ void sim_compute_forces(jd_sim *s) {
         const int tid = 0;
 #endif
         s->trips[tid].fraction = 0.0;
-        work[tid] = dispatch(s, tid, nt, &t_pairs_end);
+        work[tid] = dispatch(s, tid, &t_pairs_end);
         if (nt > 1) {
 #pragma omp barrier
-            size_t lo, hi;
-            chunk(s->n, tid, nt, &lo, &hi);
-            reduce(s, lo, hi);
+            reduce(s, tid);
         }
         if (tid == 0) t_walls_end = sim_clock();
     }

@@ -297,6 +297,10 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
 
     /* the spare buffers are needed only during a build: give them back until the next one */
     sim_contact_list_free(&s->spare);
+    if (sim_forces_partition(s) != 0) {
+        snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads);
+        return -1;
+    }
     memcpy(s->x_build, s->x, 3 * s->n * sizeof *s->x);
     for (size_t w = 0; w < s->n_walls; w++) memset(s->walls[w].disp, 0, sizeof s->walls[w].disp);
     s->n_builds++;

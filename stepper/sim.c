@@ -219,8 +219,7 @@ void sim_free(jd_sim *s) {
     free(s->species);
     free(s->orig);
     free(s->scratch);
-    free(s->tbuf);
-    free(s->trips);
+    sim_forces_free(s);
     free(s->coeffs);
     free(s->walls);
     free(s->cell_of);
@@ -245,7 +244,9 @@ size_t sim_memory_bytes(const jd_sim *s) {
     const size_t per_particle = 6 * 3 * sizeof(double) /* x v omega f torque x_build */ +
                                 3 * sizeof(double) /* scratch */ + 7 * sizeof(double) /* constants */ +
                                 4 * sizeof(int32_t) /* species orig cell_of cell_items */;
-    return s->n * per_particle + (s->tbuf ? (size_t)(s->threads - 1) * 6 * s->n * sizeof(double) : 0) +
+    size_t overflow = 0;
+    for (int t = 0; s->shares && t < s->threads; t++) overflow += 6 * s->shares[t].cap * sizeof(double);
+    return s->n * per_particle + overflow +
            s->cell_cap * sizeof(int32_t) + list_bytes(&s->pairs) + list_bytes(&s->wall_pairs) +
            list_bytes(&s->spare) + s->n_walls * sizeof *s->walls +
            s->n_materials * s->n_materials * sizeof *s->coeffs;

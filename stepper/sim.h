@@ -31,14 +31,17 @@
  * outlives a rebuild (bonds, loads) is remapped by sim_reorder through its permute function
  * (sim_bonds_permute, sim_loads_permute), and reads scene data through orig.
  *
- * Threads (OpenMP).  The force loops split the contact lists into one contiguous chunk per
- * thread; the first thread adds into f and torque, every other one into its own buffer, and
- * after one barrier the buffers are added to f and torque per particle, in thread order.  No
- * two threads write the same memory, no atomics (a contact adds to two particles that any
- * thread may also touch, so the alternatives are atomics on every addition, or a colouring of
- * the contacts that costs a sort per rebuild and still leaves a thread-count-dependent order).  For a given thread count the sums are always
- * taken in the same order, so a run is reproducible bit for bit, and runs with different thread
- * counts differ only by the round-off of that order.  Integration loops are split by particle.
+ * Threads (OpenMP).  At every neighbour build the particles are split into one contiguous range
+ * per thread, cut at the pair list's particle runs so that the threads get about equal numbers
+ * of pair entries (jd_thread_share).  A thread evaluates the pairs and walls of its particles
+ * and adds straight into f and torque, except for a pair partner j beyond its range: that goes
+ * into the thread's overflow buffer, which covers only the few particles past the range that
+ * its pairs reach (pairs list j > i in cell order).  After one barrier each thread adds the
+ * earlier threads' overflow into its own particles, in thread order.  No two threads write the
+ * same memory, no atomics, and no full-size buffer to reduce.  For a given thread count the
+ * sums are always taken in the same order, so a run is reproducible bit for bit, and runs with
+ * different thread counts differ only by the round-off of that order; with one thread the
+ * loops are exactly the serial ones.  Integration loops are split by particle.
  */
 #ifndef JDEM_SIM_H
 #define JDEM_SIM_H
@@ -145,6 +148,17 @@ typedef struct jd_sim_wall {
     double disp[3];    /* translation since the last neighbour build [m] */
 } jd_sim_wall;
 
+/* A thread's share of the force loops (see "Threads" above; forces.c). */
+typedef struct jd_thread_share {
+    size_t pair_lo, pair_hi; /* pair list entries [pair_lo, pair_hi) */
+    size_t wall_lo, wall_hi; /* wall list entries */
+    size_t p_lo, p_hi;       /* the particles it owns: every entry above has i in [p_lo, p_hi) */
+    size_t win;              /* its pairs reach particles [p_hi, p_hi + win) as j */
+    size_t cap;              /* room of ovf, in particles (>= win) */
+    double *ovf;             /* 6 cap: forces (3 cap) then torques on those particles, zero
+                              * between force evaluations */
+} jd_thread_share;
+
 /* The largest overlap beyond the watchdog's limit in one force evaluation (fraction 0: none). */
 typedef struct jd_overlap_trip {
     double fraction;   /* overlap / the smaller radius [-] */
@@ -188,9 +202,7 @@ typedef struct jd_sim {
 
     jd_sim_options opt;
     int threads;       /* threads actually used (opt.threads clamped to >= 1) */
-    double *tbuf;      /* with threads > 1: (threads - 1) x 6n, the force and torque buffer of
-                          each thread but the first, which adds into f and torque (zero between
-                          force evaluations); NULL with one thread */
+    jd_thread_share *shares; /* one per thread (see "Threads"), set at every neighbour build */
     jd_overlap_trip *trips; /* one per thread, merged into overlap_trip */
     double *scratch;   /* 3n doubles: reordering and frames in scene order */
     jd_timing timing;
@@ -281,8 +293,12 @@ void sim_walls_move(jd_sim *s);
 
 /* forces.c: zero f and torque, then pair forces, wall forces, gravity. */
 void sim_compute_forces(jd_sim *s);
-/* The force loops' buffers for s->threads threads (sim_init). */
+/* The force loops' per-thread state for s->threads threads (sim_init), and its release. */
 int sim_forces_init(jd_sim *s);
+void sim_forces_free(jd_sim *s);
+/* Split the current lists between the threads (jd_thread_share); after every neighbour build.
+ * Returns 0, or -1 when out of memory. */
+int sim_forces_partition(jd_sim *s);
 /* Monotonic wall clock [s]. */
 double sim_clock(void);
 

@@ -14,7 +14,8 @@ a cylinder, damping, friction, rolling resistance, ~50 neighbour rebuilds).
   (the coefficients read per pair instead of once) and with one radius (the pair constants
   taken once instead of per pair);
 * 2 OpenMP threads against 1: the same round-off bounds; two 2-thread runs are identical bit
-  for bit (the summation order is fixed for a given thread count);
+  for bit (the summation order is fixed for a given thread count), and so are the batched and
+  plain loops with 2 threads;
 * the scene-specialised force loop against the general one (--all-laws) on the scene without
   damping and rolling resistance (restitution 1, rolling friction 0): the general loop
   evaluates those laws with zero coefficients, which add exact zeros, so the trajectories are
@@ -148,6 +149,10 @@ c.check("two_threads_used", nt == 2, f"{nt} threads")
 roundoff_equal(c, "threads2_vs_threads1", two, srt)
 two_b, _, _ = run_file(base, env={"OMP_NUM_THREADS": "2"})
 c.check("threads2_reproducible", identical(two, two_b), "two 2-thread runs differ")
+plain_two, _, _ = run_file(base, "--plain-loops", "--threads", "2")
+c.check("threads2_batched_vs_plain_identical", identical(two, plain_two),
+        "with 2 threads the batched loops differ from the plain ones (the threads' overflow "
+        f"buffers): position {rel_diff(two, plain_two, 'position'):.3g}")
 
 text = open(base).read()
 plain = re.sub(r"restitution: 0\.6", "restitution: 1.0", text)
