@@ -189,7 +189,8 @@ static size_t first_entry_of(const jd_contact_list *l, size_t p) {
 
 /* The threads' shares of the current lists (sim.h, "Threads"): about equal numbers of pair
  * entries, never splitting a particle's run of entries; the walls of the same particles; and
- * overflow buffers large enough for the partners past each share. */
+ * overflow buffers large enough for the partners past each share.  Also whether the pair list
+ * is sparse (batch_touches). */
 int sim_forces_partition(jd_sim *s) {
     const int nt = s->threads;
     const jd_contact_list *P = &s->pairs;
@@ -219,6 +220,16 @@ int sim_forces_partition(jd_sim *s) {
             h->cap = h->win;
         }
     }
+    /* fewer than half the candidates touch: let batches without contact skip the law */
+    size_t touching = 0;
+    for (size_t c = 0; c < P->n; c++) {
+        const size_t i = (size_t)P->i[c], j = (size_t)P->j[c];
+        const double dx[3] = {s->x[3 * j] - s->x[3 * i], s->x[3 * j + 1] - s->x[3 * i + 1],
+                              s->x[3 * j + 2] - s->x[3 * i + 2]};
+        const double radsum = s->radius[i] + s->radius[j];
+        touching += jd_dot(dx, dx) < radsum * radsum;
+    }
+    s->sparse_pairs = 2 * touching < P->n;
     return 0;
 }
 
@@ -284,6 +295,24 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, c
     for (int b = 0; b < nb; b++) lane_history_write(F, B, b, hist, rhist, c0 + (size_t)b);
 }
 
+/* Whether any of the pair entries [c0, c0 + nb) passes the sphere test (SIMD, no stores).  In a
+ * list with few contacts among its candidates (sparse_pairs: dilute flows, the all-pairs
+ * reference list) a batch without contact is then only separated instead of evaluated; in a
+ * dense packing the test would cost more than the batches it saves. */
+static JD_ALWAYS_INLINE int batch_touches(const jd_sim *s, const int kinds, size_t c0, int nb) {
+    const double *restrict x = s->x, *restrict rad = s->radius;
+    const int32_t *restrict li = s->pairs.i + c0, *restrict lj = s->pairs.j + c0;
+    const double r1 = s->r_alike;
+    int any = 0;
+    for (int b = 0; b < nb; b++) {
+        const int32_t i = li[b], j = lj[b];
+        const double dx[3] = {x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
+        const double radsum = kinds == JD_KINDS_ALIKE ? r1 + r1 : rad[i] + rad[j];
+        any |= jd_dot(dx, dx) < radsum * radsum;
+    }
+    return any;
+}
+
 /* Lanes [0, nb) back: overlaps beyond the watchdog's limit, and the forces and torques of the
  * lanes that carry one added, first on the j particles, then on the i particles, each pass in
  * list order.  That is exactly the order of a plain loop over the list, one contact at a time,
@@ -333,6 +362,10 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int ki
     batch lanes; /* on the stack: the compiler then knows that no list or particle array aliases it */
     for (size_t c = c0; c < c1; c += JD_BATCH) {
         const int nb = c1 - c < JD_BATCH ? (int)(c1 - c) : JD_BATCH;
+        if (s->sparse_pairs && !batch_touches(s, kinds, c, nb)) {
+            for (int b = 0; b < nb; b++) hist_separate(&s->pairs, F, c + (size_t)b);
+            continue;
+        }
         batch_evaluate(s, F, kinds, &lanes, c, nb);
         batch_scatter(s, &lanes, nb, a.f, a.t, a.of, a.ot, a.hi, trip);
     }

@@ -203,6 +203,8 @@ typedef struct jd_sim {
     jd_sim_options opt;
     int threads;       /* threads actually used (opt.threads clamped to >= 1) */
     jd_thread_share *shares; /* one per thread (see "Threads"), set at every neighbour build */
+    int sparse_pairs;  /* fewer than half the pair candidates touched at the last neighbour build
+                        * (forces.c, batch_touches) */
     jd_overlap_trip *trips; /* one per thread, merged into overlap_trip */
     double *scratch;   /* 3n doubles: reordering and frames in scene order */
     jd_timing timing;
@@ -296,8 +298,8 @@ void sim_compute_forces(jd_sim *s);
 /* The force loops' per-thread state for s->threads threads (sim_init), and its release. */
 int sim_forces_init(jd_sim *s);
 void sim_forces_free(jd_sim *s);
-/* Split the current lists between the threads (jd_thread_share); after every neighbour build.
- * Returns 0, or -1 when out of memory. */
+/* Split the current lists between the threads (jd_thread_share) and set sparse_pairs; after
+ * every neighbour build.  Returns 0, or -1 when out of memory. */
 int sim_forces_partition(jd_sim *s);
 /* Monotonic wall clock [s]. */
 double sim_clock(void);
