@@ -102,6 +102,9 @@ struct jd_batch {
      * row, and (energy bookkeeping) the force on the wall before the step */
     double n[3][JD_BATCH], ra[3][JD_BATCH], vw[3][JD_BATCH], f_before[3][JD_BATCH];
     int32_t k_co[JD_BATCH];
+    /* packed pair batches, per list entry of the batch: whether its spheres touch
+     * (rsq < radsum^2) and then its lane */
+    int32_t touch[JD_BATCH], lane[JD_BATCH];
 };
 typedef struct jd_batch batch;
 
@@ -190,7 +193,7 @@ static size_t first_entry_of(const jd_contact_list *l, size_t p) {
 /* The threads' shares of the current lists (sim.h, "Threads"): about equal numbers of pair
  * entries, never splitting a particle's run of entries; the walls of the same particles; and
  * overflow buffers large enough for the partners past each share.  Also whether the pair list
- * is sparse (batch_touches). */
+ * is sparse (batch_evaluate). */
 int sim_forces_partition(jd_sim *s) {
     const int nt = s->threads;
     const jd_contact_list *P = &s->pairs;
@@ -220,7 +223,7 @@ int sim_forces_partition(jd_sim *s) {
             h->cap = h->win;
         }
     }
-    /* fewer than half the candidates touch: let batches without contact skip the law */
+    /* fewer than half the candidates touch: pack the touching ones into the lanes */
     size_t touching = 0;
     for (size_t c = 0; c < P->n; c++) {
         const size_t i = (size_t)P->i[c], j = (size_t)P->j[c];
@@ -238,17 +241,20 @@ int sim_forces_partition(jd_sim *s) {
  * same constants for every pair). */
 enum { JD_KINDS_ANY, JD_KINDS_ONE_MATERIAL, JD_KINDS_ALIKE };
 
-/* Geometry and law for list entries [c0, c0 + nb), one lane each, every candidate: the sphere
- * test (LIGGGHTS' rsq < radsum^2, then jd_geom_spheres_fill's) is a lane mask, not a branch.  A
- * lane that does not touch computes the law on a meaningless geometry, then keeps what
- * jd_contact_separate leaves and carries no force, so every candidate's history is exactly the
- * plain loop's.  The vectorised loop writes only the lanes (stores to the list there would be
- * stores the compiler cannot tell apart from the particle arrays it gathers from); a second
- * loop copies each lane's history to its entry.  The kernel's geometry and law have no
- * data-dependent branches. */
-static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, const int kinds,
-                                            batch *restrict B, size_t c0, int nb) {
-    const jd_contact_list *L = &s->pairs;
+/* Geometry and law for the pair entries [c0, c0 + nb), one SIMD lane per candidate; returns
+ * the number of lanes.  Dense lists (packed = 0): every entry is a lane, the sphere test (LIGGGHTS'
+ * rsq < radsum^2, then jd_geom_spheres_fill's) a lane mask rather than a branch; a lane that
+ * does not touch computes the law on a meaningless geometry, then keeps what
+ * jd_contact_separate leaves and carries no force.  Sparse lists (packed = 1, sim.h:
+ * sparse_pairs): the sphere test runs first over the entries (SIMD), only the touching ones
+ * are packed into lanes (without a branch), and the others are separated.  Either way every
+ * entry's history is exactly the plain loop's.  The SIMD loops write only the batch (stores to
+ * the list there would be stores the compiler cannot tell apart from the particle arrays it
+ * gathers from); the history goes to the list in a loop of its own.  The kernel's geometry and
+ * law have no data-dependent branches. */
+static JD_ALWAYS_INLINE int batch_evaluate(jd_sim *s, const unsigned F, const int kinds,
+                                           const int packed, batch *restrict B, size_t c0, int nb) {
+    jd_contact_list *L = &s->pairs;
     const double *restrict x = s->x, *restrict v = s->v, *restrict w = s->omega,
                            *restrict rad = s->radius;
     double *hist = L->hist, *rhist = L->rhist;
@@ -264,9 +270,24 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, c
     const jd_pair_const pc1 = s->pc_alike;
     const jd_pair_const_roll pcr1 = s->pcr_alike;
     const double r1 = s->r_alike;
-    for (int b = 0; b < nb; b++) {
+    int m = nb;
+    if (packed) {
+        for (int b = 0; b < nb; b++) {
+            const int32_t i = li[b], j = lj[b];
+            const double dx[3] = {x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
+            const double radsum = alike ? r1 + r1 : rad[i] + rad[j];
+            B->touch[b] = jd_dot(dx, dx) < radsum * radsum;
+        }
+        m = 0;
+        for (int b = 0; b < nb; b++) {
+            B->c[m] = b;
+            B->lane[b] = m;
+            m += B->touch[b];
+        }
+    }
+    for (int q = 0; q < m; q++) {
         /* int indices (vectorisable arithmetic; 3 n < 2^31 is checked at set-up) */
-        const int32_t c = (int32_t)c0 + b, i = li[b], j = lj[b];
+        const int32_t b = packed ? B->c[q] : q, c = (int32_t)c0 + b, i = li[b], j = lj[b];
         const double dx[3] = {x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
         const double ri = alike ? r1 : rad[i], rj = alike ? r1 : rad[j];
         const double rsq = jd_dot(dx, dx), radsum = ri + rj;
@@ -286,31 +307,22 @@ static JD_ALWAYS_INLINE void batch_evaluate(const jd_sim *s, const unsigned F, c
             k.vb[d] = v[3 * j + d];
             k.wb[d] = w[3 * j + d];
         }
-        lane_law(F, B, b, hist, rhist, c, &g, &k, &co, touch, dt);
-        B->i[b] = i;
-        B->j[b] = j;
-        B->delta[b] = g.delta;
-        B->excessive[b] = touch & jd_overlap_excessive(g.delta, ri, rj, max_overlap);
+        lane_law(F, B, q, hist, rhist, c, &g, &k, &co, touch, dt);
+        B->i[q] = i;
+        B->j[q] = j;
+        B->delta[q] = g.delta;
+        B->excessive[q] = touch & jd_overlap_excessive(g.delta, ri, rj, max_overlap);
     }
-    for (int b = 0; b < nb; b++) lane_history_write(F, B, b, hist, rhist, c0 + (size_t)b);
-}
-
-/* Whether any of the pair entries [c0, c0 + nb) passes the sphere test (SIMD, no stores).  In a
- * list with few contacts among its candidates (sparse_pairs: dilute flows, the all-pairs
- * reference list) a batch without contact is then only separated instead of evaluated; in a
- * dense packing the test would cost more than the batches it saves. */
-static JD_ALWAYS_INLINE int batch_touches(const jd_sim *s, const int kinds, size_t c0, int nb) {
-    const double *restrict x = s->x, *restrict rad = s->radius;
-    const int32_t *restrict li = s->pairs.i + c0, *restrict lj = s->pairs.j + c0;
-    const double r1 = s->r_alike;
-    int any = 0;
-    for (int b = 0; b < nb; b++) {
-        const int32_t i = li[b], j = lj[b];
-        const double dx[3] = {x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
-        const double radsum = kinds == JD_KINDS_ALIKE ? r1 + r1 : rad[i] + rad[j];
-        any |= jd_dot(dx, dx) < radsum * radsum;
-    }
-    return any;
+    if (!packed)
+        for (int b = 0; b < nb; b++) lane_history_write(F, B, b, hist, rhist, c0 + (size_t)b);
+    else
+        for (int b = 0; b < nb; b++) {
+            if (B->touch[b])
+                lane_history_write(F, B, B->lane[b], hist, rhist, c0 + (size_t)b);
+            else
+                hist_separate(L, F, c0 + (size_t)b);
+        }
+    return m;
 }
 
 /* Lanes [0, nb) back: overlaps beyond the watchdog's limit, and the forces and torques of the
@@ -355,19 +367,17 @@ static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, 
 }
 
 /* The pair loop over list entries [c0, c1), in batches of consecutive entries: each batch is
- * evaluated (SIMD) and scattered back.  kinds: a literal JD_KINDS_*.  Each contact's arithmetic
- * is exactly that of a plain loop over the list calling jd_geom_spheres_contact and jd_contact. */
-static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int kinds, size_t c0,
-                                       size_t c1, acc a, jd_overlap_trip *trip) {
+ * evaluated (SIMD) and scattered back.  kinds: a literal JD_KINDS_*; packed: a literal, 1 for a
+ * sparse list (batch_evaluate).  Each contact's arithmetic is exactly that of a plain loop over
+ * the list calling jd_geom_spheres_contact and jd_contact. */
+static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int kinds,
+                                       const int packed, size_t c0, size_t c1, acc a,
+                                       jd_overlap_trip *trip) {
     batch lanes; /* on the stack: the compiler then knows that no list or particle array aliases it */
     for (size_t c = c0; c < c1; c += JD_BATCH) {
         const int nb = c1 - c < JD_BATCH ? (int)(c1 - c) : JD_BATCH;
-        if (s->sparse_pairs && !batch_touches(s, kinds, c, nb)) {
-            for (int b = 0; b < nb; b++) hist_separate(&s->pairs, F, c + (size_t)b);
-            continue;
-        }
-        batch_evaluate(s, F, kinds, &lanes, c, nb);
-        batch_scatter(s, &lanes, nb, a.f, a.t, a.of, a.ot, a.hi, trip);
+        const int m = batch_evaluate(s, F, kinds, packed, &lanes, c, nb);
+        batch_scatter(s, &lanes, m, a.f, a.t, a.of, a.ot, a.hi, trip);
     }
 }
 
@@ -574,12 +584,15 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
     const acc a = acc_of(s, tid);
     const jd_thread_share *h = &s->shares[tid];
     jd_overlap_trip *trip = &s->trips[tid];
-    if (s->alike)
-        pair_loop(s, F, JD_KINDS_ALIKE, h->pair_lo, h->pair_hi, a, trip);
+    /* a sparse list packs its lanes, whatever the particles (one copy: the lanes are few) */
+    if (s->sparse_pairs)
+        pair_loop(s, F, JD_KINDS_ANY, 1, h->pair_lo, h->pair_hi, a, trip);
+    else if (s->alike)
+        pair_loop(s, F, JD_KINDS_ALIKE, 0, h->pair_lo, h->pair_hi, a, trip);
     else if (s->pair_row >= 0)
-        pair_loop(s, F, JD_KINDS_ONE_MATERIAL, h->pair_lo, h->pair_hi, a, trip);
+        pair_loop(s, F, JD_KINDS_ONE_MATERIAL, 0, h->pair_lo, h->pair_hi, a, trip);
     else
-        pair_loop(s, F, JD_KINDS_ANY, h->pair_lo, h->pair_hi, a, trip);
+        pair_loop(s, F, JD_KINDS_ANY, 0, h->pair_lo, h->pair_hi, a, trip);
     if (tid == 0) *t_pairs_end = sim_clock();
     return wall_loop(s, F, h->wall_lo, h->wall_hi, a, trip);
 }

@@ -203,8 +203,8 @@ typedef struct jd_sim {
     jd_sim_options opt;
     int threads;       /* threads actually used (opt.threads clamped to >= 1) */
     jd_thread_share *shares; /* one per thread (see "Threads"), set at every neighbour build */
-    int sparse_pairs;  /* fewer than half the pair candidates touched at the last neighbour build
-                        * (forces.c, batch_touches) */
+    int sparse_pairs;  /* fewer than half the pair candidates touched at the last neighbour build:
+                        * the pair loop packs the touching ones into its lanes (forces.c) */
     jd_overlap_trip *trips; /* one per thread, merged into overlap_trip */
     double *scratch;   /* 3n doubles: reordering and frames in scene order */
     jd_timing timing;
