@@ -37,16 +37,6 @@ static int init_coeffs(jd_sim *s) {
     }
     free(e_seen);
     free(gamma_seen);
-    s->pair_row = s->n ? s->species[0] * (int32_t)(nm + 1) : -1;
-    s->alike = s->n > 0;
-    for (size_t i = 1; i < s->n; i++) {
-        if (s->species[i] != s->species[0]) s->pair_row = -1;
-        if (s->species[i] != s->species[0] || s->radius[i] != s->radius[0]) s->alike = 0;
-    }
-    if (s->alike) { /* the constants of any pair: those of particle 0 with itself */
-        s->r_alike = s->radius[0];
-        sim_pair_constants(s, 0, 0, &s->pc_alike, &s->pcr_alike);
-    }
     return rc;
 }
 
@@ -78,6 +68,21 @@ static unsigned scene_features(const jd_sim *s) {
     free(used);
     free(wall_used);
     return f;
+}
+
+/* How alike the particles are (sim.h: pair_row, alike), which lets the pair loop read the
+ * coefficients, or also the pair constants and radii, once instead of per pair. */
+static void init_kinds(jd_sim *s) {
+    s->pair_row = s->n ? s->species[0] * (int32_t)(s->n_materials + 1) : -1;
+    s->alike = s->n > 0;
+    for (size_t i = 1; i < s->n; i++) {
+        if (s->species[i] != s->species[0]) s->pair_row = -1;
+        if (s->species[i] != s->species[0] || s->radius[i] != s->radius[0]) s->alike = 0;
+    }
+    if (s->alike) { /* the constants of any pair: those of particle 0 with itself */
+        s->r_alike = s->radius[0];
+        sim_pair_constants(s, 0, 0, &s->pc_alike, &s->pcr_alike);
+    }
 }
 
 static int init_particles(jd_sim *s, char *err, size_t errlen) {
@@ -181,6 +186,7 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
         snprintf(err, errlen, "out of memory");
         return -1;
     }
+    init_kinds(s);
     s->features = scene_features(s);
     if (sim_forces_init(s) != 0) {
         snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads);
