@@ -177,9 +177,8 @@ void sim_forces_free(jd_sim *s) {
     free(s->trips);
 }
 
-/* First entry of list l with i >= p (the lists are sorted by i). */
-static size_t first_entry_of(const jd_contact_list *l, size_t p) {
-    size_t lo = 0, hi = l->n;
+/* First entry in [lo, hi) of list l with i >= p (a sorted run of the list). */
+static size_t first_entry_of(const jd_contact_list *l, size_t lo, size_t hi, size_t p) {
     while (lo < hi) {
         const size_t mid = lo + (hi - lo) / 2;
         if ((size_t)l->i[mid] < p)
@@ -190,29 +189,42 @@ static size_t first_entry_of(const jd_contact_list *l, size_t p) {
     return lo;
 }
 
-/* The threads' shares of the current lists (sim.h, "Threads"): about equal numbers of pair
- * entries, never splitting a particle's run of entries; the walls of the same particles; and
- * overflow buffers large enough for the partners past each share.  Also whether the pair list
- * is sparse (batch_evaluate). */
+/* The estimated cost of a list entry, for splitting the work between the threads, in quarters
+ * of a pair entry that touched at the build (one SIMD lane of the law and its scatter): the
+ * sphere test of one that did not, and a wall entry (its test, then a lane). */
+enum { COST_TOUCH = 4, COST_NEAR = 1, COST_WALL = 6 };
+
+/* The threads' shares of the current lists (sim.h, "Threads"): contiguous particle ranges of
+ * about equal estimated cost, the entries of their particles in each sorted run of the lists,
+ * and overflow buffers large enough for the partners past each range. */
 int sim_forces_partition(jd_sim *s) {
     const int nt = s->threads;
-    const jd_contact_list *P = &s->pairs;
-    for (int t = 0; t < nt; t++) {
-        jd_thread_share *h = &s->shares[t];
-        const size_t before = t ? s->shares[t - 1].pair_lo : 0;
-        size_t e = P->n * (size_t)t / (size_t)nt;
-        while (e > before && e < P->n && P->i[e - 1] == P->i[e]) e--;
-        h->pair_lo = e;
-        h->p_lo = t == 0 ? 0 : e < P->n ? (size_t)P->i[e] : s->n;
+    const jd_contact_list *P = &s->pairs, *W = &s->wall_pairs;
+    const size_t total = COST_TOUCH * P->n_touch + COST_NEAR * (P->n - P->n_touch) + COST_WALL * W->n;
+    /* thread t begins after the particle where the running cost passes t / nt of the total */
+    size_t a = 0, q = P->n_touch, w = 0, cost = 0;
+    int t = 1;
+    s->shares[0].p_lo = 0;
+    for (size_t p = 0; p < s->n && t < nt; p++) {
+        for (; a < P->n_touch && (size_t)P->i[a] == p; a++) cost += COST_TOUCH;
+        for (; q < P->n && (size_t)P->i[q] == p; q++) cost += COST_NEAR;
+        for (; w < W->n && (size_t)W->i[w] == p; w++) cost += COST_WALL;
+        for (; t < nt && cost * (size_t)nt >= total * (size_t)t; t++) s->shares[t].p_lo = p + 1;
     }
-    for (int t = 0; t < nt; t++) {
+    for (; t < nt; t++) s->shares[t].p_lo = s->n;
+    for (t = 0; t < nt; t++) {
         jd_thread_share *h = &s->shares[t];
-        h->pair_hi = t + 1 < nt ? s->shares[t + 1].pair_lo : P->n;
         h->p_hi = t + 1 < nt ? s->shares[t + 1].p_lo : s->n;
-        h->wall_lo = first_entry_of(&s->wall_pairs, h->p_lo);
-        h->wall_hi = first_entry_of(&s->wall_pairs, h->p_hi);
+        h->pair_lo = first_entry_of(P, 0, P->n_touch, h->p_lo);
+        h->pair_hi = first_entry_of(P, h->pair_lo, P->n_touch, h->p_hi);
+        h->near_lo = first_entry_of(P, P->n_touch, P->n, h->p_lo);
+        h->near_hi = first_entry_of(P, h->near_lo, P->n, h->p_hi);
+        h->wall_lo = first_entry_of(W, 0, W->n, h->p_lo);
+        h->wall_hi = first_entry_of(W, h->wall_lo, W->n, h->p_hi);
         size_t reach = h->p_hi;
         for (size_t c = h->pair_lo; c < h->pair_hi; c++)
+            if ((size_t)P->j[c] + 1 > reach) reach = (size_t)P->j[c] + 1;
+        for (size_t c = h->near_lo; c < h->near_hi; c++)
             if ((size_t)P->j[c] + 1 > reach) reach = (size_t)P->j[c] + 1;
         h->win = reach - h->p_hi;
         if (h->win > h->cap) {
@@ -223,16 +235,6 @@ int sim_forces_partition(jd_sim *s) {
             h->cap = h->win;
         }
     }
-    /* fewer than half the candidates touch: pack the touching ones into the lanes */
-    size_t touching = 0;
-    for (size_t c = 0; c < P->n; c++) {
-        const size_t i = (size_t)P->i[c], j = (size_t)P->j[c];
-        const double dx[3] = {s->x[3 * j] - s->x[3 * i], s->x[3 * j + 1] - s->x[3 * i + 1],
-                              s->x[3 * j + 2] - s->x[3 * i + 2]};
-        const double radsum = s->radius[i] + s->radius[j];
-        touching += jd_dot(dx, dx) < radsum * radsum;
-    }
-    s->sparse_pairs = 2 * touching < P->n;
     return 0;
 }
 
@@ -242,12 +244,12 @@ int sim_forces_partition(jd_sim *s) {
 enum { JD_KINDS_ANY, JD_KINDS_ONE_MATERIAL, JD_KINDS_ALIKE };
 
 /* Geometry and law for the pair entries [c0, c0 + nb), one SIMD lane per candidate; returns
- * the number of lanes.  Dense lists (packed = 0): every entry is a lane, the sphere test (LIGGGHTS'
- * rsq < radsum^2, then jd_geom_spheres_fill's) a lane mask rather than a branch; a lane that
- * does not touch computes the law on a meaningless geometry, then keeps what
- * jd_contact_separate leaves and carries no force.  Sparse lists (packed = 1, sim.h:
- * sparse_pairs): the sphere test runs first over the entries (SIMD), only the touching ones
- * are packed into lanes (without a branch), and the others are separated.  Either way every
+ * the number of lanes.  Entries that touched at the build (packed = 0): every entry is a lane,
+ * the sphere test (LIGGGHTS' rsq < radsum^2, then jd_geom_spheres_fill's) a lane mask rather
+ * than a branch; a lane that no longer touches computes the law on a meaningless geometry, then
+ * keeps what jd_contact_separate leaves and carries no force.  Entries that did not (packed = 1,
+ * sim.h: jd_contact_list): the sphere test runs first over the entries (SIMD), only the
+ * touching ones are packed into lanes (without a branch), and the others are separated.  Either way every
  * entry's history is exactly the plain loop's.  The SIMD loops write only the batch (stores to
  * the list there would be stores the compiler cannot tell apart from the particle arrays it
  * gathers from); the history goes to the list in a loop of its own.  The kernel's geometry and
@@ -367,8 +369,8 @@ static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, 
 }
 
 /* The pair loop over list entries [c0, c1), in batches of consecutive entries: each batch is
- * evaluated (SIMD) and scattered back.  kinds: a literal JD_KINDS_*; packed: a literal, 1 for a
- * sparse list (batch_evaluate).  Each contact's arithmetic is exactly that of a plain loop over
+ * evaluated (SIMD) and scattered back.  kinds: a literal JD_KINDS_*; packed: a literal, 1 for
+ * the entries that did not touch at the build (batch_evaluate).  Each contact's arithmetic is exactly that of a plain loop over
  * the list calling jd_geom_spheres_contact and jd_contact. */
 static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int kinds,
                                        const int packed, size_t c0, size_t c1, acc a,
@@ -573,6 +575,7 @@ static double plain_contact_loops(jd_sim *s, int tid, double *t_pairs_end) {
     const jd_thread_share *h = &s->shares[tid];
     jd_overlap_trip *trip = &s->trips[tid];
     plain_pair_loop(s, F, h->pair_lo, h->pair_hi, a, trip);
+    plain_pair_loop(s, F, h->near_lo, h->near_hi, a, trip);
     if (tid == 0) *t_pairs_end = sim_clock();
     return plain_wall_loop(s, F, h->wall_lo, h->wall_hi, a, trip);
 }
@@ -584,15 +587,15 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
     const acc a = acc_of(s, tid);
     const jd_thread_share *h = &s->shares[tid];
     jd_overlap_trip *trip = &s->trips[tid];
-    /* a sparse list packs its lanes, whatever the particles (one copy: the lanes are few) */
-    if (s->sparse_pairs)
-        pair_loop(s, F, JD_KINDS_ANY, 1, h->pair_lo, h->pair_hi, a, trip);
-    else if (s->alike)
+    /* the entries that touched at the build, then those that did not: their few touching
+     * lanes packed, whatever the particles (one copy: compile time) */
+    if (s->alike)
         pair_loop(s, F, JD_KINDS_ALIKE, 0, h->pair_lo, h->pair_hi, a, trip);
     else if (s->pair_row >= 0)
         pair_loop(s, F, JD_KINDS_ONE_MATERIAL, 0, h->pair_lo, h->pair_hi, a, trip);
     else
         pair_loop(s, F, JD_KINDS_ANY, 0, h->pair_lo, h->pair_hi, a, trip);
+    pair_loop(s, F, JD_KINDS_ANY, 1, h->near_lo, h->near_hi, a, trip);
     if (tid == 0) *t_pairs_end = sim_clock();
     return wall_loop(s, F, h->wall_lo, h->wall_hi, a, trip);
 }

@@ -25,6 +25,14 @@ static inline void sim_pair_constants(const jd_sim *s, int32_t i, int32_t j, jd_
     }
 }
 
+/* Do spheres i and j overlap (LIGGGHTS' test, rsq < radsum^2, as jd_geom_spheres_contact)? */
+static inline int sim_pair_touching(const jd_sim *s, int32_t i, int32_t j) {
+    const double *xi = s->x + 3 * (size_t)i, *xj = s->x + 3 * (size_t)j;
+    const double dx[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
+    const double radsum = s->radius[i] + s->radius[j];
+    return jd_dot(dx, dx) < radsum * radsum;
+}
+
 /* Sphere–sphere for entry c of the pair list: returns 1 and fills g when the spheres overlap
  * (rsq < radsum^2).  The material fields come from the entry's stored constants; i_eff and
  * r_roll are only read by the rolling law, so they are filled only with JD_F_ROLLING in

@@ -81,7 +81,7 @@ static int initial_integrate(jd_sim *s, int *moved) {
         bits |= kick_drift(lo, hi, s->x, s->v, s->omega, s->x_build, s->f, s->torque, s->dtfm,
                            s->dtirot, s->dt, lim);
     }
-    *moved = (bits & 2) && !s->allpairs;
+    *moved = (bits & 2) != 0;
     return bits & 1;
 }
 

@@ -86,23 +86,28 @@ static void drop_entry(jd_sim *s, const jd_contact_list *l, size_t c) {
     s->e_fric_dropped += st.e_fric;
 }
 
-/* Give every entry of nw the history of the same (i, j) in old, or a fresh (zero) history. */
+/* Give every entry of nw (one sorted run) the history of the same (i, j) in old, or a fresh
+ * (zero) history: one merge with each of old's two sorted runs (jd_contact_list). */
 static void carry_over(jd_sim *s, const jd_contact_list *old, jd_contact_list *nw) {
     const size_t hw = (size_t)nw->hw, rw = (size_t)nw->rw;
-    size_t a = 0;
+    size_t a = 0, a_end = old->n_touch, q = old->n_touch;
     for (size_t b = 0; b < nw->n; b++) {
-        for (; a < old->n && key_less(old, a, nw, b); a++) drop_entry(s, old, a);
-        const int kept = a < old->n && !key_less(nw, b, old, a);
-        if (kept) {
-            memcpy(nw->hist + hw * b, old->hist + hw * a, hw * sizeof *nw->hist);
-            if (rw) memcpy(nw->rhist + rw * b, old->rhist + rw * a, rw * sizeof *nw->rhist);
-            a++;
+        for (; a < a_end && key_less(old, a, nw, b); a++) drop_entry(s, old, a);
+        for (; q < old->n && key_less(old, q, nw, b); q++) drop_entry(s, old, q);
+        const size_t *at = a < a_end && !key_less(nw, b, old, a)   ? &a
+                           : q < old->n && !key_less(nw, b, old, q) ? &q
+                                                                      : NULL;
+        if (at) {
+            memcpy(nw->hist + hw * b, old->hist + hw * *at, hw * sizeof *nw->hist);
+            if (rw) memcpy(nw->rhist + rw * b, old->rhist + rw * *at, rw * sizeof *nw->rhist);
+            if (at == &a) a++; else q++;
         } else {
             memset(nw->hist + hw * b, 0, hw * sizeof *nw->hist);
             if (rw) memset(nw->rhist + rw * b, 0, rw * sizeof *nw->rhist);
         }
     }
-    for (; a < old->n; a++) drop_entry(s, old, a);
+    for (; a < a_end; a++) drop_entry(s, old, a);
+    for (; q < old->n; q++) drop_entry(s, old, q);
 }
 
 /* Can particle i touch wall w before the next rebuild (relative motion <= skin)? */
@@ -114,6 +119,31 @@ static int wall_candidate(const jd_sim_wall *w, const double *x, double R, doubl
 static unsigned list_kind(const jd_sim *s, unsigned pairs) {
     return ((s->features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) |
            ((s->features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u) | pairs;
+}
+
+/* Entry c of `from` into entry d of `to` (same kind of list). */
+static void copy_entry(const jd_contact_list *from, size_t c, jd_contact_list *to, size_t d) {
+    const size_t hw = (size_t)from->hw, rw = (size_t)from->rw;
+    to->i[d] = from->i[c];
+    to->j[d] = from->j[c];
+    memcpy(to->hist + hw * d, from->hist + hw * c, hw * sizeof *to->hist);
+    if (rw) memcpy(to->rhist + rw * d, from->rhist + rw * c, rw * sizeof *to->rhist);
+    to->pc[d] = from->pc[c];
+    if (from->pcr) to->pcr[d] = from->pcr[c];
+}
+
+/* The pair list `in` (one sorted run) into `out` as two sorted runs: the candidates whose
+ * spheres touch now (LIGGGHTS' rsq < radsum^2), then the others (jd_contact_list). */
+static int split_touching(const jd_sim *s, const jd_contact_list *in, jd_contact_list *out) {
+    if (sim_list_reserve(out, in->n, list_kind(s, JD_LIST_PAIRS)) != 0) return -1;
+    size_t touching = 0;
+    for (size_t c = 0; c < in->n; c++) touching += sim_pair_touching(s, in->i[c], in->j[c]);
+    size_t t = 0, o = touching;
+    for (size_t c = 0; c < in->n; c++)
+        copy_entry(in, c, out, sim_pair_touching(s, in->i[c], in->j[c]) ? t++ : o++);
+    out->n = in->n;
+    out->n_touch = touching;
+    return 0;
 }
 
 static int build_wall_list(jd_sim *s, jd_contact_list *l) {
@@ -279,19 +309,23 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
     } else if (build_pair_list_cells(s, nw, err, errlen) != 0) {
         return -1;
     }
+    nw->n_touch = nw->n;
     fill_pair_constants(s, nw);
     carry_over(s, &s->pairs, nw);
-    jd_contact_list t = s->pairs;
-    s->pairs = *nw;
-    *nw = t;
+    /* the old list's buffers take the new list, split */
+    if (split_touching(s, nw, &s->pairs) != 0) {
+        snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", nw->n);
+        return -1;
+    }
+    sim_contact_list_free(nw); /* sized for pairs: the wall list would keep them */
 
-    nw->n = 0;
     if (build_wall_list(s, nw) != 0) {
         snprintf(err, errlen, "out of memory building the wall candidate list");
         return -1;
     }
+    nw->n_touch = nw->n;
     carry_over(s, &s->wall_pairs, nw);
-    t = s->wall_pairs;
+    jd_contact_list t = s->wall_pairs;
     s->wall_pairs = *nw;
     *nw = t;
 
@@ -308,7 +342,6 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
 }
 
 int sim_neighbour_walls_moved(const jd_sim *s) {
-    if (s->allpairs) return 0;
     const double lim = 0.25 * s->skin * s->skin; /* (skin/2)^2 */
     for (size_t w = 0; w < s->n_walls; w++)
         if (jd_dot(s->walls[w].disp, s->walls[w].disp) > lim) return 1;

@@ -86,7 +86,7 @@ static int rekey(jd_contact_list *l, int pairs, const int32_t *new_of_old, size_
         memcpy(out->hist + hw * p, l->hist + hw * (size_t)c, hw * sizeof *out->hist);
         if (rw) memcpy(out->rhist + rw * p, l->rhist + rw * (size_t)c, rw * sizeof *out->rhist);
     }
-    out->n = m;
+    out->n = out->n_touch = m; /* one sorted run */
     free(start);
     free(order);
     return 0;

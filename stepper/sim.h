@@ -32,8 +32,8 @@
  * (sim_bonds_permute, sim_loads_permute), and reads scene data through orig.
  *
  * Threads (OpenMP).  At every neighbour build the particles are split into one contiguous range
- * per thread, cut at the pair list's particle runs so that the threads get about equal numbers
- * of pair entries (jd_thread_share).  A thread evaluates the pairs and walls of its particles
+ * per thread, so that the threads get about equal estimated work: pair entries that touched at
+ * the build, the cheaper ones that did not, and wall entries (jd_thread_share).  A thread evaluates the pairs and walls of its particles
  * and adds straight into f and torque, except for a pair partner j beyond its range: that goes
  * into the thread's overflow buffer, which covers only the few particles past the range that
  * its pairs reach (pairs list j > i in cell order).  After one barrier each thread adds the
@@ -72,7 +72,9 @@ typedef struct jd_pair_const_roll {
 
 /* Run options that are not part of the scene (command line). */
 typedef struct jd_sim_options {
-    int allpairs;     /* debugging reference: every pair, never rebuilt, no sorting */
+    int allpairs;     /* debugging reference: every pair listed, never sorted; the list is built
+                         again whenever the default one would be, so that its entries are split
+                         alike (jd_contact_list) and the forces summed in the same order */
     int no_sort;      /* keep the scene's particle order (reference for the sorted path) */
     int all_laws;     /* evaluate every law even where its coefficient makes it vanish (the
                          general loop; reference for the feature-specialised ones) */
@@ -89,8 +91,13 @@ typedef struct jd_timing {
     double output;      /* frames, observables and the energy watchdog */
 } jd_timing;
 
-/* A list of contact candidates (i, j) sorted by (i, j), with the history of each contact stored
- * alongside.  For particle pairs j is a particle index (> i); for wall candidates a wall index.
+/* A list of contact candidates (i, j), with the history of each contact stored alongside.  For
+ * particle pairs j is a particle index (> i); for wall candidates a wall index.  The entries
+ * [0, n_touch) and [n_touch, n) are each sorted by (i, j).  A wall list, and a pair list between
+ * renumbering and rebuilding, is one sorted run (n_touch = n); a pair list as built has the
+ * candidates whose spheres touched at the build first, those within the skin but apart second:
+ * the force loop evaluates the first in every SIMD lane and tests the second before packing the
+ * few that touch into lanes (forces.c), so that no lane is spent on a gap that stays a gap.
  * Buffers grow geometrically and are reused across rebuilds (no allocation per contact).
  *
  * The history of entry c is the first hw doubles of the kernel's jd_contact_state (xi and flags;
@@ -100,6 +107,7 @@ typedef struct jd_timing {
  * the energy fields only with JD_F_ENERGY). */
 typedef struct jd_contact_list {
     size_t n, cap;
+    size_t n_touch;         /* entries of the first sorted run (see above) */
     int32_t *i, *j;
     int hw, rw;             /* doubles of history per entry */
     double *hist;           /* cap x hw */
@@ -150,7 +158,8 @@ typedef struct jd_sim_wall {
 
 /* A thread's share of the force loops (see "Threads" above; forces.c). */
 typedef struct jd_thread_share {
-    size_t pair_lo, pair_hi; /* pair list entries [pair_lo, pair_hi) */
+    size_t pair_lo, pair_hi; /* pair list entries [pair_lo, pair_hi) that touched at the build */
+    size_t near_lo, near_hi; /* and [near_lo, near_hi) that did not (jd_contact_list) */
     size_t wall_lo, wall_hi; /* wall list entries */
     size_t p_lo, p_hi;       /* the particles it owns: every entry above has i in [p_lo, p_hi) */
     size_t win;              /* its pairs reach particles [p_hi, p_hi + win) as j */
@@ -203,8 +212,6 @@ typedef struct jd_sim {
     jd_sim_options opt;
     int threads;       /* threads actually used (opt.threads clamped to >= 1) */
     jd_thread_share *shares; /* one per thread (see "Threads"), set at every neighbour build */
-    int sparse_pairs;  /* fewer than half the pair candidates touched at the last neighbour build:
-                        * the pair loop packs the touching ones into its lanes (forces.c) */
     jd_overlap_trip *trips; /* one per thread, merged into overlap_trip */
     double *scratch;   /* 3n doubles: reordering and frames in scene order */
     jd_timing timing;
@@ -298,8 +305,8 @@ void sim_compute_forces(jd_sim *s);
 /* The force loops' per-thread state for s->threads threads (sim_init), and its release. */
 int sim_forces_init(jd_sim *s);
 void sim_forces_free(jd_sim *s);
-/* Split the current lists between the threads (jd_thread_share) and set sparse_pairs; after
- * every neighbour build.  Returns 0, or -1 when out of memory. */
+/* Split the current lists between the threads (jd_thread_share); after every neighbour
+ * build.  Returns 0, or -1 when out of memory. */
 int sim_forces_partition(jd_sim *s);
 /* Monotonic wall clock [s]. */
 double sim_clock(void);

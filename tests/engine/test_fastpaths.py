@@ -7,7 +7,9 @@ a cylinder, damping, friction, rolling resistance, ~50 neighbour rebuilds).
   (--no-sort): the contacts are the same, only the order in which forces are summed differs, so
   the trajectories agree to round-off (differences start at 1e-17 and grow through the
   collisions; the bounds below are 1e-12 relative, far below any physical effect: one missed
-  contact step changes velocities by ~1e-3 relative) and the contact counts are identical;
+  contact step changes velocities by ~1e-3 relative) and the contact counts are identical
+  (except for pairs exactly at the contact distance, to that round-off: their contact is decided
+  by round-off);
 * the force loops in SIMD batches against one contact at a time (--plain-loops): each contact's
   arithmetic and the order of the force sums are the same, so the trajectories and every
   observable (energies included) are identical bit for bit; also with two particle materials
@@ -78,13 +80,40 @@ def identical(a, b):
     return all(np.array_equal(a[k], b[k]) for k in VECTORS)
 
 
+def marginal_pairs(a, b):
+    """Per frame, the sphere pairs whose surface gap is zero to within the round-off the
+    position check allows (2 POS_TOL of the frame's largest |x|, in either run): whether such a
+    pair touches is decided by round-off.  A lattice of bonded spheres at exactly 2 R spacing
+    has many."""
+    r = a["radius"]
+    iu = np.triu_indices(len(r), 1)
+    radsum = (r[:, None] + r[None, :])[iu]
+    counts = []
+    for xa, xb in zip(a["position"], b["position"]):
+        tol = 2 * POS_TOL * np.max(np.abs(xb))
+        near = np.zeros(len(radsum), bool)
+        for x in (xa, xb):
+            d = np.linalg.norm(x[:, None, :] - x[None, :, :], axis=2)[iu]
+            near |= np.abs(d - radsum) <= tol
+        counts.append(int(near.sum()))
+    return np.array(counts)
+
+
 def roundoff_equal(c, name, a, b):
     dp, dv = rel_diff(a, b, "position"), max(rel_diff(a, b, "velocity"), rel_diff(a, b, "angular_velocity"))
     c.check(f"{name}_positions", dp <= POS_TOL, f"relative difference {dp:.3g} > {POS_TOL:g}")
     c.check(f"{name}_velocities", dv <= VEL_TOL, f"relative difference {dv:.3g} > {VEL_TOL:g}")
-    same = np.array_equal(a["obs"]["contacts"], b["obs"]["contacts"]) and \
+    # pair contacts: equal at every sample, but for pairs at the contact distance to round-off
+    # (known only at the samples that have a frame)
+    diff = np.abs(a["obs"]["contacts"] - b["obs"]["contacts"])
+    frame_of = {t: k for k, t in enumerate(a["position_time"])}
+    marginal = marginal_pairs(a, b)
+    allowed = np.array([marginal[frame_of[t]] if t in frame_of else 0 for t in a["obs_time"]])
+    same = bool(np.all(diff <= allowed)) and \
         np.array_equal(a["obs"]["wall_contacts"], b["obs"]["wall_contacts"])
-    c.check(f"{name}_contact_counts", same, "contact counts differ")
+    c.check(f"{name}_contact_counts", same,
+            f"contact counts differ by {diff.tolist()}, pairs at the contact distance to round-off "
+            f"{allowed.tolist()}")
 
 
 c = Checks()
