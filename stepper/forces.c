@@ -83,6 +83,24 @@ static JD_ALWAYS_INLINE void hist_separate(jd_contact_list *L, const unsigned F,
     for (int k = 0; k < RW(F); k++) r[k] = 0.0;
 }
 
+/* Is entry c's history already as hist_separate leaves it (bit for bit: +0, not -0)?  Most
+ * candidates that did not touch at the build never do: checking spares their history the
+ * writes. */
+static JD_ALWAYS_INLINE int hist_separated(const jd_contact_list *L, const unsigned F, size_t c) {
+    const double *h = L->hist + (size_t)HW(F) * c, *r = L->rhist + (size_t)RW(F) * c;
+    uint64_t bits = 0, u;
+    for (int k = 0; k < HW(F); k++)
+        if (k != AT(jd_contact_state, e_damp) && k != AT(jd_contact_state, e_fric)) {
+            memcpy(&u, h + k, sizeof u);
+            bits |= u;
+        }
+    for (int k = 0; k < RW(F); k++) {
+        memcpy(&u, r + k, sizeof u);
+        bits |= u;
+    }
+    return bits == 0;
+}
+
 /* Contacts per batch of the pair loop: a multiple of the widest SIMD vector, few enough that
  * the batch's lanes stay in L1. */
 #define JD_BATCH 32
@@ -192,7 +210,7 @@ static size_t first_entry_of(const jd_contact_list *l, size_t lo, size_t hi, siz
 /* The estimated cost of a list entry, for splitting the work between the threads, in quarters
  * of a pair entry that touched at the build (one SIMD lane of the law and its scatter): the
  * sphere test of one that did not, and a wall entry (its test, then a lane). */
-enum { COST_TOUCH = 4, COST_NEAR = 1, COST_WALL = 6 };
+enum { COST_TOUCH = 4, COST_NEAR = 2, COST_WALL = 7 };
 
 /* The threads' shares of the current lists (sim.h, "Threads"): contiguous particle ranges of
  * about equal estimated cost, the entries of their particles in each sorted run of the lists,
@@ -321,7 +339,7 @@ static JD_ALWAYS_INLINE int batch_evaluate(jd_sim *s, const unsigned F, const in
         for (int b = 0; b < nb; b++) {
             if (B->touch[b])
                 lane_history_write(F, B, B->lane[b], hist, rhist, c0 + (size_t)b);
-            else
+            else if (!hist_separated(L, F, c0 + (size_t)b))
                 hist_separate(L, F, c0 + (size_t)b);
         }
     return m;
@@ -674,8 +692,6 @@ void sim_compute_forces(jd_sim *s) {
     double work[nt > 0 ? nt : 1];
     double t_pairs_end = 0.0, t_walls_end = 0.0;
     const double t0 = sim_clock();
-    memset(s->f, 0, 3 * s->n * sizeof *s->f);
-    memset(s->torque, 0, 3 * s->n * sizeof *s->torque);
 #pragma omp parallel num_threads(nt) if (nt > 1)
     {
 #ifdef _OPENMP
@@ -683,6 +699,10 @@ void sim_compute_forces(jd_sim *s) {
 #else
         const int tid = 0;
 #endif
+        /* only this thread writes its particles' f and torque directly (the others' overflow) */
+        const jd_thread_share *h = &s->shares[tid];
+        memset(s->f + 3 * h->p_lo, 0, 3 * (h->p_hi - h->p_lo) * sizeof *s->f);
+        memset(s->torque + 3 * h->p_lo, 0, 3 * (h->p_hi - h->p_lo) * sizeof *s->torque);
         s->trips[tid].fraction = 0.0;
         work[tid] = dispatch(s, tid, &t_pairs_end);
         if (nt > 1) {

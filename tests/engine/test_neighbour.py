@@ -3,7 +3,8 @@
 
 216 jittered spheres (two radii) settle on a floor inside a cylinder with damping, friction and
 rolling resistance; the Verlet list is rebuilt many times on the way.  The Verlet run keeps the
-scene's particle order (--no-sort), so both paths evaluate the same contacts in the same (i, j)
+scene's particle order (--no-sort), and the all-pairs list is built again at the same steps,
+its entries split alike (touching first), so both paths evaluate the same contacts in the same
 order and the trajectories should agree to round-off (in fact bit for bit).  The sorted path
 is checked against the unsorted one in test_fastpaths.py.
 
