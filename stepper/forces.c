@@ -2,10 +2,12 @@
  * forces.c — force loops.  The scene's feature set (JD_F_* bits) is fixed for a run; the loop
  * body is instantiated once per combination with the bits as a literal constant, so that
  * jd_contact() compiles away every law the scene does not use (DESIGN.md: "leave out what a
- * scene does not need").  Order as LIGGGHTS: pair forces in list order, wall forces, gravity.
+ * scene does not need").  Order as LIGGGHTS: pair forces in list order (the candidates that
+ * touched at the build, then the others: sim.h, jd_contact_list), wall forces, gravity.
  *
- * Threads (sim.h, "Threads"): each thread evaluates the entries of the particles it owns and
- * adds into f and torque, and into its overflow buffer for partners beyond its particles; after
+ * Threads (sim.h, "Threads"): each thread zeroes the forces of the particles it owns, evaluates
+ * their entries and adds into f and torque, and into its overflow buffer for partners beyond its
+ * particles; after
  * one barrier each thread adds the earlier threads' overflow into its particles in thread order
  * (then gravity) and zeroes it for the next evaluation.  No atomics; with one thread this is
  * exactly the serial loop.
