@@ -791,6 +791,8 @@ def summarise(runs):
                          cpu_seconds_loop=cpu_loop,
                          particle_steps_per_cpu_second=(n * steps / cpu_loop) if cpu_loop and cpu_loop > 0 else None,
                          particle_steps_per_second=n * steps / wall if wall > 0 else float("nan"),
+                         particle_steps_per_second_best=n * steps / min(r["wall_s"] for r in rs)
+                         if min(r["wall_s"] for r in rs) > 0 else None,
                          contacts_per_particle=cpp,
                          ns_per_particle_step=1e9 * wall / (n * steps),
                          jdem_timer_seconds=timer,
