@@ -7,10 +7,9 @@
  *
  * Threads (sim.h, "Threads"): each thread zeroes the forces of the particles it owns, evaluates
  * their entries and adds into f and torque, and into its overflow buffer for partners beyond its
- * particles; after
- * one barrier each thread adds the earlier threads' overflow into its particles in thread order
- * (then gravity) and zeroes it for the next evaluation.  No atomics; with one thread this is
- * exactly the serial loop.
+ * particles; after one barrier each thread adds the earlier threads' overflow into its particles
+ * in thread order and zeroes it for the next evaluation (then gravity, for all).  No atomics;
+ * with one thread this is exactly the serial loop.
  */
 #include <math.h>
 #include <stddef.h>
@@ -269,11 +268,11 @@ enum { JD_KINDS_ANY, JD_KINDS_ONE_MATERIAL, JD_KINDS_ALIKE };
  * than a branch; a lane that no longer touches computes the law on a meaningless geometry, then
  * keeps what jd_contact_separate leaves and carries no force.  Entries that did not (packed = 1,
  * sim.h: jd_contact_list): the sphere test runs first over the entries (SIMD), only the
- * touching ones are packed into lanes (without a branch), and the others are separated.  Either way every
- * entry's history is exactly the plain loop's.  The SIMD loops write only the batch (stores to
- * the list there would be stores the compiler cannot tell apart from the particle arrays it
- * gathers from); the history goes to the list in a loop of its own.  The kernel's geometry and
- * law have no data-dependent branches. */
+ * touching ones are packed into lanes (without a branch), and the others are separated (left
+ * alone when their history already is).  Either way every entry's history is exactly the plain
+ * loop's.  The SIMD loops write only the batch (stores to the list there would be stores the
+ * compiler cannot tell apart from the particle arrays it gathers from); the history goes to the
+ * list in a loop of its own.  The kernel's geometry and law have no data-dependent branches. */
 static JD_ALWAYS_INLINE int batch_evaluate(jd_sim *s, const unsigned F, const int kinds,
                                            const int packed, batch *restrict B, size_t c0, int nb) {
     jd_contact_list *L = &s->pairs;
