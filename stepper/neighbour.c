@@ -94,13 +94,12 @@ static void carry_over(jd_sim *s, const jd_contact_list *old, jd_contact_list *n
     for (size_t b = 0; b < nw->n; b++) {
         for (; a < a_end && key_less(old, a, nw, b); a++) drop_entry(s, old, a);
         for (; q < old->n && key_less(old, q, nw, b); q++) drop_entry(s, old, q);
-        const size_t *at = a < a_end && !key_less(nw, b, old, a)   ? &a
-                           : q < old->n && !key_less(nw, b, old, q) ? &q
-                                                                      : NULL;
-        if (at) {
-            memcpy(nw->hist + hw * b, old->hist + hw * *at, hw * sizeof *nw->hist);
-            if (rw) memcpy(nw->rhist + rw * b, old->rhist + rw * *at, rw * sizeof *nw->rhist);
-            if (at == &a) a++; else q++;
+        const int in_a = a < a_end && !key_less(nw, b, old, a);
+        const int in_q = !in_a && q < old->n && !key_less(nw, b, old, q);
+        if (in_a || in_q) {
+            const size_t at = in_a ? a++ : q++;
+            memcpy(nw->hist + hw * b, old->hist + hw * at, hw * sizeof *nw->hist);
+            if (rw) memcpy(nw->rhist + rw * b, old->rhist + rw * at, rw * sizeof *nw->rhist);
         } else {
             memset(nw->hist + hw * b, 0, hw * sizeof *nw->hist);
             if (rw) memset(nw->rhist + rw * b, 0, rw * sizeof *nw->rhist);
