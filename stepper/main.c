@@ -299,12 +299,15 @@ static void print_timing(const jd_sim *s) {
     for (size_t k = 0; k < sizeof part / sizeof *part; k++)
         fprintf(stderr, "jdem:   %-17s %10.4f s  %5.1f %%\n", part[k].name, part[k].v,
                 total > 0.0 ? 100.0 * part[k].v / total : 0.0);
+    fprintf(stderr, "jdem:   time loop         %10.4f s  (the parts above and the per-step checks)\n",
+            t->loop);
     fprintf(stderr, "jdem:   engine memory %.1f MB (%.0f bytes per particle; the scene and the "
             "libraries come on top)\n", (double)sim_memory_bytes(s) / 1e6,
             s->n ? (double)sim_memory_bytes(s) / (double)s->n : 0.0);
     fprintf(stderr, "jdem-timing: neighbour=%.6f pairs=%.6f walls=%.6f integration=%.6f output=%.6f "
-            "steps=%lld builds=%lld threads=%d pair_entries=%zu wall_entries=%zu engine_bytes=%zu\n",
-            t->neighbour, t->pairs, t->walls, t->integration, t->output, (long long)s->step,
+            "loop=%.6f steps=%lld builds=%lld threads=%d pair_entries=%zu wall_entries=%zu "
+            "engine_bytes=%zu\n",
+            t->neighbour, t->pairs, t->walls, t->integration, t->output, t->loop, (long long)s->step,
             (long long)s->n_builds, s->threads, s->pairs.n, s->wall_pairs.n, sim_memory_bytes(s));
 }
 

@@ -322,6 +322,7 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
     const int64_t last = sc->steps;
     jd_progress p;
     progress_start(&p, show_progress, last, s->n);
+    const double t_loop = sim_clock();
     int rc = 0;
     for (;;) {
         /* the bonds formed and broken by the last step, also when the watchdog stops here */
@@ -345,6 +346,7 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
         if ((rc = sim_step(s, err, errlen)) != 0) break;
         progress_update(&p, s->step, (double)s->step * s->dt);
     }
+    s->timing.loop += sim_clock() - t_loop;
     progress_finish(&p);
     if (rc == JD_RUN_TRIPPED || rc == JD_RUN_STOPPED) write_stop_frame(s, h);
     return rc;

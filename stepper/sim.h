@@ -90,6 +90,9 @@ typedef struct jd_timing {
     double walls;       /* particle-wall force loop */
     double integration; /* half kicks, drift, non-finite probes, wall motion */
     double output;      /* frames, observables and the energy watchdog */
+    double loop;        /* the whole time loop (sim_run), the parts above and what they leave
+                         * out: the bonds' events, the per-step watchdog, progress; what
+                         * LIGGGHTS reports as "Loop time" */
 } jd_timing;
 
 /* A list of contact candidates (i, j), with the history of each contact stored alongside.  For
