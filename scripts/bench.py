@@ -32,8 +32,8 @@ stiff (E = 7e10 Pa), with or without rolling resistance; nu = 0.3, rho = 2500, e
    Until 2026-11-22 jdem's wall time was a run of S steps minus a run of 1 step, which should
    cancel the set-up but does not reliably: the set-up (scene parsing, ~1 s at 80k, ~15 s at
    1M) varies by more than the loop takes, and the difference was off by up to 30 % at 80k and
-   50 % at 1M (in the bench of that day, both directions across repeats).  It is still recorded (diff_wall_s), and the CPU time below
-   is taken that way for every engine.
+   50 % at 1M (in the bench of that day, in both directions across repeats).  It is still
+   recorded (diff_wall_s), and the CPU time below is taken that way for every engine.
    Also the CPU time of the loop (GNU time's user+sys of the S-step run minus that of a 1-step
    run, for every engine on 1 rank): steadier than wall time when other jobs share the machine.
    The LIGGGHTS decks get `processors * * 1` (the box is twice the bed's height: a z split
