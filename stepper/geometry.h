@@ -34,20 +34,22 @@ static inline int sim_pair_touching(const jd_sim *s, int32_t i, int32_t j) {
 }
 
 /* Sphere–sphere for entry c of the pair list: returns 1 and fills g when the spheres overlap
- * (rsq < radsum^2).  The material fields come from the entry's stored constants; i_eff and
- * r_roll are only read by the rolling law, so they are filled only with JD_F_ROLLING in
- * features (a compile-time constant at the call sites). */
+ * (rsq < radsum^2).  The material fields come from the entry's stored constants, or the
+ * scene's single set (jd_sim.alike: the list keeps none); i_eff and r_roll are only read by the
+ * rolling law, so they are filled only with JD_F_ROLLING in features (a compile-time constant
+ * at the call sites). */
 static inline int sim_pair_geom(const jd_sim *s, const unsigned features, size_t c, int32_t i,
                                 int32_t j, jd_contact_geom *g) {
     if (!jd_geom_spheres_contact(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
                                  s->radius[j], g))
         return 0;
-    const jd_pair_const *pc = &s->pairs.pc[c];
+    const jd_pair_const *pc = s->pairs.pc ? &s->pairs.pc[c] : &s->pc_alike;
     g->k_n = pc->k_n;
     g->m_eff = pc->m_eff;
     if (features & JD_F_ROLLING) {
-        g->i_eff = s->pairs.pcr[c].i_eff;
-        g->r_roll = s->pairs.pcr[c].r_roll;
+        const jd_pair_const_roll *pcr = s->pairs.pcr ? &s->pairs.pcr[c] : &s->pcr_alike;
+        g->i_eff = pcr->i_eff;
+        g->r_roll = pcr->r_roll;
     } else {
         g->i_eff = g->r_roll = 0.0;
     }

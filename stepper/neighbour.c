@@ -24,7 +24,7 @@
  * sim_reorder), so a list may lack the arrays of its new kind even with enough capacity; every
  * array a list has is kept at its capacity.  The history widths (hw, rw) are the run's. */
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
-    const int rolling = (kind & JD_LIST_ROLLING) != 0, pairs = (kind & JD_LIST_PAIRS) != 0;
+    const int rolling = (kind & JD_LIST_ROLLING) != 0, pairs = (kind & JD_LIST_PAIR_CONSTS) != 0;
     const int energy = (kind & JD_LIST_ENERGY) != 0;
     const int hw = energy ? JD_CONTACT_STATE_LEN : JD_HIST_CORE;
     const int rw = rolling ? (energy ? JD_ROLLING_STATE_LEN : JD_RHIST_CORE) : 0;
@@ -115,9 +115,12 @@ static int wall_candidate(const jd_sim_wall *w, const double *x, double R, doubl
                                     : jd_geom_cylinder_near(&w->cyl, x, R, skin);
 }
 
-static unsigned list_kind(const jd_sim *s, unsigned pairs) {
+/* The kind of list the run's history needs; pairs: a particle pair list, which keeps per-pair
+ * constants unless every pair has the same (jd_sim.alike). */
+static unsigned list_kind(const jd_sim *s, int pairs) {
     return ((s->features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) |
-           ((s->features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u) | pairs;
+           ((s->features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u) |
+           (pairs && !s->alike ? JD_LIST_PAIR_CONSTS : 0u);
 }
 
 /* Entry c of `from` into entry d of `to` (same kind of list). */
@@ -127,14 +130,14 @@ static void copy_entry(const jd_contact_list *from, size_t c, jd_contact_list *t
     to->j[d] = from->j[c];
     memcpy(to->hist + hw * d, from->hist + hw * c, hw * sizeof *to->hist);
     if (rw) memcpy(to->rhist + rw * d, from->rhist + rw * c, rw * sizeof *to->rhist);
-    to->pc[d] = from->pc[c];
+    if (from->pc) to->pc[d] = from->pc[c];
     if (from->pcr) to->pcr[d] = from->pcr[c];
 }
 
 /* The pair list `in` (one sorted run) into `out` as two sorted runs: the candidates whose
  * spheres touch now (LIGGGHTS' rsq < radsum^2), then the others (jd_contact_list). */
 static int split_touching(const jd_sim *s, const jd_contact_list *in, jd_contact_list *out) {
-    if (sim_list_reserve(out, in->n, list_kind(s, JD_LIST_PAIRS)) != 0) return -1;
+    if (sim_list_reserve(out, in->n, list_kind(s, 1)) != 0) return -1;
     size_t touching = 0;
     for (size_t c = 0; c < in->n; c++) touching += sim_pair_touching(s, in->i[c], in->j[c]);
     size_t t = 0, o = touching;
@@ -146,7 +149,7 @@ static int split_touching(const jd_sim *s, const jd_contact_list *in, jd_contact
 }
 
 static int build_wall_list(jd_sim *s, jd_contact_list *l) {
-    const unsigned rolling = list_kind(s, 0u);
+    const unsigned rolling = list_kind(s, 0);
     for (size_t i = 0; i < s->n; i++)
         for (size_t w = 0; w < s->n_walls; w++)
             if ((s->allpairs || wall_candidate(&s->walls[w], s->x + 3 * i, s->radius[i], s->skin)) &&
@@ -237,7 +240,7 @@ static int sort_into_cells(jd_sim *s, char *err, size_t errlen) {
 
 static int build_pair_list_cells(jd_sim *s, jd_contact_list *l, char *err, size_t errlen) {
     if (s->n < 2) return 0;
-    const unsigned kind = list_kind(s, JD_LIST_PAIRS);
+    const unsigned kind = list_kind(s, 1);
     double h, lo[3];
     int nc[3];
     if (cell_grid(s, &h, lo, nc, err, errlen) != 0) return -1;
@@ -280,17 +283,17 @@ oom:
 }
 
 static int build_pair_list_all(jd_sim *s, jd_contact_list *l) {
-    const unsigned kind = list_kind(s, JD_LIST_PAIRS);
+    const unsigned kind = list_kind(s, 1);
     for (size_t i = 0; i < s->n; i++)
         for (size_t j = i + 1; j < s->n; j++)
             if (list_push(l, (int32_t)i, (int32_t)j, kind) != 0) return -1;
     return 0;
 }
 
-/* The per-pair constants of every entry (the list is rebuilt after each renumbering, so they
- * are never carried over). */
+/* The per-pair constants of every entry, if the list keeps them (the list is rebuilt after each
+ * renumbering, so they are never carried over). */
 static void fill_pair_constants(const jd_sim *s, jd_contact_list *l) {
-    for (size_t c = 0; c < l->n; c++)
+    for (size_t c = 0; l->pc && c < l->n; c++)
         sim_pair_constants(s, l->i[c], l->j[c], &l->pc[c], l->pcr ? &l->pcr[c] : NULL);
 }
 

@@ -116,8 +116,10 @@ typedef struct jd_contact_list {
     int hw, rw;             /* doubles of history per entry */
     double *hist;           /* cap x hw */
     double *rhist;          /* cap x rw; NULL without rolling resistance */
-    jd_pair_const *pc;      /* particle pairs only (walls: NULL): per-pair constants */
-    jd_pair_const_roll *pcr; /* particle pairs of scenes with rolling resistance, else NULL */
+    jd_pair_const *pc;      /* per-pair constants (read for the entries that touched at the
+                             * build): particle pair lists of scenes whose particles are not all
+                             * alike (jd_sim.alike), else NULL */
+    jd_pair_const_roll *pcr; /* the same with rolling resistance, else NULL */
 } jd_contact_list;
 
 /* History doubles without the energy bookkeeping: jd_contact_state's xi[3] and flags, and
@@ -204,7 +206,7 @@ typedef struct jd_sim {
                         * material (the pair loop then reads no species), else -1 */
     int alike;         /* 1 when all particles also share one radius: every pair then has the
                         * constants pc_alike, pcr_alike and radii r_alike, which the pair loop
-                        * uses instead of reading them per pair */
+                        * uses instead of reading them per pair, and the lists keep none */
     double r_alike;            /* [m] */
     jd_pair_const pc_alike;
     jd_pair_const_roll pcr_alike;
@@ -280,7 +282,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
  * rebuild criterion rides in the drift, integrate.c) */
 int sim_neighbour_walls_moved(const jd_sim *s);
 /* Capacity for `need` entries of a list of this kind (JD_LIST_* bits).  Returns 0 or -1. */
-enum { JD_LIST_ROLLING = 1, JD_LIST_PAIRS = 2, JD_LIST_ENERGY = 4 };
+enum { JD_LIST_ROLLING = 1, JD_LIST_PAIR_CONSTS = 2, JD_LIST_ENERGY = 4 };
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind);
 void sim_contact_list_free(jd_contact_list *l);
 
