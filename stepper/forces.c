@@ -280,8 +280,6 @@ static JD_ALWAYS_INLINE int batch_evaluate(jd_sim *s, const unsigned F, const in
                            *restrict rad = s->radius;
     double *hist = L->hist, *rhist = L->rhist;
     const int32_t *restrict li = L->i + c0, *restrict lj = L->j + c0;
-    const jd_pair_const *restrict pc = L->pc ? L->pc + c0 : NULL;
-    const jd_pair_const_roll *restrict pcr = L->pcr ? L->pcr + c0 : NULL;
     const double *restrict kp = s->kp, *restrict mass = s->mass, *restrict inertia = s->inertia;
     const size_t nm = s->n_materials;
     const jd_pair_coeffs *restrict coeffs = s->coeffs;
@@ -315,14 +313,14 @@ static JD_ALWAYS_INLINE int batch_evaluate(jd_sim *s, const unsigned F, const in
         const double rsq = jd_dot(dx, dx), radsum = ri + rj;
         jd_contact_geom g;
         const int touch = (rsq < radsum * radsum) & jd_geom_spheres_fill(dx, rsq, ri, rj, &g);
-        if (packed) { /* few lanes: the constants from the particles (sim_pair_constants) */
+        if (alike) {
+            g.k_n = pc1.k_n;
+            g.m_eff = pc1.m_eff;
+            g.i_eff = (F & JD_F_ROLLING) ? pcr1.i_eff : 0.0;
+            g.r_roll = (F & JD_F_ROLLING) ? pcr1.r_roll : 0.0;
+        } else { /* the pair's constants from the particles' (sim_pair_constants) */
             jd_geom_pair_material(F, &g, kp[i], kp[j], mass[i], mass[j], inertia[i], inertia[j]);
             g.r_roll = (F & JD_F_ROLLING) ? jd_rolling_radius(ri, rj) : 0.0;
-        } else {
-            g.k_n = alike ? pc1.k_n : pc[b].k_n;
-            g.m_eff = alike ? pc1.m_eff : pc[b].m_eff;
-            g.i_eff = (F & JD_F_ROLLING) ? (alike ? pcr1.i_eff : pcr[b].i_eff) : 0.0;
-            g.r_roll = (F & JD_F_ROLLING) ? (alike ? pcr1.r_roll : pcr[b].r_roll) : 0.0;
         }
         const int32_t k_co = one_row ? s->pair_row : species[i] * (int32_t)nm + species[j];
         const jd_pair_coeffs co = {coeffs[k_co].gamma, coeffs[k_co].mu, coeffs[k_co].eta,
@@ -520,7 +518,7 @@ static void plain_pair_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, a
     for (size_t c = c0; c < c1; c++) {
         const int32_t i = L->i[c], j = L->j[c];
         jd_contact_geom g;
-        if (!sim_pair_geom(s, F, c, i, j, &g)) {
+        if (!sim_pair_geom(s, F, i, j, &g)) {
             hist_separate(L, F, c);
             continue;
         }

@@ -10,8 +10,9 @@
 #include "jdem_geometry.h"
 #include "sim.h"
 
-/* The constants of pair (i, j) as jd_geom_pair_material and jd_geom_spheres compute them; the
- * neighbour build stores them with the list entry.  pcr may be NULL (no rolling). */
+/* The constants of pair (i, j) as jd_geom_pair_material and jd_geom_spheres compute them (the
+ * force loops compute the same per lane, or read the scene's single set).  pcr may be NULL (no
+ * rolling). */
 static inline void sim_pair_constants(const jd_sim *s, int32_t i, int32_t j, jd_pair_const *pc,
                                       jd_pair_const_roll *pcr) {
     jd_contact_geom g;
@@ -33,23 +34,24 @@ static inline int sim_pair_touching(const jd_sim *s, int32_t i, int32_t j) {
     return jd_dot(dx, dx) < radsum * radsum;
 }
 
-/* Sphere–sphere for entry c of the pair list: returns 1 and fills g when the spheres overlap
- * (rsq < radsum^2).  The material fields come from the entry's stored constants, or the
- * scene's single set (jd_sim.alike: the list keeps none); i_eff and r_roll are only read by the
+/* Sphere–sphere for particles i and j: returns 1 and fills g when the spheres overlap
+ * (rsq < radsum^2).  The material fields are the pair's constants (sim_pair_constants), or the
+ * scene's single set when the particles are all alike; i_eff and r_roll are only read by the
  * rolling law, so they are filled only with JD_F_ROLLING in features (a compile-time constant
  * at the call sites). */
-static inline int sim_pair_geom(const jd_sim *s, const unsigned features, size_t c, int32_t i,
+static inline int sim_pair_geom(const jd_sim *s, const unsigned features, int32_t i,
                                 int32_t j, jd_contact_geom *g) {
     if (!jd_geom_spheres_contact(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
                                  s->radius[j], g))
         return 0;
-    const jd_pair_const *pc = s->pairs.pc ? &s->pairs.pc[c] : &s->pc_alike;
-    g->k_n = pc->k_n;
-    g->m_eff = pc->m_eff;
+    jd_pair_const pc = s->pc_alike;
+    jd_pair_const_roll pcr = s->pcr_alike;
+    if (!s->alike) sim_pair_constants(s, i, j, &pc, &pcr);
+    g->k_n = pc.k_n;
+    g->m_eff = pc.m_eff;
     if (features & JD_F_ROLLING) {
-        const jd_pair_const_roll *pcr = s->pairs.pcr ? &s->pairs.pcr[c] : &s->pcr_alike;
-        g->i_eff = pcr->i_eff;
-        g->r_roll = pcr->r_roll;
+        g->i_eff = pcr.i_eff;
+        g->r_roll = pcr.r_roll;
     } else {
         g->i_eff = g->r_roll = 0.0;
     }

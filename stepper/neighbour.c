@@ -20,20 +20,18 @@
 #include "geometry.h"
 #include "sim.h"
 
-/* The buffers of a list swap roles between the pair and the wall list (sim_neighbour_build,
- * sim_reorder), so a list may lack the arrays of its new kind even with enough capacity; every
- * array a list has is kept at its capacity.  The history widths (hw, rw) are the run's. */
+/* Every list of a run is of the run's kind (history widths hw, rw); buffers swap roles between
+ * the lists (sim_neighbour_build, sim_reorder), and every array a list has is kept at its
+ * capacity. */
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
-    const int rolling = (kind & JD_LIST_ROLLING) != 0, pairs = (kind & JD_LIST_PAIR_CONSTS) != 0;
+    const int rolling = (kind & JD_LIST_ROLLING) != 0;
     const int energy = (kind & JD_LIST_ENERGY) != 0;
     const int hw = energy ? JD_CONTACT_STATE_LEN : JD_HIST_CORE;
     const int rw = rolling ? (energy ? JD_ROLLING_STATE_LEN : JD_RHIST_CORE) : 0;
-    const int complete = l->hw == hw && l->rw == rw && (!rolling || l->rhist) && (!pairs || l->pc) &&
-                         (!(pairs && rolling) || l->pcr);
+    const int complete = l->hw == hw && l->rw == rw && (!rolling || l->rhist);
     if (need <= l->cap && complete) return 0;
     size_t cap = l->cap ? l->cap : 256;
     while (cap < need) cap += cap / 2;
-    const int grow = cap != l->cap;
     int32_t *i = realloc(l->i, cap * sizeof *i);
     if (i) l->i = i;
     int32_t *j = realloc(l->j, cap * sizeof *j);
@@ -42,12 +40,7 @@ int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
     if (h) l->hist = h;
     double *r = rolling ? realloc(l->rhist, cap * (size_t)rw * sizeof *r) : l->rhist;
     if (r) l->rhist = r;
-    const int want_pc = pairs || (grow && l->pc), want_pcr = (pairs && rolling) || (grow && l->pcr);
-    jd_pair_const *pc = want_pc ? realloc(l->pc, cap * sizeof *pc) : l->pc;
-    if (pc) l->pc = pc;
-    jd_pair_const_roll *pcr = want_pcr ? realloc(l->pcr, cap * sizeof *pcr) : l->pcr;
-    if (pcr) l->pcr = pcr;
-    if (!i || !j || !h || (rolling && !r) || (want_pc && !pc) || (want_pcr && !pcr)) return -1;
+    if (!i || !j || !h || (rolling && !r)) return -1;
     l->cap = cap;
     l->hw = hw;
     l->rw = rw;
@@ -67,8 +60,6 @@ void sim_contact_list_free(jd_contact_list *l) {
     free(l->j);
     free(l->hist);
     free(l->rhist);
-    free(l->pc);
-    free(l->pcr);
     memset(l, 0, sizeof *l);
 }
 
@@ -115,12 +106,10 @@ static int wall_candidate(const jd_sim_wall *w, const double *x, double R, doubl
                                     : jd_geom_cylinder_near(&w->cyl, x, R, skin);
 }
 
-/* The kind of list the run's history needs; pairs: a particle pair list, which keeps per-pair
- * constants unless every pair has the same (jd_sim.alike). */
-static unsigned list_kind(const jd_sim *s, int pairs) {
+/* The kind of list the run's history needs. */
+static unsigned list_kind(const jd_sim *s) {
     return ((s->features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) |
-           ((s->features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u) |
-           (pairs && !s->alike ? JD_LIST_PAIR_CONSTS : 0u);
+           ((s->features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u);
 }
 
 /* Entry c of `from` into entry d of `to` (same kind of list). */
@@ -130,14 +119,12 @@ static void copy_entry(const jd_contact_list *from, size_t c, jd_contact_list *t
     to->j[d] = from->j[c];
     memcpy(to->hist + hw * d, from->hist + hw * c, hw * sizeof *to->hist);
     if (rw) memcpy(to->rhist + rw * d, from->rhist + rw * c, rw * sizeof *to->rhist);
-    if (from->pc) to->pc[d] = from->pc[c];
-    if (from->pcr) to->pcr[d] = from->pcr[c];
 }
 
 /* The pair list `in` (one sorted run) into `out` as two sorted runs: the candidates whose
  * spheres touch now (LIGGGHTS' rsq < radsum^2), then the others (jd_contact_list). */
 static int split_touching(const jd_sim *s, const jd_contact_list *in, jd_contact_list *out) {
-    if (sim_list_reserve(out, in->n, list_kind(s, 1)) != 0) return -1;
+    if (sim_list_reserve(out, in->n, list_kind(s)) != 0) return -1;
     size_t touching = 0;
     for (size_t c = 0; c < in->n; c++) touching += sim_pair_touching(s, in->i[c], in->j[c]);
     size_t t = 0, o = touching;
@@ -149,11 +136,11 @@ static int split_touching(const jd_sim *s, const jd_contact_list *in, jd_contact
 }
 
 static int build_wall_list(jd_sim *s, jd_contact_list *l) {
-    const unsigned rolling = list_kind(s, 0);
+    const unsigned kind = list_kind(s);
     for (size_t i = 0; i < s->n; i++)
         for (size_t w = 0; w < s->n_walls; w++)
             if ((s->allpairs || wall_candidate(&s->walls[w], s->x + 3 * i, s->radius[i], s->skin)) &&
-                list_push(l, (int32_t)i, (int32_t)w, rolling) != 0)
+                list_push(l, (int32_t)i, (int32_t)w, kind) != 0)
                 return -1;
     return 0;
 }
@@ -240,7 +227,7 @@ static int sort_into_cells(jd_sim *s, char *err, size_t errlen) {
 
 static int build_pair_list_cells(jd_sim *s, jd_contact_list *l, char *err, size_t errlen) {
     if (s->n < 2) return 0;
-    const unsigned kind = list_kind(s, 1);
+    const unsigned kind = list_kind(s);
     double h, lo[3];
     int nc[3];
     if (cell_grid(s, &h, lo, nc, err, errlen) != 0) return -1;
@@ -283,18 +270,11 @@ oom:
 }
 
 static int build_pair_list_all(jd_sim *s, jd_contact_list *l) {
-    const unsigned kind = list_kind(s, 1);
+    const unsigned kind = list_kind(s);
     for (size_t i = 0; i < s->n; i++)
         for (size_t j = i + 1; j < s->n; j++)
             if (list_push(l, (int32_t)i, (int32_t)j, kind) != 0) return -1;
     return 0;
-}
-
-/* The per-pair constants of every entry, if the list keeps them (the list is rebuilt after each
- * renumbering, so they are never carried over). */
-static void fill_pair_constants(const jd_sim *s, jd_contact_list *l) {
-    for (size_t c = 0; l->pc && c < l->n; c++)
-        sim_pair_constants(s, l->i[c], l->j[c], &l->pc[c], l->pcr ? &l->pcr[c] : NULL);
 }
 
 /* Build a new list into `spare`, carry the history over, swap. */
@@ -312,7 +292,6 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
         return -1;
     }
     nw->n_touch = nw->n;
-    fill_pair_constants(s, nw);
     carry_over(s, &s->pairs, nw);
     /* the old list's buffers take the new list, split */
     if (split_touching(s, nw, &s->pairs) != 0) {

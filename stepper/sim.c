@@ -240,9 +240,7 @@ void sim_free(jd_sim *s) {
 }
 
 static size_t list_bytes(const jd_contact_list *l) {
-    const size_t entry = 2 * sizeof(int32_t) + (size_t)(l->hw + l->rw) * sizeof(double) +
-                         (l->pc ? sizeof(jd_pair_const) : 0) +
-                         (l->pcr ? sizeof(jd_pair_const_roll) : 0);
+    const size_t entry = 2 * sizeof(int32_t) + (size_t)(l->hw + l->rw) * sizeof(double);
     return l->cap * entry;
 }
 

@@ -58,8 +58,10 @@
 #include "jdem_watchdog.h"
 #include "scene.h"
 
-/* Material constants of a particle pair, computed once when the pair enters the neighbour list
- * (jd_geom_pair_material gives the same bits every step, so storing them changes nothing). */
+/* Material constants of a particle pair (sim_pair_constants).  The force loops compute them per
+ * contact from the particles' constants, or, when all particles are alike, take the scene's
+ * single set (jd_sim.pc_alike); the lists store none, which keeps an entry at 40 bytes (56
+ * with rolling) instead of 56 (88). */
 typedef struct jd_pair_const {
     double k_n;       /* Hertz prefactor of the pair (eq. 5) [N/m^1.5] */
     double m_eff;     /* effective mass [kg] */
@@ -116,10 +118,6 @@ typedef struct jd_contact_list {
     int hw, rw;             /* doubles of history per entry */
     double *hist;           /* cap x hw */
     double *rhist;          /* cap x rw; NULL without rolling resistance */
-    jd_pair_const *pc;      /* per-pair constants (read for the entries that touched at the
-                             * build): particle pair lists of scenes whose particles are not all
-                             * alike (jd_sim.alike), else NULL */
-    jd_pair_const_roll *pcr; /* the same with rolling resistance, else NULL */
 } jd_contact_list;
 
 /* History doubles without the energy bookkeeping: jd_contact_state's xi[3] and flags, and
@@ -206,7 +204,7 @@ typedef struct jd_sim {
                         * material (the pair loop then reads no species), else -1 */
     int alike;         /* 1 when all particles also share one radius: every pair then has the
                         * constants pc_alike, pcr_alike and radii r_alike, which the pair loop
-                        * uses instead of reading them per pair, and the lists keep none */
+                        * uses instead of computing them per pair */
     double r_alike;            /* [m] */
     jd_pair_const pc_alike;
     jd_pair_const_roll pcr_alike;
@@ -282,7 +280,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
  * rebuild criterion rides in the drift, integrate.c) */
 int sim_neighbour_walls_moved(const jd_sim *s);
 /* Capacity for `need` entries of a list of this kind (JD_LIST_* bits).  Returns 0 or -1. */
-enum { JD_LIST_ROLLING = 1, JD_LIST_PAIR_CONSTS = 2, JD_LIST_ENERGY = 4 };
+enum { JD_LIST_ROLLING = 1, JD_LIST_ENERGY = 2 };
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind);
 void sim_contact_list_free(jd_contact_list *l);
 
