@@ -321,10 +321,10 @@ def write_report(out, rows, machine, feature_check=None, flat=None, beds=None, f
              "so bytes/particle is meaningful only at the larger sizes. jdem's peak also holds the parsed "
              "scene: the bench scenes list every particle in YAML, and libyaml's document tree of them is "
              "the largest single item; \"jdem engine\" is what the engine itself holds during the run "
-             "(particle arrays, contact lists at capacity, cells; `jdem run --timing`), the figure to hold "
+             "(particle arrays, contact lists at capacity, cells, bonds; `jdem run --timing`), the figure to hold "
              "against the budget. The budget counts as contacts the particle-particle contacts at the last step "
-             "(contacts/particle x N / 2, from the trajectory's /observables/contacts); wall contacts and bonds "
-             "are not in it.\n\n")
+             "(contacts/particle x N / 2, from the trajectory's /observables/contacts) and, in the bonded beds, "
+             "the bonds at the start (a per-pair record like a contact's history); wall contacts are not in it.\n\n")
     L.append("## LIGGGHTS' own time split (median run, % of loop time)\n\n| size | variant | engine | ranks | Pair | Neigh | Comm | Other (fixes: walls, integration, gravity) |\n|---|---|---|---:|---:|---:|---:|---:|\n")
     for r in rows:
         sp = r.get("liggghts_split_percent")

@@ -144,6 +144,14 @@ void sim_bonds_free(jd_sim *s) {
     s->bonds = NULL;
 }
 
+size_t sim_bonds_memory_bytes(const jd_bonds *b, size_t n_particles) {
+    if (!b) return 0;
+    const size_t per_bond = 3 * sizeof(int32_t) + sizeof(jd_bond_section) + 2 * sizeof(double) +
+                            sizeof(jd_bond_state);
+    return b->cap * per_bond + b->n_types * sizeof *b->params + n_particles /* ever */ +
+           b->formed_cap * sizeof *b->formed + b->events_cap * sizeof *b->events;
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* Rules                                                                                     */
 
@@ -326,6 +334,13 @@ int sim_bonds_output(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     if (h && rc == 0 && (b->n_events || s->step == 0))
         rc = jd_h5md_write_bond_breaks(h, b->n_events, b->events, err, errlen);
     b->n_formed = b->n_events = 0;
+    /* a scene's bonds all form in one step (step 0, or a rule's): do not keep their records'
+     * room for the rest of the run */
+    if (b->formed_cap > 4096) {
+        free(b->formed);
+        b->formed = NULL;
+        b->formed_cap = 0;
+    }
     return rc;
 }
 

@@ -59,6 +59,9 @@ void sim_bond_observables_values(const jd_bond_observables *o, double out[JD_N_B
 /* Set up s->bonds from the scene (NULL when the scene has no bond types).  0 or -1 with err. */
 int sim_bonds_init(struct jd_sim *s, char *err, size_t errlen);
 void sim_bonds_free(struct jd_sim *s);
+/* Bytes the bonds hold (the bond arrays at their capacity, the output not yet written); 0 for
+ * NULL. */
+size_t sim_bonds_memory_bytes(const jd_bonds *b, size_t n_particles);
 
 /* Form the bonds of rules due at the step being computed (s->step + 1), then add every intact
  * bond's force and torques to s->f and s->torque.  Called by sim_compute_forces.  At step 0

@@ -47,6 +47,24 @@ int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
     return 0;
 }
 
+/* Give back what a list holds beyond its entries, an eighth more and the 256 a list starts
+ * with (sim_list_reserve grows from there): the geometric growth of a build can leave up to a
+ * third of its capacity unused, which the run would carry until the next build.  Every array
+ * then holds at least cap entries: shrunk, or as it was if a shrink failed. */
+static void list_fit(jd_contact_list *l) {
+    const size_t cap = l->n + l->n / 8 + 256;
+    if (cap >= l->cap) return;
+    int32_t *i = realloc(l->i, cap * sizeof *i);
+    if (i) l->i = i;
+    int32_t *j = realloc(l->j, cap * sizeof *j);
+    if (j) l->j = j;
+    double *h = realloc(l->hist, cap * (size_t)l->hw * sizeof *h);
+    if (h) l->hist = h;
+    double *r = l->rhist ? realloc(l->rhist, cap * (size_t)l->rw * sizeof *r) : NULL;
+    if (r) l->rhist = r;
+    l->cap = cap;
+}
+
 static int list_push(jd_contact_list *l, int32_t i, int32_t j, unsigned kind) {
     if ((l->n == l->cap || l->n == 0) && sim_list_reserve(l, l->n + 1, kind) != 0) return -1;
     l->i[l->n] = i;
@@ -298,6 +316,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
         snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", nw->n);
         return -1;
     }
+    list_fit(&s->pairs);
     sim_contact_list_free(nw); /* sized for pairs: the wall list would keep them */
 
     if (build_wall_list(s, nw) != 0) {
@@ -308,6 +327,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
     carry_over(s, &s->wall_pairs, nw);
     jd_contact_list t = s->wall_pairs;
     s->wall_pairs = *nw;
+    list_fit(&s->wall_pairs);
     *nw = t;
 
     /* the spare buffers are needed only during a build: give them back until the next one */

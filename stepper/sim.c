@@ -250,7 +250,7 @@ size_t sim_memory_bytes(const jd_sim *s) {
                                 4 * sizeof(int32_t) /* species orig cell_of cell_items */;
     size_t overflow = 0;
     for (int t = 0; s->shares && t < s->threads; t++) overflow += 6 * s->shares[t].cap * sizeof(double);
-    return s->n * per_particle + overflow +
+    return s->n * per_particle + overflow + sim_bonds_memory_bytes(s->bonds, s->n) +
            s->cell_cap * sizeof(int32_t) + list_bytes(&s->pairs) + list_bytes(&s->wall_pairs) +
            list_bytes(&s->spare) + s->n_walls * sizeof *s->walls +
            s->n_materials * s->n_materials * sizeof *s->coeffs;

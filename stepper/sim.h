@@ -271,7 +271,7 @@ struct jd_h5md;
 int sim_run(jd_sim *s, struct jd_h5md *h, int show_progress, char *err, size_t errlen);
 
 /* Bytes the engine holds for the run (particle arrays, contact lists at their capacity, cells,
- * thread buffers): its memory apart from the scene and the libraries. */
+ * thread buffers, bonds): its memory apart from the scene and the libraries. */
 size_t sim_memory_bytes(const jd_sim *s);
 
 /* neighbour.c */
