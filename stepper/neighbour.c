@@ -20,6 +20,20 @@
 #include "geometry.h"
 #include "sim.h"
 
+/* Every array of l resized to cap entries with history widths hw and rw (rhist only if rw > 0).
+ * Returns 0, or -1 when a realloc failed: that array is as it was, the others resized. */
+static int list_resize(jd_contact_list *l, size_t cap, int hw, int rw) {
+    int32_t *i = realloc(l->i, cap * sizeof *i);
+    if (i) l->i = i;
+    int32_t *j = realloc(l->j, cap * sizeof *j);
+    if (j) l->j = j;
+    double *h = realloc(l->hist, cap * (size_t)hw * sizeof *h);
+    if (h) l->hist = h;
+    double *r = rw ? realloc(l->rhist, cap * (size_t)rw * sizeof *r) : l->rhist;
+    if (r) l->rhist = r;
+    return !i || !j || !h || (rw && !r) ? -1 : 0;
+}
+
 /* Every list of a run is of the run's kind (history widths hw, rw); buffers swap roles between
  * the lists (sim_neighbour_build, sim_reorder), and every array a list has is kept at its
  * capacity. */
@@ -32,15 +46,7 @@ int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
     if (need <= l->cap && complete) return 0;
     size_t cap = l->cap ? l->cap : 256;
     while (cap < need) cap += cap / 2;
-    int32_t *i = realloc(l->i, cap * sizeof *i);
-    if (i) l->i = i;
-    int32_t *j = realloc(l->j, cap * sizeof *j);
-    if (j) l->j = j;
-    double *h = realloc(l->hist, cap * (size_t)hw * sizeof *h);
-    if (h) l->hist = h;
-    double *r = rolling ? realloc(l->rhist, cap * (size_t)rw * sizeof *r) : l->rhist;
-    if (r) l->rhist = r;
-    if (!i || !j || !h || (rolling && !r)) return -1;
+    if (list_resize(l, cap, hw, rw) != 0) return -1;
     l->cap = cap;
     l->hw = hw;
     l->rw = rw;
@@ -54,14 +60,7 @@ int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
 static void list_fit(jd_contact_list *l) {
     const size_t cap = l->n + l->n / 8 + 256;
     if (cap >= l->cap) return;
-    int32_t *i = realloc(l->i, cap * sizeof *i);
-    if (i) l->i = i;
-    int32_t *j = realloc(l->j, cap * sizeof *j);
-    if (j) l->j = j;
-    double *h = realloc(l->hist, cap * (size_t)l->hw * sizeof *h);
-    if (h) l->hist = h;
-    double *r = l->rhist ? realloc(l->rhist, cap * (size_t)l->rw * sizeof *r) : NULL;
-    if (r) l->rhist = r;
+    (void)list_resize(l, cap, l->hw, l->rw); /* a failed shrink leaves the larger array */
     l->cap = cap;
 }
 
