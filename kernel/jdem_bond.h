@@ -173,8 +173,8 @@ double jd_bond_omega2_bound(const jd_bond_params *p, const jd_bond_section *sec,
 /* Hot path.                                                                                   */
 /* ------------------------------------------------------------------------------------------ */
 
-/* Geometry of a bonded pair, touching or separated: fills n, delta, ra, rb of g (not sec, m_eff,
- * i_eff, which the engine sets once per bond).  Returns 0 when the centres coincide (no normal:
+/* Geometry of a bonded pair, touching or separated: fills n, delta, ra, rb of g (not sec, which
+ * the engine sets from jd_bond_section_of, nor m_eff, i_eff: jd_bond_set_masses).  Returns 0 when the centres coincide (no normal:
  * the engine reports it), else 1. */
 static inline int jd_bond_geom_spheres(const double xa[3], double Ra, const double xb[3],
                                        double Rb, jd_bond_geom *g) {
@@ -190,6 +190,14 @@ static inline int jd_bond_geom_spheres(const double xa[3], double Ra, const doub
         g->rb[k] = g->ra[k] - dx[k];
     }
     return 1;
+}
+
+/* The dashpots' effective mass and inertia of g from the particles' masses m [kg] and moments
+ * of inertia I [kg m^2] (read only with JD_B_DAMPING). */
+static inline void jd_bond_set_masses(jd_bond_geom *g, double m_a, double m_b, double I_a,
+                                      double I_b) {
+    g->m_eff = m_a * m_b / (m_a + m_b);
+    g->i_eff = I_a * I_b / (I_a + I_b);
 }
 
 /* A new intact bond: zero forces and moments, zero energy accumulators. */

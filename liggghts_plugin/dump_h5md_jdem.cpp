@@ -204,15 +204,15 @@ void DumpH5mdJdem::write() {
   MPI_Bcast(&failed, 1, MPI_INT, 0, world);
   if (!failed && bonds.write(lmp, h5, err, sizeof err) != 0) failed = 1;
   if (me == 0 && !failed && bonds.active()) {
-    const struct { const char *name; double value; } b[] = {
-        {"bonds", bonds.bonds()},
-        {"fragments", bonds.fragments()},
-        {"bond_elastic_energy", all_obs[JDO_BOND_ELASTIC]},
-        {"bond_damping_dissipation", all_obs[JDO_BOND_DAMPING]},
-        {"bond_breakage_energy", all_obs[JDO_BOND_BREAKAGE]},
+    const struct { const char *name; double value; bool on; } b[] = {
+        {"bonds", bonds.bonds(), true},
+        {"fragments", bonds.fragments(), true},
+        {"bond_elastic_energy", all_obs[JDO_BOND_ELASTIC], energy},
+        {"bond_damping_dissipation", all_obs[JDO_BOND_DAMPING], energy},
+        {"bond_breakage_energy", all_obs[JDO_BOND_BREAKAGE], energy},
     };
     for (size_t k = 0; !failed && k < sizeof b / sizeof b[0]; k++)
-      if (jd_h5md_write_observable(h5, b[k].name, (int64_t)step, time, b[k].value, err, sizeof err) != 0)
+      if (b[k].on && jd_h5md_write_observable(h5, b[k].name, (int64_t)step, time, b[k].value, err, sizeof err) != 0)
         failed = 1;
   }
   /* Like the standalone engine, also write the last step of the run when it is not a multiple of

@@ -398,11 +398,9 @@ void FixBondJiang::loop(bool commit) {
       }
       std::memcpy(&g.sec, section(i, k), sizeof g.sec);
       g.m_eff = g.i_eff = 0.0; /* read only by the dashpots */
-      if (F & JD_B_DAMPING) {
-        const double Ii = jd_sphere_inertia(rmass[i], radius[i]), Ij = jd_sphere_inertia(rmass[j], radius[j]);
-        g.m_eff = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
-        g.i_eff = Ii * Ij / (Ii + Ij);
-      }
+      if (F & JD_B_DAMPING)
+        jd_bond_set_masses(&g, rmass[i], rmass[j], jd_sphere_inertia(rmass[i], radius[i]),
+                           jd_sphere_inertia(rmass[j], radius[j]));
       jd_kinematics kin;
       for (int d = 0; d < 3; d++) {
         kin.va[d] = v[i][d];

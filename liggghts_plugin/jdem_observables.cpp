@@ -74,8 +74,10 @@ void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]) {
 }
 
 bool jdem_wants_energy(LAMMPS *lmp) {
-  for (int k = 0; k < lmp->output->ndump; k++)
-    if (dynamic_cast<DumpH5mdJdem *>(lmp->output->dump[k])) return true;
+  for (int k = 0; k < lmp->output->ndump; k++) {
+    DumpH5mdJdem *d = dynamic_cast<DumpH5mdJdem *>(lmp->output->dump[k]);
+    if (d && d->writes_energy()) return true;
+  }
   for (int k = 0; k < lmp->modify->nfix; k++) {
     FixJdemWatchdog *w = dynamic_cast<FixJdemWatchdog *>(lmp->modify->fix[k]);
     if (w && w->checks_energy()) return true;

@@ -20,7 +20,8 @@ enum { JDO_KINETIC = 0, JDO_ROTATIONAL, JDO_GRAVITATIONAL, JDO_ELASTIC, JDO_DAMP
  * terms stay 0 without pair_style gran/jiang, the bond terms without fix bond/jiang. */
 void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]);
 
-/* True when some consumer of the bond energies is defined (a dump h5md/jdem, which writes them,
+/* True when some consumer of the bond energies is defined (a dump h5md/jdem without `energy
+ * no`, which writes them,
  * or a fix jdem/watchdog that checks the energy balance): fix bond/jiang then books them. */
 bool jdem_wants_energy(LAMMPS *lmp);
 

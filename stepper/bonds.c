@@ -4,6 +4,7 @@
  * broken-bond events, /connectivity output, observables, the guard's bond bound.
  */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,6 +20,12 @@
 const char *const jd_bond_observable_names[JD_N_BOND_OBSERVABLES] = {
     "bonds", "fragments", "bond_elastic_energy", "bond_damping_dissipation",
     "bond_breakage_energy"};
+const int jd_bond_observable_is_energy[JD_N_BOND_OBSERVABLES] = {0, 0, 1, 1, 1};
+_Static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double) &&
+                   offsetof(jd_bond_state, flags) == (JD_BOND_CORE - 1) * sizeof(double) &&
+                   offsetof(jd_bond_state, e_break) == (JD_BOND_STATE_LEN - 1) * sizeof(double),
+               "state_get/state_set: the kernel's bond state is a plain array of doubles, the "
+               "law's fields first");
 
 void sim_bond_observables_values(const jd_bond_observables *o, double out[JD_N_BOND_OBSERVABLES]) {
     const double v[JD_N_BOND_OBSERVABLES] = {o->bonds, o->fragments, o->elastic_energy,
@@ -40,26 +47,73 @@ static int grow(void **p, size_t *cap, size_t need, size_t size) {
     return 0;
 }
 
+/* Give the bond arrays capacity c (>= b->n). */
+static int resize(jd_bonds *b, size_t c) {
+#define RE(p, per)                                             \
+    do {                                                       \
+        void *q = realloc((p), c * (per) * sizeof *(p));       \
+        if (!q) return -1;                                     \
+        (p) = q;                                               \
+    } while (0)
+    RE(b->i, 1);
+    RE(b->j, 1);
+    RE(b->type, 1);
+    RE(b->state, (size_t)b->sw);
+#undef RE
+    b->cap = c;
+    return 0;
+}
+
 static int reserve(jd_bonds *b, size_t need) {
     if (need <= b->cap) return 0;
     size_t c = b->cap ? b->cap : 64;
     while (c < need) c *= 2;
-#define RE(p)                                          \
-    do {                                               \
-        void *q = realloc((p), c * sizeof *(p));       \
-        if (!q) return -1;                             \
-        (p) = q;                                       \
-    } while (0)
-    RE(b->i);
-    RE(b->j);
-    RE(b->type);
-    RE(b->sec);
-    RE(b->m_eff);
-    RE(b->i_eff);
-    RE(b->state);
-#undef RE
-    b->cap = c;
-    return 0;
+    return resize(b, c);
+}
+
+/* Bonds form only at step 0 and when a rule applies, and afterwards only break: give back the
+ * room the doubling left once they have formed.  (A failure keeps the larger arrays.) */
+static void fit(jd_bonds *b) {
+    if (b->cap > b->n + 64) (void)resize(b, b->n + 64);
+}
+
+/* The state of bond k as the kernel's struct (the energy fields zero when not kept); sw is
+ * b->sw, a compile-time constant in the bond loop.  Field by field, not through a double *:
+ * GCC then keeps the struct in registers instead of copying it through the stack. */
+static JD_ALWAYS_INLINE jd_bond_state state_get(const jd_bonds *b, const int sw, size_t k) {
+    const double *a = b->state + (size_t)sw * k;
+    jd_bond_state st = {.fn = a[0], .ft = {a[1], a[2], a[3]}, .mn = a[4],
+                        .mt = {a[5], a[6], a[7]}, .flags = a[8]};
+    if (sw == JD_BOND_STATE_LEN) {
+        for (int d = 0; d < 3; d++) {
+            st.f_prev[d] = a[9 + d];
+            st.m_prev[d] = a[12 + d];
+        }
+        st.u_prev = a[15];
+        st.e_damp = a[16];
+        st.e_break = a[17];
+    }
+    return st;
+}
+
+static JD_ALWAYS_INLINE void state_set(jd_bonds *b, const int sw, size_t k, const jd_bond_state *st) {
+    double *a = b->state + (size_t)sw * k;
+    a[0] = st->fn;
+    a[4] = st->mn;
+    a[8] = st->flags;
+    for (int d = 0; d < 3; d++) {
+        a[1 + d] = st->ft[d];
+        a[5 + d] = st->mt[d];
+    }
+    if (sw == JD_BOND_STATE_LEN) {
+        for (int d = 0; d < 3; d++) {
+            a[9 + d] = st->f_prev[d];
+            a[12 + d] = st->m_prev[d];
+        }
+        a[15] = st->u_prev;
+        a[16] = st->e_damp;
+        a[17] = st->e_break;
+    }
 }
 
 /* Append an intact bond between particle indices i and j (a = the smaller id). */
@@ -77,10 +131,9 @@ static int add_bond(jd_sim *s, int32_t i, int32_t j, int32_t type, int64_t step)
     b->i[k] = i;
     b->j[k] = j;
     b->type[k] = type;
-    b->sec[k] = jd_bond_section_of(b->params[type].lambda, s->radius[i], s->radius[j]);
-    b->m_eff[k] = s->mass[i] * s->mass[j] / (s->mass[i] + s->mass[j]);
-    b->i_eff[k] = s->inertia[i] * s->inertia[j] / (s->inertia[i] + s->inertia[j]);
-    jd_bond_form(&b->state[k]);
+    jd_bond_state fresh;
+    jd_bond_form(&fresh);
+    state_set(b, b->sw, k, &fresh);
     b->ever[i] = b->ever[j] = 1;
     b->formed[b->n_formed++] =
         (jd_h5md_bond){{sim_particle_id(s, (size_t)i), sim_particle_id(s, (size_t)j)}, type, step};
@@ -109,17 +162,27 @@ int sim_bonds_init(jd_sim *s, char *err, size_t errlen) {
     b->n_types = sc->n_bond_types;
     jd_bond_params *p = malloc(b->n_types * sizeof *p);
     if (!p) goto oom;
-    b->features = JD_B_ENERGY;
+    b->features = sc->energy ? JD_B_ENERGY : 0u;
+    b->sw = sc->energy ? JD_BOND_STATE_LEN : JD_BOND_CORE;
     for (size_t t = 0; t < b->n_types; t++) {
         p[t] = sc->bond_types[t].p;
         if (p[t].gamma > 0.0) b->features |= JD_B_DAMPING;
     }
     b->params = p;
+    int one_radius = 1;
+    for (size_t i = 1; i < s->n; i++) one_radius &= s->radius[i] == s->radius[0];
+    if (one_radius && s->n) {
+        jd_bond_section *sec = malloc(b->n_types * sizeof *sec);
+        if (!sec) goto oom;
+        for (size_t t = 0; t < b->n_types; t++) sec[t] = jd_bond_section_of(p[t].lambda, s->radius[0], s->radius[0]);
+        b->sec_type = sec;
+    }
     for (size_t k = 0; k < sc->n_bonds; k++) {
         /* indices equal ids' positions: the scene's particles are sorted by id */
         const long i = index_of_id(sc, sc->bond_ids[2 * k]), j = index_of_id(sc, sc->bond_ids[2 * k + 1]);
         if (i < 0 || j < 0 || add_bond(s, (int32_t)i, (int32_t)j, sc->bond_type[k], 0)) goto oom;
     }
+    fit(b);
     return 0;
 oom:
     snprintf(err, errlen, "out of memory for %zu bonds", sc->n_bonds);
@@ -130,12 +193,10 @@ void sim_bonds_free(jd_sim *s) {
     jd_bonds *b = s->bonds;
     if (!b) return;
     free((void *)b->params);
+    free((void *)b->sec_type);
     free(b->i);
     free(b->j);
     free(b->type);
-    free(b->sec);
-    free(b->m_eff);
-    free(b->i_eff);
     free(b->state);
     free(b->ever);
     free(b->formed);
@@ -146,9 +207,9 @@ void sim_bonds_free(jd_sim *s) {
 
 size_t sim_bonds_memory_bytes(const jd_bonds *b, size_t n_particles) {
     if (!b) return 0;
-    const size_t per_bond = 3 * sizeof(int32_t) + sizeof(jd_bond_section) + 2 * sizeof(double) +
-                            sizeof(jd_bond_state);
-    return b->cap * per_bond + b->n_types * sizeof *b->params + n_particles /* ever */ +
+    const size_t per_bond = 3 * sizeof(int32_t) + (size_t)b->sw * sizeof(double);
+    return b->cap * per_bond + b->n_types * (sizeof *b->params + (b->sec_type ? sizeof *b->sec_type : 0)) +
+           n_particles /* ever */ +
            b->formed_cap * sizeof *b->formed + b->events_cap * sizeof *b->events;
 }
 
@@ -208,6 +269,7 @@ static void apply_rule(jd_sim *s, const jd_bond_rule *rule, int64_t step) {
     }
     free(pairs);
     free(have);
+    fit(b);
 }
 
 /* ---------------------------------------------------------------------------------------- */
@@ -238,6 +300,7 @@ static JD_ALWAYS_INLINE size_t bond_loop(jd_sim *s, const unsigned F, int64_t st
     jd_bonds *b = s->bonds;
     /* Step 0 (LIGGGHTS `setup`): no increment, the force is the stored one (bonds.h) */
     const double dt = s->in_setup ? 0.0 : s->dt;
+    const int sw = (F & JD_B_ENERGY) ? JD_BOND_STATE_LEN : JD_BOND_CORE; /* = b->sw */
     size_t broke = 0;
     for (size_t k = 0; k < b->n; k++) {
         const int32_t i = b->i[k], j = b->j[k];
@@ -245,9 +308,11 @@ static JD_ALWAYS_INLINE size_t bond_loop(jd_sim *s, const unsigned F, int64_t st
         if (!jd_bond_geom_spheres(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
                                   s->radius[j], &g))
             continue; /* coincident centres: no direction (the contact watchdog reports it) */
-        g.sec = b->sec[k];
-        g.m_eff = b->m_eff[k];
-        g.i_eff = b->i_eff[k];
+        const jd_bond_params *p = &b->params[b->type[k]];
+        g.sec = b->sec_type ? b->sec_type[b->type[k]]
+                            : jd_bond_section_of(p->lambda, s->radius[i], s->radius[j]);
+        if (F & JD_B_DAMPING)
+            jd_bond_set_masses(&g, s->mass[i], s->mass[j], s->inertia[i], s->inertia[j]);
         jd_kinematics kin;
         const double *va = s->v + 3 * (size_t)i, *wa = s->omega + 3 * (size_t)i;
         const double *vb = s->v + 3 * (size_t)j, *wb = s->omega + 3 * (size_t)j;
@@ -257,9 +322,11 @@ static JD_ALWAYS_INLINE size_t bond_loop(jd_sim *s, const unsigned F, int64_t st
             kin.vb[d] = vb[d];
             kin.wb[d] = wb[d];
         }
+        jd_bond_state st = state_get(b, sw, k);
         jd_bond_result out;
-        if (jd_bond(F, &b->params[b->type[k]], &g, &kin, dt, &b->state[k], &out) !=
-            JD_BOND_INTACT) {
+        const int mode = jd_bond(F, p, &g, &kin, dt, &st, &out);
+        state_set(b, sw, k, &st);
+        if (mode != JD_BOND_INTACT) {
             record_break(s, k, &g, &out, step);
             broke++;
             continue;
@@ -280,19 +347,17 @@ static JD_ALWAYS_INLINE size_t bond_loop(jd_sim *s, const unsigned F, int64_t st
 static void compact(jd_bonds *b) {
     size_t w = 0;
     for (size_t k = 0; k < b->n; k++) {
-        if (!jd_bond_intact(&b->state[k])) {
-            b->e_damp_dropped += b->state[k].e_damp;
-            b->e_break_dropped += b->state[k].e_break;
+        const jd_bond_state st = state_get(b, b->sw, k);
+        if (!jd_bond_intact(&st)) {
+            b->e_damp_dropped += st.e_damp;
+            b->e_break_dropped += st.e_break;
             continue;
         }
         if (w != k) {
             b->i[w] = b->i[k];
             b->j[w] = b->j[k];
             b->type[w] = b->type[k];
-            b->sec[w] = b->sec[k];
-            b->m_eff[w] = b->m_eff[k];
-            b->i_eff[w] = b->i_eff[k];
-            b->state[w] = b->state[k];
+            state_set(b, b->sw, w, &st);
         }
         w++;
     }
@@ -306,8 +371,13 @@ void sim_bonds_forces(jd_sim *s) {
     while (!s->in_setup && b->next_rule < sc->n_bond_rules &&
            sc->bond_rules[b->next_rule].step <= step)
         apply_rule(s, &sc->bond_rules[b->next_rule++], step);
-    const size_t broke = (b->features & JD_B_DAMPING) ? bond_loop(s, JD_B_ENERGY | JD_B_DAMPING, step)
-                                                      : bond_loop(s, JD_B_ENERGY, step);
+    size_t broke;
+    switch (b->features) {
+    case 0: broke = bond_loop(s, 0u, step); break;
+    case JD_B_DAMPING: broke = bond_loop(s, JD_B_DAMPING, step); break;
+    case JD_B_ENERGY: broke = bond_loop(s, JD_B_ENERGY, step); break;
+    default: broke = bond_loop(s, JD_B_ENERGY | JD_B_DAMPING, step); break;
+    }
     if (broke && !s->in_setup) compact(b);
 }
 
@@ -357,10 +427,11 @@ void sim_bonds_observables(const jd_sim *s, jd_bond_observables *o) {
     *o = (jd_bond_observables){.bonds = (double)b->n,
                                .damping_dissipation = b->e_damp_dropped,
                                .breakage_energy = b->e_break_dropped};
-    for (size_t k = 0; k < b->n; k++) {
-        o->elastic_energy += b->state[k].u_prev;
-        o->damping_dissipation += b->state[k].e_damp;
-        o->breakage_energy += b->state[k].e_break;
+    for (size_t k = 0; (b->features & JD_B_ENERGY) && k < b->n; k++) {
+        const jd_bond_state st = state_get(b, b->sw, k);
+        o->elastic_energy += st.u_prev;
+        o->damping_dissipation += st.e_damp;
+        o->breakage_energy += st.e_break;
     }
     /* fragments: union-find over the intact bonds; components among the particles ever bonded */
     int32_t *parent = malloc((s->n ? s->n : 1) * sizeof *parent);

@@ -22,16 +22,26 @@
 struct jd_sim;
 struct jd_scene;
 
+/* Bond state doubles without the energy bookkeeping: jd_bond_state's fn, ft[3], mn, mt[3] and
+ * flags (its leading fields).  The cross-section and the dashpots' effective masses are not
+ * stored: the bond loop computes them from the particles' radii and masses each step (as the
+ * LIGGGHTS plugin does for the masses), which keeps a bond at 84 bytes, 156 with the
+ * bookkeeping.  (When all particles share one radius the sections are taken per type:
+ * jd_bond_section_of's three divisions cost a fifth of a bond's evaluation.) */
+enum { JD_BOND_CORE = 9 };
+
 typedef struct jd_bonds {
     unsigned features;         /* JD_B_* of the bond loop, fixed for the run */
     size_t n_types;
     const jd_bond_params *params; /* per type (n_types), copied from the scene */
+    const jd_bond_section *sec_type; /* per type when all particles share one radius (every bond of
+                                        a type then has the same section), else NULL */
     size_t n, cap;             /* intact bonds */
     int32_t *i, *j;            /* particle indices of a and b */
     int32_t *type;             /* index into params */
-    jd_bond_section *sec;      /* cross-section of eq. (15) */
-    double *m_eff, *i_eff;     /* for the dashpots [kg], [kg m^2] */
-    jd_bond_state *state;
+    int sw;                    /* doubles of state per bond: JD_BOND_CORE, or JD_BOND_STATE_LEN
+                                  with the energy bookkeeping (JD_B_ENERGY) */
+    double *state;             /* cap x sw: the leading sw doubles of each bond's jd_bond_state */
     size_t next_rule;          /* first scene rule not yet applied */
     unsigned char *ever;       /* per particle: 1 once it has been bonded (fragment count) */
     /* output not yet written */
@@ -50,10 +60,13 @@ typedef struct jd_bonds {
 typedef struct jd_bond_observables {
     double bonds, fragments;   /* intact bonds; components of the intact-bond graph over the
                                   particles ever bonded */
-    double elastic_energy, damping_dissipation, breakage_energy; /* [J] */
+    double elastic_energy, damping_dissipation, breakage_energy; /* [J]; 0 without the energy
+                                                                    bookkeeping */
 } jd_bond_observables;
 #define JD_N_BOND_OBSERVABLES 5
 extern const char *const jd_bond_observable_names[JD_N_BOND_OBSERVABLES];
+/* 1 for the observables that need the energy bookkeeping (not written with output.energy off) */
+extern const int jd_bond_observable_is_energy[JD_N_BOND_OBSERVABLES];
 void sim_bond_observables_values(const jd_bond_observables *o, double out[JD_N_BOND_OBSERVABLES]);
 
 /* Set up s->bonds from the scene (NULL when the scene has no bond types).  0 or -1 with err. */

@@ -295,7 +295,8 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
         double bv[JD_N_BOND_OBSERVABLES];
         sim_bond_observables_values(&o.bond, bv);
         for (int k = 0; h && k < JD_N_BOND_OBSERVABLES; k++)
-            if (jd_h5md_write_observable(h, jd_bond_observable_names[k], s->step,
+            if ((s->scene->energy || !jd_bond_observable_is_energy[k]) &&
+                jd_h5md_write_observable(h, jd_bond_observable_names[k], s->step,
                                          (double)s->step * s->dt, bv[k], err, errlen) != 0)
                 return JD_RUN_ERROR;
     }

@@ -27,7 +27,10 @@ a cylinder, damping, friction, rolling resistance, ~50 neighbour rebuilds).
 * bonds through the renumbering: the bonded 4x4x4 block of scripts/bond_checks.py dropped onto a
   tilted plate (bonds break progressively), sorted against --no-sort: the bonds are remapped at
   every renumbering, so the same bonds break at the same steps and the trajectories agree to
-  round-off.
+  round-off;
+* the same block without the energy bookkeeping (9 bond state doubles instead of 18), and with
+  the bonds' cross-sections computed per bond and step instead of taken per bond type (a lone
+  sphere of another radius far away): identical bit for bit.
 
 Run:  /usr/bin/python3 tests/engine/test_fastpaths.py        (JDEM=path/to/jdem to override)
 """
@@ -228,4 +231,30 @@ c.check("bonds_sorting_changes_summation_order", not identical(bt_ref, bt_srt),
 roundoff_equal(c, "bonds_sorted_vs_unsorted", bt_srt, bt_ref)
 ba, bb = breaks(bt_ref["path"]), breaks(bt_srt["path"])
 c.check("bonds_sorted_same_breaks", len(ba) > 0 and ba == bb, f"{len(ba)} and {len(bb)} breaks, equal: {ba == bb}")
+
+# Bonds without the energy bookkeeping keep 9 state doubles instead of 18 and run a loop without
+# the accounts, which never feed back into the forces: the same trajectory and breaks, bit for
+# bit, and no bond energy observables.
+bt_ne, _, _ = run_file(variant(yaml.safe_dump(dict(resolved, output=dict(resolved["output"], energy=False)),
+                                              sort_keys=False), "block_drop_no_energy"))
+c.check("bonds_energy_off_same_trajectory", identical(bt_ne, bt_srt), "the bond energy bookkeeping changed the trajectory")
+c.check("bonds_energy_off_same_breaks", breaks(bt_ne["path"]) == bb, "the bond energy bookkeeping changed the breaks")
+c.check("bonds_energy_off_observables",
+        "bonds" in bt_ne["obs"] and not any(k.startswith("bond_") for k in bt_ne["obs"]) and
+        "bond_elastic_energy" in bt_srt["obs"], f"observables {sorted(bt_ne['obs'])}")
+
+# With all particles of one radius the bond loop takes each bond's cross-section from a table per
+# bond type; a free sphere of another radius, far from the block, makes it compute the sections
+# per bond and step instead.  Unsorted runs keep every sum in the same order: the block's
+# trajectory must be the same bit for bit.
+extra_id = max(rename.values()) + 1
+lone = dict(resolved, particles=resolved["particles"] + [
+    {"id": extra_id, "material": resolved["particles"][0]["material"], "radius": 0.5e-3,
+     "position": [0.0, 0.0, 0.05], "velocity": [0.0, 0.0, 0.0]}])
+bt_lone, _, _ = run_file(variant(yaml.safe_dump(lone, sort_keys=False), "block_drop_lone_sphere"), "--no-sort")
+keep = bt_lone["id"] != extra_id
+c.check("bonds_sections_per_step_vs_per_type",
+        len(bt_lone["id"]) == len(bt_ref["id"]) + 1 and np.array_equal(bt_lone["id"][keep], bt_ref["id"]) and
+        all(np.array_equal(bt_lone[k][:, keep], bt_ref[k]) for k in VECTORS) and breaks(bt_lone["path"]) == ba,
+        "the sections computed per bond and step differ from the per-type ones")
 c.exit()
