@@ -53,12 +53,14 @@ int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
     return 0;
 }
 
-/* Give back what a list holds beyond its entries, an eighth more and the 256 a list starts
+/* Give back what a list holds beyond its entries, a sixteenth more and the 256 a list starts
  * with (sim_list_reserve grows from there): the geometric growth of a build can leave up to a
- * third of its capacity unused, which the run would carry until the next build.  Every array
- * then holds at least cap entries: shrunk, or as it was if a shrink failed. */
+ * third of its capacity unused, which the run would carry until the next build.  The sixteenth
+ * lets the next build's split (which takes this list's buffers) grow by that much without a
+ * reallocation.  Every array then holds at least cap entries: shrunk, or as it was if a shrink
+ * failed. */
 static void list_fit(jd_contact_list *l) {
-    const size_t cap = l->n + l->n / 8 + 256;
+    const size_t cap = l->n + l->n / 16 + 256;
     if (cap >= l->cap) return;
     (void)list_resize(l, cap, l->hw, l->rw); /* a failed shrink leaves the larger array */
     l->cap = cap;
