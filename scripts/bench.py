@@ -740,10 +740,15 @@ def feature_check(out, size, steps, repeats):
         f.write(plain)
     n = int(np.load(make_bed(out, size, "mono"))["id"].shape[0])
     res = {}
-    for tag, extra in (("specialised", []), ("general", ["--all-laws"])):
-        runs = [run_jdem(out, size, "soft_mono_plain", scene, steps, n, extra=extra, tag="_" + tag,
-                         keep_trajectory=True)
-                for _ in range(repeats)]
+    loops = (("specialised", []), ("general", ["--all-laws"]))
+    # alternately, so that a change in the machine's load falls on both loops alike
+    timed = {tag: [] for tag, _ in loops}
+    for _ in range(repeats):
+        for tag, extra in loops:
+            timed[tag].append(run_jdem(out, size, "soft_mono_plain", scene, steps, n, extra=extra,
+                                       tag="_" + tag, keep_trajectory=True))
+    for tag, _ in loops:
+        runs = timed[tag]
         res[tag] = dict(wall_s=[r["wall_s"] for r in runs], cpu_s=[r["cpu_s"] for r in runs],
                         wall_s_median=statistics.median(r["wall_s"] for r in runs),
                         cpu_s_median=statistics.median(r["cpu_s"] for r in runs),
