@@ -72,9 +72,13 @@ static int reserve(jd_bonds *b, size_t need) {
 }
 
 /* Bonds form only at step 0 and when a rule applies, and afterwards only break: give back the
- * room the doubling left once they have formed.  (A failure keeps the larger arrays.) */
+ * room the doubling left once they have formed.  Every array then holds at least cap bonds:
+ * shrunk, or as it was if its shrink failed. */
 static void fit(jd_bonds *b) {
-    if (b->cap > b->n + 64) (void)resize(b, b->n + 64);
+    const size_t c = b->n + 64;
+    if (b->cap <= c) return;
+    (void)resize(b, c);
+    b->cap = c;
 }
 
 /* The state of bond k as the kernel's struct (the energy fields zero when not kept); sw is
