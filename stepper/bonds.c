@@ -11,6 +11,10 @@
 #include "bonds.h"
 #include "sim.h"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #if defined(__GNUC__)
 #define JD_ALWAYS_INLINE inline __attribute__((always_inline))
 #else
@@ -120,6 +124,16 @@ static JD_ALWAYS_INLINE void state_set(jd_bonds *b, const int sw, size_t k, cons
     }
 }
 
+/* Room for b->n results of the threaded bond loop (allocated only when it runs). */
+static int out_reserve(jd_bonds *b) {
+    if (b->out_cap >= b->n) return 0;
+    jd_bond_out *o = realloc(b->out, b->cap * sizeof *o);
+    if (!o) return -1;
+    b->out = o;
+    b->out_cap = b->cap;
+    return 0;
+}
+
 /* Append an intact bond between particle indices i and j (a = the smaller id). */
 static int add_bond(jd_sim *s, int32_t i, int32_t j, int32_t type, int64_t step) {
     jd_bonds *b = s->bonds;
@@ -202,6 +216,7 @@ void sim_bonds_free(jd_sim *s) {
     free(b->j);
     free(b->type);
     free(b->state);
+    free(b->out);
     free(b->ever);
     free(b->formed);
     free(b->events);
@@ -213,7 +228,7 @@ size_t sim_bonds_memory_bytes(const jd_bonds *b, size_t n_particles) {
     if (!b) return 0;
     const size_t per_bond = 3 * sizeof(int32_t) + (size_t)b->sw * sizeof(double);
     return b->cap * per_bond + b->n_types * (sizeof *b->params + (b->sec_type ? sizeof *b->sec_type : 0)) +
-           n_particles /* ever */ +
+           b->out_cap * sizeof *b->out + n_particles /* ever */ +
            b->formed_cap * sizeof *b->formed + b->events_cap * sizeof *b->events;
 }
 
@@ -279,7 +294,8 @@ static void apply_rule(jd_sim *s, const jd_bond_rule *rule, int64_t step) {
 /* ---------------------------------------------------------------------------------------- */
 /* The bond loop                                                                             */
 
-static void record_break(jd_sim *s, size_t k, const jd_bond_geom *g, const jd_bond_result *out,
+/* A broken bond's event; xc: the bond point x_C at failure [m]. */
+static void record_break(jd_sim *s, size_t k, const jd_bond_result *out, const double xc[3],
                          int64_t step) {
     jd_bonds *b = s->bonds;
     b->n_broken[out->mode]++;
@@ -296,53 +312,132 @@ static void record_break(jd_sim *s, size_t k, const jd_bond_geom *g, const jd_bo
                               .normal_force = out->fn, .shear_force = out->ft,
                               .twisting_moment = out->mn, .bending_moment = out->mt,
                               .sigma_max = out->sigma_max, .tau_max = out->tau_max};
-    for (int d = 0; d < 3; d++) e->position[d] = s->x[3 * (size_t)i + d] + g->ra[d];
+    for (int d = 0; d < 3; d++) e->position[d] = xc[d];
 }
 
-/* Returns the number of bonds that broke. */
+/* Evaluate bond k (state updated in place).  Returns the kernel's mode, or -1 when the centres
+ * coincide (no direction: skipped; the contact watchdog reports it).  xc: the bond point. */
+static JD_ALWAYS_INLINE int bond_eval(jd_sim *s, const unsigned F, const double dt, size_t k,
+                                      jd_bond_result *out, double xc[3]) {
+    jd_bonds *b = s->bonds;
+    const int sw = (F & JD_B_ENERGY) ? JD_BOND_STATE_LEN : JD_BOND_CORE; /* = b->sw */
+    const int32_t i = b->i[k], j = b->j[k];
+    jd_bond_geom g;
+    if (!jd_bond_geom_spheres(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
+                              s->radius[j], &g))
+        return -1;
+    const jd_bond_params *p = &b->params[b->type[k]];
+    g.sec = b->sec_type ? b->sec_type[b->type[k]]
+                        : jd_bond_section_of(p->lambda, s->radius[i], s->radius[j]);
+    if (F & JD_B_DAMPING)
+        jd_bond_set_masses(&g, s->mass[i], s->mass[j], s->inertia[i], s->inertia[j]);
+    jd_kinematics kin;
+    const double *va = s->v + 3 * (size_t)i, *wa = s->omega + 3 * (size_t)i;
+    const double *vb = s->v + 3 * (size_t)j, *wb = s->omega + 3 * (size_t)j;
+    for (int d = 0; d < 3; d++) {
+        kin.va[d] = va[d];
+        kin.wa[d] = wa[d];
+        kin.vb[d] = vb[d];
+        kin.wb[d] = wb[d];
+        xc[d] = s->x[3 * (size_t)i + d] + g.ra[d];
+    }
+    jd_bond_state st = state_get(b, sw, k);
+    const int mode = jd_bond(F, p, &g, &kin, dt, &st, out);
+    state_set(b, sw, k, &st);
+    return mode;
+}
+
+/* Add an intact bond's force and torques to its particles. */
+static inline void bond_add(double *f, double *t, int32_t i, int32_t j, const double fb[3],
+                            const double ta[3], const double tb[3]) {
+    double *fa_ = f + 3 * (size_t)i, *fb_ = f + 3 * (size_t)j;
+    double *ta_ = t + 3 * (size_t)i, *tb_ = t + 3 * (size_t)j;
+    for (int d = 0; d < 3; d++) {
+        fa_[d] -= fb[d];
+        fb_[d] += fb[d];
+        ta_[d] += ta[d];
+        tb_[d] += tb[d];
+    }
+}
+
+/* One thread: evaluate and add as it goes.  Returns the number of bonds that broke. */
 static JD_ALWAYS_INLINE size_t bond_loop(jd_sim *s, const unsigned F, int64_t step) {
     jd_bonds *b = s->bonds;
     /* Step 0 (LIGGGHTS `setup`): no increment, the force is the stored one (bonds.h) */
     const double dt = s->in_setup ? 0.0 : s->dt;
-    const int sw = (F & JD_B_ENERGY) ? JD_BOND_STATE_LEN : JD_BOND_CORE; /* = b->sw */
     size_t broke = 0;
     for (size_t k = 0; k < b->n; k++) {
-        const int32_t i = b->i[k], j = b->j[k];
-        jd_bond_geom g;
-        if (!jd_bond_geom_spheres(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
-                                  s->radius[j], &g))
-            continue; /* coincident centres: no direction (the contact watchdog reports it) */
-        const jd_bond_params *p = &b->params[b->type[k]];
-        g.sec = b->sec_type ? b->sec_type[b->type[k]]
-                            : jd_bond_section_of(p->lambda, s->radius[i], s->radius[j]);
-        if (F & JD_B_DAMPING)
-            jd_bond_set_masses(&g, s->mass[i], s->mass[j], s->inertia[i], s->inertia[j]);
-        jd_kinematics kin;
-        const double *va = s->v + 3 * (size_t)i, *wa = s->omega + 3 * (size_t)i;
-        const double *vb = s->v + 3 * (size_t)j, *wb = s->omega + 3 * (size_t)j;
-        for (int d = 0; d < 3; d++) {
-            kin.va[d] = va[d];
-            kin.wa[d] = wa[d];
-            kin.vb[d] = vb[d];
-            kin.wb[d] = wb[d];
-        }
-        jd_bond_state st = state_get(b, sw, k);
         jd_bond_result out;
-        const int mode = jd_bond(F, p, &g, &kin, dt, &st, &out);
-        state_set(b, sw, k, &st);
+        double xc[3];
+        const int mode = bond_eval(s, F, dt, k, &out, xc);
+        if (mode < 0) continue;
         if (mode != JD_BOND_INTACT) {
-            record_break(s, k, &g, &out, step);
+            record_break(s, k, &out, xc, step);
             broke++;
             continue;
         }
-        double *fa = s->f + 3 * (size_t)i, *fb = s->f + 3 * (size_t)j;
-        double *ta = s->torque + 3 * (size_t)i, *tb = s->torque + 3 * (size_t)j;
-        for (int d = 0; d < 3; d++) {
-            fa[d] -= out.f[d];
-            fb[d] += out.f[d];
-            ta[d] += out.ta[d];
-            tb[d] += out.tb[d];
+        bond_add(s->f, s->torque, b->i[k], b->j[k], out.f, out.ta, out.tb);
+    }
+    return broke;
+}
+
+/* Several threads (called by each thread of a parallel region, sim_bonds_forces): the bonds
+ * are evaluated in parallel into b->out; after the loop's barrier each thread adds the intact
+ * bonds' forces to the particles it owns (jd_thread_share), scanning the bonds in order, so that
+ * every particle's sum has the one-thread order: the same bits for any thread count.  The
+ * breaks are recorded afterwards, in bond order (bond_breaks). */
+static JD_ALWAYS_INLINE void bond_loop_threads(jd_sim *s, const unsigned F, int tid) {
+    jd_bonds *b = s->bonds;
+    const double dt = s->in_setup ? 0.0 : s->dt;
+    jd_bond_out *o = b->out;
+    const long n = (long)b->n;
+#pragma omp for schedule(static)
+    for (long k = 0; k < n; k++) {
+        jd_bond_result r;
+        double xc[3];
+        o[k].mode = bond_eval(s, F, dt, (size_t)k, &r, xc);
+        if (o[k].mode == JD_BOND_INTACT) {
+            for (int d = 0; d < 3; d++) {
+                o[k].force.f[d] = r.f[d];
+                o[k].force.ta[d] = r.ta[d];
+                o[k].force.tb[d] = r.tb[d];
+            }
+        } else if (o[k].mode > 0) {
+            o[k].broke.r = (jd_bond_failure){r.fn, r.ft, r.mn, r.mt, r.sigma_max, r.tau_max};
+            for (int d = 0; d < 3; d++) o[k].broke.xc[d] = xc[d];
         }
+    }
+    const size_t lo = s->shares[tid].p_lo, hi = s->shares[tid].p_hi;
+    for (long k = 0; k < n; k++) {
+        if (o[k].mode != JD_BOND_INTACT) continue;
+        const size_t i = (size_t)b->i[k], j = (size_t)b->j[k];
+        const double *fb = o[k].force.f;
+        if (i >= lo && i < hi)
+            for (int d = 0; d < 3; d++) {
+                s->f[3 * i + d] -= fb[d];
+                s->torque[3 * i + d] += o[k].force.ta[d];
+            }
+        if (j >= lo && j < hi)
+            for (int d = 0; d < 3; d++) {
+                s->f[3 * j + d] += fb[d];
+                s->torque[3 * j + d] += o[k].force.tb[d];
+            }
+    }
+}
+
+/* The breaks the threaded loop found, in bond order; returns their number. */
+static size_t bond_breaks(jd_sim *s, int64_t step) {
+    jd_bonds *b = s->bonds;
+    size_t broke = 0;
+    for (size_t k = 0; k < b->n; k++) {
+        const jd_bond_out *o = &b->out[k];
+        if (o->mode <= 0) continue; /* intact (JD_BOND_INTACT is 0), or skipped */
+        const jd_bond_failure *q = &o->broke.r;
+        const jd_bond_result r = {.fn = q->fn, .ft = q->ft, .mn = q->mn, .mt = q->mt,
+                                  .sigma_max = q->sigma_max, .tau_max = q->tau_max,
+                                  .mode = o->mode};
+        record_break(s, k, &r, o->broke.xc, step);
+        broke++;
     }
     return broke;
 }
@@ -376,11 +471,35 @@ void sim_bonds_forces(jd_sim *s) {
            sc->bond_rules[b->next_rule].step <= step)
         apply_rule(s, &sc->bond_rules[b->next_rule++], step);
     size_t broke;
-    switch (b->features) {
-    case 0: broke = bond_loop(s, 0u, step); break;
-    case JD_B_DAMPING: broke = bond_loop(s, JD_B_DAMPING, step); break;
-    case JD_B_ENERGY: broke = bond_loop(s, JD_B_ENERGY, step); break;
-    default: broke = bond_loop(s, JD_B_ENERGY | JD_B_DAMPING, step); break;
+    if (s->threads > 1 && b->n > 0) {
+        if (out_reserve(b) != 0) {
+            b->failed = "out of memory for the threaded bond loop";
+            return;
+        }
+        /* the region around the switch, so that each copy of the loop has its features as a
+         * literal (a region inside a copy would pass them to its threads as a value) */
+#pragma omp parallel num_threads(s->threads)
+        {
+#ifdef _OPENMP
+            const int tid = omp_get_thread_num();
+#else
+            const int tid = 0;
+#endif
+            switch (b->features) {
+            case 0: bond_loop_threads(s, 0u, tid); break;
+            case JD_B_DAMPING: bond_loop_threads(s, JD_B_DAMPING, tid); break;
+            case JD_B_ENERGY: bond_loop_threads(s, JD_B_ENERGY, tid); break;
+            default: bond_loop_threads(s, JD_B_ENERGY | JD_B_DAMPING, tid); break;
+            }
+        }
+        broke = bond_breaks(s, step);
+    } else {
+        switch (b->features) {
+        case 0: broke = bond_loop(s, 0u, step); break;
+        case JD_B_DAMPING: broke = bond_loop(s, JD_B_DAMPING, step); break;
+        case JD_B_ENERGY: broke = bond_loop(s, JD_B_ENERGY, step); break;
+        default: broke = bond_loop(s, JD_B_ENERGY | JD_B_DAMPING, step); break;
+        }
     }
     if (broke && !s->in_setup) compact(b);
 }

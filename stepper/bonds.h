@@ -30,6 +30,27 @@ struct jd_scene;
  * jd_bond_section_of's three divisions cost a fifth of a bond's evaluation.) */
 enum { JD_BOND_CORE = 9 };
 
+/* A failed bond's figures, what its event records (jd_bond_result's). */
+typedef struct jd_bond_failure {
+    double fn, ft, mn, mt, sigma_max, tau_max;
+} jd_bond_failure;
+
+/* One bond's result in the threaded bond loop, kept from its evaluation to the forces' sums
+ * and the events (bonds.c bond_loop_threads). */
+typedef struct jd_bond_out {
+    int mode; /* jd_bond_mode (JD_BOND_INTACT or a failure), or -1: not evaluated (coincident
+                 centres) */
+    union {
+        struct {
+            double f[3], ta[3], tb[3]; /* force on b, torques on a and b [N], [N m] */
+        } force;                       /* intact */
+        struct {
+            jd_bond_failure r;
+            double xc[3]; /* the bond point [m] */
+        } broke;          /* failed */
+    };
+} jd_bond_out;
+
 typedef struct jd_bonds {
     unsigned features;         /* JD_B_* of the bond loop, fixed for the run */
     size_t n_types;
@@ -42,6 +63,9 @@ typedef struct jd_bonds {
     int sw;                    /* doubles of state per bond: JD_BOND_CORE, or JD_BOND_STATE_LEN
                                   with the energy bookkeeping (JD_B_ENERGY) */
     double *state;             /* cap x sw: the leading sw doubles of each bond's jd_bond_state */
+    jd_bond_out *out;          /* out_cap results of the threaded bond loop; NULL with one
+                                  thread */
+    size_t out_cap;
     size_t next_rule;          /* first scene rule not yet applied */
     unsigned char *ever;       /* per particle: 1 once it has been bonded (fragment count) */
     /* output not yet written */

@@ -30,10 +30,13 @@ a cylinder, damping, friction, rolling resistance, ~50 neighbour rebuilds).
   round-off;
 * the same block without the energy bookkeeping (9 bond state doubles instead of 18), and with
   the bonds' cross-sections computed per bond and step instead of taken per bond type (a lone
-  sphere of another radius far away): identical bit for bit.
+  sphere of another radius far away): identical bit for bit;
+* the bond loop on 2 threads: a bonded lattice without contacts identical bit for bit to 1 thread,
+  the block to round-off with the same breaks, and reproducible.
 
 Run:  /usr/bin/python3 tests/engine/test_fastpaths.py        (JDEM=path/to/jdem to override)
 """
+import math
 import os
 import re
 import tempfile
@@ -257,4 +260,33 @@ c.check("bonds_sections_per_step_vs_per_type",
         len(bt_lone["id"]) == len(bt_ref["id"]) + 1 and np.array_equal(bt_lone["id"][keep], bt_ref["id"]) and
         all(np.array_equal(bt_lone[k][:, keep], bt_ref[k]) for k in VECTORS) and breaks(bt_lone["path"]) == ba,
         "the sections computed per bond and step differ from the per-type ones")
+# The bond loop with 2 threads evaluates the bonds in parallel and then lets each thread add the
+# forces of its own particles in bond order: the serial order.  A lattice of bonded spheres with
+# gaps (no contact force; up to 6 bonds per sphere, so the order of a sum shows in its bits),
+# damped bonds, set vibrating by random velocities, is then the same bit for bit on 1 and 2
+# threads; the dropped block, with contacts, agrees to round-off, breaks the same bonds at the
+# same steps, and is reproducible on 2 threads.
+L, shape = bond_checks.L, (4, 4, 3)
+rng = np.random.default_rng(5)
+cells = [(a, b, z) for z in range(shape[2]) for b in range(shape[1]) for a in range(shape[0])]
+pid = {c: k + 1 for k, c in enumerate(cells)}
+lattice = variant(yaml.safe_dump(bond_checks.scene(
+    "lattice", 5.0e-8, 2000,
+    [bond_checks.sphere(pid[c], tuple(L * q for q in c), v=tuple(rng.uniform(-0.01, 0.01, 3).tolist()))
+     for c in cells],
+    bonds=[(pid[c], pid[d]) for c in cells for d in ((c[0] + 1, c[1], c[2]), (c[0], c[1] + 1, c[2]),
+                                                    (c[0], c[1], c[2] + 1)) if d in pid],
+    every=100, bond=bond_checks.bond_type(math.inf, math.inf, damping=0.2)), sort_keys=False), "lattice")
+lat1, _, _ = run_file(lattice)
+lat2, _, nt_lat = run_file(lattice, "--threads", "2")
+c.check("bonds_threads2_used", nt_lat == 2, f"{nt_lat} threads")
+c.check("bonds_threads2_lattice_no_contacts", not lat1["obs"]["contacts"].any(), "the lattice's spheres touched")
+c.check("bonds_threads2_lattice_identical", identical(lat1, lat2),
+        "the bonded lattice differs between 1 and 2 threads: position "
+        f"{rel_diff(lat1, lat2, 'position'):.3g}")
+bt_2, _, _ = run_file(block, "--threads", "2")
+bt_2b, _, _ = run_file(block, "--threads", "2")
+roundoff_equal(c, "bonds_threads2_vs_threads1", bt_2, bt_srt)
+c.check("bonds_threads2_same_breaks", breaks(bt_2["path"]) == bb, "2 threads broke other bonds or at other steps")
+c.check("bonds_threads2_reproducible", identical(bt_2, bt_2b), "two 2-thread block runs differ")
 c.exit()
