@@ -11,6 +11,8 @@
 #include "bonds.h"
 #include "sim.h"
 
+/* The pragmas are guarded: the scene checker and the fuzzer link this file (for the guard's
+ * bond bound) without OpenMP. */
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -391,7 +393,9 @@ static JD_ALWAYS_INLINE void bond_loop_threads(jd_sim *s, const unsigned F, int 
     const double dt = s->in_setup ? 0.0 : s->dt;
     jd_bond_out *o = b->out;
     const long n = (long)b->n;
+#ifdef _OPENMP
 #pragma omp for schedule(static)
+#endif
     for (long k = 0; k < n; k++) {
         jd_bond_result r;
         double xc[3];
@@ -478,7 +482,9 @@ void sim_bonds_forces(jd_sim *s) {
         }
         /* the region around the switch, so that each copy of the loop has its features as a
          * literal (a region inside a copy would pass them to its threads as a value) */
+#ifdef _OPENMP
 #pragma omp parallel num_threads(s->threads)
+#endif
         {
 #ifdef _OPENMP
             const int tid = omp_get_thread_num();
