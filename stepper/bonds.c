@@ -318,7 +318,8 @@ static void record_break(jd_sim *s, size_t k, const jd_bond_result *out, const d
 }
 
 /* Evaluate bond k (state updated in place).  Returns the kernel's mode, or -1 when the centres
- * coincide (no direction: skipped; the contact watchdog reports it).  xc: the bond point. */
+ * coincide (no direction: skipped; the contact watchdog reports it).  xc: the bond point, set
+ * only when the bond failed. */
 static JD_ALWAYS_INLINE int bond_eval(jd_sim *s, const unsigned F, const double dt, size_t k,
                                       jd_bond_result *out, double xc[3]) {
     jd_bonds *b = s->bonds;
@@ -341,11 +342,12 @@ static JD_ALWAYS_INLINE int bond_eval(jd_sim *s, const unsigned F, const double 
         kin.wa[d] = wa[d];
         kin.vb[d] = vb[d];
         kin.wb[d] = wb[d];
-        xc[d] = s->x[3 * (size_t)i + d] + g.ra[d];
     }
     jd_bond_state st = state_get(b, sw, k);
     const int mode = jd_bond(F, p, &g, &kin, dt, &st, out);
     state_set(b, sw, k, &st);
+    if (mode != JD_BOND_INTACT)
+        for (int d = 0; d < 3; d++) xc[d] = s->x[3 * (size_t)i + d] + g.ra[d];
     return mode;
 }
 
