@@ -9,8 +9,10 @@ Usage: tests/run_tests.py [SUITE ...]     (default: all, in order)
 """
 import os
 import re
+import shutil
 import subprocess
 import sys
+import tempfile
 import time
 
 PY = "/usr/bin/python3"
@@ -97,9 +99,13 @@ def count(style, text):
 
 
 def run_suite(name, cmd, style, env):
+    # Each suite writes its scratch files (tempfile in Python, mpirun's session files) into a
+    # directory of its own (TMPDIR), removed when the suite passes and kept for a look when it
+    # fails.
+    tmp = tempfile.mkdtemp(prefix=f"jdem_test_{name}_")
     start = time.monotonic()
     proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                          env={**os.environ, **env})
+                          env={**os.environ, **env, "TMPDIR": tmp})
     elapsed = time.monotonic() - start
     passed, failed = count(style, proc.stdout)
     if proc.returncode != 0 and not failed:
@@ -108,6 +114,10 @@ def run_suite(name, cmd, style, env):
     print(f"== {name}: {passed} passed, {len(failed)} failed ({elapsed:.1f} s)", flush=True)
     for line in failed:
         print("   " + line, flush=True)
+    if failed:
+        print(f"   (its scratch files are kept in {tmp})", flush=True)
+    else:
+        shutil.rmtree(tmp, ignore_errors=True)
     return passed, len(failed)
 
 
