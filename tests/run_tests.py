@@ -102,7 +102,7 @@ def run_suite(name, cmd, style, env):
     # Each suite writes its scratch files (tempfile in Python, mpirun's session files) into a
     # directory of its own (TMPDIR), removed when the suite passes and kept for a look when it
     # fails.
-    tmp = tempfile.mkdtemp(prefix=f"jdem_test_{name}_")
+    tmp = tempfile.mkdtemp(prefix="jdem_suite_")  # (no suite name: tests match words in paths)
     start = time.monotonic()
     proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                           env={**os.environ, **env, "TMPDIR": tmp})

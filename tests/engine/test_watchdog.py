@@ -64,6 +64,6 @@ c.check("nonfinite_message", "jdem: watchdog: step 1: position inf for particle(
 check_part("nonfinite", out, 0)
 
 p, out = run("chung_ooi_1", check=False)
-c.check("resolved_impact_does_not_trip", p.returncode == 0 and "watchdog" not in p.stderr
+c.check("resolved_impact_does_not_trip", p.returncode == 0 and "jdem: watchdog:" not in p.stderr
         and os.path.exists(out), f"exit {p.returncode}: {p.stderr.strip()!r}")
 c.exit()
