@@ -74,8 +74,8 @@ typedef enum {
 /* Parameters of a bond type (Jiang's five, plus damping and the bending option).              */
 /* ------------------------------------------------------------------------------------------ */
 typedef struct jd_bond_params {
-    double kn;      /* normal stiffness per unit area (stress per displacement)    [N/m^3] */
-    double kt;      /* shear stiffness per unit area                               [N/m^3] */
+    double kn;      /* normal stiffness per unit area (stress per displacement), >= 0 [N/m^3] */
+    double kt;      /* shear stiffness per unit area, >= 0 (0: no load carried) [N/m^3] */
     double sigma_c; /* tensile strength; INFINITY: no tensile failure             [Pa]    */
     double tau_c;   /* shear strength; INFINITY: no shear failure                  [Pa]    */
     double lambda;  /* bond-radius multiplier, R_bar = lambda min(R_a, R_b)        [-]     */
@@ -212,12 +212,16 @@ static inline int jd_bond_intact(const jd_bond_state *s) {
 }
 
 /* Elastic energy stored in the bond's springs [J]:
- * Fn^2/(2 kn A) + |Ft|^2/(2 kt A) + Mn^2/(2 kt J) + |Mt|^2/(2 kn I_bend). */
+ * Fn^2/(2 kn A) + |Ft|^2/(2 kt A) + Mn^2/(2 kt J) + |Mt|^2/(2 kn I_bend).  A spring of zero
+ * stiffness (kn or kt = 0: a bond that carries no load) holds no force and no energy. */
 static inline double jd_bond_energy(const jd_bond_params *p, const jd_bond_section *sec,
                                     const jd_bond_state *s) {
     const double Ib = p->bending == JD_BOND_BEND_J_LITERAL ? sec->J : sec->I;
-    return 0.5 * s->fn * s->fn / (p->kn * sec->A) + 0.5 * jd_dot(s->ft, s->ft) / (p->kt * sec->A) +
-           0.5 * s->mn * s->mn / (p->kt * sec->J) + 0.5 * jd_dot(s->mt, s->mt) / (p->kn * Ib);
+    const int n = p->kn > 0.0, t = p->kt > 0.0;
+    return (n ? 0.5 * s->fn * s->fn / (p->kn * sec->A) : 0.0) +
+           (t ? 0.5 * jd_dot(s->ft, s->ft) / (p->kt * sec->A) : 0.0) +
+           (t ? 0.5 * s->mn * s->mn / (p->kt * sec->J) : 0.0) +
+           (n ? 0.5 * jd_dot(s->mt, s->mt) / (p->kn * Ib) : 0.0);
 }
 
 /* One evaluation of an intact bond (docs/model.md §9.3).

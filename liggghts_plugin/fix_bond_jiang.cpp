@@ -81,8 +81,8 @@ FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
   }
   for (int s = 0; s < 5; s++)
     if (!seen[s]) error->all(FLERR, (std::string("fix bond/jiang: kn, kt, sigma_c, tau_c and lambda are required; ") + usage).c_str());
-  if (!(params.kn > 0.0) || !(params.kt > 0.0))
-    error->all(FLERR, "fix bond/jiang: kn and kt must be > 0 [N/m^3]");
+  if (!(params.kn >= 0.0) || !(params.kt >= 0.0) || std::isinf(params.kn) || std::isinf(params.kt))
+    error->all(FLERR, "fix bond/jiang: kn and kt must be finite and >= 0 [N/m^3] (0: the bond carries no load)");
   if (!(params.sigma_c > 0.0) || !(params.tau_c > 0.0))
     error->all(FLERR, "fix bond/jiang: sigma_c and tau_c must be > 0 [Pa] (inf: unbreakable)");
   if (!(params.lambda > 0.0)) error->all(FLERR, "fix bond/jiang: lambda must be > 0");

@@ -29,6 +29,11 @@ stiff (E = 7e10 Pa), with or without rolling resistance; nu = 0.3, rho = 2500, e
      per-step checks), the counterpart of LIGGGHTS' "Loop time";
    * liggghts-jdem and stock liggghts: LIGGGHTS' "Loop time of ..." (the run loop only).  The
      decks come from scene_to_liggghts.py (stock: --builtin, dump removed).
+   The throughput tables, ratios and flatness use that loop time less its output (jdem: the
+   `output=` part, frames and observables; LIGGGHTS: its "Outpt" share), because the engines
+   write different output: jdem and liggghts-jdem write two full frames, stock LIGGGHTS (which
+   has no dump h5md/jdem) only thermo lines.  At 1M the frames are 12 % of jdem's loop, at 20k
+   1 %.  The loop with its output is kept as well (loop_seconds_with_output).
    Until 2026-11-22 jdem's wall time was a run of S steps minus a run of 1 step, which should
    cancel the set-up but does not reliably: the set-up (scene parsing, ~1 s at 80k, ~15 s at
    1M) varies by more than the loop takes, and the difference was off by up to 30 % at 80k and
@@ -630,12 +635,26 @@ def jdem_loop_seconds(split):
     return split["loop"] if "loop" in split else sum(split[k] for k in LOOP_PARTS)
 
 
-def wall_of(r):
-    """The wall time of a timing's loop, the throughput tables' measure: LIGGGHTS' Loop time,
-    jdem's loop timer (also for runs recorded with the older run(S) - run(1) as wall_s)."""
+def loop_of(r):
+    """The wall time of a timing's loop, output included: LIGGGHTS' Loop time, jdem's loop timer
+    (also for runs recorded with the older run(S) - run(1) as wall_s)."""
     if r["engine"] == "jdem" and r.get("jdem_split"):
         return jdem_loop_seconds(r["jdem_split"])
     return r["wall_s"]
+
+
+def output_of(r):
+    """The part of a timing's loop spent writing output: jdem's `output=`, LIGGGHTS' "Outpt"
+    share of its Loop time (0 for records without a split)."""
+    if r["engine"] == "jdem":
+        return (r.get("jdem_split") or {}).get("output", 0.0)
+    return r["wall_s"] * (r.get("liggghts_split_percent") or {}).get("outpt", 0.0) / 100.0
+
+
+def wall_of(r):
+    """The throughput tables' measure: the loop's wall time less its output (see the module
+    docstring, 3), so that the engines are timed on the same work."""
+    return loop_of(r) - output_of(r)
 
 
 def remove_files(*paths):
@@ -719,13 +738,26 @@ def same_final_state(a, b):
                    for k in ("position", "velocity", "angular_velocity"))
 
 
+# The bonds of the feature check's general scene: every touching pair bonded at step 0 (as in the
+# bonded variants) by springs of zero stiffness, which carry no load.
+IDLE_BONDS = """bond_types:
+  idle: {normal_stiffness: 0.0, shear_stiffness: 0.0, tensile_strength: 1.0e9, shear_strength: 1.0e9}
+bond_rules:
+  - {type: idle, time: 0.0, max_gap: 1e-09}
+
+"""
+
+
 def feature_check(out, size, steps, repeats):
-    """The scene-specialisation check of issue 6: the soft monodisperse bed without damping and
-    rolling resistance (restitution 1, rolling friction 0), run by the loop specialised for it
-    and by the general loop (--all-laws: every law evaluated, with zero coefficients).  Speed
-    ratio (medians of `repeats` timings, 1 thread: wall by jdem's loop timer, CPU as
-    run(S) - run(1)) and whether the trajectories
-    are identical bit for bit.  Writes OUT/feature_check.json (kept: delete it to re-measure)."""
+    """The scene-specialisation check of issue 6: the soft monodisperse bed without damping,
+    rolling resistance and bonds (restitution 1, rolling friction 0), run by the loop
+    specialised for it, against the same scene with those laws enabled at zero coefficients:
+    the general contact loop (--all-laws: damping, rolling and mu_R evaluated with zero
+    coefficients) and zero-stiffness bonds between all touching pairs.  Also against the general
+    contact loop alone (no bonds), which shows what the contact loop's specialisation saves by
+    itself.  Speed ratios (medians of `repeats` timings, 1 thread, runs alternated: wall by jdem's
+    loop timer less its output, CPU as run(S) - run(1)) and whether the trajectories are
+    identical bit for bit.  Writes OUT/feature_check.json (kept: delete it to re-measure)."""
     path = os.path.join(out, "feature_check.json")
     if os.path.exists(path):
         return
@@ -733,36 +765,43 @@ def feature_check(out, size, steps, repeats):
     with open(src) as f:
         text = f.read()
     plain = re.sub(r"restitution: 0\.5", "restitution: 1.0", text)
-    if plain.count("restitution: 1.0") != 2:
+    if plain.count("restitution: 1.0") != 2 or plain.count("\nparticles:\n") != 1 or "bond_" in plain:
         raise RuntimeError("feature check: cannot switch off the damping in " + src)
-    scene = scene_path(out, size, "soft_mono_plain")
-    with open(scene, "w") as f:
-        f.write(plain)
+    scenes = {"plain": scene_path(out, size, "soft_mono_plain"),
+              "idle_bonds": scene_path(out, size, "soft_mono_plain_idle_bonds")}
+    for key, body in (("plain", plain), ("idle_bonds", plain.replace("\nparticles:\n", "\n" + IDLE_BONDS + "particles:\n"))):
+        with open(scenes[key], "w") as f:
+            f.write(body)
     n = int(np.load(make_bed(out, size, "mono"))["id"].shape[0])
-    res = {}
-    loops = (("specialised", []), ("general", ["--all-laws"]))
-    # alternately, so that a change in the machine's load falls on both loops alike
-    timed = {tag: [] for tag, _ in loops}
+    loops = (("specialised", "plain", []), ("general_contact_laws", "plain", ["--all-laws"]),
+             ("general", "idle_bonds", ["--all-laws"]))
+    # alternately, so that a change in the machine's load falls on every loop alike
+    timed = {tag: [] for tag, _, _ in loops}
     for _ in range(repeats):
-        for tag, extra in loops:
-            timed[tag].append(run_jdem(out, size, "soft_mono_plain", scene, steps, n, extra=extra,
+        for tag, key, extra in loops:
+            timed[tag].append(run_jdem(out, size, "soft_mono_plain", scenes[key], steps, n, extra=extra,
                                        tag="_" + tag, keep_trajectory=True))
-    for tag, _ in loops:
+    res = {}
+    for tag, key, _ in loops:
         runs = timed[tag]
-        res[tag] = dict(wall_s=[r["wall_s"] for r in runs], cpu_s=[r["cpu_s"] for r in runs],
-                        wall_s_median=statistics.median(r["wall_s"] for r in runs),
+        walls = [r["wall_s"] - r["jdem_split"].get("output", 0.0) for r in runs]
+        res[tag] = dict(scene=os.path.relpath(scenes[key], out), wall_s=walls, cpu_s=[r["cpu_s"] for r in runs],
+                        wall_s_median=statistics.median(walls),
                         cpu_s_median=statistics.median(r["cpu_s"] for r in runs),
-                        trajectory=runs[-1]["trajectory"])
+                        bonds=runs[-1]["bonds_start"], trajectory=runs[-1]["trajectory"])
         log("feature check %s: %.3f s" % (tag, res[tag]["wall_s_median"]))
-    fc = dict(scene=os.path.relpath(scene, out), size=size, N=n, steps=steps, repeats=repeats,
-              description="soft_mono with restitution 1 and rolling friction 0: the loop specialised for "
-                          "friction only against the general loop (--all-laws) evaluating damping, rolling "
-                          "and mu_R with zero coefficients",
-              specialised=res["specialised"], general=res["general"],
-              speed_ratio_wall=res["general"]["wall_s_median"] / res["specialised"]["wall_s_median"],
-              speed_ratio_cpu=res["general"]["cpu_s_median"] / res["specialised"]["cpu_s_median"],
-              identical_trajectory=bool(same_final_state(res["specialised"]["trajectory"],
-                                                         res["general"]["trajectory"])))
+    spec = res["specialised"]
+    fc = dict(scene=os.path.relpath(scenes["plain"], out), size=size, N=n, steps=steps, repeats=repeats,
+              description="soft_mono with restitution 1, rolling friction 0 and no bonds: the loop specialised "
+                          "for friction only, against the same scene with damping, rolling and mu_R evaluated "
+                          "at zero coefficients (--all-laws) and zero-stiffness bonds between all touching pairs "
+                          "(general), and against --all-laws without the bonds (general_contact_laws)",
+              specialised=spec, general=res["general"], general_contact_laws=res["general_contact_laws"])
+    for tag in ("general", "general_contact_laws"):
+        sfx = "" if tag == "general" else "_contact_laws"
+        fc["speed_ratio_wall" + sfx] = res[tag]["wall_s_median"] / spec["wall_s_median"]
+        fc["speed_ratio_cpu" + sfx] = res[tag]["cpu_s_median"] / spec["cpu_s_median"]
+        fc["identical_trajectory" + sfx] = bool(same_final_state(spec["trajectory"], res[tag]["trajectory"]))
     with open(path, "w") as f:
         json.dump(fc, f, indent=1)
 
@@ -795,6 +834,7 @@ def summarise(runs):
             ENGINES.index(kv[0][2]), kv[0][3], kv[0][4])):
         walls = [wall_of(r) for r in rs]
         wall = statistics.median(walls)
+        loop_with_output = statistics.median(loop_of(r) for r in rs)
         n, steps = rs[0]["n"], rs[0]["steps"]
         rss = max(r["peak_rss"] for r in rs)
         cpu = statistics.median(r["cpu_s"] for r in rs)
@@ -808,8 +848,8 @@ def summarise(runs):
         splits = [r["jdem_split"] for r in rs if r.get("jdem_split")]
         split = ({k: statistics.median(s[k] for s in splits) for k in splits[0]} if splits else None)
         engine_bytes = split.get("engine_bytes") if split else None
-        # the sum of jdem's --timing parts (the loop timer less the per-step checks)
-        timer = sum(split[k] for k in LOOP_PARTS) if split else None
+        # the sum of jdem's --timing parts but the output (the loop timer less the per-step checks)
+        timer = sum(split[k] for k in LOOP_PARTS if k != "output") if split else None
         bonds = rs[0].get("bonds_start")
         # a bond is a per-pair record like a contact's history: the bonded beds' budget counts
         # the bonds at the start as contacts too
@@ -817,6 +857,7 @@ def summarise(runs):
         rows.append(dict(scene="%s_%s" % (size, variant), size=size, variant=variant, engine=engine,
                          threads=threads, ranks=ranks, N=n, steps=steps, dt=rs[0]["dt"], repeats=len(rs),
                          wall_seconds=wall, wall_seconds_all=walls,
+                         loop_seconds_with_output=loop_with_output,
                          cpu_seconds_loop=cpu_loop,
                          particle_steps_per_cpu_second=(n * steps / cpu_loop) if cpu_loop and cpu_loop > 0 else None,
                          particle_steps_per_second=n * steps / wall if wall > 0 else float("nan"),

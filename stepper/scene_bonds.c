@@ -56,8 +56,8 @@ static int read_type(loader *L, const yaml_node_pair_t *p, jd_bond_type *t) {
     snprintf(t->name, sizeof t->name, "%s", name);
     t->p = (jd_bond_params){.lambda = 1.0, .gamma = 0.0, .bending = JD_BOND_BEND_I};
     return sd_keys(&L->c, m, path, TYPE_KEYS) ||
-                   sd_req_num(&L->c, m, path, "normal_stiffness", SD_POSITIVE, &t->p.kn) ||
-                   sd_req_num(&L->c, m, path, "shear_stiffness", SD_POSITIVE, &t->p.kt) ||
+                   sd_req_num(&L->c, m, path, "normal_stiffness", SD_NONNEGATIVE, &t->p.kn) ||
+                   sd_req_num(&L->c, m, path, "shear_stiffness", SD_NONNEGATIVE, &t->p.kt) ||
                    read_strength(L, m, path, "tensile_strength", &t->p.sigma_c) ||
                    read_strength(L, m, path, "shear_strength", &t->p.tau_c) ||
                    sd_opt_num(&L->c, m, path, "radius_multiplier", SD_POSITIVE, &t->p.lambda) ||

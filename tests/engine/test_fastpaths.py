@@ -21,7 +21,8 @@ a cylinder, damping, friction, rolling resistance, ~50 neighbour rebuilds).
 * the scene-specialised force loop against the general one (--all-laws) on the scene without
   damping and rolling resistance (restitution 1, rolling friction 0): the general loop
   evaluates those laws with zero coefficients, which add exact zeros, so the trajectories are
-  identical bit for bit;
+  identical bit for bit, also with bonds of zero stiffness added (bonds enabled at zero
+  coefficients: they carry no load and hold no energy);
 * energy bookkeeping off (output.energy: false) against on: it never feeds back into the
   forces, so the trajectories are identical bit for bit, and the energy observables are absent;
 * bonds through the renumbering: the bonded 4x4x4 block of scripts/bond_checks.py dropped onto a
@@ -200,6 +201,23 @@ c.check("specialised_vs_general_identical", identical(spec, general),
         "the specialised loop differs from the general one at zero coefficients: "
         f"position {rel_diff(spec, general, 'position'):.3g}")
 c.check("plain_scene_differs_from_base", not identical(spec, srt), "the variant changed nothing")
+# Bonds enabled at zero coefficients as well (issue 6's general scene): springs of zero stiffness
+# between the pairs within half a radius at the start carry no load, so the trajectory is still the
+# specialised loop's bit for bit, no bond breaks, and the bonds hold no energy (0, not 0/0).
+assert plain.count("\nwalls:\n") == 1
+idle_path = variant(plain.replace("\nwalls:\n", "\nbond_types:\n  idle: {normal_stiffness: 0.0, shear_stiffness: 0.0, "
+                                  "tensile_strength: 1.0e6, shear_strength: 1.0e6}\nbond_rules:\n"
+                                  "  - {type: idle, time: 0.0, max_gap: 0.5}\nwalls:\n"), "fastpaths_idle_bonds")
+idle, _, _ = run_file(idle_path, "--all-laws")
+n_idle = idle["obs"]["bonds"]
+c.check("idle_bonds_formed_and_kept", n_idle[0] >= 50 and np.all(n_idle == n_idle[0]),
+        f"bonds per sample {n_idle.tolist()}")
+c.check("specialised_vs_general_with_idle_bonds_identical", identical(spec, idle),
+        "zero-stiffness bonds changed the trajectory: position "
+        f"{rel_diff(spec, idle, 'position'):.3g}")
+e_idle = idle["obs"].get("bond_elastic_energy")
+c.check("idle_bonds_hold_no_energy", e_idle is not None and np.all(e_idle == 0.0),
+        f"bond elastic energy {None if e_idle is None else e_idle.tolist()}")
 
 no_energy = variant(text.replace("  observables_every: 500\n", "  observables_every: 500\n  energy: false\n"),
                     "fastpaths_no_energy")
