@@ -441,12 +441,12 @@ static JD_ALWAYS_INLINE void wall_batch_evaluate(const jd_sim *s, const unsigned
 }
 
 /* Lanes [0, nb) of a wall batch back: history, watchdog, the walls' work (energy bookkeeping:
- * also over the step a contact ends) and the forces on the particles, in list order.  Returns
- * the work. */
-static JD_ALWAYS_INLINE double wall_batch_scatter(jd_sim *s, const unsigned F, const batch *B,
-                                                  int nb, acc a, jd_overlap_trip *trip) {
+ * also over the step a contact ends; added to *work one contact at a time, the plain loop's
+ * order) and the forces on the particles, in list order. */
+static JD_ALWAYS_INLINE void wall_batch_scatter(jd_sim *s, const unsigned F, const batch *B,
+                                                int nb, acc a, jd_overlap_trip *trip,
+                                                double *work) {
     jd_contact_list *L = &s->wall_pairs;
-    double work = 0.0;
     for (int b = 0; b < nb; b++) {
         const size_t c = (size_t)B->c[b];
         const int32_t i = B->i[b];
@@ -457,7 +457,7 @@ static JD_ALWAYS_INLINE double wall_batch_scatter(jd_sim *s, const unsigned F, c
             const double f_before[3] = {B->f_before[0][b], B->f_before[1][b], B->f_before[2][b]};
             const double f[3] = {B->f[0][b], B->f[1][b], B->f[2][b]};
             const double vw[3] = {B->vw[0][b], B->vw[1][b], B->vw[2][b]};
-            work += jd_wall_work(f_before, f, vw, s->dt);
+            *work += jd_wall_work(f_before, f, vw, s->dt);
         }
         if (!B->carries[b]) continue;
         double *fa = a.f + 3 * (size_t)i, *ta = a.t + 3 * (size_t)i;
@@ -466,7 +466,6 @@ static JD_ALWAYS_INLINE double wall_batch_scatter(jd_sim *s, const unsigned F, c
             ta[d] += B->ta[d][b];
         }
     }
-    return work;
 }
 
 /* The wall loop over entries [c0, c1), in batches like the pair loop: the wall's own test
@@ -500,12 +499,13 @@ static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0,
         }
         if (++nb == JD_BATCH) {
             wall_batch_evaluate(s, F, B, nb);
-            work += wall_batch_scatter(s, F, B, nb, a, trip);
+            wall_batch_scatter(s, F, B, nb, a, trip, &work);
             nb = 0;
         }
     }
     wall_batch_evaluate(s, F, B, nb);
-    return work + wall_batch_scatter(s, F, B, nb, a, trip);
+    wall_batch_scatter(s, F, B, nb, a, trip, &work);
+    return work;
 }
 
 /* The reference path (--plain-loops): one contact at a time, as the loops were before they

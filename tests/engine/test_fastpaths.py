@@ -12,7 +12,8 @@ a cylinder, damping, friction, rolling resistance, ~50 neighbour rebuilds).
   by round-off);
 * the force loops in SIMD batches against one contact at a time (--plain-loops): each contact's
   arithmetic and the order of the force sums are the same, so the trajectories and every
-  observable (energies included) are identical bit for bit; also with two particle materials
+  observable (energies included) are identical bit for bit; also with a moving floor (the
+  walls' work summed across the wall loop's batches), with two particle materials
   (the coefficients read per pair instead of once) and with one radius (the pair constants
   taken once instead of per pair);
 * 2 OpenMP threads against 1: the same round-off bounds; two 2-thread runs are identical bit
@@ -143,6 +144,34 @@ c.check("batched_vs_plain_loops_identical", identical(srt, plain),
 c.check("batched_vs_plain_loops_same_observables",
         all(np.array_equal(srt["obs"][k], plain["obs"][k]) for k in srt["obs"]),
         "observables differ between the batched and the plain force loops")
+
+# A moving floor does work (energy bookkeeping), which the wall loop sums contact by contact in
+# list order as the plain loop does, also across its batches of 32 contacts: a 7 x 7 layer of
+# spheres resting on a floor that rises under them (49 wall contacts).
+layer = dict(
+    jdem_scene=1, name="moving_floor", description="a layer of spheres lifted by a rising floor",
+    time=dict(dt=1.0e-6, steps=2000), output=dict(every=500, observables_every=100),
+    gravity=[0.0, 0.0, -9.81],
+    materials=dict(grain=dict(youngs_modulus=1.0e8, poisson_ratio=0.3, density=2500, restitution=0.6,
+                              friction=0.4, rolling_friction=0.05),
+                   steel=dict(restitution=0.6, friction=0.4, rolling_friction=0.05)),
+    walls=[dict(name="floor", type="plane", material="steel", velocity=[0.0, 0.0, 0.01],
+                corners=[[-0.01, -0.01, 0], [0.02, -0.01, 0], [0.02, 0.02, 0], [-0.01, 0.02, 0]])],
+    particles=[dict(id=1 + a + 7 * b, material="grain", radius=1.0e-3,
+                    position=[2.2e-3 * a, 2.2e-3 * b, 1.0e-3], velocity=[1.0e-3 * (a - 3), 0.0, 0.0])
+               for b in range(7) for a in range(7)])
+lift = variant(yaml.safe_dump(layer, sort_keys=False), "moving_floor")
+lift_batched, _, _ = run_file(lift)
+lift_plain, _, _ = run_file(lift, "--plain-loops")
+c.check("moving_floor_many_wall_contacts", lift_batched["obs"]["wall_contacts"].max() > 32 and
+        np.any(lift_batched["obs"]["wall_work"] != 0.0),
+        f"wall contacts {lift_batched['obs']['wall_contacts'].tolist()}, wall work "
+        f"{lift_batched['obs']['wall_work'].tolist()}")
+c.check("moving_floor_batched_vs_plain_identical",
+        identical(lift_batched, lift_plain) and
+        all(np.array_equal(lift_batched["obs"][k], lift_plain["obs"][k]) for k in lift_plain["obs"]),
+        "with a moving floor the batched loops differ from the plain ones: "
+        + ", ".join(k for k in lift_plain["obs"] if not np.array_equal(lift_batched["obs"][k], lift_plain["obs"][k])))
 
 # Two particle materials: the batches then read each pair's coefficient row through the
 # species (one material: the one row, read once per batch).
