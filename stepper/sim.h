@@ -167,6 +167,8 @@ typedef struct jd_thread_share {
     size_t wall_lo, wall_hi; /* wall list entries */
     size_t p_lo, p_hi;       /* the particles it owns: every entry above has i in [p_lo, p_hi) */
     size_t win;              /* its pairs reach particles [p_hi, p_hi + win) as j */
+    size_t span;             /* the largest j - i of its pairs (how far ahead of i the loop
+                              * first touches a particle) */
     size_t cap;              /* room of ovf, in particles (>= win) */
     double *ovf;             /* 6 cap: forces (3 cap) then torques on those particles, zero
                               * between force evaluations */
