@@ -41,7 +41,8 @@ double sim_clock(void) {
 
 
 /* Where a thread adds its forces and torques: f and torque for particles below hi, its
- * overflow buffer (of, ot: index j - hi) for the partners j >= hi. */
+ * overflow buffer (of, ot: index j - hi) for the partners j >= hi; span: how far beyond its
+ * rows i its partners j reach (jd_thread_share, prefetch_particles). */
 typedef struct acc {
     double *f, *t, *of, *ot;
     size_t hi, span;
