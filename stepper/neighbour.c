@@ -18,20 +18,39 @@
 #include <string.h>
 
 #include "geometry.h"
+#include "hugepages.h"
 #include "sim.h"
 
-/* Every array of l resized to cap entries with history widths hw and rw (rhist only if rw > 0).
- * Returns 0, or -1 when a realloc failed: that array is as it was, the others resized. */
+/* The bytes of l's arrays at capacity cap with history widths hw and rw (rw 0: no rhist). */
+static void list_array_bytes(size_t cap, int hw, int rw, size_t bytes[4]) {
+    bytes[0] = bytes[1] = cap * sizeof(int32_t);
+    bytes[2] = cap * (size_t)hw * sizeof(double);
+    bytes[3] = cap * (size_t)rw * sizeof(double);
+}
+
+/* Every array of l resized to cap entries with history widths hw and rw (rhist only if rw > 0),
+ * keeping their leading bytes like realloc, on huge pages (hugepages.h).  Returns 0, or -1 when
+ * there was no memory: then l is as it was. */
 static int list_resize(jd_contact_list *l, size_t cap, int hw, int rw) {
-    int32_t *i = realloc(l->i, cap * sizeof *i);
-    if (i) l->i = i;
-    int32_t *j = realloc(l->j, cap * sizeof *j);
-    if (j) l->j = j;
-    double *h = realloc(l->hist, cap * (size_t)hw * sizeof *h);
-    if (h) l->hist = h;
-    double *r = rw ? realloc(l->rhist, cap * (size_t)rw * sizeof *r) : l->rhist;
-    if (r) l->rhist = r;
-    return !i || !j || !h || (rw && !r) ? -1 : 0;
+    size_t old[4], now[4];
+    list_array_bytes(l->cap, l->hw, l->rhist ? l->rw : 0, old);
+    list_array_bytes(cap, hw, rw, now);
+    void *from[4] = {l->i, l->j, l->hist, l->rhist}, *to[4] = {NULL, NULL, NULL, NULL};
+    int failed = 0;
+    for (int k = 0; k < 4; k++) failed |= now[k] && !(to[k] = jd_huge_alloc(now[k]));
+    if (failed) {
+        for (int k = 0; k < 4; k++) jd_huge_free(to[k], now[k]);
+        return -1;
+    }
+    for (int k = 0; k < 4; k++) {
+        if (from[k] && to[k]) memcpy(to[k], from[k], old[k] < now[k] ? old[k] : now[k]);
+        jd_huge_free(from[k], old[k]);
+    }
+    l->i = to[0];
+    l->j = to[1];
+    l->hist = to[2];
+    l->rhist = to[3];
+    return 0;
 }
 
 /* Every list of a run is of the run's kind (history widths hw, rw); buffers swap roles between
@@ -62,8 +81,7 @@ int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
 static void list_fit(jd_contact_list *l) {
     const size_t cap = l->n + l->n / 16 + 256;
     if (cap >= l->cap) return;
-    (void)list_resize(l, cap, l->hw, l->rw); /* a failed shrink leaves the larger array */
-    l->cap = cap;
+    if (list_resize(l, cap, l->hw, l->rw) == 0) l->cap = cap; /* if not, the list keeps its room */
 }
 
 static int list_push(jd_contact_list *l, int32_t i, int32_t j, unsigned kind) {
@@ -75,10 +93,12 @@ static int list_push(jd_contact_list *l, int32_t i, int32_t j, unsigned kind) {
 }
 
 void sim_contact_list_free(jd_contact_list *l) {
-    free(l->i);
-    free(l->j);
-    free(l->hist);
-    free(l->rhist);
+    size_t bytes[4];
+    list_array_bytes(l->cap, l->hw, l->rhist ? l->rw : 0, bytes);
+    jd_huge_free(l->i, bytes[0]);
+    jd_huge_free(l->j, bytes[1]);
+    jd_huge_free(l->hist, bytes[2]);
+    jd_huge_free(l->rhist, bytes[3]);
     memset(l, 0, sizeof *l);
 }
 

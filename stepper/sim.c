@@ -9,7 +9,15 @@
 
 #include "geometry.h"
 #include "h5md.h"
+#include "hugepages.h"
 #include "sim.h"
+
+#if defined(__SANITIZE_ADDRESS__)
+#include <sanitizer/asan_interface.h>
+#else
+#define ASAN_POISON_MEMORY_REGION(p, n) ((void)(p), (void)(n))
+#define ASAN_UNPOISON_MEMORY_REGION(p, n) ((void)(p), (void)(n))
+#endif
 
 /* Interaction coefficients for every ordered material pair.  gamma costs up to ~50 ms per
  * restitution value with the exact mapping, so each distinct e is mapped once. */
@@ -85,19 +93,60 @@ static void init_kinds(jd_sim *s) {
     }
 }
 
+/* The next `bytes` of the per-particle block (alloc_particle_arrays) at offset *at: 64-byte
+ * aligned and followed by a gap of at least 64 bytes, which AddressSanitizer builds mark
+ * unaddressable, so that an overrun of one array is still reported rather than landing in the
+ * next.  With block NULL only the offset advances. */
+static void *slice(char *block, size_t *at, size_t bytes) {
+    enum { LINE = 64 };
+    const size_t len = (bytes + LINE - 1) / LINE * LINE + LINE;
+    char *p = block ? block + *at : NULL;
+    if (p) ASAN_POISON_MEMORY_REGION(p + bytes, len - bytes);
+    *at += len;
+    return p;
+}
+
+/* The per-particle arrays of n particles as slices of block (NULL: none); returns the bytes
+ * they take.  The five arrays the pair loop reads and writes come first. */
+static size_t carve(jd_sim *s, size_t n, char *block) {
+    size_t at = 0;
+    s->x = slice(block, &at, 3 * n * sizeof *s->x);
+    s->v = slice(block, &at, 3 * n * sizeof *s->v);
+    s->omega = slice(block, &at, 3 * n * sizeof *s->omega);
+    s->f = slice(block, &at, 3 * n * sizeof *s->f);
+    s->torque = slice(block, &at, 3 * n * sizeof *s->torque);
+    s->dtfm = slice(block, &at, n * sizeof *s->dtfm);
+    s->dtirot = slice(block, &at, n * sizeof *s->dtirot);
+    s->radius = slice(block, &at, n * sizeof *s->radius);
+    s->mass = slice(block, &at, n * sizeof *s->mass);
+    s->inertia = slice(block, &at, n * sizeof *s->inertia);
+    s->kp = slice(block, &at, n * sizeof *s->kp);
+    s->kw = slice(block, &at, n * sizeof *s->kw);
+    s->x_build = slice(block, &at, 3 * n * sizeof *s->x_build);
+    s->scratch = slice(block, &at, 3 * n * sizeof *s->scratch);
+    s->species = slice(block, &at, n * sizeof *s->species);
+    s->orig = slice(block, &at, n * sizeof *s->orig);
+    s->cell_of = slice(block, &at, n * sizeof *s->cell_of);
+    s->cell_items = slice(block, &at, n * sizeof *s->cell_items);
+    return at;
+}
+
+/* The per-particle arrays, zeroed, in one block on huge pages (hugepages.h).  Returns 0, or
+ * -1 when there is no memory for them. */
+static int alloc_particle_arrays(jd_sim *s, size_t n) {
+    const size_t bytes = carve(s, n, NULL);
+    char *block = jd_huge_alloc(bytes);
+    if (!block) return -1;
+    s->particle_block = block;
+    s->particle_block_bytes = bytes;
+    carve(s, n, block);
+    return 0;
+}
+
 static int init_particles(jd_sim *s, char *err, size_t errlen) {
     const jd_scene *sc = s->scene;
     const size_t n = sc->n_particles, n1 = n ? n : 1;
-    double **vec[] = {&s->x, &s->v, &s->omega, &s->f, &s->torque, &s->x_build};
-    for (size_t k = 0; k < sizeof vec / sizeof *vec; k++)
-        if (!(*vec[k] = calloc(3 * n1, sizeof(double)))) goto oom;
-    double **per[] = {&s->radius, &s->mass, &s->inertia, &s->kp, &s->kw, &s->dtfm, &s->dtirot};
-    for (size_t k = 0; k < sizeof per / sizeof *per; k++)
-        if (!(*per[k] = calloc(n1, sizeof(double)))) goto oom;
-    if (!(s->species = calloc(n1, sizeof *s->species)) || !(s->cell_of = calloc(n1, sizeof(int32_t))) ||
-        !(s->cell_items = calloc(n1, sizeof(int32_t))) || !(s->orig = calloc(n1, sizeof *s->orig)) ||
-        !(s->scratch = calloc(3 * n1, sizeof *s->scratch)))
-        goto oom;
+    if (alloc_particle_arrays(s, n1) != 0) goto oom;
     memcpy(s->x, sc->position, 3 * n * sizeof(double));
     memcpy(s->v, sc->velocity, 3 * n * sizeof(double));
     memcpy(s->omega, sc->angular_velocity, 3 * n * sizeof(double));
@@ -219,17 +268,11 @@ int sim_init(jd_sim *s, const jd_scene *scene, const jd_sim_options *opt, char *
 }
 
 void sim_free(jd_sim *s) {
-    double *arrays[] = {s->x,    s->v,      s->omega, s->f,  s->torque, s->x_build, s->radius,
-                        s->mass, s->inertia, s->kp,   s->kw, s->dtfm,   s->dtirot};
-    for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++) free(arrays[k]);
-    free(s->species);
-    free(s->orig);
-    free(s->scratch);
+    if (s->particle_block) ASAN_UNPOISON_MEMORY_REGION(s->particle_block, s->particle_block_bytes);
+    jd_huge_free(s->particle_block, s->particle_block_bytes);
     sim_forces_free(s);
     free(s->coeffs);
     free(s->walls);
-    free(s->cell_of);
-    free(s->cell_items);
     free(s->cell_start);
     sim_contact_list_free(&s->pairs);
     sim_contact_list_free(&s->wall_pairs);

@@ -188,6 +188,10 @@ typedef struct jd_sim {
     int64_t frame_step; /* step of the last frame written by sim_run, -1 before the first */
     unsigned features; /* JD_F_* bits of the force loops, fixed for the run */
 
+    /* The per-particle arrays below (x ... torque, the constants, scratch, x_build, orig,
+     * species, cell_of, cell_items) are slices of one block (sim.c, hugepages.h). */
+    void *particle_block;
+    size_t particle_block_bytes;
     /* particle state, 3n each */
     double *x, *v, *omega, *f, *torque;
     /* per-particle constants */
