@@ -19,9 +19,11 @@ void jd_huge_free(void *p, size_t bytes) {
 
 static size_t round_up(size_t a, size_t to) { return (a + to - 1) / to * to; }
 
-/* The size of the mapping jd_huge_alloc(bytes) makes (and jd_huge_free unmaps). */
+/* The size of the mapping jd_huge_alloc(bytes) makes (and jd_huge_free unmaps): from half a
+ * huge page on, whole huge pages (at 80k particles the lists' index arrays are 1.2 MB; on huge
+ * pages the pair loop's median was 3-6 % lower, docs/performance.md), else whole pages. */
 static size_t mapped_size(size_t bytes) {
-    return bytes >= HUGE_PAGE ? round_up(bytes, HUGE_PAGE)
+    return bytes >= HUGE_PAGE / 2 ? round_up(bytes, HUGE_PAGE)
                               : round_up(bytes ? bytes : 1, (size_t)sysconf(_SC_PAGESIZE));
 }
 

@@ -16,7 +16,7 @@
 #include <stddef.h>
 
 /* A zeroed mapping of at least `bytes` bytes, or NULL when the system has no memory for it.
- * From 2 MiB on it is 2 MiB-aligned, a whole number of 2 MiB pages, and advised for huge pages
+ * From 1 MiB on it is 2 MiB-aligned, a whole number of 2 MiB pages, and advised for huge pages
  * (a hint: where the kernel does not follow it, the mapping has 4 KiB pages).  AddressSanitizer
  * builds take the memory from calloc instead, so that their bounds are checked. */
 void *jd_huge_alloc(size_t bytes);
