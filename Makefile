@@ -54,7 +54,7 @@ STEPPER_SRC := $(wildcard stepper/*.c)
 # also writes bond frames: io/)
 SCENE_SRC   := $(wildcard stepper/scene*.c) stepper/guard.c stepper/bonds.c $(KERNEL_SRC) $(IO_SRC)
 PLUGIN_SRC  := $(wildcard liggghts_plugin/*.cpp)
-UNIT_SRC    := $(wildcard tests/unit/*.c)
+UNIT_SRC    := $(wildcard tests/unit/*.c) stepper/hugepages.c # and the engine's block allocator
 HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)
 
 .PHONY: all deps test demo chung-ooi stability unit clean

@@ -10,5 +10,6 @@ int main(void) {
     failed += run_guard_tests();
     failed += run_bond_tests();
     failed += run_h5md_bonds_tests();
+    failed += run_hugepages_tests();
     return failed;
 }

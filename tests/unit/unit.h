@@ -28,5 +28,6 @@ int run_watchdog_tests(void);
 int run_guard_tests(void);
 int run_bond_tests(void);
 int run_h5md_bonds_tests(void);
+int run_hugepages_tests(void);
 
 #endif
