@@ -1,4 +1,4 @@
-/* hugepages.c — aligned, huge-page-advised mappings for the per-particle arrays (hugepages.h). */
+/* hugepages.c — aligned, huge-page-advised mappings for the engine's large arrays (hugepages.h). */
 #define _DEFAULT_SOURCE /* MAP_ANONYMOUS, madvise, MADV_HUGEPAGE */
 #include "hugepages.h"
 

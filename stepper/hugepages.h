@@ -1,5 +1,5 @@
 /*
- * hugepages.h — memory for the engine's per-particle arrays, on transparent huge pages.
+ * hugepages.h — memory for the engine's large arrays, on transparent huge pages.
  *
  * Beds of 80k particles and more do not fit in the cache, and with 4 KiB pages their streams
  * also miss the TLB.  The kernel backs a mapping with 2 MiB pages where it is advised to
