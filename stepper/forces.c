@@ -414,9 +414,9 @@ static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, 
 
 /* Software prefetch of the particles at the front of the pair loop's window.  In cell order a
  * row i's partners j reach up to a.span (the largest j - i of the thread's entries) beyond i,
- * about one layer of cells, so a particle's x, v, omega, f and torque are first touched, as a
- * partner, span particles ahead of the rows being evaluated, at scattered j the hardware
- * prefetchers do not follow.  The loop fetches every cache line of the five arrays once,
+ * about one slab of cells (neighbour.c, cell_axes), so a particle's x, v, omega, f and torque
+ * are first touched, as a partner, span particles ahead of the rows being evaluated, at
+ * scattered j the hardware prefetchers do not follow.  The loop fetches every cache line of the five arrays once,
  * JD_PREFETCH_AHEAD particles ahead of that front.  Measured (docs/performance.md): 320k pair
  * loop 2.7-2.8 s against 3.3-3.7 s, 80k 0.94-1.04 s against 1.07-1.28 s; at 5k and 20k, whose
  * particles stay in cache, the prefetches cost 2-4 %, hence only from JD_PREFETCH_MIN_N
