@@ -1,7 +1,10 @@
 /*
  * integrate.c — one time step, written exactly as LIGGGHTS `fix nve/sphere` (initial_integrate,
  * neighbour check, force computation, final_integrate) so that one- and two-particle cases agree
- * with LIGGGHTS to round-off: same expressions, same evaluation order.  The loops are split by
+ * with LIGGGHTS to round-off: same expressions, same evaluation order.  When nothing looks at
+ * the state between two steps (no frame, no observables), the first step's final_integrate is
+ * done in the second step's first pass, which gives the same numbers and streams the particle
+ * arrays once per step instead of twice (docs/performance.md).  The loops are split by
  * particle over the threads (each particle's update is independent, so the result does not
  * depend on the thread count at all).
  */
@@ -39,6 +42,33 @@ static int kick_drift(long lo, long hi, double *restrict x, double *restrict v, 
     return bad | (far << 1);
 }
 
+/* The particles [lo, hi) of the last step's final_integrate and this step's initial_integrate
+ * in one pass, when nothing looked at the state in between (sim_step): the same two half kicks,
+ * each rounded as in its own pass (C11 contracts no multiply-add), so the numbers are those of
+ * kick then kick_drift, bit for bit.  Returns kick_drift's bits, and bit 2: some v or omega
+ * after the first half kick is not finite (the last step's state). */
+static int kick_kick_drift(long lo, long hi, double *restrict x, double *restrict v,
+                           double *restrict w, const double *restrict x0, const double *restrict f,
+                           const double *restrict t, const double *restrict dtfm,
+                           const double *restrict dtirot, double dt, double lim) {
+    int bad = 0, was_bad = 0, far = 0;
+    for (long i = lo; i < hi; i++) {
+        double d[3];
+        for (int k = 0; k < 3; k++) {
+            const double dv = dtfm[i] * f[3 * i + k], dw = dtirot[i] * t[3 * i + k];
+            const double v1 = v[3 * i + k] + dv, w1 = w[3 * i + k] + dw;
+            was_bad |= not_finite(v1) | not_finite(w1);
+            v[3 * i + k] = v1 + dv;
+            w[3 * i + k] = w1 + dw;
+            x[3 * i + k] += dt * v[3 * i + k];
+            bad |= not_finite(x[3 * i + k]);
+            d[k] = x[3 * i + k] - x0[3 * i + k];
+        }
+        far |= !(jd_dot(d, d) <= lim);
+    }
+    return bad | (far << 1) | (was_bad << 2);
+}
+
 /* The particles [lo, hi) of final_integrate; returns 1 when some new v or omega is not finite. */
 static int kick(long lo, long hi, double *restrict v, double *restrict w, const double *restrict f,
                 const double *restrict t, const double *restrict dtfm,
@@ -67,22 +97,29 @@ static void share(long n, long *lo, long *hi) {
 /* initial_integrate: v += (0.5 dt/m) f; omega += (0.5 dt/0.4)/(r r m) torque; x += dt v.
  * dtfm and dtirot are precomputed per particle with exactly LIGGGHTS' expressions, so the
  * products are bit-identical; each particle's update is independent, so doing the kick and the
- * drift in one pass gives LIGGGHTS' numbers exactly.  The same pass checks whether some
+ * drift in one pass gives LIGGGHTS' numbers exactly.  With s->kick_pending the pass first
+ * applies the last step's final half kick (kick_kick_drift).  The same pass checks whether some
  * particle moved more than half the skin since the last neighbour build (*moved; !(<=) so that a
- * NaN position forces a rebuild, which reports it) and returns 1 when some new x is not
- * finite. */
+ * NaN position forces a rebuild, which reports it).  Returns bit 0: some new x is not finite;
+ * bit 2: the pending kick left some v or omega not finite. */
 static int initial_integrate(jd_sim *s, int *moved) {
     const double lim = 0.25 * s->skin * s->skin; /* (skin/2)^2 */
+    const int pending = s->kick_pending;
     int bits = 0;
 #pragma omp parallel num_threads(s->threads) if (s->threads > 1) reduction(| : bits)
     {
         long lo, hi;
         share((long)s->n, &lo, &hi);
-        bits |= kick_drift(lo, hi, s->x, s->v, s->omega, s->x_build, s->f, s->torque, s->dtfm,
-                           s->dtirot, s->dt, lim);
+        if (pending)
+            bits |= kick_kick_drift(lo, hi, s->x, s->v, s->omega, s->x_build, s->f, s->torque,
+                                    s->dtfm, s->dtirot, s->dt, lim);
+        else
+            bits |= kick_drift(lo, hi, s->x, s->v, s->omega, s->x_build, s->f, s->torque,
+                               s->dtfm, s->dtirot, s->dt, lim);
     }
+    s->kick_pending = 0;
     *moved = (bits & 2) != 0;
-    return bits & 1;
+    return bits & 5;
 }
 
 /* final_integrate: the same half kick, returning 1 when some new v or omega is not finite. */
@@ -97,12 +134,27 @@ static int final_integrate(jd_sim *s) {
     return bad;
 }
 
-int sim_step(jd_sim *s, char *err, size_t errlen) {
+void sim_finish_step(jd_sim *s) {
+    if (!s->kick_pending) return;
+    const double t0 = sim_clock();
+    s->nonfinite |= final_integrate(s);
+    s->kick_pending = 0;
+    s->timing.integration += sim_clock() - t0;
+}
+
+int sim_step(jd_sim *s, int seen, char *err, size_t errlen) {
     const double t0 = sim_clock();
     int moved;
+    const int bad = initial_integrate(s, &moved);
+    if (bad & 4) {
+        /* the last step's forces gave a non-finite v or omega: that step's state is the one to
+         * report (as without the deferred kick); the watchdog names the force or torque */
+        s->nonfinite = 1;
+        return 0;
+    }
     /* A non-finite position stops the step here, before the neighbour search bins it: the run
      * loop's watchdog reports it (sim_watchdog_step) and the run ends. */
-    if (initial_integrate(s, &moved)) {
+    if (bad) {
         s->nonfinite = 1;
         s->step++;
         return 0;
@@ -113,7 +165,10 @@ int sim_step(jd_sim *s, char *err, size_t errlen) {
     const double t2 = sim_clock();
     sim_compute_forces(s);
     const double t3 = sim_clock();
-    s->nonfinite = final_integrate(s);
+    if (seen)
+        s->nonfinite = final_integrate(s);
+    else
+        s->kick_pending = 1;
     s->step++;
     const double t4 = sim_clock();
     s->timing.integration += (t1 - t0) + (t4 - t3);

@@ -385,9 +385,12 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
             rc = JD_RUN_STOPPED;
             break;
         }
-        if ((rc = sim_step(s, err, errlen)) != 0) break;
+        const int seen = due(s->step + 1, sc->output_every, last) ||
+                         due(s->step + 1, sc->observables_every, last);
+        if ((rc = sim_step(s, seen, err, errlen)) != 0) break;
         progress_update(&p, s->step, (double)s->step * s->dt);
     }
+    sim_finish_step(s); /* a run stopped between samples: its stop frame, and the caller */
     s->timing.loop += sim_clock() - t_loop;
     progress_finish(&p);
     if (rc == JD_RUN_TRIPPED || rc == JD_RUN_STOPPED) write_stop_frame(s, h);

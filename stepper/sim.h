@@ -250,6 +250,8 @@ typedef struct jd_sim {
     int nonfinite;              /* the last step left a non-finite x (it then stopped before
                                    the neighbour search), v or omega (a non-finite force or
                                    torque shows up in v or omega) */
+    int kick_pending;           /* the last step's final half kick is not applied yet: v and
+                                   omega are at the half step (sim_step, sim_finish_step) */
     int has_energy_ref;         /* energy_ref holds the previous observable sample */
     jd_energy_terms energy_ref;
     int64_t energy_ref_step;
@@ -329,8 +331,12 @@ void sim_loads_apply(jd_sim *s);
 /* Remap the loaded particles after a re-sort (reorder.c): particle k is now new_index[k]. */
 void sim_loads_permute(jd_loads *l, const int32_t *new_index);
 
-/* integrate.c: one full step.  Returns 0, or -1 with a reason in err. */
-int sim_step(jd_sim *s, char *err, size_t errlen);
+/* integrate.c: one full step.  seen: the state at the step's end is looked at (frame,
+ * observables); else the step's final half kick is left pending (s->kick_pending) and done in
+ * the next step's first pass.  Returns 0, or -1 with a reason in err. */
+int sim_step(jd_sim *s, int seen, char *err, size_t errlen);
+/* Apply a pending final half kick, so that v and omega are those at s->step. */
+void sim_finish_step(jd_sim *s);
 
 /* observables.c */
 typedef struct jd_observables {
