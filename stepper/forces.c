@@ -2,15 +2,14 @@
  * forces.c — force loops.  The scene's feature set (JD_F_* bits) is fixed for a run; the loop
  * body is instantiated once per combination with the bits as a literal constant, so that
  * jd_contact() compiles away every law the scene does not use (DESIGN.md: "leave out what a
- * scene does not need").  Order: the particles' weight (start_forces), then as LIGGGHTS pair
- * forces in list order (the candidates that touched at the build, then the others: sim.h,
- * jd_contact_list), wall forces, bonds, loads.
+ * scene does not need").  Order as LIGGGHTS: pair forces in list order (the candidates that
+ * touched at the build, then the others: sim.h, jd_contact_list), wall forces, gravity.
  *
- * Threads (sim.h, "Threads"): each thread starts the forces of the particles it owns, evaluates
+ * Threads (sim.h, "Threads"): each thread zeroes the forces of the particles it owns, evaluates
  * their entries and adds into f and torque, and into its overflow buffer for partners beyond its
  * particles; after one barrier each thread adds the earlier threads' overflow into its particles
- * in thread order and zeroes it for the next evaluation.  No atomics; with one thread this is
- * exactly the serial loop.
+ * in thread order and zeroes it for the next evaluation (then gravity, for all).  No atomics;
+ * with one thread this is exactly the serial loop.
  */
 #include <math.h>
 #include <stddef.h>
@@ -785,25 +784,15 @@ static void reduce(jd_sim *s, int tid) {
     }
 }
 
-/* The forces of particles [lo, hi) before any contact: their weight (fix gravity), so that no
- * pass over the particles adds it after the contacts, as LIGGGHTS does.  A particle's force is
- * then the same terms summed in another order: with one contact or none, the same bits
- * (a + b = b + a), else round-off (docs/performance.md, "weight first"). */
-static void start_forces(jd_sim *s, size_t lo, size_t hi) {
-    memset(s->torque + 3 * lo, 0, 3 * (hi - lo) * sizeof *s->torque);
+static void gravity(jd_sim *s) {
     const double *g = s->g;
-    if (g[0] == 0.0 && g[1] == 0.0 && g[2] == 0.0) {
-        memset(s->f + 3 * lo, 0, 3 * (hi - lo) * sizeof *s->f);
-        return;
-    }
-    double *restrict f = s->f;
-    const double *restrict mass = s->mass;
-    const double g0 = g[0], g1 = g[1], g2 = g[2];
-    for (size_t i = lo; i < hi; i++) {
-        f[3 * i] = mass[i] * g0;
-        f[3 * i + 1] = mass[i] * g1;
-        f[3 * i + 2] = mass[i] * g2;
-    }
+    if (g[0] == 0.0 && g[1] == 0.0 && g[2] == 0.0) return;
+    const long n = (long)s->n;
+    double *f = s->f;
+    const double *mass = s->mass;
+#pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1)
+    for (long i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) f[3 * i + d] += mass[i] * g[d];
 }
 
 void sim_compute_forces(jd_sim *s) {
@@ -820,7 +809,8 @@ void sim_compute_forces(jd_sim *s) {
 #endif
         /* only this thread writes its particles' f and torque directly (the others' overflow) */
         const jd_thread_share *h = &s->shares[tid];
-        start_forces(s, h->p_lo, h->p_hi);
+        memset(s->f + 3 * h->p_lo, 0, 3 * (h->p_hi - h->p_lo) * sizeof *s->f);
+        memset(s->torque + 3 * h->p_lo, 0, 3 * (h->p_hi - h->p_lo) * sizeof *s->torque);
         s->trips[tid].fraction = 0.0;
         work[tid] = dispatch(s, tid, &t_pairs_end);
         if (nt > 1) {
@@ -835,9 +825,10 @@ void sim_compute_forces(jd_sim *s) {
         if (s->trips[t].fraction > s->overlap_trip.fraction) s->overlap_trip = s->trips[t];
         s->wall_work += work[t];
     }
-    /* then in LIGGGHTS' order: bonds (in parallel with the contacts, bonds.c) and the
+    /* then in LIGGGHTS' order: bonds (in parallel with the contacts, bonds.c), gravity, and the
      * post-force loads (loads.c) */
     if (s->bonds) sim_bonds_forces(s);
+    gravity(s);
     if (s->loads) sim_loads_apply(s);
     const double t1 = sim_clock();
     s->timing.pairs += (t_pairs_end - t0) + (t1 - t_walls_end);

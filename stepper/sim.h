@@ -34,10 +34,10 @@
  * Threads (OpenMP).  At every neighbour build the particles are split into one contiguous range
  * per thread, so that the threads get about equal estimated work: pair entries that touched at
  * the build, the cheaper ones that did not, and wall entries (jd_thread_share).  A thread
- * starts the forces of its particles at their weight (forces.c start_forces), evaluates their
- * pairs and walls and adds straight into f and torque, except for a pair partner j beyond its
- * range: that goes into the thread's overflow buffer, which covers only the few particles past
- * the range that its pairs reach (pairs list j > i in cell order).  After one barrier each thread adds the
+ * zeroes the forces of its particles, evaluates their pairs and walls and adds straight into f
+ * and torque, except for a pair partner j beyond its range: that goes into the thread's
+ * overflow buffer, which covers only the few particles past the range that
+ * its pairs reach (pairs list j > i in cell order).  After one barrier each thread adds the
  * earlier threads' overflow into its own particles, in thread order.  No two threads write the
  * same memory, no atomics, and no full-size buffer to reduce.  For a given thread count the
  * sums are always taken in the same order, so a run is reproducible bit for bit, and runs with
