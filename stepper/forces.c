@@ -784,7 +784,7 @@ static void reduce(jd_sim *s, int tid) {
     }
 }
 
-static void gravity(jd_sim *s) {
+void sim_gravity(jd_sim *s) {
     const double *g = s->g;
     if (g[0] == 0.0 && g[1] == 0.0 && g[2] == 0.0) return;
     const long n = (long)s->n;
@@ -826,9 +826,11 @@ void sim_compute_forces(jd_sim *s) {
         s->wall_work += work[t];
     }
     /* then in LIGGGHTS' order: bonds (in parallel with the contacts, bonds.c), gravity, and the
-     * post-force loads (loads.c) */
+     * post-force loads (loads.c); without loads, the weight is added by the half kick that
+     * follows (integrate.c), which reads f anyway: the same sums, one pass less (sim.h,
+     * weight_in_kick) */
     if (s->bonds) sim_bonds_forces(s);
-    gravity(s);
+    if (s->in_setup || !s->weight_in_kick) sim_gravity(s);
     if (s->loads) sim_loads_apply(s);
     const double t1 = sim_clock();
     s->timing.pairs += (t_pairs_end - t0) + (t1 - t_walls_end);

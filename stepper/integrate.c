@@ -4,7 +4,9 @@
  * with LIGGGHTS to round-off: same expressions, same evaluation order.  When nothing looks at
  * the state between two steps (no frame, no observables), the first step's final_integrate is
  * done in the second step's first pass, which gives the same numbers and streams the particle
- * arrays once per step instead of twice (docs/performance.md).  The loops are split by
+ * arrays once per step instead of twice (docs/performance.md); the kick after a force
+ * evaluation also adds the weight m g when the evaluation left it out (sim.h, weight_in_kick),
+ * which saves gravity's pass over f (the same sums).  The loops are split by
  * particle over the threads (each particle's update is independent, so the result does not
  * depend on the thread count at all).
  */
@@ -19,25 +21,42 @@
  * costs no branch per element. */
 static inline int not_finite(double x) { return x - x != 0.0; }
 
-/* The particles [lo, hi) of initial_integrate, and with twice (s->kick_pending) first the last
- * step's final_integrate, in the same pass: nothing looked at the state in between (sim_step).
+/* What the passes take besides the arrays, as plain values (only the arrays carry restrict). */
+typedef struct pass_consts {
+    double dt;                 /* [s] */
+    double lim;                /* (skin/2)^2 [m^2]: the rebuild check */
+    double g[3];               /* gravity [m/s^2], for the weight m g (s->weight_in_kick) */
+    double dtfm, dtirot, mass; /* every particle's, when they are uniform (s->uniform_mass) */
+} pass_consts;
+
+/* The literal flags of a pass's compiled copies: twice, the last step's final half kick first
+ * (s->kick_pending); weight, add m g to the force the kicks use (s->weight_in_kick); uniform,
+ * take dtfm, dtirot and m from pass_consts rather than streaming their arrays. */
+enum { P_TWICE = 1, P_WEIGHT = 2, P_UNIFORM = 4 };
+
+/* The particles [lo, hi) of initial_integrate, and with twice first the last step's
+ * final_integrate, in the same pass: nothing looked at the state in between (sim_step).
  * Each half kick is rounded as in its own pass (C11 contracts no multiply-add), so the numbers
- * are those of kick then the single kick and drift, bit for bit.  Returns bit 0: some new x is
- * not finite; bit 1: some particle moved more than half the skin; bit 2 (twice): some v or
- * omega after the first half kick, the last step's state, is not finite.  Called through
- * separate functions with restrict arrays, so that the compiler vectorises it (inside an OpenMP
- * region the arrays reach the loop through the region's shared data, and their independence is
- * lost). */
+ * are those of kick then the single kick and drift, bit for bit; so is the weight, f + m g,
+ * the sum the force evaluation would have stored (forces.c, sim_gravity).  The force with its
+ * weight is not stored: nothing looks at it before the next evaluation zeroes it.  Returns
+ * bit 0: some new x is not finite; bit 1: some particle moved more than half the skin; bit 2
+ * (twice): some v or omega after the first half kick, the last step's state, is not finite. */
 static inline __attribute__((always_inline)) int
 kick_drift_pass(long lo, long hi, double *restrict x, double *restrict v, double *restrict w,
                 const double *restrict x0, const double *restrict f, const double *restrict t,
-                const double *restrict dtfm, const double *restrict dtirot, double dt, double lim,
-                const int twice) {
+                const double *restrict dtfm, const double *restrict dtirot,
+                const double *restrict mass, const pass_consts *c, const int twice,
+                const int weight, const int uniform) {
+    const double dt = c->dt, lim = c->lim, g[3] = {c->g[0], c->g[1], c->g[2]};
     int bad = 0, was_bad = 0, far = 0;
     for (long i = lo; i < hi; i++) {
+        const double a = uniform ? c->dtfm : dtfm[i], b = uniform ? c->dtirot : dtirot[i];
+        const double m = uniform ? c->mass : weight ? mass[i] : 0.0;
         double d[3];
         for (int k = 0; k < 3; k++) {
-            const double dv = dtfm[i] * f[3 * i + k], dw = dtirot[i] * t[3 * i + k];
+            const double fk = weight ? f[3 * i + k] + m * g[k] : f[3 * i + k];
+            const double dv = a * fk, dw = b * t[3 * i + k];
             double vn = v[3 * i + k] + dv, wn = w[3 * i + k] + dw;
             if (twice) {
                 was_bad |= not_finite(vn) | not_finite(wn);
@@ -55,33 +74,71 @@ kick_drift_pass(long lo, long hi, double *restrict x, double *restrict v, double
     return bad | (far << 1) | (was_bad << 2);
 }
 
-/* One compiled copy each (twice a literal): a run-time twice made GCC give up the
- * vectorisation (20k integration 0.069 s against 0.026 s). */
-static int kick_drift(long lo, long hi, double *restrict x, double *restrict v, double *restrict w,
-                      const double *restrict x0, const double *restrict f,
-                      const double *restrict t, const double *restrict dtfm,
-                      const double *restrict dtirot, double dt, double lim) {
-    return kick_drift_pass(lo, hi, x, v, w, x0, f, t, dtfm, dtirot, dt, lim, 0);
-}
-static int kick_kick_drift(long lo, long hi, double *restrict x, double *restrict v,
-                           double *restrict w, const double *restrict x0, const double *restrict f,
-                           const double *restrict t, const double *restrict dtfm,
-                           const double *restrict dtirot, double dt, double lim) {
-    return kick_drift_pass(lo, hi, x, v, w, x0, f, t, dtfm, dtirot, dt, lim, 1);
-}
-
-/* The particles [lo, hi) of final_integrate; returns 1 when some new v or omega is not finite. */
-static int kick(long lo, long hi, double *restrict v, double *restrict w, const double *restrict f,
-                const double *restrict t, const double *restrict dtfm,
-                const double *restrict dtirot) {
+/* The particles [lo, hi) of final_integrate; with weight the force gets its weight first, and
+ * keeps it (the state is looked at).  Returns 1 when some new v or omega is not finite. */
+static inline __attribute__((always_inline)) int
+kick_pass(long lo, long hi, double *restrict v, double *restrict w, double *restrict f,
+          const double *restrict t, const double *restrict dtfm, const double *restrict dtirot,
+          const double *restrict mass, const pass_consts *c, const int weight, const int uniform) {
+    const double g[3] = {c->g[0], c->g[1], c->g[2]};
     int bad = 0;
-    for (long i = lo; i < hi; i++)
+    for (long i = lo; i < hi; i++) {
+        const double a = uniform ? c->dtfm : dtfm[i], b = uniform ? c->dtirot : dtirot[i];
+        const double m = uniform ? c->mass : weight ? mass[i] : 0.0;
         for (int d = 0; d < 3; d++) {
-            v[3 * i + d] += dtfm[i] * f[3 * i + d];
-            w[3 * i + d] += dtirot[i] * t[3 * i + d];
+            const double fd = weight ? f[3 * i + d] + m * g[d] : f[3 * i + d];
+            if (weight) f[3 * i + d] = fd;
+            v[3 * i + d] += a * fd;
+            w[3 * i + d] += b * t[3 * i + d];
             bad |= not_finite(v[3 * i + d]) | not_finite(w[3 * i + d]);
         }
+    }
     return bad;
+}
+
+/* The compiled copies, one per set of flags (a literal each): a run-time flag inside the loop
+ * made GCC give up the vectorisation (20k integration 0.069 s against 0.026 s).  Separate
+ * functions with restrict arrays: inside an OpenMP region the arrays reach the loop through the
+ * region's shared data, and their independence is lost. */
+static int kick_drift(int flags, long lo, long hi, double *restrict x, double *restrict v,
+                      double *restrict w, const double *restrict x0, const double *restrict f,
+                      const double *restrict t, const double *restrict dtfm,
+                      const double *restrict dtirot, const double *restrict mass,
+                      const pass_consts *c) {
+#define JD_KICK_DRIFT(tw, we, un) kick_drift_pass(lo, hi, x, v, w, x0, f, t, dtfm, dtirot, mass, c, tw, we, un)
+    switch (flags) {
+    case 0: return JD_KICK_DRIFT(0, 0, 0);
+    case P_UNIFORM: return JD_KICK_DRIFT(0, 0, 1);
+    case P_TWICE: return JD_KICK_DRIFT(1, 0, 0);
+    case P_TWICE | P_UNIFORM: return JD_KICK_DRIFT(1, 0, 1);
+    case P_TWICE | P_WEIGHT: return JD_KICK_DRIFT(1, 1, 0);
+    default: return JD_KICK_DRIFT(1, 1, 1); /* P_TWICE | P_WEIGHT | P_UNIFORM */
+    }
+#undef JD_KICK_DRIFT
+}
+
+static int kick(int flags, long lo, long hi, double *restrict v, double *restrict w,
+                double *restrict f, const double *restrict t, const double *restrict dtfm,
+                const double *restrict dtirot, const double *restrict mass, const pass_consts *c) {
+#define JD_KICK(we, un) kick_pass(lo, hi, v, w, f, t, dtfm, dtirot, mass, c, we, un)
+    switch (flags) {
+    case 0: return JD_KICK(0, 0);
+    case P_UNIFORM: return JD_KICK(0, 1);
+    case P_WEIGHT: return JD_KICK(1, 0);
+    default: return JD_KICK(1, 1); /* P_WEIGHT | P_UNIFORM */
+    }
+#undef JD_KICK
+}
+
+static pass_consts consts_of(const jd_sim *s) {
+    pass_consts c = {.dt = s->dt, .lim = 0.25 * s->skin * s->skin,
+                     .g = {s->g[0], s->g[1], s->g[2]}};
+    if (s->uniform_mass) {
+        c.dtfm = s->dtfm[0];
+        c.dtirot = s->dtirot[0];
+        c.mass = s->mass[0];
+    }
+    return c;
 }
 
 /* [lo, hi) of thread tid's share of n particles (the same split as schedule(static)). */
@@ -99,38 +156,42 @@ static void share(long n, long *lo, long *hi) {
  * dtfm and dtirot are precomputed per particle with exactly LIGGGHTS' expressions, so the
  * products are bit-identical; each particle's update is independent, so doing the kick and the
  * drift in one pass gives LIGGGHTS' numbers exactly.  With s->kick_pending the pass first
- * applies the last step's final half kick (kick_kick_drift).  The same pass checks whether some
- * particle moved more than half the skin since the last neighbour build (*moved; !(<=) so that a
- * NaN position forces a rebuild, which reports it).  Returns bit 0: some new x is not finite;
- * bit 2: the pending kick left some v or omega not finite. */
+ * applies the last step's final half kick (kick_drift with P_TWICE), with the weight if the
+ * force evaluation left it out.  The same pass checks whether some particle moved more than
+ * half the skin since the last neighbour build (*moved; !(<=) so that a NaN position forces a
+ * rebuild, which reports it).  Returns bit 0: some new x is not finite; bit 2: the pending kick
+ * left some v or omega not finite. */
 static int initial_integrate(jd_sim *s, int *moved) {
-    const double lim = 0.25 * s->skin * s->skin; /* (skin/2)^2 */
+    const pass_consts c = consts_of(s);
     const int pending = s->kick_pending;
+    const int flags = (pending ? P_TWICE : 0) | (pending && s->weight_in_kick ? P_WEIGHT : 0) |
+                      (s->uniform_mass ? P_UNIFORM : 0);
     int bits = 0;
 #pragma omp parallel num_threads(s->threads) if (s->threads > 1) reduction(| : bits)
     {
         long lo, hi;
         share((long)s->n, &lo, &hi);
-        if (pending)
-            bits |= kick_kick_drift(lo, hi, s->x, s->v, s->omega, s->x_build, s->f, s->torque,
-                                    s->dtfm, s->dtirot, s->dt, lim);
-        else
-            bits |= kick_drift(lo, hi, s->x, s->v, s->omega, s->x_build, s->f, s->torque,
-                               s->dtfm, s->dtirot, s->dt, lim);
+        bits |= kick_drift(flags, lo, hi, s->x, s->v, s->omega, s->x_build, s->f, s->torque,
+                           s->dtfm, s->dtirot, s->mass, &c);
     }
     s->kick_pending = 0;
     *moved = (bits & 2) != 0;
     return bits & 5;
 }
 
-/* final_integrate: the same half kick, returning 1 when some new v or omega is not finite. */
+/* final_integrate: the same half kick, returning 1 when some new v or omega is not finite.  The
+ * force it follows is always a fresh evaluation's (sim_step, sim_finish_step): with
+ * s->weight_in_kick the weight is added to it here, and kept. */
 static int final_integrate(jd_sim *s) {
+    const pass_consts c = consts_of(s);
+    const int flags = (s->weight_in_kick ? P_WEIGHT : 0) | (s->uniform_mass ? P_UNIFORM : 0);
     int bad = 0;
 #pragma omp parallel num_threads(s->threads) if (s->threads > 1) reduction(| : bad)
     {
         long lo, hi;
         share((long)s->n, &lo, &hi);
-        bad |= kick(lo, hi, s->v, s->omega, s->f, s->torque, s->dtfm, s->dtirot);
+        bad |= kick(flags, lo, hi, s->v, s->omega, s->f, s->torque, s->dtfm, s->dtirot, s->mass,
+                    &c);
     }
     return bad;
 }
@@ -149,7 +210,9 @@ int sim_step(jd_sim *s, int seen, char *err, size_t errlen) {
     const int bad = initial_integrate(s, &moved);
     if (bad & 4) {
         /* the last step's forces gave a non-finite v or omega: that step's state is the one to
-         * report (as without the deferred kick); the watchdog names the force or torque */
+         * report (as without the deferred kick); the watchdog names the force or torque, which
+         * gets its weight as final_integrate would have given it */
+        if (s->weight_in_kick) sim_gravity(s);
         s->nonfinite = 1;
         return 0;
     }

@@ -91,6 +91,10 @@ static void init_kinds(jd_sim *s) {
         s->r_alike = s->radius[0];
         sim_pair_constants(s, 0, 0, &s->pc_alike, &s->pcr_alike);
     }
+    s->uniform_mass = s->n > 0 && !s->opt.plain_loops; /* plain: the reference path */
+    for (size_t i = 1; i < s->n && s->uniform_mass; i++)
+        s->uniform_mass = s->mass[i] == s->mass[0] && s->dtfm[i] == s->dtfm[0] &&
+                          s->dtirot[i] == s->dtirot[0];
 }
 
 /* The next `bytes` of the per-particle block (alloc_particle_arrays) at offset *at: 64-byte
@@ -243,6 +247,8 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
     }
     if (sim_walls_init(s, err, errlen) != 0) return -1;
     if (sim_bonds_init(s, err, errlen) != 0 || sim_loads_init(s, err, errlen) != 0) return -1;
+    s->weight_in_kick = !s->loads && !s->opt.plain_loops &&
+                        (s->g[0] != 0.0 || s->g[1] != 0.0 || s->g[2] != 0.0);
     if (sim_neighbour_build(s, err, errlen) != 0) return -1;
     return setup_forces(s, err, errlen);
 }

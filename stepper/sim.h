@@ -81,7 +81,9 @@ typedef struct jd_sim_options {
     int no_sort;      /* keep the scene's particle order (reference for the sorted path) */
     int all_laws;     /* evaluate every law even where its coefficient makes it vanish (the
                          general loop; reference for the feature-specialised ones) */
-    int plain_loops;  /* one contact at a time instead of SIMD batches (reference for them) */
+    int plain_loops;  /* the reference for the fast paths: one contact at a time instead of
+                       * SIMD batches, gravity in a pass of its own, the integration constants
+                       * read per particle */
     int threads;      /* OpenMP threads of the force and integration loops; <= 0: 1 */
 } jd_sim_options;
 
@@ -252,6 +254,12 @@ typedef struct jd_sim {
                                    torque shows up in v or omega) */
     int kick_pending;           /* the last step's final half kick is not applied yet: v and
                                    omega are at the half step (sim_step, sim_finish_step) */
+    int weight_in_kick;         /* gravity acts and no post-force load comes after it: the
+                                   weight m g is added by the half kick that follows each force
+                                   evaluation (integrate.c) rather than by a pass of its own;
+                                   the step-0 evaluation still adds it (sim_gravity) */
+    int uniform_mass;           /* every particle has particle 0's mass, dtfm and dtirot, bit
+                                   for bit: the integration passes read them once */
     int has_energy_ref;         /* energy_ref holds the previous observable sample */
     jd_energy_terms energy_ref;
     int64_t energy_ref_step;
@@ -312,8 +320,11 @@ static inline long long sim_particle_id(const jd_sim *s, size_t i) {
 int sim_walls_init(jd_sim *s, char *err, size_t errlen);
 void sim_walls_move(jd_sim *s);
 
-/* forces.c: zero f and torque, then pair forces, wall forces, gravity. */
+/* forces.c: zero f and torque, then pair forces, wall forces, bonds, gravity (unless
+ * s->weight_in_kick), loads. */
 void sim_compute_forces(jd_sim *s);
+/* Add every particle's weight m g to its force. */
+void sim_gravity(jd_sim *s);
 /* The force loops' per-thread state for s->threads threads (sim_init), and its release. */
 int sim_forces_init(jd_sim *s);
 void sim_forces_free(jd_sim *s);
