@@ -387,6 +387,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
         return -1;
     }
     memcpy(s->x_build, s->x, 3 * s->n * sizeof *s->x);
+    s->drift_bound = 0.0;
     for (size_t w = 0; w < s->n_walls; w++) memset(s->walls[w].disp, 0, sizeof s->walls[w].disp);
     s->n_builds++;
     return 0;

@@ -83,7 +83,7 @@ typedef struct jd_sim_options {
                          general loop; reference for the feature-specialised ones) */
     int plain_loops;  /* the reference for the fast paths: one contact at a time instead of
                        * SIMD batches, gravity in a pass of its own, the integration constants
-                       * read per particle */
+                       * read per particle, the rebuild check against x_build at every step */
     int threads;      /* OpenMP threads of the force and integration loops; <= 0: 1 */
 } jd_sim_options;
 
@@ -258,6 +258,9 @@ typedef struct jd_sim {
                                    weight m g is added by the half kick that follows each force
                                    evaluation (integrate.c) rather than by a pass of its own;
                                    the step-0 evaluation still adds it (sim_gravity) */
+    double drift_bound;         /* [m] the sum, over the steps since the last neighbour build,
+                                   of dt times the largest speed: no particle has moved further
+                                   (integrate.c, the rebuild check) */
     int uniform_mass;           /* every particle has particle 0's mass, dtfm and dtirot, bit
                                    for bit: the integration passes read them once */
     int has_energy_ref;         /* energy_ref holds the previous observable sample */

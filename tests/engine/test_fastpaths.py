@@ -134,12 +134,36 @@ contacts = ref["obs"]["contacts"]
 c.check("scene_has_many_contacts", contacts.max() >= 20 and (contacts[1:] > 0).all(),
         f"pair contacts per sample {contacts.tolist()}")
 
-srt, _, _ = run_file(base)
+srt, srt_builds, _ = run_file(base)
 c.check("sorting_changes_summation_order", not identical(ref, srt),
         "sorted and unsorted runs are identical: was anything renumbered?")
 roundoff_equal(c, "sorted_vs_unsorted", srt, ref)
 
-plain, _, _ = run_file(base, "--plain-loops")
+plain, plain_builds, _ = run_file(base, "--plain-loops")
+# the plain path checks every step whether to rebuild; the fast one only once the particles
+# could have moved half the skin (integrate.c, drift_bound): the rebuilds must be the same
+c.check("batched_vs_plain_same_rebuilds", srt_builds == plain_builds,
+        f"{srt_builds} neighbour builds against {plain_builds} with the check at every step")
+# Two spheres in free flight, each 0.63 of the skin per step (skin 0.2 R, sim.c): every step
+# must rebuild, also the first step after a build, where the fast check's bound jumps past its
+# mark in one step and the exact test decides on its own (integrate.c, far_check).
+STEPS_FAST = 40
+fast = variant(f"""jdem_scene: 1
+name: fast_flight
+description: two spheres each moving more than half the skin per step
+time: {{dt: 1.4e-5, steps: {STEPS_FAST}}}
+output: {{every: {STEPS_FAST}}}
+materials:
+  soft: {{youngs_modulus: 1.0e5, poisson_ratio: 0.3, density: 2500, restitution: 0.5, friction: 0.5}}
+particles:
+  - {{material: soft, radius: 0.001, position: [0, 0, 0], velocity: [9.0, 0.0, 0.0]}}
+  - {{material: soft, radius: 0.001, position: [0.0, 0.01, 0.0], velocity: [-9.0, 0.0, 0.0]}}
+""", "fast_flight")
+assert 9.0 * 1.4e-5 > 0.5 * 0.2 * 0.001
+_, fast_builds, _ = run_file(fast)
+c.check("fast_flight_rebuilds_every_step", fast_builds == STEPS_FAST + 1,
+        f"{fast_builds} neighbour builds in {STEPS_FAST} steps of 0.63 skin each (expected "
+        f"{STEPS_FAST + 1}: the set-up build and one per step)")
 c.check("batched_vs_plain_loops_identical", identical(srt, plain),
         "the SIMD-batched force loops differ from the one-contact-at-a-time loops: position "
         f"{rel_diff(srt, plain, 'position'):.3g}")
