@@ -40,6 +40,15 @@ typedef struct pass_consts {
  * (s->drift_bound). */
 enum { P_TWICE = 1, P_WEIGHT = 2, P_UNIFORM = 4, P_CHECK = 8 };
 
+/* The rebuild check of particle i: 1 when it moved more than half the skin since the last
+ * neighbour build (lim = (skin/2)^2; !(<=) so that a NaN position counts as moved). */
+static inline __attribute__((always_inline)) int
+moved_far(const double *restrict x, const double *restrict x0, long i, double lim) {
+    const double d[3] = {x[3 * i] - x0[3 * i], x[3 * i + 1] - x0[3 * i + 1],
+                         x[3 * i + 2] - x0[3 * i + 2]};
+    return !(jd_dot(d, d) <= lim);
+}
+
 /* The particles [lo, hi) of initial_integrate, and with twice first the last step's
  * final_integrate, in the same pass: nothing looked at the state in between (sim_step).
  * Each half kick is rounded as in its own pass (C11 contracts no multiply-add), so the numbers
@@ -62,7 +71,7 @@ kick_drift_pass(long lo, long hi, double *restrict x, double *restrict v, double
     for (long i = lo; i < hi; i++) {
         const double a = uniform ? c->dtfm : dtfm[i], b = uniform ? c->dtirot : dtirot[i];
         const double m = uniform ? c->mass : weight ? mass[i] : 0.0;
-        double d[3], u[3];
+        double u[3];
         for (int k = 0; k < 3; k++) {
             const double fk = weight ? f[3 * i + k] + m * g[k] : f[3 * i + k];
             const double dv = a * fk, dw = b * t[3 * i + k];
@@ -76,13 +85,10 @@ kick_drift_pass(long lo, long hi, double *restrict x, double *restrict v, double
             w[3 * i + k] = wn;
             x[3 * i + k] += dt * vn;
             bad |= not_finite(x[3 * i + k]);
-            if (check)
-                d[k] = x[3 * i + k] - x0[3 * i + k];
-            else
-                u[k] = vn;
+            u[k] = vn;
         }
         if (check) {
-            far |= !(jd_dot(d, d) <= lim);
+            far |= moved_far(x, x0, i, lim);
         } else {
             /* u2 >= +0 (or NaN), whose bits order as the numbers do: an integer maximum, which
              * GCC vectorises (a floating-point one only with -ffinite-math-only: 5k bed,
@@ -148,15 +154,11 @@ static int kick_drift(int flags, long lo, long hi, double *restrict x, double *r
 }
 
 /* The rebuild check alone over [lo, hi): 1 when some particle moved more than half the skin
- * since the last neighbour build (the expression of kick_drift_pass with check). */
+ * since the last neighbour build. */
 static int far_check(long lo, long hi, const double *restrict x, const double *restrict x0,
                      double lim) {
     int far = 0;
-    for (long i = lo; i < hi; i++) {
-        const double d[3] = {x[3 * i] - x0[3 * i], x[3 * i + 1] - x0[3 * i + 1],
-                             x[3 * i + 2] - x0[3 * i + 2]};
-        far |= !(jd_dot(d, d) <= lim);
-    }
+    for (long i = lo; i < hi; i++) far |= moved_far(x, x0, i, lim);
     return far;
 }
 
