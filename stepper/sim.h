@@ -92,7 +92,8 @@ typedef struct jd_timing {
     double neighbour;   /* rebuild check and rebuilds, including the reordering */
     double pairs;       /* particle-pair force loop, zeroing and the reduction of the buffers */
     double walls;       /* particle-wall force loop */
-    double integration; /* half kicks, drift, non-finite probes, wall motion */
+    double integration; /* half kicks, drift, non-finite probes, wall motion, and the weight
+                         * when the kicks add it (weight_in_kick) */
     double output;      /* frames, observables and the energy watchdog */
     double loop;        /* the whole time loop (sim_run), the parts above and what they leave
                          * out: the bonds' events, the per-step watchdog, progress; what
