@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "atom.h"
@@ -25,6 +26,7 @@
 #include "pair.h"
 #include "update.h"
 
+#include "jdem_input_file.h"
 #include "jdem_observables.h"
 
 using namespace LAMMPS_NS;
@@ -255,13 +257,14 @@ void FixBondJiang::read_bond_file(const char *path) {
   int nbad = 0;
   char msg[512] = "";
   if (comm->me == 0) {
-    std::ifstream in(path);
-    if (!in) {
-      std::snprintf(msg, sizeof msg, "fix bond/jiang: cannot read bond file %s", path);
-      nbad = 1;
-    }
+    std::ifstream in;
+    std::string why = jdem_open_input("fix bond/jiang: bond file", path, in);
+    std::map<std::pair<long, long>, int> seen; /* pair -> line */
     std::string line;
-    for (int lineno = 1; !nbad && std::getline(in, line); lineno++) {
+    int lineno = 1;
+    for (; why.empty() && std::getline(in, line); lineno++) {
+      why = jdem_text_line("fix bond/jiang: bond file", path, lineno, line);
+      if (!why.empty()) break;
       const size_t hash = line.find('#');
       if (hash != std::string::npos) line.erase(hash);
       std::istringstream ls(line);
@@ -276,8 +279,22 @@ void FixBondJiang::read_bond_file(const char *path) {
         nbad = 1;
         break;
       }
+      const std::pair<long, long> key(std::min(a, b), std::max(a, b));
+      if (seen.count(key)) {
+        std::snprintf(msg, sizeof msg, "fix bond/jiang: %s line %d: the bond %ld-%ld is listed twice "
+                      "(first on line %d)", path, lineno, key.first, key.second, seen[key]);
+        nbad = 1;
+        break;
+      }
+      seen[key] = lineno;
       pairs.push_back((int)std::min(a, b));
       pairs.push_back((int)std::max(a, b));
+    }
+    if (why.empty() && !nbad && pairs.empty())
+      why = std::string("fix bond/jiang: bond file ") + path + ": holds no bonds (lines \"ID_A ID_B\")";
+    if (!why.empty() && !nbad) {
+      std::snprintf(msg, sizeof msg, "%s", why.c_str());
+      nbad = 1;
     }
   }
   MPI_Bcast(&nbad, 1, MPI_INT, 0, world);

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "memory.h"
 #include "update.h"
 
+#include "jdem_input_file.h"
 #include "jdem_kernel.h"
 
 using namespace LAMMPS_NS;
@@ -47,13 +49,13 @@ void FixJdemLoads::read_file(const char *path) {
   char msg[512] = "";
   int bad = 0;
   if (comm->me == 0) {
-    std::ifstream in(path);
-    if (!in) {
-      std::snprintf(msg, sizeof msg, "fix jdem/loads: cannot read %s", path);
-      bad = 1;
-    }
+    std::ifstream in;
+    std::string why = jdem_open_input("fix jdem/loads: file", path, in);
+    std::map<double, int> seen; /* id -> line */
     std::string line;
-    for (int lineno = 1; !bad && std::getline(in, line); lineno++) {
+    for (int lineno = 1; !bad && why.empty() && std::getline(in, line); lineno++) {
+      why = jdem_text_line("fix jdem/loads: file", path, lineno, line);
+      if (!why.empty()) break;
       const size_t hash = line.find('#');
       if (hash != std::string::npos) line.erase(hash);
       std::istringstream ls(line);
@@ -65,8 +67,19 @@ void FixJdemLoads::read_file(const char *path) {
         std::snprintf(msg, sizeof msg, "fix jdem/loads: %s line %d: expected \"ID FX FY FZ HELD\" with an "
                       "atom id between 1 and %d and HELD 0 or 1", path, lineno, atom->map_tag_max);
         bad = 1;
+      } else if (seen.count(v[0])) {
+        std::snprintf(msg, sizeof msg, "fix jdem/loads: %s line %d: atom id %.0f is listed twice (first on "
+                      "line %d)", path, lineno, v[0], seen[v[0]]);
+        bad = 1;
       }
+      seen[v[0]] = lineno;
       rows.insert(rows.end(), v, v + 5);
+    }
+    if (why.empty() && !bad && rows.empty())
+      why = std::string("fix jdem/loads: file ") + path + ": holds no loads (lines \"ID FX FY FZ HELD\")";
+    if (!why.empty() && !bad) {
+      std::snprintf(msg, sizeof msg, "%s", why.c_str());
+      bad = 1;
     }
   }
   MPI_Bcast(&bad, 1, MPI_INT, 0, world);

@@ -223,7 +223,10 @@ void FixJdemWatchdog::trip(const std::string &msg, bool write_frame) {
   std::string full = msg;
   for (int k = 0; k < output->ndump; k++) {
     DumpH5mdJdem *d = dynamic_cast<DumpH5mdJdem *>(output->dump[k]);
-    if (d) /* a non-finite state gets no frame: the file ends with the step before */
+    if (d && d->last_frame_step() < 0) /* a non-finite state at set-up: no frame, no file */
+      full += format("; no trajectory was written (%s: the run failed before its first frame)",
+                     d->file_name().c_str());
+    else if (d) /* a non-finite state gets no frame: the file ends with the step before */
       full += format("; the trajectory up to step " BIGINT_FORMAT " is kept, closed, as %s.part "
                      "(the run failed)", d->last_frame_step(), d->file_name().c_str());
   }

@@ -16,12 +16,14 @@
  *                           same way, so that h5md/jdem can tell a normal end from LIGGGHTS'
  *                           error path (Error::all deletes Output) and keep PATH.part then.
  * SIGINT/SIGTERM stop a run cleanly (jdem_stop.h: Integrate::ev_set is interposed the same way).
+ * Error::all/one are interposed too (jdem_error.h): every rank's error reaches stderr and the log.
  * Do not use the `clear` command: it re-creates Force and Modify and drops the registrations. */
 #include <dlfcn.h>
 #include <mpi.h>
 
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <string>
 
@@ -41,6 +43,8 @@
 #include "fix_jdem_guard.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_wall_jiang.h"
+#include "jdem_error.h"
+#include "jdem_input_file.h"
 #include "jdem_stop.h"
 #include "pair_gran_jiang.h"
 
@@ -120,6 +124,14 @@ void Output::add_dump(int narg, char **arg) {
     var_dump = (char **)memory->srealloc(var_dump, max_dump * sizeof(char *), "output:var_dump");
     memory->grow(ivar_dump, max_dump, "output:ivar_dump");
   }
+  /* the scene_yaml file is copied whole into /parameters: a directory, /dev/zero or an empty
+   * file is refused here, with its name (every rank sees the same file) */
+  for (int i = 5; i + 1 < narg; i++)
+    if (std::strcmp(arg[i], "scene_yaml") == 0) {
+      std::ifstream in;
+      const std::string why = jdem_open_input("dump h5md/jdem: scene_yaml", arg[i + 1], in);
+      if (!why.empty()) error->all(FLERR, why.c_str());
+    }
   dump[ndump] = new DumpH5mdJdem(lmp, narg, arg);
   every_dump[ndump] = every;
   last_dump[ndump] = -1;
@@ -167,6 +179,9 @@ int main(int argc, char **argv) {
       std::fputs(jdem_help, stdout);
       std::fflush(stdout);
     }
+  for (int i = 1; i + 1 < argc; i++)
+    if (std::strcmp(argv[i], "-log") == 0 || std::strcmp(argv[i], "-l") == 0)
+      jdem_error_log_path(std::strcmp(argv[i + 1], "none") == 0 ? NULL : argv[i + 1]);
   LAMMPS *lmp = new LAMMPS(argc, argv, MPI_COMM_WORLD);
   register_jdem_styles(lmp);
   jdem_catch_stop_signals();

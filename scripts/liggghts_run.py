@@ -3,20 +3,53 @@
 
     scripts/liggghts_run.py SCENE [--case NAME] -o OUT.h5 [--np N] [--force]
 
-Resolves the scene with `build/jdem resolve`, generates the deck with scene_to_liggghts.py into
-OUT minus .h5 plus `.deck/` (in.jdem, particles.data, resolved.yaml, log.lammps) and runs
-build/liggghts-jdem there (through mpirun for N > 1; the root flags of Open MPI are added only
-when running as root).  --force runs an unsafe time step anyway (fix jdem/guard ... force).
-Exits non-zero on failure with the tail of the log.
+Resolves the scene with `build/jdem resolve` first (a bad scene changes nothing on disk), then
+takes an exclusive lock on the deck directory OUT minus .h5 plus `.deck/` (in.jdem,
+particles.data, resolved.yaml, log.lammps): a second run on the same OUT is refused while one
+runs.  It generates the deck with scene_to_liggghts.py there and runs build/liggghts-jdem in it
+(through mpirun for N > 1; the root flags of Open MPI are added only when running as root).
+The dump writes OUT.h5.part and renames it, with its OUT.xdmf, only once the run is complete: an
+earlier OUT.h5 and OUT.xdmf stay in place until then, and a stopped run leaves OUT.h5.part.
+SIGINT and SIGTERM are forwarded to LIGGGHTS (or mpirun) and waited for: it stops at its next
+step and keeps OUT.h5.part.  --force runs an unsafe time step anyway (fix jdem/guard ... force).
+
+Exit status (the classes of `jdem`'s):
+  0        the trajectory OUT.h5 is complete
+  1        internal error (LIGGGHTS failed without a message, or wrote no trajectory)
+  2        bad input: the scene, the deck generator's refusal or a LIGGGHTS error
+  3        I/O: another run holds OUT's lock, or writing the deck or the trajectory failed
+  4        the watchdog stopped the run (OUT.h5.part kept)
+  5        out of memory
+  128 + N  stopped by signal N (130 SIGINT, 143 SIGTERM; OUT.h5.part kept)
+On failure the tail of the log follows the message.
 """
 import argparse
+import errno
+import fcntl
 import os
+import re
 import shutil
+import signal
 import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
+
+EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_IO, EXIT_WATCHDOG, EXIT_MEMORY = 0, 1, 2, 3, 4, 5
+
+# the failure class of a LIGGGHTS error line (the first pattern that matches; else bad input)
+ERROR_CLASSES = [
+    (re.compile(r"jdem: watchdog:"), EXIT_WATCHDOG),
+    (re.compile(r"out of memory|Failed to allocate|std::bad_alloc", re.I), EXIT_MEMORY),
+    (re.compile(r"h5md/jdem|HDF5|cannot (create|write|open|rename)|No space left|Read-only|"
+                r"Permission denied", re.I), EXIT_IO),
+]
+
+
+def say(msg):
+    sys.stderr.write("liggghts_run: %s\n" % msg)
+    sys.stderr.flush()
 
 
 def tail(path, n=25):
@@ -25,6 +58,100 @@ def tail(path, n=25):
             return "".join(f.readlines()[-n:])
     except OSError:
         return ""
+
+
+def error_class(log_text):
+    """The exit status of a LIGGGHTS run that failed with ERROR lines in its log."""
+    errors = [line for line in log_text.splitlines() if line.startswith("ERROR") or "jdem: watchdog:" in line]
+    if not errors:
+        return EXIT_INTERNAL
+    for pattern, code in ERROR_CLASSES:
+        if any(pattern.search(line) for line in errors):
+            return code
+    return EXIT_INPUT
+
+
+def lock_deck(deck_dir):
+    """An exclusive flock on the deck directory, or None when another run holds it."""
+    fd = os.open(deck_dir, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as e:
+        os.close(fd)
+        if e.errno in (errno.EWOULDBLOCK, errno.EAGAIN):
+            return None
+        raise
+    return fd
+
+
+class Child:
+    """LIGGGHTS (or mpirun) in a process group of its own, so that a terminal's ^C reaches it
+    once, through us: SIGINT/SIGTERM to this script are forwarded to it, and it is waited for.
+    A signal before it starts is forwarded when it does (or ends the script before it)."""
+
+    def __init__(self):
+        self.proc = None
+        self.signal = 0
+        self.forwarded = 0  # signals sent: a second one takes LIGGGHTS' default action
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, self.forward)
+
+    def forward(self, sig, _frame):
+        self.signal = sig
+        if self.proc is not None and self.proc.poll() is None:
+            self.forwarded += 1
+            os.kill(self.proc.pid, sig)
+
+    def run(self, cmd, cwd, lock_fd):
+        # the lock is passed on: it holds while LIGGGHTS runs, even if this script is killed
+        self.proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True, errors="replace", process_group=0, pass_fds=(lock_fd,))
+        if self.signal and not self.forwarded:
+            self.forwarded += 1
+            os.kill(self.proc.pid, self.signal)
+        out, err = self.proc.communicate()
+        return self.proc.returncode, out, err
+
+
+def resolve(a):
+    """The resolved scene (text), or the exit status of `jdem resolve` with its message shown."""
+    cmd = [a.jdem, "resolve", a.scene] + (["--case", a.case] if a.case else [])
+    try:
+        r = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
+    except OSError as e:
+        say("cannot run %s: %s" % (a.jdem, e))
+        return None, EXIT_INTERNAL
+    if r.returncode != 0:
+        say("%s failed (exit %d); nothing was written:\n%s" % (" ".join(cmd), r.returncode, r.stderr))
+        return None, r.returncode if 0 < r.returncode < 128 else EXIT_INPUT
+    return r.stdout, EXIT_OK
+
+
+def write_deck(a, text, deck_dir, out):
+    """resolved.yaml and the deck in DECK_DIR; 0 or the exit status of a failure (shown)."""
+    resolved = os.path.join(deck_dir, "resolved.yaml")
+    try:
+        with open(resolved, "w") as f:
+            f.write(text)
+    except OSError as e:
+        say("cannot write %s: %s" % (resolved, e))
+        return EXIT_IO
+    r = subprocess.run([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), resolved,
+                        "-o", os.path.join(deck_dir, "in.jdem"), "--trajectory", out] +
+                       (["--force"] if a.force else []), capture_output=True, text=True, errors="replace")
+    if r.returncode != 0:
+        say("deck generation failed (exit %d):\n%s" % (r.returncode, r.stderr))
+        return r.returncode if r.returncode in (EXIT_INPUT, EXIT_IO) else EXIT_INTERNAL
+    return EXIT_OK
+
+
+def liggghts_command(a):
+    run = [os.path.abspath(a.liggghts), "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"]
+    if a.np > 1:
+        mpirun = shutil.which("mpirun") or "mpirun"
+        flags = ["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []
+        run = [mpirun] + flags + ["-np", str(a.np)] + run
+    return run
 
 
 def main():
@@ -37,44 +164,47 @@ def main():
     ap.add_argument("--jdem", default=os.path.join(ROOT, "build", "jdem"))
     ap.add_argument("--liggghts", default=os.path.join(ROOT, "build", "liggghts-jdem"))
     a = ap.parse_args()
+    child = Child()
 
     out = os.path.abspath(a.output)
     base = out[:-3] if out.endswith(".h5") else out
     deck_dir = base + ".deck"
-    os.makedirs(deck_dir, exist_ok=True)
-    for stale in (out, out + ".part"):
-        if os.path.exists(stale):
-            os.remove(stale)
+    text, rc = resolve(a)
+    if text is None:
+        return rc
+    if child.signal:
+        return 128 + child.signal
+    try:
+        os.makedirs(deck_dir, exist_ok=True)
+        lock = lock_deck(deck_dir)
+    except OSError as e:
+        say("cannot create the deck directory %s: %s" % (deck_dir, e))
+        return EXIT_IO
+    if lock is None:
+        say("another run is writing %s (it holds the lock on %s); this one is not started" % (out, deck_dir))
+        return EXIT_IO
+    rc = write_deck(a, text, deck_dir, out)
+    if rc != EXIT_OK:
+        return rc
+    if child.signal:
+        return 128 + child.signal
 
-    cmd = [a.jdem, "resolve", a.scene] + (["--case", a.case] if a.case else [])
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.stderr.write("liggghts_run: %s failed:\n%s" % (" ".join(cmd), r.stderr))
-        return 1
-    resolved = os.path.join(deck_dir, "resolved.yaml")
-    with open(resolved, "w") as f:
-        f.write(r.stdout)
-    deck = os.path.join(deck_dir, "in.jdem")
-    r = subprocess.run([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), resolved,
-                        "-o", deck, "--trajectory", out] + (["--force"] if a.force else []),
-                       capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.stderr.write("liggghts_run: deck generation failed:\n%s" % r.stderr)
-        return 1
-
-    exe = os.path.abspath(a.liggghts)
-    run = [exe, "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"]
-    if a.np > 1:
-        mpirun = shutil.which("mpirun") or "mpirun"
-        flags = ["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []
-        run = [mpirun] + flags + ["-np", str(a.np)] + run
-    r = subprocess.run(run, cwd=deck_dir, capture_output=True, text=True)
+    run = liggghts_command(a)
+    rc, stdout, stderr = child.run(run, deck_dir, lock)
     log = os.path.join(deck_dir, "log.lammps")
-    if r.returncode != 0 or not os.path.exists(out):
-        sys.stderr.write("liggghts_run: %s failed (exit %d) in %s\n--- log tail ---\n%s%s%s" % (
-            " ".join(run), r.returncode, deck_dir, tail(log), r.stdout[-2000:], r.stderr[-2000:]))
-        return 1
-    return 0
+    if rc < 0:
+        rc = 128 - rc
+    if rc == 0 and os.path.exists(out):
+        return EXIT_OK
+    if rc >= 128:
+        status = rc
+    elif rc == 0:
+        status = EXIT_INTERNAL  # exit 0 without the trajectory
+    else:
+        status = error_class(tail(log, 200) + stderr)
+    say("%s failed (exit %d) in %s\n--- log tail ---\n%s%s%s" % (
+        " ".join(run), rc, deck_dir, tail(log), stdout[-2000:], stderr[-2000:]))
+    return status
 
 
 if __name__ == "__main__":

@@ -81,6 +81,13 @@ SUITES += [
      "lines", {}),
 ]
 
+# The Ch. 4 mixing analysis (scripts/mixing) on synthetic deposits, and its pictures.
+SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py; a=$?; "
+                                f"{PY} tests/mixing/test_pictures.py; b=$?; exit $((a | b))"],
+            "lines", {})]
+# The campaign driver (scripts/campaign.py) with dummy units, a killed run resumed.
+SUITES += [("campaign", [PY, "tests/mixing/test_campaign.py"], "lines", {})]
+
 CMOCKA_OK = re.compile(r"^\[\s+OK\s+\] (\S+)")
 CMOCKA_FAIL = re.compile(r"^\[\s+FAILED\s+\] (\S+)$")
 

@@ -1,6 +1,9 @@
 /* main.c — runs every unit-test suite of tests/unit; exit status is the number of failures. */
 #include "unit.h"
 
+int run_inlet_tests(void);
+int run_servo_tests(void);
+
 int main(void) {
     int failed = 0;
     failed += run_kernel_tests();
@@ -11,5 +14,7 @@ int main(void) {
     failed += run_bond_tests();
     failed += run_h5md_bonds_tests();
     failed += run_hugepages_tests();
+    failed += run_inlet_tests();
+    failed += run_servo_tests();
     return failed;
 }

@@ -1,0 +1,304 @@
+/* jdem_inlet.c — the conveyor inlet's stream (jdem_inlet.h has the definitions it implements). */
+#include "jdem_inlet.h"
+
+#include <math.h>
+#include <stdio.h>
+
+static double dot3(const double a[3], const double b[3]) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static double norm3(const double a[3]) {
+    return sqrt(dot3(a, a));
+}
+
+/* The belt direction u = v/|v|. */
+static void belt_direction(const jd_inlet_spec *s, double u[3]) {
+    const double speed = norm3(s->velocity);
+    for (int i = 0; i < 3; i++)
+        u[i] = s->velocity[i] / speed;
+}
+
+/* (offset + c L): how far copy c is set back along u [m]. */
+static double setback(const jd_inlet_spec *s, int64_t copy) {
+    return s->offset + (double)copy * s->period;
+}
+
+double jd_inlet_signed_distance(const jd_inlet_spec *s, int64_t copy, size_t p, int64_t step) {
+    double u[3], q[3];
+    belt_direction(s, u);
+    for (int i = 0; i < 3; i++)
+        q[i] = s->origin[i] + s->rel[3 * p + i] - s->plane_point[i];
+    const double a = dot3(s->plane_normal, q) - setback(s, copy) * dot3(s->plane_normal, u);
+    const double w = dot3(s->plane_normal, s->velocity) * s->dt;
+    return a + (double)step * w;
+}
+
+int64_t jd_inlet_crossing_step(const jd_inlet_spec *s, int64_t copy, size_t p) {
+    const double a = jd_inlet_signed_distance(s, copy, p, 0);
+    if (a >= 0.0)
+        return 0;
+    const double w = dot3(s->plane_normal, s->velocity) * s->dt;
+    const double estimate = ceil(-a / w);
+    if (!(estimate < 9.0e18)) /* beyond any run (and int64) */
+        return JD_INLET_NEVER;
+    int64_t k = (int64_t)estimate;
+    while (k > 0 && jd_inlet_signed_distance(s, copy, p, k - 1) >= 0.0)
+        k--;
+    while (jd_inlet_signed_distance(s, copy, p, k) < 0.0)
+        k++;
+    return k;
+}
+
+int64_t jd_inlet_section_start(const jd_inlet_spec *s, int64_t copy) {
+    int64_t first = JD_INLET_NEVER;
+    for (size_t p = 0; p < s->n; p++) {
+        const int64_t k = jd_inlet_crossing_step(s, copy, p);
+        if (k < first)
+            first = k;
+    }
+    return first;
+}
+
+void jd_inlet_particle_at_crossing(const jd_inlet_spec *s, int64_t copy, size_t p,
+                                   jd_inlet_particle *out) {
+    double u[3];
+    belt_direction(s, u);
+    out->id = s->first_id + copy * (int64_t)s->n + (int64_t)p;
+    out->copy = copy;
+    out->index = p;
+    out->step = jd_inlet_crossing_step(s, copy, p);
+    const double t = (double)out->step * s->dt;
+    const double back = setback(s, copy);
+    for (int i = 0; i < 3; i++) {
+        const double b = (s->origin[i] + s->rel[3 * p + i]) - back * u[i];
+        out->position[i] = b + s->velocity[i] * t;
+        out->velocity[i] = s->velocity[i];
+    }
+    out->radius = s->radius[p];
+    out->species = s->species[p];
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Checks                                                                                   */
+/* ---------------------------------------------------------------------------------------- */
+
+static int finite3(const double a[3]) {
+    return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]);
+}
+
+/* Overlap of particle p (copy 0) with particle q of the copy `shift` periods behind [m]. */
+static double overlap(const jd_inlet_spec *s, const double u[3], size_t p, size_t q, int64_t shift) {
+    double d[3];
+    for (int i = 0; i < 3; i++)
+        d[i] = s->rel[3 * p + i] - (s->rel[3 * q + i] - (double)shift * s->period * u[i]);
+    return s->radius[p] + s->radius[q] - norm3(d);
+}
+
+static int too_much(double ov, double ra, double rb) {
+    return ov > JD_INLET_OVERLAP_TOL * (ra < rb ? ra : rb);
+}
+
+static jd_inlet_status check_values(const jd_inlet_spec *s, int allow_unbounded, char *msg,
+                                    size_t len) {
+    if (s->n == 0 || !s->rel || !s->radius || !s->species) {
+        snprintf(msg, len, "the section has no particles; valid: at least one particle");
+        return JD_INLET_EMPTY;
+    }
+    for (size_t p = 0; p < s->n; p++) {
+        if (!(s->radius[p] > 0.0) || !isfinite(s->radius[p])) {
+            snprintf(msg, len, "section particle %zu: radius %g is not valid; valid: a number > 0",
+                     p, s->radius[p]);
+            return JD_INLET_BAD_VALUE;
+        }
+        if (!finite3(&s->rel[3 * p])) {
+            snprintf(msg, len, "section particle %zu: position is not finite", p);
+            return JD_INLET_BAD_VALUE;
+        }
+    }
+    if (!(s->dt > 0.0) || !isfinite(s->dt)) {
+        snprintf(msg, len, "dt %g is not valid; valid: a number > 0", s->dt);
+        return JD_INLET_BAD_VALUE;
+    }
+    if (s->max_sections != 1 && (!(s->period > 0.0) || !isfinite(s->period))) {
+        snprintf(msg, len, "period %g is not valid; valid: a number > 0", s->period);
+        return JD_INLET_BAD_VALUE;
+    }
+    if (!(s->offset >= 0.0) || !isfinite(s->offset)) {
+        snprintf(msg, len, "offset %g is not valid; valid: a number >= 0", s->offset);
+        return JD_INLET_BAD_VALUE;
+    }
+    if (s->first_id <= 0 || s->max_sections < 0 || s->stop_step <= 0) {
+        snprintf(msg, len,
+                 "first id %lld, sections %lld or stop step %lld is not valid; valid: an id > 0, "
+                 "sections >= 1 (0: no limit), a stop step > 0",
+                 (long long)s->first_id, (long long)s->max_sections, (long long)s->stop_step);
+        return JD_INLET_BAD_VALUE;
+    }
+    if (!allow_unbounded && s->max_sections == 0 && s->stop_step == JD_INLET_NO_STOP) {
+        snprintf(msg, len, "the stream never stops; valid: a number of sections, a deposit "
+                           "height or a time");
+        return JD_INLET_NO_STOP_RULE;
+    }
+    if (!finite3(s->origin) || !finite3(s->velocity) || !finite3(s->plane_point) ||
+        !finite3(s->plane_normal) || !(norm3(s->velocity) > 0.0)) {
+        snprintf(msg, len, "belt velocity [%g, %g, %g] is not valid; valid: a finite non-zero "
+                           "vector (and finite origin and plane)",
+                 s->velocity[0], s->velocity[1], s->velocity[2]);
+        return JD_INLET_BAD_VALUE;
+    }
+    if (!(norm3(s->plane_normal) > 0.0)) {
+        snprintf(msg, len, "plane normal has zero length; valid: a non-zero vector towards the domain");
+        return JD_INLET_NO_NORMAL;
+    }
+    return JD_INLET_OK;
+}
+
+static jd_inlet_status check_geometry(const jd_inlet_spec *s, char *msg, size_t len) {
+    const double vn = dot3(s->plane_normal, s->velocity);
+    if (!(vn > 0.0)) {
+        snprintf(msg, len,
+                 "the belt never crosses the inlet plane: velocity . normal = %g <= 0; valid: a "
+                 "velocity with a positive component along the normal (towards the domain)",
+                 vn);
+        return JD_INLET_NEVER_CROSSES;
+    }
+    for (size_t p = 0; p < s->n; p++) {
+        const double d = jd_inlet_signed_distance(s, 0, p, 0);
+        if (d >= 0.0) {
+            snprintf(msg, len,
+                     "section particle %zu is already past the inlet plane at step 0 (signed "
+                     "distance %g >= 0); valid: a section behind the plane (move the origin back "
+                     "against the belt, or raise the offset)",
+                     p, d);
+            return JD_INLET_ALREADY_INSIDE;
+        }
+    }
+    return JD_INLET_OK;
+}
+
+/* Copies up to `shift` periods apart can touch when shift L is below the section's extent
+ * along u plus the largest diameter. */
+static int64_t shifts_to_check(const jd_inlet_spec *s, const double u[3]) {
+    if (s->max_sections == 1)
+        return 0;
+    double lo = INFINITY, hi = -INFINITY, rmax = 0.0;
+    for (size_t p = 0; p < s->n; p++) {
+        const double a = dot3(&s->rel[3 * p], u);
+        lo = a < lo ? a : lo;
+        hi = a > hi ? a : hi;
+        rmax = s->radius[p] > rmax ? s->radius[p] : rmax;
+    }
+    int64_t k = (int64_t)floor((hi - lo + 2.0 * rmax) / s->period);
+    if (k < 1)
+        k = 1;
+    if (s->max_sections > 1 && k > s->max_sections - 1)
+        k = s->max_sections - 1;
+    return k;
+}
+
+static jd_inlet_status check_overlaps(const jd_inlet_spec *s, char *msg, size_t len) {
+    double u[3];
+    belt_direction(s, u);
+    const int64_t kmax = shifts_to_check(s, u);
+    for (int64_t k = 0; k <= kmax; k++)
+        for (size_t p = 0; p < s->n; p++)
+            for (size_t q = k == 0 ? p + 1 : 0; q < s->n; q++) {
+                const double ov = overlap(s, u, p, q, k);
+                if (!too_much(ov, s->radius[p], s->radius[q]))
+                    continue;
+                if (k == 0) {
+                    snprintf(msg, len, "section particles %zu and %zu overlap by %g m; valid: "
+                                       "spheres that do not overlap",
+                             p, q, ov);
+                    return JD_INLET_OVERLAP;
+                }
+                snprintf(msg, len,
+                         "the section overlaps itself across the period: particle %zu overlaps "
+                         "particle %zu of the copy %lld period(s) behind by %g m (period %g m); "
+                         "valid: a longer period",
+                         p, q, (long long)k, ov, s->period);
+                return JD_INLET_PERIOD_OVERLAP;
+            }
+    return JD_INLET_OK;
+}
+
+jd_inlet_status jd_inlet_check(const jd_inlet_spec *s, int allow_unbounded, char *msg,
+                               size_t msglen) {
+    jd_inlet_status st = check_values(s, allow_unbounded, msg, msglen);
+    if (st == JD_INLET_OK)
+        st = check_geometry(s, msg, msglen);
+    if (st == JD_INLET_OK)
+        st = check_overlaps(s, msg, msglen);
+    if (st == JD_INLET_OK && msglen > 0)
+        msg[0] = '\0';
+    return st;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* The stream during a run                                                                  */
+/* ---------------------------------------------------------------------------------------- */
+
+/* Point cursor p at copy c (or at the end of its stream past max_sections). */
+static void aim(const jd_inlet_spec *s, jd_inlet_cursor *cur, int64_t copy, size_t p) {
+    cur->copy = copy;
+    cur->step = s->max_sections > 0 && copy >= s->max_sections ? JD_INLET_NEVER
+                                                                : jd_inlet_crossing_step(s, copy, p);
+}
+
+static void update_next(const jd_inlet_spec *s, jd_inlet_stream *st) {
+    int64_t next = JD_INLET_NEVER;
+    for (size_t p = 0; p < s->n; p++)
+        if (st->cursor[p].step < next)
+            next = st->cursor[p].step;
+    st->next_step = next;
+}
+
+void jd_inlet_stream_init(const jd_inlet_spec *s, jd_inlet_stream *st, jd_inlet_cursor *cursor) {
+    st->cursor = cursor;
+    st->started = 0;
+    st->stop_step = s->stop_step;
+    st->inserted = 0;
+    for (size_t p = 0; p < s->n; p++)
+        aim(s, &cursor[p], 0, p);
+    update_next(s, st);
+}
+
+/* The smallest copy due at `step`, or -1. */
+static int64_t first_copy_due(const jd_inlet_spec *s, const jd_inlet_stream *st, int64_t step) {
+    int64_t c = -1;
+    for (size_t p = 0; p < s->n; p++)
+        if (st->cursor[p].step == step && (c < 0 || st->cursor[p].copy < c))
+            c = st->cursor[p].copy;
+    return c;
+}
+
+size_t jd_inlet_pop(const jd_inlet_spec *s, jd_inlet_stream *st, int64_t step,
+                    jd_inlet_particle *out, size_t cap) {
+    size_t count = 0;
+    if (step != st->next_step)
+        return 0;
+    for (int64_t c = first_copy_due(s, st, step); c >= 0; c = first_copy_due(s, st, step)) {
+        for (size_t p = 0; p < s->n; p++) {
+            jd_inlet_cursor *cur = &st->cursor[p];
+            if (cur->step != step || cur->copy != c)
+                continue;
+            /* a copy is admitted at its start step, the first step one of its particles is due */
+            if (c == st->started && step < st->stop_step)
+                st->started++;
+            if (c >= st->started) {
+                cur->step = JD_INLET_NEVER;
+                continue;
+            }
+            if (count == cap) {
+                update_next(s, st);
+                return count;
+            }
+            jd_inlet_particle_at_crossing(s, c, p, &out[count++]);
+            st->inserted++;
+            aim(s, cur, c + 1, p);
+        }
+    }
+    update_next(s, st);
+    return count;
+}

@@ -1,0 +1,154 @@
+/*
+ * jdem_inlet.h — the conveyor inlet of Jiang (2021) Sec. 2.7.3: one rule for both engines.
+ *
+ * Pure C11. No I/O, no allocation, no globals.  Both engines (the stepper and the LIGGGHTS fix)
+ * call these functions on the same description, so the particle stream (ids, insertion steps,
+ * positions, velocities, order) is identical by construction.  docs/mixing.md explains the
+ * design and the scene keys; units are SI (m, s, m/s).
+ *
+ * The stream.  A section of n particles (positions relative to the section's origin) rides a belt
+ * at the constant velocity v.  Copy c of the section sits one period L behind copy c - 1 along
+ * the belt direction u = v/|v|; at step k (time t_k = k dt) particle p of copy c would be at
+ *
+ *     x(c, p, k) = b(c, p) + v t_k,      b(c, p) = (origin + rel_p) - (offset + c L) u,
+ *
+ * each component evaluated in exactly that order (the sums left to right; the library is built
+ * with -ffp-contract=off, so no fused multiply-add changes a bit).  The particle takes part in
+ * nothing until its centre crosses the inlet plane (point P, normal N pointing into the domain);
+ * from its crossing step on it is an ordinary particle, placed at x(c, p, k*) with velocity v.
+ *
+ * Crossing step.  With the signed distance of the rigid motion
+ *
+ *     s(c, p, k) = a(c, p) + k w,   a(c, p) = N.(origin + rel_p - P) - (offset + c L) (N.u),
+ *                                    w = (N.v) dt,
+ *
+ * (N.q = N_x q_x + N_y q_y + N_z q_z, left to right), the crossing step k*(c, p) is the smallest
+ * integer k >= 0 with s(c, p, k) >= 0.  Because w > 0 (a checked condition) and k w is rounded
+ * monotonically, s is non-decreasing in k in floating point too, so k* is well defined whatever
+ * the round-off; it is found from the estimate ceil(-a/w) and corrected by evaluating s itself.
+ * N need not be a unit vector: only the sign of s matters.
+ *
+ * Ids and order.  Particle p of copy c has id first_id + c n + p.  The particles that cross at
+ * one step are inserted in increasing id (copy, then position in the section).
+ *
+ * Stop rule.  Copies are inserted whole: copy c belongs to the stream if c < max_sections (when
+ * max_sections > 0) and its start step (the smallest k* of its particles) is < stop_step.  A
+ * deposit-height rule is measured by the engine, which then sets jd_inlet_stream.stop_step to the
+ * current step: copies already started are completed, no new copy starts.
+ */
+#ifndef JDEM_KERNEL_INLET_H
+#define JDEM_KERNEL_INLET_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* No step limit: the stream ends by max_sections or by the engine's deposit-height rule. */
+#define JD_INLET_NO_STOP INT64_MAX
+
+/* A particle that never crosses (past the stop rule): its step is JD_INLET_NEVER. */
+#define JD_INLET_NEVER INT64_MAX
+
+/* Overlap allowed between section particles (of one copy, or of neighbouring copies), as a
+ * fraction of the smaller radius: the round-off of a lattice of touching spheres, as the scene
+ * reader's start-overlap rule (docs/scenes.md "Start overlaps"). */
+#define JD_INLET_OVERLAP_TOL 1e-6
+
+/* The description of one inlet, fixed for a run (the resolved scene's `inlets:` entry). */
+typedef struct jd_inlet_spec {
+    size_t n;               /* particles per section, >= 1                                 [-]   */
+    const double *rel;      /* [3n] positions relative to the section origin               [m]   */
+    const double *radius;   /* [n] radii, > 0                                              [m]   */
+    const int32_t *species; /* [n] material index of each particle (copied to the output)  [-]   */
+    double origin[3];       /* position of copy 0's origin at t = 0 (before offset)         [m]   */
+    double velocity[3];     /* belt velocity v, non-zero; every inserted particle's velocity [m/s] */
+    double plane_point[3];  /* a point P of the inlet plane                                [m]   */
+    double plane_normal[3]; /* normal N of the plane, towards the domain (any length > 0)  [-]   */
+    double period;          /* L: distance between copies along u, > 0 (unused if max_sections = 1) [m] */
+    double offset;          /* distance copy 0 is set back along u from origin, >= 0       [m]   */
+    double dt;              /* time step, > 0                                              [s]   */
+    int64_t first_id;       /* id of particle 0 of copy 0, > 0                             [-]   */
+    int64_t max_sections;   /* copies in the stream, >= 1, or 0 for no limit               [-]   */
+    int64_t stop_step;      /* no copy starts at or after this step, > 0, or JD_INLET_NO_STOP [-] */
+} jd_inlet_spec;
+
+/* Result codes of jd_inlet_check. */
+typedef enum {
+    JD_INLET_OK = 0,
+    JD_INLET_EMPTY,          /* n = 0 or a NULL array                                          */
+    JD_INLET_BAD_VALUE,      /* a radius, dt, period, offset, id or limit out of range or NaN   */
+    JD_INLET_NO_NORMAL,      /* plane normal of zero length                                     */
+    JD_INLET_NEVER_CROSSES,  /* N.v <= 0: the belt is parallel to the plane or moves away      */
+    JD_INLET_ALREADY_INSIDE, /* a particle of copy 0 is on the domain side at step 0           */
+    JD_INLET_OVERLAP,        /* two particles of one copy overlap                               */
+    JD_INLET_PERIOD_OVERLAP, /* a particle overlaps one of a neighbouring copy across L         */
+    JD_INLET_NO_STOP_RULE    /* max_sections = 0 and stop_step = JD_INLET_NO_STOP (the engine
+                                must then have a deposit-height rule: pass allow_unbounded)    */
+} jd_inlet_status;
+
+/* Check a description.  Returns JD_INLET_OK, or a code with a one-line message in msg (naming
+ * the value, the particle indices (0-based, in the section) and what would be valid) that the
+ * engines prefix with the scene file and key.  allow_unbounded = 1 accepts a stream without a
+ * step or section limit (the engine stops it by deposit height).  O(n^2) in the section size. */
+jd_inlet_status jd_inlet_check(const jd_inlet_spec *s, int allow_unbounded, char *msg,
+                               size_t msglen);
+
+/* Signed distance s(c, p, k) of the header comment [m times |N|]. */
+double jd_inlet_signed_distance(const jd_inlet_spec *s, int64_t copy, size_t p, int64_t step);
+
+/* Crossing step k*(c, p) of the header comment (the stop rule is not applied here). */
+int64_t jd_inlet_crossing_step(const jd_inlet_spec *s, int64_t copy, size_t p);
+
+/* Start step of copy c: the smallest crossing step of its particles. O(n). */
+int64_t jd_inlet_section_start(const jd_inlet_spec *s, int64_t copy);
+
+/* One inserted particle. */
+typedef struct jd_inlet_particle {
+    int64_t id;          /* first_id + c n + p                                       [-]   */
+    int64_t copy;        /* c                                                        [-]   */
+    size_t index;        /* p, its position in the section                           [-]   */
+    int64_t step;        /* the crossing step k*, at which it becomes a particle     [-]   */
+    double position[3];  /* x(c, p, k*)                                              [m]   */
+    double velocity[3];  /* the belt velocity v                                      [m/s] */
+    double radius;       /* [m] */
+    int32_t species;     /* [-] */
+} jd_inlet_particle;
+
+/* Particle p of copy c at its crossing step (the stop rule is not applied here). */
+void jd_inlet_particle_at_crossing(const jd_inlet_spec *s, int64_t copy, size_t p,
+                                   jd_inlet_particle *out);
+
+/* The state of a stream during a run: one cursor per section particle (an array of n that the
+ * engine allocates), the next copy of that particle due and its step.  The engine compares the
+ * current step with next_step only, so particles not yet inserted cost nothing per step. */
+typedef struct jd_inlet_cursor {
+    int64_t copy; /* the next copy of this section particle to insert             [-] */
+    int64_t step; /* its crossing step, or JD_INLET_NEVER when its stream is over [-] */
+} jd_inlet_cursor;
+
+typedef struct jd_inlet_stream {
+    jd_inlet_cursor *cursor; /* [n], owned by the engine                                  */
+    int64_t started;         /* copies started so far (admitted by the stop rule)     [-] */
+    int64_t stop_step;       /* copy of the spec's; the engine lowers it to stop by height [-] */
+    int64_t next_step;       /* the smallest cursor step: nothing to do before it     [-] */
+    int64_t inserted;        /* particles inserted so far                             [-] */
+} jd_inlet_stream;
+
+/* Initialise a stream (cursor: an array of s->n entries). */
+void jd_inlet_stream_init(const jd_inlet_spec *s, jd_inlet_stream *st, jd_inlet_cursor *cursor);
+
+/* Insert the particles due at `step` (call it whenever step == st->next_step; a step with nothing
+ * due returns 0).  Writes at most cap particles in insertion order (increasing id) and returns
+ * how many it wrote; when more than cap are due, the rest stay due (call again with the same
+ * step).  Updates st->next_step. */
+size_t jd_inlet_pop(const jd_inlet_spec *s, jd_inlet_stream *st, int64_t step,
+                    jd_inlet_particle *out, size_t cap);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

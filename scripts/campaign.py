@@ -1,0 +1,196 @@
+#!/usr/bin/python3
+"""campaign.py — run a campaign: a list of units, each with its own output files.
+
+    scripts/campaign.py PLAN.py [--model M] [--engine E] [--unit NAME] [--list] [-- PLAN ARGS]
+
+PLAN.py defines units(argv) returning a list of Unit.  A unit is done when every one of its
+final outputs exists and validates; a rerun skips the done units, so an interrupted campaign
+resumes where it stopped.  A unit runs with its outputs in a directory of its own next to the
+first output (DIR/.partial/UNIT/, the same file names), and they are moved to their final names
+(os.replace, atomic per file) only once all of them validate: a killed run never leaves a
+partial file under a final name, and its partial directory is cleared when the unit runs again.
+--model, --engine and --unit run part of the campaign (a unit whose needs are neither done nor
+selected is an error).  Progress and the ETA go to stderr: the ETA is the remaining units'
+estimated cost times the measured seconds per unit of cost of the units finished so far (in this
+run and earlier ones: DIR/.campaign_times.json beside the first unit's output).
+"""
+import argparse
+import importlib.util
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+
+
+@dataclass
+class Unit:
+    name: str                   # unique, e.g. "jdem/model2/fill1"
+    outputs: list               # final output paths
+    command: list               # argv; "{out0}", "{out1}", ... stand for the outputs being written
+    model: str = None
+    engine: str = None
+    needs: list = field(default_factory=list)  # names of the units whose outputs it reads
+    validate: object = None     # f(path) -> None if valid, else the reason; default: non-empty
+    cost: float = 1.0           # relative cost, for the ETA (e.g. particle-steps)
+
+
+def non_empty(path):
+    return None if os.path.getsize(path) > 0 else "empty file"
+
+
+def invalid_reason(unit, path):
+    """None when path exists and validates, else why not."""
+    if not os.path.exists(path):
+        return "missing"
+    return (unit.validate or non_empty)(path)
+
+
+def is_done(unit):
+    return all(invalid_reason(unit, p) is None for p in unit.outputs)
+
+
+def partial_dir(unit):
+    return os.path.join(os.path.dirname(os.path.abspath(unit.outputs[0])), ".partial",
+                        unit.name.replace("/", "_"))
+
+
+def select(units, model=None, engine=None, name=None):
+    return [u for u in units if (model is None or u.model == model)
+            and (engine is None or u.engine == engine) and (name is None or u.name == name)]
+
+
+def check_needs(units, chosen):
+    names = {u.name for u in chosen}
+    by_name = {u.name: u for u in units}
+    for u in chosen:
+        for n in u.needs:
+            if n not in by_name:
+                return f"unit {u.name} needs unknown unit {n}"
+            if n not in names and not is_done(by_name[n]):
+                return f"unit {u.name} needs {n}, which is neither done nor selected"
+    return None
+
+
+class Times:
+    """Measured seconds per unit, kept across runs (written atomically)."""
+
+    def __init__(self, path):
+        self.path = path
+        try:
+            with open(path) as f:
+                self.seconds = json.load(f)
+        except (OSError, ValueError):
+            self.seconds = {}
+
+    def add(self, unit, seconds):
+        self.seconds[unit.name] = {"seconds": seconds, "cost": unit.cost}
+        tmp = self.path + ".tmp"
+        with open(tmp, "w") as f:
+            json.dump(self.seconds, f, indent=1)
+        os.replace(tmp, self.path)
+
+    def eta(self, remaining):
+        done = list(self.seconds.values())
+        cost = sum(d["cost"] for d in done)
+        if not done or cost <= 0:
+            return None
+        return sum(u.cost for u in remaining) * sum(d["seconds"] for d in done) / cost
+
+
+def run_unit(unit):
+    """Run one unit into its partial directory; returns None or the reason it failed."""
+    tmp = partial_dir(unit)
+    shutil.rmtree(tmp, ignore_errors=True)
+    os.makedirs(tmp)
+    staged = [os.path.join(tmp, os.path.basename(p)) for p in unit.outputs]
+    subs = {f"out{i}": p for i, p in enumerate(staged)}
+    argv = [a.format(**subs) for a in unit.command]
+    proc = subprocess.run(argv)
+    if proc.returncode != 0:
+        return f"exit status {proc.returncode}"
+    for s in staged:
+        reason = invalid_reason(unit, s)
+        if reason:
+            return f"output {os.path.basename(s)} does not validate: {reason}"
+    for s, final in zip(staged, unit.outputs):
+        os.makedirs(os.path.dirname(os.path.abspath(final)), exist_ok=True)
+        os.replace(s, final)
+    shutil.rmtree(tmp, ignore_errors=True)
+    return None
+
+
+def fmt_seconds(s):
+    return f"{s:.1f} s" if s < 120 else f"{s / 60:.1f} min" if s < 7200 else f"{s / 3600:.1f} h"
+
+
+def run(units, times, log=sys.stderr):
+    """Run the units in order, skipping the done ones; returns the number that failed."""
+    todo = [u for u in units if not is_done(u)]
+    for u in units:
+        if u not in todo:
+            print(f"campaign: skip {u.name} (done)", file=log, flush=True)
+    failed = 0
+    for i, u in enumerate(todo):
+        eta = times.eta(todo[i:])
+        print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: running"
+              + (f"; ETA {fmt_seconds(eta)}" if eta is not None else ""), file=log, flush=True)
+        start = time.monotonic()
+        reason = run_unit(u)
+        took = time.monotonic() - start
+        if reason:
+            failed += 1
+            print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: FAILED after {fmt_seconds(took)}: "
+                  f"{reason}", file=log, flush=True)
+            continue
+        times.add(u, took)
+        eta = times.eta(todo[i + 1:])
+        print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: done in {fmt_seconds(took)}; "
+              f"{len(todo) - i - 1} left, ETA {fmt_seconds(eta)}", file=log, flush=True)
+    return failed
+
+
+def load_plan(path, argv):
+    spec = importlib.util.spec_from_file_location("campaign_plan", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.units(argv)
+
+
+def main(argv):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("plan")
+    ap.add_argument("--model")
+    ap.add_argument("--engine")
+    ap.add_argument("--unit")
+    ap.add_argument("--list", action="store_true", help="list the units and whether they are done")
+    ap.add_argument("plan_args", nargs="*")
+    a = ap.parse_args(argv)
+    units = load_plan(a.plan, a.plan_args)
+    names = [u.name for u in units]
+    if len(set(names)) != len(names):
+        print(f"campaign: {a.plan}: unit names are not unique", file=sys.stderr)
+        return 2
+    chosen = select(units, a.model, a.engine, a.unit)
+    if not chosen:
+        print(f"campaign: no unit matches --model {a.model} --engine {a.engine} --unit {a.unit}; "
+              f"valid models: {sorted({str(u.model) for u in units})}, engines: "
+              f"{sorted({str(u.engine) for u in units})}", file=sys.stderr)
+        return 2
+    if a.list:
+        for u in chosen:
+            print(f"{'done' if is_done(u) else 'todo'} {u.name}")
+        return 0
+    problem = check_needs(units, chosen)
+    if problem:
+        print(f"campaign: {problem}", file=sys.stderr)
+        return 2
+    times = Times(os.path.join(os.path.dirname(os.path.abspath(units[0].outputs[0])),
+                               ".campaign_times.json"))
+    return 1 if run(chosen, times) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,86 @@
+"""A deposit: one frame of the particle set of an H5MD trajectory, and the regions cut from it.
+
+read_frame() is the only function that knows the layout of the engines' files
+(io/h5md.h: /particles/all/{id,species,radius,mass} and /particles/all/position/value [F][N][3]);
+a growing particle set is to be added there.
+"""
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+
+class DepositError(ValueError):
+    """Bad input to the readers or the cutters; the message names the file or value."""
+
+
+@dataclass
+class Deposit:
+    id: np.ndarray        # [N] int64
+    species: np.ndarray   # [N] int32, index in the scene's material list
+    radius: np.ndarray    # [N] m
+    mass: np.ndarray      # [N] kg
+    position: np.ndarray  # [N, 3] m
+    step: int = 0
+    time: float = 0.0     # s
+
+    @property
+    def density(self):
+        """Particle density [kg/m^3] from its mass and radius."""
+        return self.mass / (4.0 / 3.0 * math.pi * self.radius ** 3)
+
+    def subset(self, keep):
+        """The particles selected by the boolean or index array `keep`."""
+        return Deposit(self.id[keep], self.species[keep], self.radius[keep], self.mass[keep],
+                       self.position[keep], self.step, self.time)
+
+    def translated(self, shift):
+        return Deposit(self.id, self.species, self.radius, self.mass,
+                       self.position + np.asarray(shift, dtype=float), self.step, self.time)
+
+
+def read_frame(path, frame=-1):
+    """Frame `frame` (Python index: -1 is the last) of the trajectory at `path`."""
+    import h5py
+    if not os.path.exists(path):
+        raise DepositError(f"{path}: no such file; valid: an H5MD trajectory written by jdem or "
+                           f"liggghts-jdem")
+    with h5py.File(path, "r") as f:
+        if "particles/all/position/value" not in f:
+            raise DepositError(f"{path}: no /particles/all/position; valid: an H5MD trajectory "
+                               f"written by jdem or liggghts-jdem")
+        p = f["particles/all"]
+        frames = p["position/value"].shape[0]
+        if not -frames <= frame < frames:
+            raise DepositError(f"{path}: frame {frame} does not exist; valid: {-frames} to "
+                               f"{frames - 1} ({frames} frames)")
+        return Deposit(p["id"][()], p["species"][()], p["radius"][()], p["mass"][()],
+                       p["position/value"][frame], int(p["position/step"][frame]),
+                       float(p["position/time"][frame]))
+
+
+def inside_box(dep, lo, hi):
+    """Boolean mask of the particles whose centre lies in [lo, hi) (componentwise)."""
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    return np.all((dep.position >= lo) & (dep.position < hi), axis=1)
+
+
+def keep_box(dep, lo, hi, source="deposit"):
+    """The particles whose centre lies in the box [lo, hi); an error if the box holds none or
+    reaches beyond the deposit's extent."""
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    if np.any(hi <= lo):
+        raise DepositError(f"region {lo.tolist()}..{hi.tolist()}: empty; valid: lo < hi")
+    ext_lo = dep.position.min(axis=0) - dep.radius.max()
+    ext_hi = dep.position.max(axis=0) + dep.radius.max()
+    if np.any(lo < ext_lo - 1e-12) or np.any(hi > ext_hi + 1e-12):
+        raise DepositError(f"region {lo.tolist()}..{hi.tolist()} lies outside the {source} "
+                           f"(extent {ext_lo.round(6).tolist()}..{ext_hi.round(6).tolist()}); "
+                           f"valid: a region inside it")
+    return dep.subset(inside_box(dep, lo, hi))
+
+
+def deposit_height(dep):
+    """Top of the deposit [m]: the highest particle top (z + R)."""
+    return float(np.max(dep.position[:, 2] + dep.radius))

@@ -1,0 +1,132 @@
+#!/usr/bin/python3
+"""The campaign driver (scripts/campaign.py) with dummy units: resume after a killed run, skip of
+finished units, validation, selection by model / engine / unit, needs, progress and ETA."""
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+from common import ROOT, check, finish
+
+CAMPAIGN = os.path.join(ROOT, "scripts", "campaign.py")
+
+# A dummy unit appends its name to runs.log, sleeps SLEEP_<name> seconds (default 0.1) and
+# writes "ok" (or the content of CONTENT_<name>) to its output.
+PLAN = '''
+import os, sys
+sys.path.insert(0, {scripts!r})
+from campaign import Unit
+
+HERE = {here!r}
+WORKER = [sys.executable, "-c", """
+import os, sys, time
+name, out = sys.argv[1], sys.argv[2]
+open(os.path.join({here!r}, "runs.log"), "a").write(name + "\\\\n")
+open(out + ".started", "w").close()
+time.sleep(float(os.environ.get("SLEEP_" + name, "0.1")))
+open(out, "w").write(os.environ.get("CONTENT_" + name, "ok"))
+"""]
+
+
+def valid(path):
+    text = open(path).read()
+    return None if text == "ok" else f"content {{text!r}}, expected 'ok'"
+
+
+def units(argv):
+    out = lambda n: os.path.join(HERE, "out", n + ".txt")
+    return [
+        Unit("a", [out("a")], WORKER + ["a", "{{out0}}"], model="m1", engine="e1", validate=valid),
+        Unit("b", [out("b")], WORKER + ["b", "{{out0}}"], model="m1", engine="e2", validate=valid,
+             needs=["a"]),
+        Unit("c", [out("c")], WORKER + ["c", "{{out0}}"], model="m2", engine="e1", validate=valid,
+             cost=2.0),
+    ]
+'''
+
+
+def campaign(here, *args, env=None, wait=True):
+    cmd = [sys.executable, CAMPAIGN, os.path.join(here, "plan.py"), *args]
+    e = {**os.environ, **(env or {})}
+    if not wait:
+        return subprocess.Popen(cmd, env=e, stderr=subprocess.PIPE, text=True,
+                                start_new_session=True)
+    return subprocess.run(cmd, env=e, stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+
+
+def runs(here):
+    path = os.path.join(here, "runs.log")
+    return open(path).read().split() if os.path.exists(path) else []
+
+
+def reset_log(here):
+    if os.path.exists(os.path.join(here, "runs.log")):
+        os.remove(os.path.join(here, "runs.log"))
+
+
+def final(here, name):
+    return os.path.join(here, "out", name + ".txt")
+
+
+def setup():
+    here = tempfile.mkdtemp()
+    with open(os.path.join(here, "plan.py"), "w") as f:
+        f.write(PLAN.format(scripts=os.path.join(ROOT, "scripts"), here=here))
+    return here
+
+
+def test_killed_run_resumes():
+    here = setup()
+    proc = campaign(here, env={"SLEEP_b": "30"}, wait=False)
+    started = os.path.join(here, "out", ".partial", "b", "b.txt.started")
+    deadline = time.monotonic() + 20
+    while not os.path.exists(started) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)  # the driver and its running unit, as a power cut would
+    proc.wait()
+    check("killed_run_kept_finished_unit", open(final(here, "a")).read() == "ok", "a missing")
+    check("killed_run_no_partial_final", not os.path.exists(final(here, "b")),
+          "b exists under its final name")
+    reset_log(here)
+    r = campaign(here)
+    check("resume_exit_status", r.returncode == 0, r.stderr)
+    check("resume_skips_finished", runs(here) == ["b", "c"], f"ran {runs(here)}")
+    check("resume_says_skip", "campaign: skip a (done)" in r.stderr, r.stderr)
+    check("resume_clears_partial", not os.path.exists(os.path.join(here, "out", ".partial", "b")),
+          "partial directory left")
+    # progress and an ETA from the measured units: before c, 1 cost unit of b took ~0.1 s and
+    # c costs 2, so the ETA is given
+    check("progress_and_eta", "[2/2] c: running; ETA " in r.stderr
+          and "[1/2] b: done in " in r.stderr, r.stderr)
+    reset_log(here)
+    r = campaign(here)
+    check("rerun_runs_nothing", r.returncode == 0 and runs(here) == [], f"ran {runs(here)}")
+
+
+def test_validation_and_selection():
+    here = setup()
+    r = campaign(here, "--unit", "a", env={"CONTENT_a": "garbage"})
+    check("invalid_output_fails", r.returncode == 1 and "a: FAILED" in r.stderr
+          and "output a.txt does not validate: content 'garbage', expected 'ok'" in r.stderr,
+          r.stderr)
+    check("invalid_output_not_final", not os.path.exists(final(here, "a")), "a.txt exists")
+    r = campaign(here, "--engine", "e2")
+    check("needs_unfinished", r.returncode == 2 and "campaign: unit b needs a, which is neither "
+          "done nor selected" in r.stderr, r.stderr)
+    reset_log(here)
+    r = campaign(here, "--model", "m1")
+    check("select_model", r.returncode == 0 and runs(here) == ["a", "b"], f"ran {runs(here)}")
+    reset_log(here)
+    r = campaign(here, "--engine", "e1")
+    check("select_engine", r.returncode == 0 and runs(here) == ["c"], f"ran {runs(here)}")
+    r = campaign(here, "--model", "m9")
+    check("select_nothing", r.returncode == 2 and "no unit matches --model m9" in r.stderr, r.stderr)
+    r = campaign(here, "--list")
+    check("list", r.stdout.split("\n")[:3] == ["done a", "done b", "done c"], r.stdout)
+
+
+test_killed_run_resumes()
+test_validation_and_selection()
+finish()

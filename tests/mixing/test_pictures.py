@@ -1,0 +1,75 @@
+#!/usr/bin/python3
+"""The campaign's pictures (scripts/mixing/plots.py), checked for content: the number of objects
+drawn, and the pixel fractions of the cohort colours, the obstacle and the ideal line."""
+import math
+import os
+import tempfile
+
+import matplotlib.image as mpimg
+import numpy as np
+
+from common import check, finish
+from mixing import deposit, plots
+
+
+def colour_fraction(img, hex_colour, tol=0.08):
+    rgb = np.array([int(hex_colour[i:i + 2], 16) / 255 for i in (1, 3, 5)])
+    return float(np.mean(np.all(np.abs(img[:, :, :3] - rgb) < tol, axis=2)))
+
+
+def synthetic_deposit():
+    """A 0.3 m deep simple-cubic bed of small spheres over the 1 x 1 m floor with a layer of
+    big ones on top of its left half."""
+    rs, rb = 0.015, 0.03
+    g = np.arange(0.015, 1.0, 0.03)
+    xs = np.array([[x, y, z] for x in g for y in g for z in np.arange(0.015, 0.3, 0.03)])
+    gb = np.arange(0.03, 0.5, 0.06)
+    xb = np.array([[x, y, 0.33] for x in gb for y in np.arange(0.03, 1.0, 0.06)])
+    x = np.vstack([xs, xb])
+    r = np.concatenate([np.full(len(xs), rs), np.full(len(xb), rb)])
+    n = len(r)
+    return deposit.Deposit(np.arange(1, n + 1), (r > 0.02).astype(np.int32), r,
+                           4000 * 4 / 3 * math.pi * r ** 3, x, time=11.0), len(xs), len(xb)
+
+
+def test_views(tmp):
+    dep, n_small, n_big = synthetic_deposit()
+    cyl = [(0.5, 1.2, 0.05)]
+    front = os.path.join(tmp, "front.png")
+    drawn = plots.deposit_view(dep, front, "front", cylinders=cyl)
+    check("front_draws_every_sphere", drawn == n_small + n_big, f"{drawn} of {n_small + n_big}")
+    img = mpimg.imread(front)
+    red, blue = colour_fraction(img, plots.BIG_COLOUR), colour_fraction(img, plots.SMALL_COLOUR)
+    # the bed covers 1 x 0.3 m and the big layer 0.5 x 0.06 m of the 1.1 x 2.1 m frame
+    check("front_has_both_cohorts", blue > 0.05 and red > 0.003, f"blue {blue:.4f}, red {red:.4f}")
+    check("front_small_cover_more", blue > 3 * red, f"blue {blue:.4f}, red {red:.4f}")
+    grey = colour_fraction(img, "#666666")
+    check("front_draws_the_cylinder", grey > 0.001, f"grey fraction {grey:.5f}")
+    clip = os.path.join(tmp, "clip.png")
+    drawn = plots.deposit_view(dep, clip, "front", cylinders=cyl, clip=0.0)
+    cut = int(np.count_nonzero(np.abs(dep.position[:, 1] - 0.5) <= dep.radius))
+    check("middle_clip_draws_the_cut_spheres", drawn == cut and 0 < cut < len(dep.radius),
+          f"{drawn} drawn, {cut} cut by y = 0.5")
+    side = os.path.join(tmp, "side.png")
+    plots.deposit_view(dep, side, "side", cylinders=cyl)
+    img = mpimg.imread(side)
+    check("side_not_blank", colour_fraction(img, plots.SMALL_COLOUR) > 0.05, "no small spheres")
+
+
+def test_strip_plot(tmp):
+    rng = np.random.default_rng(1)
+    values = {f"M{m}": rng.uniform(0, 0.4, 9) for m in range(1, 7)}
+    values["M2"][3] = float("nan")  # a point without small spheres is left out
+    path = os.path.join(tmp, "phi_v.png")
+    drawn = plots.strip_plot(values, path, ideal=0.0625)
+    check("strip_plot_markers", drawn == 53, f"{drawn} markers for 53 finite values")
+    img = mpimg.imread(path)
+    red = float(np.mean((img[:, :, 0] > 0.9) & (img[:, :, 1] < 0.2) & (img[:, :, 2] < 0.2)))
+    check("strip_plot_mean_and_ideal_line", red > 0.001, f"red fraction {red:.5f}")
+    check("strip_plot_not_blank", float(img[:, :, :3].std()) > 0.05, "uniform image")
+
+
+tmp = tempfile.mkdtemp()
+test_views(tmp)
+test_strip_plot(tmp)
+finish()

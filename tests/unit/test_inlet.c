@@ -1,0 +1,313 @@
+/* test_inlet.c — the conveyor inlet's stream (kernel/jdem_inlet.h) against closed forms. */
+#include "unit.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "jdem_inlet.h"
+
+/* One sphere of radius 0.01 on a belt along +x towards the plane x = 0. */
+static jd_inlet_spec one_sphere(const double *rel, const double *radius, const int32_t *species) {
+    jd_inlet_spec s = {
+        .n = 1, .rel = rel, .radius = radius, .species = species,
+        .origin = {-0.0505, 0.5, 1.8}, .velocity = {1.0, 0.0, 0.0},
+        .plane_point = {0.0, 0.0, 0.0}, .plane_normal = {1.0, 0.0, 0.0},
+        .period = 0.2, .offset = 0.0, .dt = 1e-3, .first_id = 7,
+        .max_sections = 0, .stop_step = JD_INLET_NO_STOP,
+    };
+    return s;
+}
+
+static const double ORIGIN_REL[3] = {0.0, 0.0, 0.0};
+static const double R1[1] = {0.01};
+static const int32_t SP1[1] = {2};
+
+/* k* = ceil((0.0505 + 0.2 c) / 0.001) = 51 + 200 c, far (half a step) from any round-off. */
+static void crossing_step_of_each_copy(void **state) {
+    (void)state;
+    const jd_inlet_spec s = one_sphere(ORIGIN_REL, R1, SP1);
+    char msg[256];
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_OK);
+    for (int64_t c = 0; c < 5; c++) {
+        jd_inlet_particle p;
+        jd_inlet_particle_at_crossing(&s, c, 0, &p);
+        assert_int_equal(p.step, 51 + 200 * c);
+        assert_int_equal(p.id, 7 + c);
+        assert_int_equal(p.species, 2);
+        assert_rel(p.radius, 0.01, 0.0);
+        /* x = -0.0505 - 0.2 c + 1 m/s * k* dt = 0.0005 m past the plane */
+        assert_rel(p.position[0], 0.0005, 1e-9);
+        assert_rel(p.position[1], 0.5, 0.0);
+        assert_rel(p.position[2], 1.8, 0.0);
+        assert_rel(p.velocity[0], 1.0, 0.0);
+        assert_rel(p.velocity[2], 0.0, 0.0);
+    }
+}
+
+/* Dyadic values: s(50) = -50 2^-10 + 50 2^-10 = 0 exactly, and s >= 0 counts as crossed. */
+static void exactly_on_the_plane_counts_as_crossed(void **state) {
+    (void)state;
+    jd_inlet_spec s = one_sphere(ORIGIN_REL, R1, SP1);
+    s.dt = 0x1p-10;
+    s.origin[0] = -50.0 * 0x1p-10;
+    assert_rel(jd_inlet_signed_distance(&s, 0, 0, 50), 0.0, 0.0);
+    assert_int_equal(jd_inlet_crossing_step(&s, 0, 0), 50);
+    jd_inlet_particle p;
+    jd_inlet_particle_at_crossing(&s, 0, 0, &p);
+    assert_rel(p.position[0], 0.0, 0.0);
+}
+
+/* Round-off cases (dt = 1e-4, distances that are integers of steps in decimal): k* is, by the
+ * definition, the first k with s(k) >= 0 as evaluated, never more than one step from the real
+ * quotient. */
+static void crossing_step_is_the_first_nonnegative_distance(void **state) {
+    (void)state;
+    jd_inlet_spec s = one_sphere(ORIGIN_REL, R1, SP1);
+    s.dt = 1e-4;
+    s.period = 0.24;
+    s.velocity[0] = 0.8;
+    s.velocity[2] = -0.6; /* inclined belt, plane normal along x: N.v = 0.8 */
+    for (int i = 1; i < 400; i++) {
+        s.origin[0] = -0.0001 * i * 0.8;
+        for (int64_t c = 0; c < 3; c++) {
+            const int64_t k = jd_inlet_crossing_step(&s, c, 0);
+            assert_true(jd_inlet_signed_distance(&s, c, 0, k) >= 0.0);
+            assert_true(k == 0 || jd_inlet_signed_distance(&s, c, 0, k - 1) < 0.0);
+            /* real quotient: (0.0001 i 0.8 + 0.24 c 0.8) / (0.8 * 1e-4) = i + 2400 c */
+            assert_true(llabs(k - (i + 2400 * c)) <= 1);
+        }
+    }
+}
+
+/* An inclined plane: normal (1, 0, 1)/sqrt 2 through (0, 0, 1.8), belt v = (1, 0, 0) at
+ * z = 1.8 - 0.3: the centre crosses at x = 0.3, i.e. after (0.3 - x0)/v = 0.35 s from x0 = -0.05. */
+static void inclined_plane_closed_form(void **state) {
+    (void)state;
+    jd_inlet_spec s = one_sphere(ORIGIN_REL, R1, SP1);
+    s.origin[0] = -0.05;
+    s.origin[2] = 1.5;
+    s.plane_point[2] = 1.8;
+    s.plane_normal[0] = 1.0;
+    s.plane_normal[2] = 1.0; /* not unit: only the sign of s matters */
+    s.dt = 1.0 / 1024.0;
+    jd_inlet_particle p;
+    jd_inlet_particle_at_crossing(&s, 0, 0, &p);
+    assert_int_equal(p.step, (int64_t)ceil(0.35 * 1024.0)); /* 358.4 -> 359 */
+    assert_rel(p.position[0], -0.05 + 359.0 / 1024.0, 1e-12);
+}
+
+/* Three particles at x = -0.10, -0.05, -0.15 (relative to origin 0), L = 0.3, 4 sections, dt 1e-3:
+ * particle p of copy c crosses at ceil((d_p + 0.3 c)/1e-3) + tiny; the stream pops every particle
+ * once, at its step, in increasing step and, within a step, increasing id. */
+static void stream_order_ids_and_steps(void **state) {
+    (void)state;
+    const double rel[9] = {-0.1005, 0, 0, -0.0505, 0, 0.05, -0.1505, 0.0, -0.05};
+    const double radius[3] = {0.01, 0.01, 0.02};
+    const int32_t species[3] = {0, 0, 1};
+    jd_inlet_spec s = one_sphere(rel, radius, species);
+    s.n = 3;
+    s.origin[0] = 0.0;
+    s.period = 0.3;
+    s.max_sections = 4;
+    s.first_id = 1;
+    char msg[256];
+    assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_OK);
+    jd_inlet_cursor cur[3];
+    jd_inlet_stream st;
+    jd_inlet_stream_init(&s, &st, cur);
+    assert_int_equal(st.next_step, 51);
+    int seen[13] = {0};
+    int64_t last_step = -1, last_id = 0, got = 0;
+    while (st.next_step != JD_INLET_NEVER) {
+        jd_inlet_particle out[8];
+        const int64_t step = st.next_step;
+        const size_t k = jd_inlet_pop(&s, &st, step, out, 8);
+        assert_true(k >= 1);
+        for (size_t i = 0; i < k; i++) {
+            const int64_t c = (out[i].id - 1) / 3, p = (out[i].id - 1) % 3;
+            const double d[3] = {100.5, 50.5, 150.5};
+            assert_int_equal(out[i].step, step);
+            assert_int_equal(step, (int64_t)ceil(d[p] + 300.0 * (double)c));
+            assert_true(step > last_step || out[i].id > last_id);
+            seen[out[i].id]++;
+            last_step = step;
+            last_id = out[i].id;
+            got++;
+        }
+    }
+    assert_int_equal(got, 12);
+    for (int id = 1; id <= 12; id++)
+        assert_int_equal(seen[id], 1);
+    assert_int_equal(st.inserted, 12);
+    assert_int_equal(st.started, 4);
+}
+
+/* The stop rule cuts at section boundaries: with stop_step 400 copy 1 (start 351) is completed
+ * (its last particle at 451), copy 2 (start 651) never starts.  A cap of 1 leaves the rest due. */
+static void stop_step_keeps_whole_sections(void **state) {
+    (void)state;
+    const double rel[6] = {-0.0505, 0, 0, -0.1505, 0, 0};
+    const double radius[2] = {0.01, 0.01};
+    const int32_t species[2] = {0, 0};
+    jd_inlet_spec s = one_sphere(rel, radius, species);
+    s.n = 2;
+    s.origin[0] = 0.0;
+    s.period = 0.3;
+    s.stop_step = 400;
+    s.first_id = 1;
+    jd_inlet_cursor cur[2];
+    jd_inlet_stream st;
+    jd_inlet_stream_init(&s, &st, cur);
+    int64_t ids[8], steps[8];
+    size_t got = 0;
+    while (st.next_step != JD_INLET_NEVER) {
+        jd_inlet_particle out[1];
+        const int64_t step = st.next_step;
+        const size_t k = jd_inlet_pop(&s, &st, step, out, 1);
+        for (size_t i = 0; i < k && got < 8; i++, got++) {
+            ids[got] = out[i].id;
+            steps[got] = out[i].step;
+        }
+    }
+    assert_int_equal(got, 4);
+    const int64_t want_ids[4] = {1, 2, 3, 4}, want_steps[4] = {51, 151, 351, 451};
+    for (size_t i = 0; i < 4; i++) {
+        assert_int_equal(ids[i], want_ids[i]);
+        assert_int_equal(steps[i], want_steps[i]);
+    }
+    assert_int_equal(st.started, 2);
+    /* a pop at a step with nothing due inserts nothing */
+    jd_inlet_particle out[1];
+    assert_int_equal(jd_inlet_pop(&s, &st, 500, out, 1), 0);
+}
+
+/* Two particles of different copies due at one step (period shorter than one step's travel) and
+ * cap 1: one particle per call, in id order, the rest stays due at the same step. */
+static void cap_leaves_the_rest_due(void **state) {
+    (void)state;
+    jd_inlet_spec s = one_sphere(ORIGIN_REL, R1, SP1);
+    s.dt = 0.1;        /* 0.1 m per step */
+    s.period = 0.025;  /* > 2 R = 0.02: no overlap; 4 periods per step's travel */
+    s.max_sections = 3;
+    s.first_id = 1;
+    char msg[256];
+    assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_OK);
+    jd_inlet_cursor cur[1];
+    jd_inlet_stream st;
+    jd_inlet_stream_init(&s, &st, cur);
+    assert_int_equal(st.next_step, 1); /* copies 0 and 1: -0.0505 - 0.025 c + 0.1 >= 0 */
+    jd_inlet_particle out[1];
+    assert_int_equal(jd_inlet_pop(&s, &st, 1, out, 1), 1);
+    assert_int_equal(out[0].id, 1);
+    assert_int_equal(st.next_step, 1);
+    assert_int_equal(jd_inlet_pop(&s, &st, 1, out, 1), 1);
+    assert_int_equal(out[0].id, 2);
+    assert_int_equal(st.next_step, 2); /* copy 2: -0.1005 + 0.1 k >= 0 at k = 2 */
+    assert_int_equal(jd_inlet_pop(&s, &st, 2, out, 1), 1);
+    assert_int_equal(out[0].id, 3);
+    assert_int_equal(st.next_step, JD_INLET_NEVER);
+}
+
+/* Jiang's Ch. 4 section: 8 x 8 x 8 small spheres (R 0.015, pitch 0.03) and 4 big (R 0.03) on top.
+ * Touching across L = 0.24 (the block length) is accepted; L = 0.23 overlaps itself. */
+static void jiang_section_period(void **state) {
+    (void)state;
+    static double rel[3 * 516];
+    static double radius[516];
+    static int32_t species[516];
+    size_t n = 0;
+    for (int k = 0; k < 8; k++)
+        for (int j = 0; j < 8; j++)
+            for (int i = 0; i < 8; i++, n++) {
+                rel[3 * n] = -0.105 + 0.03 * i;
+                rel[3 * n + 1] = -0.105 + 0.03 * j;
+                rel[3 * n + 2] = 0.015 + 0.03 * k;
+                radius[n] = 0.015;
+                species[n] = 1;
+            }
+    for (int q = 0; q < 4; q++, n++) {
+        rel[3 * n] = q % 2 ? 0.06 : -0.06;
+        rel[3 * n + 1] = q / 2 ? 0.06 : -0.06;
+        rel[3 * n + 2] = 0.24 + 0.03;
+        radius[n] = 0.03;
+        species[n] = 0;
+    }
+    jd_inlet_spec s = {
+        .n = n, .rel = rel, .radius = radius, .species = species,
+        .origin = {-0.13005, 0.5, 1.8}, .velocity = {1.0, 0.0, 0.0},
+        .plane_point = {0.0, 0.0, 0.0}, .plane_normal = {1.0, 0.0, 0.0},
+        .period = 0.24, .offset = 0.0, .dt = 1e-4, .first_id = 1,
+        .max_sections = 80, .stop_step = JD_INLET_NO_STOP,
+    };
+    char msg[256];
+    assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_OK);
+    s.period = 0.23;
+    assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_PERIOD_OVERLAP);
+    assert_non_null(strstr(msg, "overlaps itself across the period"));
+    /* the first sphere of copy 1 starts 0.13005 + 0.105 + 0.24 = 0.47505 m behind the plane */
+    s.period = 0.24;
+    assert_int_equal(jd_inlet_crossing_step(&s, 1, 0), 4751);
+}
+
+static void check_messages(void **state) {
+    (void)state;
+    char msg[512];
+    jd_inlet_spec s = one_sphere(ORIGIN_REL, R1, SP1);
+    s.velocity[0] = -1.0;
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_NEVER_CROSSES);
+    assert_string_equal(msg, "the belt never crosses the inlet plane: velocity . normal = -1 <= 0; "
+                             "valid: a velocity with a positive component along the normal "
+                             "(towards the domain)");
+    s = one_sphere(ORIGIN_REL, R1, SP1);
+    s.origin[0] = 0.01;
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_ALREADY_INSIDE);
+    assert_string_equal(msg, "section particle 0 is already past the inlet plane at step 0 "
+                             "(signed distance 0.01 >= 0); valid: a section behind the plane "
+                             "(move the origin back against the belt, or raise the offset)");
+    s = one_sphere(ORIGIN_REL, R1, SP1);
+    assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_NO_STOP_RULE);
+    assert_string_equal(msg, "the stream never stops; valid: a number of sections, a deposit "
+                             "height or a time");
+    const double bad_r[1] = {-0.01};
+    s = one_sphere(ORIGIN_REL, bad_r, SP1);
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_BAD_VALUE);
+    assert_string_equal(msg, "section particle 0: radius -0.01 is not valid; valid: a number > 0");
+    s = one_sphere(ORIGIN_REL, R1, SP1);
+    s.period = 0.0;
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_BAD_VALUE);
+    assert_string_equal(msg, "period 0 is not valid; valid: a number > 0");
+    s.max_sections = 1; /* a single section (the second pass's queued cells) needs no period */
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_OK);
+    s = one_sphere(ORIGIN_REL, R1, SP1);
+    s.plane_normal[0] = 0.0;
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_NO_NORMAL);
+    s = one_sphere(ORIGIN_REL, R1, SP1);
+    s.dt = -1e-4;
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_BAD_VALUE);
+    assert_string_equal(msg, "dt -0.0001 is not valid; valid: a number > 0");
+    const double two[6] = {0, 0, 0, 0.015, 0, 0};
+    const double r2[2] = {0.01, 0.01};
+    const int32_t sp2[2] = {0, 0};
+    s = one_sphere(two, r2, sp2);
+    s.n = 2;
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_OVERLAP);
+    assert_string_equal(msg, "section particles 0 and 1 overlap by 0.005 m; valid: spheres that "
+                             "do not overlap");
+    s.n = 0;
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_EMPTY);
+}
+
+int run_inlet_tests(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(crossing_step_of_each_copy),
+        cmocka_unit_test(exactly_on_the_plane_counts_as_crossed),
+        cmocka_unit_test(crossing_step_is_the_first_nonnegative_distance),
+        cmocka_unit_test(inclined_plane_closed_form),
+        cmocka_unit_test(stream_order_ids_and_steps),
+        cmocka_unit_test(stop_step_keeps_whole_sections),
+        cmocka_unit_test(cap_leaves_the_rest_due),
+        cmocka_unit_test(jiang_section_period),
+        cmocka_unit_test(check_messages),
+    };
+    return cmocka_run_group_tests_name("inlet", tests, NULL, NULL);
+}
