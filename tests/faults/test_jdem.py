@@ -49,21 +49,16 @@ def scene_with(**fields):
 # ---- names are data ---------------------------------------------------------------------
 
 def hostile_names():
-    refused("name_newline_shell", scene_with(name="a\nshell touch PWNED"),
-            f"2: key 'name': the name 'a' has byte 0x0a at character 2, not allowed in a name; "
-            f"{VALID_NAME}")
-    refused("name_traversal", scene_with(name="../../esc"),
-            f"2: key 'name': the name '' has '.' at character 1, not allowed in a name; "
-            f"{VALID_NAME}")
-    refused("name_slash", scene_with(name="a/b"),
-            f"2: key 'name': the name 'a' has '/' at character 2, not allowed in a name; "
-            f"{VALID_NAME}")
-    refused("name_dollar_hash_space", scene_with(name="x$(id)"),
-            f"2: key 'name': the name 'x' has '$' at character 2, not allowed in a name; "
-            f"{VALID_NAME}")
-    refused("name_nul", scene_with(name="ab\0cd"),
-            f"2: key 'name': the name 'ab' has byte 0x00 at character 3, not allowed in a name; "
-            f"{VALID_NAME}")
+    # (check, top-level key, value, line, the valid prefix quoted, the character, its position)
+    for name, key, value, line, prefix, what, pos in (
+            ("name_newline_shell", "name", "a\nshell touch PWNED", 2, "a", "byte 0x0a", 2),
+            ("name_traversal", "name", "../../esc", 2, "", "'.'", 1),
+            ("name_slash", "name", "a/b", 2, "a", "'/'", 2),
+            ("name_dollar", "name", "x$(id)", 2, "x", "'$'", 2),
+            ("name_nul", "name", "ab\0cd", 2, "ab", "byte 0x00", 3)):
+        refused(name, scene_with(**{key: value}),
+                f"{line}: key '{key}': the name '{prefix}' has {what} at character {pos}, not "
+                f"allowed in a name; {VALID_NAME}")
     long_name = "a" * 1000
     refused("name_1000_chars_keeps_reason", scene_with(name=long_name),
             f"2: key 'name': the name '{'a' * 32}...' is too long (1000 characters); "
@@ -75,6 +70,16 @@ def hostile_names():
     refused("material_semicolon", scene_with(materials={"gl;ass": mats["glass"]}),
             f"9: key 'materials': the name 'gl' has ';' at character 3, not allowed in a name; "
             f"{VALID_NAME}")
+    refused("wall_hash", small_scene() + (
+        "walls:\n  - {name: 'w#1', type: plane, material: glass, corners: [[-1, -1, -1], [1, -1, "
+        "-1], [1, 1, -1], [-1, 1, -1]]}\n"),
+        f"11: key 'walls.0.name': the name 'w' has '#' at character 2, not allowed in a name; "
+        f"{VALID_NAME}")
+    refused("bond_type_quote", small_scene() + (
+        "bond_types:\n  \"c'x\": {normal_stiffness: 1.0, shear_stiffness: 1.0, tensile_strength: "
+        "1.0, shear_strength: 1.0}\n"),
+        f"11: key 'bond_types': the name 'c' has ''' at character 2, not allowed in a "
+        f"name; {VALID_NAME}")
     sweep = [{"axis": "speed", "values": {"v1": {}, "v 2\nshell touch PWNED": {}}}]
     refused("sweep_value_newline", scene_with(sweep=sweep),
             f"40: key 'sweep.0.values': the name 'v' has byte 0x20 at character 2, not allowed "
