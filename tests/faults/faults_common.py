@@ -145,7 +145,8 @@ class Result:
         self.rc, self.out, self.err, self.timed_out = rc, out, err, timed_out
 
     def __repr__(self):
-        return f"exit {self.rc}{' (timed out)' if self.timed_out else ''}, stderr {self.err.strip()!r}"
+        timed_out = " (timed out)" if self.timed_out else ""
+        return f"exit {self.rc}{timed_out}, stderr {self.err.strip()!r}"
 
 
 def _limits(mem_bytes):

@@ -9,13 +9,14 @@ import math
 import os
 import re
 import signal
+import subprocess
 import time
 
 import yaml
 
 from faults_common import (EXIT, JDEM, Checks, expect_files, files, finish, h5_frames,
-                           h5_readable, is_root, read_only, run, scratch, signal_exit, small_scene, start,
-                           tmpfs, wait_for, write_scene)
+                           h5_readable, is_root, read_only, run, scratch, signal_exit,
+                           small_scene, start, tmpfs, wait_for, write_scene)
 
 c = Checks()
 VALID_NAME = ("valid: 1 to 63 characters from A-Z a-z 0-9 _ . + -, the first a letter, a digit "
@@ -220,7 +221,8 @@ particles:
   - {{id: 1, material: clay, radius: 0.001, position: [0, 0, 0]}}
   - {{id: 2, material: clay, radius: 0.001, position: [0.002, 0, 0]}}
 bond_types:
-  cement: {{normal_stiffness: 2.0e12, shear_stiffness: 1.0e12, tensile_strength: 5.0e6, shear_strength: 5.0e6}}
+  cement: {{normal_stiffness: 2.0e12, shear_stiffness: 1.0e12, tensile_strength: 5.0e6,
+           shear_strength: 5.0e6}}
 bond_rules:
   - {{type: cement, time: 1.0e-5}}
   - {{type: cement, step: 2}}
@@ -395,6 +397,11 @@ def exit_codes():
     r = run([JDEM, "run", small, "-o", os.path.join(blocker, "sub", "x.h5"), "--quiet"])
     c.check("exit_output_dir_cannot_be_made_is_io", r.rc == EXIT["io"] and
             r.err == f"jdem: cannot create directory {blocker}/sub: Not a directory\n", repr(r))
+    with open("/dev/full", "w") as full:
+        p = subprocess.run([JDEM, "resolve", small], stdout=full, stderr=subprocess.PIPE, text=True)
+    c.check("exit_resolve_to_full_disk_is_io", p.returncode == EXIT["io"] and
+            p.stderr == "jdem: cannot write the resolved scene\n",
+            f"exit {p.returncode}, {p.stderr!r}")
     h = run([JDEM, "--help"])
     c.check("help_lists_exit_codes", all(f"  {k}  " in h.out or f"  {k}        " in h.out
                                          for k in ("0", "1", "2", "3", "4", "5")) and
