@@ -436,9 +436,9 @@ static int cmd_run(const cli *c) {
         fprintf(stderr, "jdem: %s\n", err);
         rc = setup_failure(err);
     } else {
-        jd_h5md *h = stop_signal ? NULL : create_output(&sc, &sim, out, &rc);
-        if (stop_signal && !h) rc = stopped_in_setup();
-        else if (h) rc = run_and_close(c, &sim, h, out);
+        jd_h5md *h = NULL;
+        if (stop_signal) rc = stopped_in_setup();
+        else if ((h = create_output(&sc, &sim, out, &rc))) rc = run_and_close(c, &sim, h, out);
         sim_free(&sim);
     }
     scene_free(&sc);
