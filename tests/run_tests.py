@@ -78,9 +78,11 @@ SUITES += [
      "lines", {}),
 ]
 
-# The Ch. 4 mixing analysis (scripts/mixing) on synthetic deposits, and its pictures.
+# The Ch. 4 mixing analysis (scripts/mixing) on synthetic deposits, its pictures, and the
+# generator of the second pass and the cubes (reference_runs/mixing/ch4/generate.py).
 SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py; a=$?; "
-                                f"{PY} tests/mixing/test_pictures.py; b=$?; exit $((a | b))"],
+                                f"{PY} tests/mixing/test_pictures.py; b=$?; "
+                                f"{PY} tests/mixing/test_generate.py; c=$?; exit $((a | b | c))"],
             "lines", {})]
 # The campaign driver (scripts/campaign.py) with dummy units, a killed run resumed.
 SUITES += [("campaign", [PY, "tests/mixing/test_campaign.py"], "lines", {})]
