@@ -60,6 +60,9 @@ SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--engines", "jde
                       "--out", "out/test/bonds"], "lines", {}),
            ("bonds-sanitized", [PY, "scripts/bond_checks.py", "--quick", "--out",
                                 "out/test/bonds-san"], "lines", SANITIZED)]
+# Fault injection (tests/faults/, run as root in CI: tmpfs, read-only mounts, ulimit -v):
+# hostile names, signals at each phase, disk full, memory limits; exit code, message, files left.
+SUITES += [("faults", [PY, "tests/faults/run_faults.py"], "lines", {})]
 # The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
 # `make demo` runs the full sweeps.
 CHUNG_OOI = "out/test/chung_ooi"
