@@ -44,19 +44,20 @@ def fail(msg):
 def word(value, what):
     """VALUE as one literal word of a LIGGGHTS input line.  LIGGGHTS' Input::file() joins a line
     ending in '&' to the next; Input::parse() cuts a '#' comment and substitutes '$' variables
-    outside quotes, and takes a word that starts with ' or " up to the same quote.  So every
-    string is quoted (a line then never ends in '&' of ours), and what no quote can hold is
-    refused: a line break or another control character, or both quote characters."""
+    outside quotes, and takes a word that starts with a quote up to the same quote.  Its quote
+    tracking (for '#' and '$') switches to any quote character met inside a quoted word, so a
+    word can be held literally only in quotes that it does not contain at all.  Every string is
+    written in single quotes (a line then never ends in an '&' of ours); a string with a quote
+    character, a line break or another control character is refused."""
     s = str(value)
     bad = sorted({c for c in s if ord(c) < 0x20 or ord(c) == 0x7F})
     if bad:
         fail("%s %r holds the control character(s) %s, which a LIGGGHTS input line cannot hold"
              % (what, s, ", ".join("0x%02x" % ord(c) for c in bad)))
-    if "'" not in s:
-        return "'%s'" % s
-    if '"' not in s:
-        return '"%s"' % s
-    fail("%s %r holds both quote characters ' and \", which LIGGGHTS cannot read as one word" % (what, s))
+    if "'" in s or '"' in s:
+        fail("%s %r holds a quote character (' or \"), which LIGGGHTS cannot read literally; "
+             "rename it without quotes" % (what, s))
+    return "'%s'" % s
 
 
 def choice(value, allowed, what):
