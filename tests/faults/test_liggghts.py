@@ -343,10 +343,14 @@ def setup_watchdog(c, d):
     r, log = liggghts(deck)
     out = os.path.join(deck, "out.h5")
     c.check("setup_watchdog_exit", r.rc == 1, repr(r)[-800:])
-    c.check("setup_watchdog_trips", "jdem: watchdog: step 0:" in r.err, r.err[-800:])
-    c.check("setup_watchdog_names_no_missing_part", ".part" not in r.err or os.path.exists(out + ".part"),
-            "the message names %s.part, which does not exist: %r" % (out, r.err[-800:]))
-    c.check("setup_watchdog_says_nothing_written", "no trajectory was written" in r.err, r.err[-800:])
+    trip = [ln for ln in log.splitlines() if "jdem: watchdog: step 0:" in ln]
+    c.check("setup_watchdog_trips", trip and trip[0] in r.err, "log %r, stderr %r" % (log[-800:], r.err[-800:]))
+    msg = trip[0] if trip else ""
+    c.check("setup_watchdog_names_no_missing_part", ".part" not in msg or os.path.exists(out + ".part"),
+            "the message names %s.part, which does not exist: %r" % (out, msg))
+    c.check("setup_watchdog_says_nothing_written", "no trajectory was written (%s: the run failed before its "
+            "first frame)" % out in msg, msg)
+    c.check("setup_watchdog_no_files", not os.path.exists(out) and not os.path.exists(out + ".part"), files(deck))
 
 
 def main():
