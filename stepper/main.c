@@ -299,6 +299,8 @@ static void print_timing(const jd_sim *s) {
                 {"wall forces", t->walls}, {"integration", t->integration}, {"output", t->output}};
     fprintf(stderr, "jdem: timing of %lld steps, %zu particles, %d thread(s), %lld neighbour builds:\n",
             (long long)s->step, s->n, s->threads, (long long)s->n_builds);
+    char laws[96];
+    fprintf(stderr, "jdem:   law set %s\n", jd_law_set_describe(s->features, laws, sizeof laws));
     for (size_t k = 0; k < sizeof part / sizeof *part; k++)
         fprintf(stderr, "jdem:   %-17s %10.4f s  %5.1f %%\n", part[k].name, part[k].v,
                 total > 0.0 ? 100.0 * part[k].v / total : 0.0);
