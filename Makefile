@@ -59,6 +59,7 @@ HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)
 
 .PHONY: all deps test demo chung-ooi stability unit clean
 all: build/jdem build/liggghts-jdem
+-include $(shell find build -name '*.d' 2>/dev/null)
 
 # ---------------------------------------------------------------------------------------------
 # Dependencies (Debian only)
@@ -75,19 +76,22 @@ deps:
 
 # ---------------------------------------------------------------------------------------------
 # Standalone engine (C11) and its sanitizer twin
-build/obj/%.o: %.c $(HEADERS)
+# Every object lists the headers it includes in a .d file next to it (-MMD -MP), read back below:
+# a changed header rebuilds exactly the objects that include it.
+DEPFLAGS := -MMD -MP
+build/obj/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -c $< -o $@
-build/obj/stepper/%.o: stepper/%.c $(HEADERS)
+	$(CC) $(CFLAGS) $(DEPFLAGS) -c $< -o $@
+build/obj/stepper/%.o: stepper/%.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(OMPFLAGS) -c $< -o $@
+	$(CC) $(CFLAGS) $(OMPFLAGS) $(DEPFLAGS) -c $< -o $@
 
-build/san/%.o: %.c $(HEADERS)
+build/san/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(SANFLAGS) -c $< -o $@
-build/san/stepper/%.o: stepper/%.c $(HEADERS)
+	$(CC) $(CFLAGS) $(SANFLAGS) $(DEPFLAGS) -c $< -o $@
+build/san/stepper/%.o: stepper/%.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(OMPFLAGS) $(SANFLAGS) -c $< -o $@
+	$(CC) $(CFLAGS) $(OMPFLAGS) $(SANFLAGS) $(DEPFLAGS) -c $< -o $@
 
 # The bond loop is scalar code (a bond per iteration); GCC's straight-line vectoriser packs its
 # 3-vectors into 512-bit registers with shuffles, which made it a sixth slower (docs/performance.md).
@@ -105,14 +109,13 @@ build/san/jdem: $(patsubst %.c,build/san/%.o,$(KERNEL_SRC) $(IO_SRC) $(STEPPER_S
 # C objects as in the stepper (compiled position-independent), and the same code generation (OPT).
 PLUGIN_CXXFLAGS := -std=c++11 $(OPT) -g -Wall -Wextra -Werror -Wno-unused-parameter -fPIC \
                    -DOMPI_SKIP_MPICXX -DJDEM_VERSION=\"$(VERSION)\" -Ikernel -Iio -isystem /usr/include/liggghts $(PKG_CFLAGS)
-build/pic/%.o: %.c $(HEADERS)
+build/pic/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -fPIC -c $< -o $@
-build/plugin/%.o: %.cpp $(wildcard liggghts_plugin/*.h) $(HEADERS)
+	$(CC) $(CFLAGS) -fPIC $(DEPFLAGS) -c $< -o $@
+build/plugin/%.o: %.cpp
 	@mkdir -p $(dir $@)
-	$(CXX) $(PLUGIN_CXXFLAGS) -c $< -o $@
-# The bond loop, as in the stepper (build/obj/stepper/bonds.o): bond_bench 45 ns per bond-step
-# against 49 with the straight-line vectoriser (5 alternating runs each).
+	$(CXX) $(PLUGIN_CXXFLAGS) $(DEPFLAGS) -c $< -o $@
+# The bond loop, as in the stepper (build/obj/stepper/bonds.o; docs/performance.md).
 build/plugin/liggghts_plugin/fix_bond_jiang.o: PLUGIN_CXXFLAGS += -fno-tree-slp-vectorize
 build/liggghts-jdem: $(patsubst %.cpp,build/plugin/%.o,$(PLUGIN_SRC)) \
                      $(patsubst %.c,build/pic/%.o,$(KERNEL_SRC) $(IO_SRC))
@@ -166,7 +169,7 @@ bench: all
 	    $(if $(BENCH_VARIANTS),--variants $(BENCH_VARIANTS))
 	$(PY) scripts/bond_bench.py --engines jdem,liggghts-jdem --out out/bench/bonds $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS))
 
-# Parallel bonds (issue 4): every check of scripts/bond_checks.py in full length, in the engines
+# Parallel bonds: every check of scripts/bond_checks.py in full length, in the engines
 # of BONDS_ENGINES (jdem, liggghts-jdem), plus the ns-per-bond-step figure of bond_bench.py;
 # records in out/bonds/summary.json.  `make test` runs the same checks shortened (--quick).
 BONDS_ENGINES ?= jdem,liggghts-jdem
@@ -175,7 +178,7 @@ bonds: all
 	$(PY) scripts/bond_bench.py --engines $(BONDS_ENGINES) --out out/bonds
 	$(PY) scripts/bond_checks.py --engines $(BONDS_ENGINES) --out out/bonds --bench out/bonds/bench.json
 
-# Error against run time (issue 6): Chung–Ooi tests 1, 3, 4 and a settling bed, dt swept over
+# Error against run time: Chung–Ooi tests 1, 3, 4 and a settling bed, dt swept over
 # factors of the time-step guard's dt, in jdem, liggghts-jdem and LIGGGHTS hertz/history; timings
 # medians of ACCURACY_REPEATS (default 3).  ~11 min on 2 busy cores.  Report: out/accuracy/report.md
 .PHONY: accuracy

@@ -58,6 +58,8 @@ typedef struct obs {
 struct jd_h5md {
     char *path; /* final name */
     char *part; /* PATH.part */
+    char *sidecar, *sidecar_part; /* PATH's .xdmf and its .part */
+    int fd;     /* PATH.part, open while the writer lives: it holds the lock (h5md_file.c) */
     hid_t file;
     hid_t all; /* /particles/all */
     size_t n;
@@ -83,7 +85,8 @@ h5md_view h5md_view_of(jd_h5md *h) {
     return (h5md_view){h->file, h->part, h->h5detail, &h->broken};
 }
 
-static void free_handle(jd_h5md *h) {
+/* Every HDF5 object of the writer but the file; what the sidecar needs stays. */
+static void free_objects(jd_h5md *h) {
     for (size_t i = 0; i < h->nobs; ++i) {
         h5md_close_id(&h->obs[i].step);
         h5md_close_id(&h->obs[i].time);
@@ -98,11 +101,20 @@ static void free_handle(jd_h5md *h) {
     h5md_close_id(&h->step_ds);
     h5md_close_id(&h->time_ds);
     h5md_close_id(&h->all);
-    h5md_close_id(&h->file);
     free(h->obs);
+    h->obs = NULL;
+    h->nobs = 0;
+}
+
+static void free_handle(jd_h5md *h) {
+    free_objects(h);
+    h5md_close_id(&h->file);
     free(h->times);
     free(h->path);
     free(h->part);
+    free(h->sidecar);
+    free(h->sidecar_part);
+    if (h->fd >= 0) close(h->fd);
     free(h);
 }
 
@@ -205,6 +217,11 @@ fail:
 
 jd_h5md *jd_h5md_create(const char *path, const jd_h5md_meta *meta,
                         const jd_h5md_particles *particles, char *err, size_t errlen) {
+    /* HDF5's exit-time clean-up closes what is still open; after a failed H5Fclose (disk full,
+     * out of memory) the file stays registered half-closed and that clean-up crashes in
+     * HDF5 1.10.  Every file is closed explicitly here, so the clean-up is not needed.  Only
+     * effective before the library's first use (a later call fails harmlessly). */
+    H5dont_atexit();
     if (!path || !*path || !particles) {
         h5md_set_err(err, errlen, "h5md: missing path or particle description");
         return NULL;
@@ -227,37 +244,32 @@ jd_h5md *jd_h5md_create(const char *path, const jd_h5md_meta *meta,
         h5md_set_err(err, errlen, "h5md: out of memory");
         return NULL;
     }
+    h->fd = -1;
     h->file = h->all = h->step_ds = h->time_ds = H5I_INVALID_HID;
     for (int k = 0; k < TD_COUNT; ++k) h->grp[k] = h->value[k] = H5I_INVALID_HID;
     h->n = particles->n;
     size_t len = strlen(path);
     h->path = malloc(len + 1);
     h->part = malloc(len + 6);
-    if (!h->path || !h->part) {
+    h->sidecar = xdmf_path(path);
+    h->sidecar_part = h->sidecar ? malloc(strlen(h->sidecar) + 6) : NULL;
+    if (!h->path || !h->part || !h->sidecar_part) {
         h5md_set_err(err, errlen, "h5md: out of memory");
         free_handle(h);
         return NULL;
     }
     memcpy(h->path, path, len + 1);
-    memcpy(h->part, path, len);
-    memcpy(h->part + len, ".part", 6);
+    snprintf(h->part, len + 6, "%s.part", path);
+    snprintf(h->sidecar_part, strlen(h->sidecar) + 6, "%s.part", h->sidecar);
 
-    /* Probe with open(2) first: HDF5's own message for a missing directory is verbose. */
-    int fd = open(h->part, O_WRONLY | O_CREAT | O_TRUNC, 0666);
-    if (fd < 0) {
-        h5md_set_err(err, errlen, "cannot create '%s': %s", h->part, strerror(errno));
-        free_handle(h);
+    if (h5md_part_open(h->path, h->part, h->sidecar, &h->fd, err, errlen) != 0) {
+        free_handle(h); /* PATH.part is not ours (or not usable): left as it is */
         return NULL;
     }
-    close(fd);
-
     quiet_t q;
     h5md_quiet_on(&q, h->h5detail);
-    h->file = H5Fcreate(h->part, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-    if (h->file < 0) {
-        h5md_err(h->h5detail, err, errlen, "cannot create '%s'", h->part);
-        goto fail;
-    }
+    h->file = h5md_part_create(h->part, h->fd, err, errlen, h->h5detail);
+    if (h->file < 0) goto fail;
     if (write_header(h, meta, particles, err, errlen) < 0) goto fail;
     if (H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0) {
         h5md_err(h->h5detail, err, errlen, "cannot flush '%s'", h->part);
@@ -267,13 +279,9 @@ jd_h5md *jd_h5md_create(const char *path, const jd_h5md_meta *meta,
     return h;
 
 fail:
-    {
-        char *part = h->part;
-        h->part = NULL;
-        free_handle(h);
-        unlink(part); /* nothing useful in a half-created file */
-        free(part);
-    }
+    /* nothing useful in a half-created file; it is ours (locked), so it is removed */
+    unlink(h->part);
+    free_handle(h);
     h5md_quiet_off(&q);
     return NULL;
 }
@@ -525,37 +533,30 @@ fail:
 int jd_h5md_close(jd_h5md *h, int ok, char *err, size_t errlen) {
     if (!h) return 0;
     quiet_t q;
-    char detail[256]; /* h is freed before the file is closed */
-    h5md_quiet_on(&q, detail);
-    int rc = 0;
-    /* Keep what the sidecar needs, close every object, then the file itself (H5Fclose does
-     * the final flush and reports its failure). */
+    h5md_quiet_on(&q, h->h5detail);
+    int rc = 0, clean = !h->broken;
+    /* Close every object, then the file itself (H5Fclose does the final flush and reports its
+     * failure). */
     hid_t file = h->file;
     h->file = H5I_INVALID_HID;
-    char *path = h->path, *part = h->part;
-    double *times = h->times;
-    int present[TD_COUNT];
-    memcpy(present, h->present, sizeof present);
-    xdmf_info xi = {path, h->n, h->nframes, times, present};
-    h->path = h->part = NULL;
-    h->times = NULL;
-    free_handle(h);
+    xdmf_info xi = {h->path, h->n, h->nframes, h->times, h->present};
+    free_objects(h);
     if (file >= 0 && H5Fclose(file) < 0) {
-        h5md_err(detail, err, errlen, "cannot close '%s'", part);
+        h5md_err(h->h5detail, err, errlen, "cannot close '%s'", h->part);
+        rc = -1;
+        clean = 0;
+    }
+    if (rc == 0 && ok && h->broken) {
+        h5md_set_err(err, errlen, "'%s' is incomplete after an earlier write error", h->part);
         rc = -1;
     }
-    if (rc == 0 && ok) {
-        if (rename(part, path) != 0) {
-            h5md_set_err(err, errlen, "cannot rename '%s' to '%s': %s", part, path,
-                         strerror(errno));
-            rc = -1;
-        } else {
-            rc = xdmf_write(&xi, err, errlen);
-        }
-    }
-    free(times);
-    free(path);
-    free(part);
+    /* the sidecar first: PATH and its sidecar replace the previous pair only when both exist */
+    if (rc == 0 && ok) rc = xdmf_write(&xi, h->sidecar_part, err, errlen);
+    if (rc == 0 && ok)
+        rc = h5md_publish(h->part, h->path, h->sidecar_part, h->sidecar, err, errlen);
+    else if (ok || !clean)
+        h5md_part_keep_or_remove(h->part, clean, err, errlen);
     h5md_quiet_off(&q);
+    free_handle(h);
     return rc;
 }

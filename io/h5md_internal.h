@@ -55,6 +55,19 @@ h5md_view h5md_view_of(jd_h5md *h);
 int h5md_append_rows(hid_t d, hsize_t at, hsize_t n, int rank, const hsize_t *rest, hid_t mtype,
                      const void *buf);
 
+/* h5md_file.c: the file on disk.  h5md_part_open refuses a directory at PATH or SIDECAR and a
+ * link or non-regular file at PART, takes an exclusive lock on PART (another run holding it is
+ * an error) and only then truncates it; the descriptor (*fd, kept open for the lock) is closed
+ * by the caller after the final rename.  h5md_part_create has HDF5 create PART and checks that
+ * it is the locked file.  h5md_publish renames PART to PATH, then SIDECAR_PART to SIDECAR. */
+int h5md_part_open(const char *path, const char *part, const char *sidecar, int *fd, char *err,
+                   size_t errlen);
+hid_t h5md_part_create(const char *part, int fd, char *err, size_t errlen, char *detail);
+int h5md_part_readable(const char *part);
+void h5md_part_keep_or_remove(const char *part, int clean, char *err, size_t errlen);
+int h5md_publish(const char *part, const char *path, const char *sidecar_part,
+                 const char *sidecar, char *err, size_t errlen);
+
 /* xdmf.c: what the sidecar needs of a closed writer */
 typedef struct xdmf_info {
     const char *path; /* final .h5 path */
@@ -64,6 +77,9 @@ typedef struct xdmf_info {
     const int *present;
 } xdmf_info;
 
-int xdmf_write(const xdmf_info *h, char *err, size_t errlen);
+/* PATH with its extension replaced by .xdmf (malloc'd; NULL when out of memory). */
+char *xdmf_path(const char *path);
+/* Write the sidecar of h to TMP (an existing TMP is replaced, never followed). */
+int xdmf_write(const xdmf_info *h, const char *tmp, char *err, size_t errlen);
 
 #endif

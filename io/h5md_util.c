@@ -17,7 +17,15 @@
 static herr_t walk_cb(unsigned n, const H5E_error2_t *e, void *data) {
     char *buf = data;
     if (n == 0 && e && e->desc) {
-        snprintf(buf, 256, "%s", e->desc);
+        /* a failed system call: HDF5's description carries the time, the buffer address and
+         * the sizes; the system's message is the part a user needs */
+        const char *sys = strstr(e->desc, "error message = '");
+        if (sys) {
+            sys += strlen("error message = '");
+            snprintf(buf, 256, "%.*s", (int)strcspn(sys, "'"), sys);
+        } else {
+            snprintf(buf, 256, "%s", e->desc);
+        }
         return 1; /* the innermost message is enough */
     }
     return 0;

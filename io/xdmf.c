@@ -7,6 +7,7 @@
  * [1, N, 3] of the .h5 (referenced by basename).
  */
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,7 +29,7 @@ static void xml_escaped(FILE *fp, const char *s) {
 }
 
 /* PATH with its extension replaced by .xdmf (only the last one: a.jdem.h5 -> a.jdem.xdmf). */
-static char *xdmf_path(const char *path) {
+char *xdmf_path(const char *path) {
     const char *slash = strrchr(path, '/');
     const char *base = slash ? slash + 1 : path;
     const char *dot = strrchr(base, '.');
@@ -63,29 +64,15 @@ static void xdmf_slab(FILE *fp, const xdmf_info *h, const char *file, const char
     fprintf(fp, "\n          </DataItem>\n        ");
 }
 
-int xdmf_write(const xdmf_info *h, char *err, size_t errlen) {
-    char *xpath = xdmf_path(h->path);
-    if (!xpath) {
-        h5md_set_err(err, errlen, "h5md: out of memory");
-        return -1;
-    }
-    size_t xl = strlen(xpath);
-    char *tmp = malloc(xl + 6);
-    if (!tmp) {
-        free(xpath);
-        h5md_set_err(err, errlen, "h5md: out of memory");
-        return -1;
-    }
-    memcpy(tmp, xpath, xl);
-    memcpy(tmp + xl, ".part", 6);
+int xdmf_write(const xdmf_info *h, const char *tmp, char *err, size_t errlen) {
     const char *slash = strrchr(h->path, '/');
     const char *file = slash ? slash + 1 : h->path; /* relative: the pair moves together */
-
-    FILE *fp = fopen(tmp, "w");
+    unlink(tmp); /* a link or a stale file at TMP is replaced, never written through */
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW, 0666);
+    FILE *fp = fd >= 0 ? fdopen(fd, "w") : NULL;
     if (!fp) {
         h5md_set_err(err, errlen, "cannot create '%s': %s", tmp, strerror(errno));
-        free(tmp);
-        free(xpath);
+        if (fd >= 0) close(fd);
         return -1;
     }
     char n1[32];
@@ -144,18 +131,7 @@ int xdmf_write(const xdmf_info *h, char *err, size_t errlen) {
     if (bad) {
         h5md_set_err(err, errlen, "cannot write '%s': %s", tmp, strerror(errno));
         unlink(tmp);
-        free(tmp);
-        free(xpath);
         return -1;
     }
-    if (rename(tmp, xpath) != 0) {
-        h5md_set_err(err, errlen, "cannot rename '%s' to '%s': %s", tmp, xpath, strerror(errno));
-        unlink(tmp);
-        free(tmp);
-        free(xpath);
-        return -1;
-    }
-    free(tmp);
-    free(xpath);
     return 0;
 }

@@ -3,6 +3,7 @@
  * eq. (15) and the frequency bound used by the engines' time-step guards.
  */
 #include "jdem_bond.h"
+#include "jdem_guard.h"
 
 _Static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double),
                "jd_bond_state is a flat array of JD_BOND_STATE_LEN doubles");
@@ -30,4 +31,19 @@ double jd_bond_omega2_bound(const jd_bond_params *p, const jd_bond_section *sec,
         p->kt * sec->A * (inv_m + la * la / I_a + lb * lb / I_b) + p->kn * Ib * inv_i;
     double w2 = axial > twist ? axial : twist;
     return shear_bend > w2 ? shear_bend : w2;
+}
+
+double jd_bond_omega2_pair(const jd_bond_params *p, double R_a, double R_b, double m_a,
+                           double m_b, double dist) {
+    const jd_bond_section sec = jd_bond_section_of(p->lambda, R_a, R_b);
+    const double delta = R_a + R_b - dist;
+    const double la = fabs(R_a - 0.5 * delta), lb = fabs(dist - la);
+    return jd_bond_omega2_bound(p, &sec, m_a, m_b, jd_sphere_inertia(m_a, R_a),
+                                jd_sphere_inertia(m_b, R_b), la, lb);
+}
+
+double jd_bond_omega2_rule(const jd_bond_params *p, double R, double m) {
+    const double I = jd_sphere_inertia(m, R);
+    const jd_bond_section sec = jd_bond_section_of(p->lambda, R, R);
+    return JD_GUARD_DEFAULT_COORDINATION * jd_bond_omega2_bound(p, &sec, m, m, I, I, R, R);
 }

@@ -169,6 +169,21 @@ jd_bond_section jd_bond_section_of(double lambda, double Ra, double Rb);
 double jd_bond_omega2_bound(const jd_bond_params *p, const jd_bond_section *sec, double m_a,
                             double m_b, double I_a, double I_b, double la, double lb);
 
+/* jd_bond_omega2_bound of a bond of type p between spheres of radii R_a, R_b [m] and masses m_a,
+ * m_b [kg] whose centres are dist [m] apart (lever arms from the bond's contact plane, solid
+ * spheres' inertia) [rad^2/s^2]. */
+double jd_bond_omega2_pair(const jd_bond_params *p, double R_a, double R_b, double m_a,
+                           double m_b, double dist);
+
+/* The bound a bond rule adds to a particle of radius R [m] and mass m [kg] that it may bond:
+ * JD_GUARD_DEFAULT_COORDINATION bonds to equal neighbours (the densest packing's
+ * coordination) [rad^2/s^2]. */
+double jd_bond_omega2_rule(const jd_bond_params *p, double R, double m);
+
+/* The bond law's set of a run (JD_B_*): the dashpots when a bond type has gamma > 0, the energy
+ * bookkeeping when asked; one of JD_BOND_LAW_SETS (jdem_laws.h). */
+static inline unsigned jd_bond_laws(double gamma) { return gamma > 0.0 ? (unsigned)JD_B_DAMPING : 0u; }
+
 /* ------------------------------------------------------------------------------------------ */
 /* Hot path.                                                                                   */
 /* ------------------------------------------------------------------------------------------ */
@@ -224,56 +239,66 @@ static inline double jd_bond_energy(const jd_bond_params *p, const jd_bond_secti
            (n ? 0.5 * jd_dot(s->mt, s->mt) / (p->kn * Ib) : 0.0);
 }
 
-/* One evaluation of an intact bond (docs/model.md §9.3).
- *
- * features: JD_B_* bits, a compile-time constant at the call site.
- * p, g, k:  parameters, geometry (jd_bond_geom_spheres + sec, m_eff, i_eff) and kinematics.
- * dt:       time step [s] (the increments are rate * dt).
- * s:        bond state (intact), updated.  On failure its flags become JD_BS_BROKEN and its
- *           forces zero; the energy it stored goes to e_break (JD_B_ENERGY).
- * out:      force on b, torques, the bond's force and moment magnitudes and stresses.
- * Returns out->mode: JD_BOND_INTACT, or the failure mode.  When both strengths are reached in
- * the same step the mode is the one with the larger stress/strength ratio (tension on a tie). */
-#if defined(__GNUC__)
-#define JD_BOND_INLINE static inline __attribute__((always_inline))
-#else
-#define JD_BOND_INLINE static inline
-#endif
-/* (always inlined: `features` must fold into each engine's specialised loop) */
-JD_BOND_INLINE int jd_bond(const unsigned features, const jd_bond_params *p, const jd_bond_geom *g,
-                          const jd_kinematics *k, double dt, jd_bond_state *s,
-                          jd_bond_result *out) {
-    const jd_bond_section *sec = &g->sec;
-    const double Ib = p->bending == JD_BOND_BEND_J_LITERAL ? sec->J : sec->I;
-    const double Kn = p->kn * sec->A, Kt = p->kt * sec->A; /* [N/m] */
-    const double Ktw = p->kt * sec->J, Kb = p->kn * Ib;    /* [N m/rad] */
+/* ------------------------------------------------------------------------------------------ */
+/* jd_bond as a composition of small laws, each unit-tested alone (tests/unit/test_laws.c),    */
+/* called by jd_bond in the order of docs/model.md §9.                                         */
+/* ------------------------------------------------------------------------------------------ */
 
-    /* Relative motion at the bond point. */
-    double wxa[3], wxb[3], vrel[3], wrel[3];
+/* The relative motion at the bond point, split along n and in the plane. */
+typedef struct jd_bond_motion {
+    double vrel[3], wrel[3]; /* relative velocity [m/s] and angular velocity [rad/s] of b */
+    double vn, wn;           /* their components along n                                  */
+    double vt[3], wt[3];     /* and in the plane                                          */
+} jd_bond_motion;
+
+static JD_ALWAYS_INLINE void jd_bond_kinematics(const jd_bond_geom *g, const jd_kinematics *k,
+                                                jd_bond_motion *m) {
+    double wxa[3], wxb[3];
     jd_cross(k->wa, g->ra, wxa);
     jd_cross(k->wb, g->rb, wxb);
     for (int d = 0; d < 3; d++) {
-        vrel[d] = (k->vb[d] + wxb[d]) - (k->va[d] + wxa[d]);
-        wrel[d] = k->wb[d] - k->wa[d];
+        m->vrel[d] = (k->vb[d] + wxb[d]) - (k->va[d] + wxa[d]);
+        m->wrel[d] = k->wb[d] - k->wa[d];
     }
-    const double vn = jd_dot(vrel, g->n), wn = jd_dot(wrel, g->n);
-    double vt[3], wt[3];
+    m->vn = jd_dot(m->vrel, g->n);
+    m->wn = jd_dot(m->wrel, g->n);
     for (int d = 0; d < 3; d++) {
-        vt[d] = vrel[d] - vn * g->n[d];
-        wt[d] = wrel[d] - wn * g->n[d];
+        m->vt[d] = m->vrel[d] - m->vn * g->n[d];
+        m->wt[d] = m->wrel[d] - m->wn * g->n[d];
     }
+}
 
-    /* Stored vectors into the current plane, then the increments of eq. (16). */
+/* The bond's spring stiffnesses: normal and shear kn A, kt A [N/m]; twisting kt J and bending
+ * kn I_bend [N m/rad]. */
+typedef struct jd_bond_stiffness {
+    double Kn, Kt, Ktw, Kb;
+} jd_bond_stiffness;
+
+static JD_ALWAYS_INLINE jd_bond_stiffness jd_bond_stiffness_of(const jd_bond_params *p,
+                                                               const jd_bond_section *sec) {
+    const double Ib = p->bending == JD_BOND_BEND_J_LITERAL ? sec->J : sec->I;
+    const jd_bond_stiffness K = {p->kn * sec->A, p->kt * sec->A, p->kt * sec->J, p->kn * Ib};
+    return K;
+}
+
+/* The stored force and moment vectors turned into the current plane, then the increments of
+ * eq. (16). */
+static JD_ALWAYS_INLINE void jd_bond_springs(const jd_bond_stiffness *K, const jd_bond_geom *g,
+                                             const jd_bond_motion *m, double dt, jd_bond_state *s) {
     jd_rotate_into_plane(s->ft, g->n);
     jd_rotate_into_plane(s->mt, g->n);
-    s->fn -= Kn * vn * dt;
-    s->mn -= Ktw * wn * dt;
+    s->fn -= K->Kn * m->vn * dt;
+    s->mn -= K->Ktw * m->wn * dt;
     for (int d = 0; d < 3; d++) {
-        s->ft[d] -= Kt * vt[d] * dt;
-        s->mt[d] -= Kb * wt[d] * dt;
+        s->ft[d] -= K->Kt * m->vt[d] * dt;
+        s->mt[d] -= K->Kb * m->wt[d] * dt;
     }
+}
 
-    /* Stresses on the periphery, eq. (17), and failure. */
+/* Stresses on the periphery, eq. (17), and the failure they cause: fills out's magnitudes and
+ * stresses and returns out->mode (the larger stress/strength ratio; tension on a tie). */
+static JD_ALWAYS_INLINE int jd_bond_strength(const jd_bond_params *p, const jd_bond_section *sec,
+                                             const jd_bond_state *s, jd_bond_result *out) {
     out->fn = s->fn;
     out->ft = sqrt(jd_dot(s->ft, s->ft));
     out->mn = fabs(s->mn);
@@ -285,67 +310,109 @@ JD_BOND_INLINE int jd_bond(const unsigned features, const jd_bond_params *p, con
         const double rs = out->sigma_max / p->sigma_c, rt = out->tau_max / p->tau_c;
         out->mode = rs >= rt ? JD_BOND_BROKE_TENSION : JD_BOND_BROKE_SHEAR;
     }
+    return out->mode;
+}
 
-    if (out->mode != JD_BOND_INTACT) {
-        if (features & JD_B_ENERGY) {
-            /* The bond's last force still did half of this step's trapezoid; what it stored
-             * beyond that is lost (as at Luding's end of a contact). */
-            const double w = jd_dot(s->f_prev, vrel) + jd_dot(s->m_prev, wrel);
-            s->e_break += s->u_prev - 0.5 * w * dt;
-        }
-        const double e_damp = s->e_damp, e_break = s->e_break;
-        double *v = (double *)s;
-        for (int q = 0; q < JD_BOND_STATE_LEN; q++) v[q] = 0.0;
-        s->flags = (double)JD_BS_BROKEN;
-        s->e_damp = e_damp;
-        s->e_break = e_break;
-        for (int d = 0; d < 3; d++) out->f[d] = out->ta[d] = out->tb[d] = 0.0;
-        return out->mode;
+/* A bond that failed this step: with JD_B_ENERGY the energy it stored beyond the half of this
+ * step's trapezoid its last force still did is lost (as at Luding's end of a contact); the
+ * state becomes broken with zero forces, keeping the accumulators; no force on the bodies. */
+static JD_ALWAYS_INLINE void jd_bond_break(const unsigned features, const jd_bond_motion *m,
+                                           double dt, jd_bond_state *s, jd_bond_result *out) {
+    if (features & JD_B_ENERGY) {
+        const double w = jd_dot(s->f_prev, m->vrel) + jd_dot(s->m_prev, m->wrel);
+        s->e_break += s->u_prev - 0.5 * w * dt;
     }
+    const double e_damp = s->e_damp, e_break = s->e_break;
+    double *v = (double *)s;
+    for (int q = 0; q < JD_BOND_STATE_LEN; q++) v[q] = 0.0;
+    s->flags = (double)JD_BS_BROKEN;
+    s->e_damp = e_damp;
+    s->e_break = e_break;
+    for (int d = 0; d < 3; d++) out->f[d] = out->ta[d] = out->tb[d] = 0.0;
+}
 
-    /* Force and couple on b: the springs, plus the dashpots (not part of the bond's stress). */
-    double f[3], m[3];
+/* Force f and couple mo on b: the springs, plus with JD_B_DAMPING the dashpots (not part of
+ * the bond's stress), 2 gamma sqrt(m K) on each of the four motions. */
+static JD_ALWAYS_INLINE void jd_bond_load(const unsigned features, const jd_bond_params *p,
+                                          const jd_bond_stiffness *K, const jd_bond_geom *g,
+                                          const jd_bond_motion *m, const jd_bond_state *s,
+                                          double f[3], double mo[3]) {
     for (int d = 0; d < 3; d++) {
         f[d] = s->fn * g->n[d] + s->ft[d];
-        m[d] = s->mn * g->n[d] + s->mt[d];
+        mo[d] = s->mn * g->n[d] + s->mt[d];
     }
     if (features & JD_B_DAMPING) {
-        const double cn = 2.0 * p->gamma * sqrt(g->m_eff * Kn);
-        const double ct = 2.0 * p->gamma * sqrt(g->m_eff * Kt);
-        const double ctw = 2.0 * p->gamma * sqrt(g->i_eff * Ktw);
-        const double cb = 2.0 * p->gamma * sqrt(g->i_eff * Kb);
+        const double cn = 2.0 * p->gamma * sqrt(g->m_eff * K->Kn);
+        const double ct = 2.0 * p->gamma * sqrt(g->m_eff * K->Kt);
+        const double ctw = 2.0 * p->gamma * sqrt(g->i_eff * K->Ktw);
+        const double cb = 2.0 * p->gamma * sqrt(g->i_eff * K->Kb);
         for (int d = 0; d < 3; d++) {
-            f[d] -= cn * vn * g->n[d] + ct * vt[d];
-            m[d] -= ctw * wn * g->n[d] + cb * wt[d];
+            f[d] -= cn * m->vn * g->n[d] + ct * m->vt[d];
+            mo[d] -= ctw * m->wn * g->n[d] + cb * m->wt[d];
         }
     }
+}
 
-    if (features & JD_B_ENERGY) {
-        /* Work on the bodies this step by the trapezoidal rule (as jd_contact); with dashpots,
-         * what the springs did not store was dissipated.  Without dashpots nothing is booked:
-         * the O(dt^2) remainder is the integrator's, and the undamped energy checks see it. */
-        const double u_new = jd_bond_energy(p, sec, s);
-        if (features & JD_B_DAMPING) {
-            const double w = jd_dot(s->f_prev, vrel) + jd_dot(f, vrel) + jd_dot(s->m_prev, wrel) +
-                             jd_dot(m, wrel);
-            s->e_damp += -0.5 * w * dt - (u_new - s->u_prev);
-        }
-        s->u_prev = u_new;
-        for (int d = 0; d < 3; d++) {
-            s->f_prev[d] = f[d];
-            s->m_prev[d] = m[d];
-        }
+/* Energy bookkeeping (JD_B_ENERGY): work on the bodies this step by the trapezoidal rule (as
+ * jd_contact); with dashpots, what the springs did not store was dissipated.  Without dashpots
+ * nothing is booked: the O(dt^2) remainder is the integrator's, and the undamped energy checks
+ * see it. */
+static JD_ALWAYS_INLINE void jd_bond_energy_book(const unsigned features, const jd_bond_params *p,
+                                                 const jd_bond_section *sec,
+                                                 const jd_bond_motion *m, const double f[3],
+                                                 const double mo[3], double dt, jd_bond_state *s) {
+    const double u_new = jd_bond_energy(p, sec, s);
+    if (features & JD_B_DAMPING) {
+        const double w = jd_dot(s->f_prev, m->vrel) + jd_dot(f, m->vrel) +
+                         jd_dot(s->m_prev, m->wrel) + jd_dot(mo, m->wrel);
+        s->e_damp += -0.5 * w * dt - (u_new - s->u_prev);
     }
+    s->u_prev = u_new;
+    for (int d = 0; d < 3; d++) {
+        s->f_prev[d] = f[d];
+        s->m_prev[d] = mo[d];
+    }
+}
 
-    /* Torques about the centres: the force at x_C plus the couple. */
+/* Torques about the centres: the force at x_C plus the couple. */
+static JD_ALWAYS_INLINE void jd_bond_assemble(const jd_bond_geom *g, const double f[3],
+                                              const double mo[3], jd_bond_result *out) {
     const double fa[3] = {-f[0], -f[1], -f[2]};
     jd_cross(g->ra, fa, out->ta);
     jd_cross(g->rb, f, out->tb);
     for (int d = 0; d < 3; d++) {
         out->f[d] = f[d];
-        out->ta[d] -= m[d];
-        out->tb[d] += m[d];
+        out->ta[d] -= mo[d];
+        out->tb[d] += mo[d];
     }
+}
+
+/* One evaluation of an intact bond (docs/model.md §9.3).
+ *
+ * features: a bond law set (JD_B_* bits, jdem_laws.h JD_BOND_LAW_SETS), a compile-time constant
+ *           at the call site.
+ * p, g, k:  parameters, geometry (jd_bond_geom_spheres + sec, m_eff, i_eff) and kinematics.
+ * dt:       time step [s] (the increments are rate * dt).
+ * s:        bond state (intact), updated.  On failure its flags become JD_BS_BROKEN and its
+ *           forces zero; the energy it stored goes to e_break (JD_B_ENERGY).
+ * out:      force on b, torques, the bond's force and moment magnitudes and stresses.
+ * Returns out->mode: JD_BOND_INTACT, or the failure mode.  When both strengths are reached in
+ * the same step the mode is the one with the larger stress/strength ratio (tension on a tie). */
+static JD_ALWAYS_INLINE int jd_bond(const unsigned features, const jd_bond_params *p,
+                                    const jd_bond_geom *g, const jd_kinematics *k, double dt,
+                                    jd_bond_state *s, jd_bond_result *out) {
+    const jd_bond_stiffness K = jd_bond_stiffness_of(p, &g->sec);
+    jd_bond_motion m;
+    jd_bond_kinematics(g, k, &m);
+    jd_bond_springs(&K, g, &m, dt, s);
+    if (jd_bond_strength(p, &g->sec, s, out) != JD_BOND_INTACT) {
+        jd_bond_break(features, &m, dt, s, out);
+        return out->mode;
+    }
+    double f[3], mo[3];
+    jd_bond_load(features, p, &K, g, &m, s, f, mo);
+    if (features & JD_B_ENERGY) jd_bond_energy_book(features, p, &g->sec, &m, f, mo, dt, s);
+    jd_bond_assemble(g, f, mo, out);
     return JD_BOND_INTACT;
 }
 

@@ -95,8 +95,8 @@ static double overlap(const jd_inlet_spec *s, const double u[3], size_t p, size_
     return s->radius[p] + s->radius[q] - norm3(d);
 }
 
-static int too_much(double ov, double ra, double rb) {
-    return ov > JD_INLET_OVERLAP_TOL * (ra < rb ? ra : rb);
+static int too_much(double ov, double ra, double rb, double tol) {
+    return ov > tol * (ra < rb ? ra : rb);
 }
 
 static jd_inlet_status check_values(const jd_inlet_spec *s, int allow_unbounded, char *msg,
@@ -122,6 +122,11 @@ static jd_inlet_status check_values(const jd_inlet_spec *s, int allow_unbounded,
     }
     if (s->max_sections != 1 && (!(s->period > 0.0) || !isfinite(s->period))) {
         snprintf(msg, len, "period %g is not valid; valid: a number > 0", s->period);
+        return JD_INLET_BAD_VALUE;
+    }
+    if (!(s->overlap_tol >= 0.0) || !isfinite(s->overlap_tol)) {
+        snprintf(msg, len, "overlap tolerance %g is not valid; valid: a number >= 0",
+                 s->overlap_tol);
         return JD_INLET_BAD_VALUE;
     }
     if (!(s->offset >= 0.0) || !isfinite(s->offset)) {
@@ -205,7 +210,7 @@ static jd_inlet_status check_overlaps(const jd_inlet_spec *s, char *msg, size_t 
         for (size_t p = 0; p < s->n; p++)
             for (size_t q = k == 0 ? p + 1 : 0; q < s->n; q++) {
                 const double ov = overlap(s, u, p, q, k);
-                if (!too_much(ov, s->radius[p], s->radius[q]))
+                if (!too_much(ov, s->radius[p], s->radius[q], s->overlap_tol))
                     continue;
                 if (k == 0) {
                     snprintf(msg, len, "section particles %zu and %zu overlap by %g m; valid: "

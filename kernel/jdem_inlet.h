@@ -52,9 +52,8 @@ extern "C" {
 /* A particle that never crosses (past the stop rule): its step is JD_INLET_NEVER. */
 #define JD_INLET_NEVER INT64_MAX
 
-/* Overlap allowed between section particles (of one copy, or of neighbouring copies), as a
- * fraction of the smaller radius: the round-off of a lattice of touching spheres, as the scene
- * reader's start-overlap rule (docs/scenes.md "Start overlaps"). */
+/* The overlap_tol of a generated section: the round-off of a lattice of touching spheres, as the
+ * scene reader's start-overlap rule (docs/scenes.md "Start overlaps"). */
 #define JD_INLET_OVERLAP_TOL 1e-6
 
 /* The description of one inlet, fixed for a run (the resolved scene's `inlets:` entry). */
@@ -73,6 +72,10 @@ typedef struct jd_inlet_spec {
     int64_t first_id;       /* id of particle 0 of copy 0, > 0                             [-]   */
     int64_t max_sections;   /* copies in the stream, >= 1, or 0 for no limit               [-]   */
     int64_t stop_step;      /* no copy starts at or after this step, > 0, or JD_INLET_NO_STOP [-] */
+    double overlap_tol;     /* overlap allowed between section particles (of one copy, or of
+                               neighbouring copies), fraction of the smaller radius, >= 0:
+                               JD_INLET_OVERLAP_TOL, or for cells cut from a deposit the largest
+                               contact overlap it may hold (the watchdog's limit)      [-]   */
 } jd_inlet_spec;
 
 /* Result codes of jd_inlet_check. */

@@ -36,14 +36,15 @@
 extern "C" {
 #endif
 
-/* How jd_contact and its two helpers (jd_rotate_into_plane, jd_capped_spring) are declared.
- * An engine whose force loops are specialised per feature set defines JD_CONTACT_INLINE as
- * `static inline __attribute__((always_inline))` before including this header, so that each
- * loop gets its own copy of the law with the unused laws compiled away (compilers otherwise
- * keep one out-of-line copy, with the features as a run-time value, for a function this large
- * called from many loops).  Same arithmetic either way. */
-#ifndef JD_CONTACT_INLINE
-#define JD_CONTACT_INLINE static inline
+/* How every law of the kernel is declared: `static JD_ALWAYS_INLINE`.  Each engine's force
+ * loops are specialised per law set (jdem_laws.h), and each must get its own copy of the laws
+ * with the unused ones compiled away; compilers otherwise keep one out-of-line copy, with the
+ * features as a run-time value, for functions this large called from many loops.  The same
+ * arithmetic either way (no contraction, no fast-math). */
+#if defined(__GNUC__)
+#define JD_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define JD_ALWAYS_INLINE inline
 #endif
 
 /* ------------------------------------------------------------------------------------------ */
@@ -240,7 +241,7 @@ static inline void jd_contact_separate(jd_contact_state *s, jd_rolling_state *r)
  * rescale it to its previous length, so that a turning contact frame neither creates nor destroys
  * spring energy (§4.3).  A zero vector stays as it is; one that lies along n is projected to zero
  * length and not rescaled.  Written with selects instead of branches (see jd_contact). */
-JD_CONTACT_INLINE void jd_rotate_into_plane(double v[3], const double n[3]) {
+static JD_ALWAYS_INLINE void jd_rotate_into_plane(double v[3], const double n[3]) {
     const double len2 = jd_dot(v, v);
     const double vn = jd_dot(v, n);
     const double p[3] = {v[0] - vn * n[0], v[1] - vn * n[1], v[2] - vn * n[2]};
@@ -275,8 +276,9 @@ static inline double jd_normal_energy(double k_n, double delta) {
  * (or moment) on b; the return value is 1 when the cap was active (sliding).  With
  * JD_XI_COULOMB the stored vector is reset to -out/K while sliding (the dashpot is off while
  * sliding, as the seed states), so K |stored| never exceeds the cap.  Written with selects. */
-JD_CONTACT_INLINE int jd_capped_spring(double stored[3], const double rate[3], double K, double C,
-                                       double cap, double dt, int xi_limit, double out[3]) {
+static JD_ALWAYS_INLINE int jd_capped_spring(double stored[3], const double rate[3], double K,
+                                             double C, double cap, double dt, int xi_limit,
+                                             double out[3]) {
     for (int d = 0; d < 3; d++) {
         stored[d] += rate[d] * dt;
         out[d] = -K * stored[d] - C * rate[d];
@@ -293,9 +295,257 @@ JD_CONTACT_INLINE int jd_capped_spring(double stored[3], const double rate[3], d
     return sliding;
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* jd_contact as a composition of small laws (docs/adding_a_law.md).  Each takes the part of   */
+/* the step it needs and is unit-tested alone (tests/unit/test_laws.c); jd_contact calls them  */
+/* in the order of the reference algorithm (docs/model.md §9), so that every value is the same */
+/* expression on the same operands as in one body.                                             */
+/* ------------------------------------------------------------------------------------------ */
+
+/* The relative motion at the contact point (eq. 6). */
+typedef struct jd_contact_motion {
+    double wxa[3], wxb[3]; /* w_a x r_a and w_b x r_b                                  [m/s]  */
+    double vrel[3];        /* velocity of b's material point relative to a's            [m/s]  */
+    double vn;             /* vrel . n                                                  [m/s]  */
+    double ddelta;         /* overlap rate -vn                                          [m/s]  */
+    double wrel[3];        /* w_b - w_a with JD_F_ROLLING, else zero                   [rad/s] */
+} jd_contact_motion;
+
+static JD_ALWAYS_INLINE void jd_contact_kinematics(const unsigned features, const jd_contact_geom *g,
+                                            const jd_kinematics *k, jd_contact_motion *m) {
+    jd_cross(k->wa, g->ra, m->wxa);
+    jd_cross(k->wb, g->rb, m->wxb);
+    for (int d = 0; d < 3; d++) m->vrel[d] = (k->vb[d] + m->wxb[d]) - (k->va[d] + m->wxa[d]);
+    m->vn = jd_dot(m->vrel, g->n);
+    m->ddelta = -m->vn;
+    for (int d = 0; d < 3; d++) m->wrel[d] = 0.0;
+    if (features & JD_F_ROLLING)
+        for (int d = 0; d < 3; d++) m->wrel[d] = k->wb[d] - k->wa[d];
+}
+
+/* The history one evaluation starts from, and the phase it is in.  An ended contact stays
+ * ended while the bodies keep separating; a new approach while still overlapping begins a new
+ * contact (the history as jd_contact_separate leaves it). */
+typedef struct jd_contact_step {
+    int still_ended;     /* ended before, and the bodies are still separating          [-]    */
+    int restart;         /* ended before, and approaching again: a new contact          [-]    */
+    double flags;        /* phase the step starts from (jd_contact_state.flags)          [-]    */
+    double xi[3];        /* tangential displacement, updated by jd_law_tangential        [m]    */
+    double theta[3];     /* rolling rotation, updated by jd_law_rolling (JD_F_ROLLING)   [rad]  */
+    /* the energy bookkeeping's starting values (JD_F_ENERGY; else zero) */
+    double f_prev[3], m_prev[3];          /* force [N] and rolling moment [N m] of the last step */
+    double fd_prev, u_prev, e_damp, e_fric; /* dashpot force [N], stored energy, totals [J]      */
+} jd_contact_step;
+
+static JD_ALWAYS_INLINE void jd_contact_begin(const unsigned features, const jd_contact_geom *g,
+                                       const jd_contact_state *s, const jd_rolling_state *r,
+                                       double ddelta, jd_contact_step *h) {
+    const int rolling = (features & JD_F_ROLLING) != 0;
+    const int was_ended = s->flags == (double)JD_S_ENDED;
+    h->still_ended = was_ended & (ddelta <= 0.0);
+    h->restart = was_ended & !h->still_ended;
+    const int restart = h->restart;
+    h->flags = restart ? 0.0 : s->flags;
+    for (int d = 0; d < 3; d++) h->xi[d] = restart ? 0.0 : s->xi[d];
+    for (int d = 0; d < 3; d++) h->theta[d] = 0.0;
+    if (rolling)
+        for (int d = 0; d < 3; d++) h->theta[d] = restart ? 0.0 : r->theta[d];
+    for (int d = 0; d < 3; d++) h->f_prev[d] = h->m_prev[d] = 0.0;
+    h->fd_prev = h->u_prev = h->e_damp = h->e_fric = 0.0;
+    if (features & JD_F_ENERGY) {
+        for (int d = 0; d < 3; d++) {
+            h->f_prev[d] = restart ? 0.0 : s->f_prev[d];
+            if (rolling) h->m_prev[d] = restart ? 0.0 : r->m_prev[d];
+        }
+        h->fd_prev = restart ? 0.0 : s->fd_prev;
+        /* The restarted contact's normal spring is already compressed.  That energy was booked as
+         * damping at the end of the collision and is stored again now: take it back from
+         * damping, so that the friction term does not see it. */
+        const double u_spring = jd_normal_energy(g->k_n, g->delta);
+        h->u_prev = restart ? u_spring : s->u_prev;
+        h->e_damp = restart ? s->e_damp - u_spring : s->e_damp;
+        h->e_fric = s->e_fric;
+    }
+}
+
+/* What the normal law gives the other laws. */
+typedef struct jd_normal {
+    double fn;   /* normal force, unclamped (jd_normal_force)                          [N]    */
+    double Kn;   /* secant stiffness k_n sqrt(delta)                                   [N/m]  */
+    double Cn;   /* dashpot coefficient 2 gamma sqrt(m_eff K_n)                        [N s/m] */
+    int ends;    /* Luding's end of collision this step                                 [-]    */
+    int carries; /* the contact carries force after this step                           [-]    */
+} jd_normal;
+
+/* Normal law with damping and Luding's end of contact (§3, §7, §8): with JD_F_DAMPING the
+ * contact ends, never pulling, once the total normal force reaches zero while unloading. */
+static JD_ALWAYS_INLINE void jd_law_normal(const unsigned features, const jd_pair_coeffs *c,
+                                    const jd_contact_geom *g, double ddelta, int still_ended,
+                                    jd_normal *nl) {
+    const int damping = (features & JD_F_DAMPING) != 0;
+    nl->fn = jd_normal_force(g->k_n, g->delta, ddelta, damping, damping ? c->gamma : 0.0, g->m_eff,
+                             &nl->Kn, &nl->Cn);
+    nl->ends = damping ? !still_ended & (nl->fn <= 0.0) : 0;
+    nl->carries = !still_ended & !nl->ends;
+}
+
+/* Tangential stiffness K_t from the normal law: K_t = K_n (Sec. 2.3.2), hence C_t = C_n
+ * (eq. 29). */
+static JD_ALWAYS_INLINE double jd_tangential_stiffness(const jd_normal *nl) { return nl->Kn; }
+static JD_ALWAYS_INLINE double jd_tangential_damping(const jd_normal *nl) { return nl->Cn; }
+
+/* Tangential law (§4): the cumulative spring on h->xi, turned into the tangent plane, with its
+ * dashpot and Coulomb cap mu F_n; with JD_F_MU_R only mu_R of the rotational slip acts on the
+ * spring while sliding (eq. 76).  Adds the tangential force to f, sets h->flags (sliding or
+ * sticking); with JD_F_ENERGY adds the spring's stored energy to *u and the dashpot's
+ * dissipation of the step to *dash. */
+static JD_ALWAYS_INLINE void jd_law_tangential(const unsigned features, const jd_pair_coeffs *c,
+                                        const jd_contact_geom *g, const jd_contact_motion *m,
+                                        const jd_normal *nl, double dt, jd_contact_step *h,
+                                        double f[3], double *u, double *dash) {
+    double vt[3], vt_law[3];
+    for (int d = 0; d < 3; d++) vt_law[d] = vt[d] = m->vrel[d] - m->vn * g->n[d];
+    if (features & JD_F_MU_R) {
+        const int was_sliding = h->flags == (double)JD_S_SLIDING;
+        const double red = 1.0 - c->mu_r;
+        double wr[3];
+        for (int d = 0; d < 3; d++) wr[d] = m->wxb[d] - m->wxa[d];
+        const double wrn = jd_dot(wr, g->n);
+        for (int d = 0; d < 3; d++)
+            vt_law[d] = was_sliding ? vt_law[d] - red * (wr[d] - wrn * g->n[d]) : vt_law[d];
+    }
+    jd_rotate_into_plane(h->xi, g->n);
+    const double Kt = jd_tangential_stiffness(nl), Ct = jd_tangential_damping(nl);
+    double ft[3];
+    const int sliding = jd_capped_spring(h->xi, vt_law, Kt, Ct, c->mu * nl->fn, dt, c->xi_limit, ft);
+    h->flags = sliding ? (double)JD_S_SLIDING : 0.0;
+    for (int d = 0; d < 3; d++) f[d] += ft[d];
+    if (features & JD_F_ENERGY) {
+        /* the spring carries the whole force while sliding, -K_t xi while sticking */
+        double fs[3];
+        for (int d = 0; d < 3; d++) fs[d] = sliding ? ft[d] : -Kt * h->xi[d];
+        *u += Kt > 0.0 ? 0.5 * jd_dot(fs, fs) / (Kt > 0.0 ? Kt : 1.0) : 0.0;
+        /* the dashpot acts on vt_law, and only while sticking */
+        *dash = sliding ? *dash : *dash + Ct * jd_dot(vt_law, vt) * dt;
+    }
+}
+
+/* Rolling law (§5): the spring on h->theta with K_r = K_t r^2, its dashpot (eq. 32) and the cap
+ * eta r F_n.  The moment on b goes to m_roll; with JD_F_ENERGY the stored energy is added to *u
+ * and the dashpot's dissipation to *dash. */
+static JD_ALWAYS_INLINE void jd_law_rolling(const unsigned features, const jd_pair_coeffs *c,
+                                     const jd_contact_geom *g, const jd_contact_motion *m,
+                                     const jd_normal *nl, double dt, jd_contact_step *h,
+                                     double m_roll[3], double *u, double *dash) {
+    const double Kr = nl->Kn * g->r_roll * g->r_roll; /* K_r = K_t r^2 */
+    const double Cr = (features & JD_F_DAMPING) ? 2.0 * c->gamma * sqrt(g->i_eff * Kr) : 0.0;
+    const int rsl = jd_capped_spring(h->theta, m->wrel, Kr, Cr, c->eta * g->r_roll * nl->fn, dt,
+                                     c->xi_limit, m_roll);
+    if (features & JD_F_ENERGY) {
+        double ms[3];
+        for (int d = 0; d < 3; d++) ms[d] = rsl ? m_roll[d] : -Kr * h->theta[d];
+        *u += Kr > 0.0 ? 0.5 * jd_dot(ms, ms) / (Kr > 0.0 ? Kr : 1.0) : 0.0;
+        *dash = rsl ? *dash : *dash + Cr * jd_dot(m->wrel, m->wrel) * dt;
+    }
+}
+
+/* What the energy bookkeeping books for one step. */
+typedef struct jd_contact_energy {
+    double fd;     /* normal dashpot force C_n d(delta)/dt at this evaluation          [N]    */
+    double e_damp; /* dissipated by the dashpots (and at Luding's end) so far          [J]    */
+    double e_fric; /* dissipated by the sliders so far                                 [J]    */
+} jd_contact_energy;
+
+/* Energy bookkeeping (JD_F_ENERGY), second order in dt like the velocity-Verlet integrator.
+ * Velocity Verlet changes the bodies' kinetic energy by the average of the forces at the two
+ * ends of a step times its displacement (exactly, up to terms that cancel over a collision), so
+ * the contact books the same: work W on the bodies this step, and what it dissipated is -W less
+ * the change of its stored energy.  The normal dashpot's share is the same trapezoid on its own
+ * force; the remainder is the sliders' (friction), or the dashpot's too when there are no
+ * sliders.  f, m_roll: this step's force and rolling moment on b; u_new: the energy stored now;
+ * dash: the tangential and rolling dashpots' share so far. */
+static JD_ALWAYS_INLINE void jd_law_energy(const unsigned features, const jd_contact_motion *m,
+                                    const jd_normal *nl, const jd_contact_step *h,
+                                    const double f[3], const double m_roll[3], double u_new,
+                                    double dash, double dt, jd_contact_energy *e) {
+    const int rolling = (features & JD_F_ROLLING) != 0;
+    double w = jd_dot(h->f_prev, m->vrel) + jd_dot(f, m->vrel);
+    if (rolling) w += jd_dot(h->m_prev, m->wrel) + jd_dot(m_roll, m->wrel);
+    double w_prev = jd_dot(h->f_prev, m->vrel); /* the previous step's force alone (Luding's end) */
+    if (rolling) w_prev += jd_dot(h->m_prev, m->wrel);
+    e->fd = nl->Cn * m->ddelta;
+    dash += 0.5 * (h->fd_prev + e->fd) * m->ddelta * dt;
+    const double diss = -0.5 * w * dt - (u_new - h->u_prev);
+    if (features & (JD_F_FRICTION | JD_F_ROLLING)) {
+        e->e_damp = h->e_damp + dash;
+        e->e_fric = h->e_fric + (diss - dash);
+    } else {
+        e->e_damp = h->e_damp + diss; /* no sliders: all of it is the dashpot's (to O(dt^2)) */
+        e->e_fric = h->e_fric;
+    }
+    /* At Luding's end the energy still stored in the springs is never returned, so it counts as
+     * dissipated, less the work the previous step's force still does during this step (the same
+     * trapezoid). */
+    if (features & JD_F_DAMPING) {
+        e->e_damp = nl->ends ? h->e_damp + (h->u_prev - 0.5 * w_prev * dt) : e->e_damp;
+        e->e_fric = nl->ends ? h->e_fric : e->e_fric;
+    }
+}
+
+/* The history after the step: unchanged while still ended, reset (and marked ended) at Luding's
+ * end, else the evaluated one. */
+static JD_ALWAYS_INLINE void jd_contact_commit(const unsigned features, const jd_contact_step *h,
+                                        const jd_normal *nl, const double f[3],
+                                        const double m_roll[3], double u_new,
+                                        const jd_contact_energy *e, jd_contact_state *s,
+                                        jd_rolling_state *r) {
+    const int rolling = (features & JD_F_ROLLING) != 0;
+    const int still_ended = h->still_ended, carries = nl->carries;
+    s->flags = still_ended ? s->flags : (nl->ends ? (double)JD_S_ENDED : h->flags);
+    for (int d = 0; d < 3; d++) s->xi[d] = carries ? h->xi[d] : (still_ended ? s->xi[d] : 0.0);
+    if (rolling)
+        for (int d = 0; d < 3; d++)
+            r->theta[d] = carries ? h->theta[d] : (still_ended ? r->theta[d] : 0.0);
+    if (features & JD_F_ENERGY) {
+        for (int d = 0; d < 3; d++) {
+            s->f_prev[d] = carries ? f[d] : (still_ended ? s->f_prev[d] : 0.0);
+            if (rolling) r->m_prev[d] = carries ? m_roll[d] : (still_ended ? r->m_prev[d] : 0.0);
+        }
+        s->fd_prev = carries ? e->fd : (still_ended ? s->fd_prev : 0.0);
+        s->u_prev = carries ? u_new : (still_ended ? s->u_prev : 0.0);
+        s->e_damp = still_ended ? s->e_damp : e->e_damp;
+        s->e_fric = still_ended ? s->e_fric : e->e_fric;
+    }
+}
+
+/* The force on b and the torques about each centre (eq. 19), with the rolling moment on b
+ * (without rolling resistance nothing is added: the engines' torque sums start from +0, so
+ * adding a +0 moment could only have turned a -0 torque into +0, which their sums never see).
+ * All zero once the contact has ended (carries 0). */
+static JD_ALWAYS_INLINE void jd_contact_assemble(const unsigned features, const jd_contact_geom *g,
+                                          const jd_normal *nl, const double f[3],
+                                          const double m_roll[3], jd_contact_result *out) {
+    const int carries = nl->carries;
+    const double fa[3] = {-f[0], -f[1], -f[2]};
+    double ta[3], tb[3];
+    jd_cross(g->ra, fa, ta);
+    jd_cross(g->rb, f, tb);
+    if (features & JD_F_ROLLING)
+        for (int d = 0; d < 3; d++) {
+            ta[d] -= m_roll[d];
+            tb[d] += m_roll[d];
+        }
+    for (int d = 0; d < 3; d++) {
+        out->f[d] = carries ? f[d] : 0.0;
+        out->ta[d] = carries ? ta[d] : 0.0;
+        out->tb[d] = carries ? tb[d] : 0.0;
+    }
+    out->fn = carries ? nl->fn : 0.0;
+}
+
 /* One evaluation of a contact (the reference algorithm of docs/model.md §9).
  *
- * features: JD_F_* bits, a compile-time constant at the call site.
+ * features: a law set (jdem_laws.h, JD_LAW_SETS), a compile-time constant at the call site.
  * c, g, k:  coefficients, geometry (g->delta > 0) and kinematics.
  * dt:       time step [s] (the springs accumulate rate * dt).
  * s:        contact history, updated.   r: rolling history (NULL unless JD_F_ROLLING).
@@ -311,174 +561,29 @@ JD_CONTACT_INLINE int jd_capped_spring(double stored[3], const double rate[3], d
  * approach, Luding's end, sticking, sliding) is computed and the result selected, so that an
  * engine can evaluate a batch of contacts in SIMD lanes (`#pragma omp simd` over the batch); the
  * arithmetic of each case is exactly that of the case alone. */
-JD_CONTACT_INLINE int jd_contact(const unsigned features, const jd_pair_coeffs *c,
-                                 const jd_contact_geom *g, const jd_kinematics *k, double dt,
-                                 jd_contact_state *s, jd_rolling_state *r, jd_contact_result *out) {
-    const int damping = (features & JD_F_DAMPING) != 0, friction = (features & JD_F_FRICTION) != 0;
-    const int rolling = (features & JD_F_ROLLING) != 0, energy = (features & JD_F_ENERGY) != 0;
-    /* Relative velocity at the contact point, eq. (6). */
-    double wxa[3], wxb[3];
-    jd_cross(k->wa, g->ra, wxa);
-    jd_cross(k->wb, g->rb, wxb);
-    double vrel[3];
-    for (int d = 0; d < 3; d++) vrel[d] = (k->vb[d] + wxb[d]) - (k->va[d] + wxa[d]);
-    const double vn = jd_dot(vrel, g->n);
-    const double ddelta = -vn; /* overlap rate */
-    double wrel[3] = {0.0, 0.0, 0.0};
-    if (rolling)
-        for (int d = 0; d < 3; d++) wrel[d] = k->wb[d] - k->wa[d];
+static JD_ALWAYS_INLINE int jd_contact(const unsigned features, const jd_pair_coeffs *c,
+                                const jd_contact_geom *g, const jd_kinematics *k, double dt,
+                                jd_contact_state *s, jd_rolling_state *r, jd_contact_result *out) {
+    const int energy = (features & JD_F_ENERGY) != 0;
+    jd_contact_motion m;
+    jd_contact_kinematics(features, g, k, &m);
+    jd_contact_step h;
+    jd_contact_begin(features, g, s, r, m.ddelta, &h);
+    jd_normal nl;
+    jd_law_normal(features, c, g, m.ddelta, h.still_ended, &nl);
 
-    /* The history this step starts from.  An ended contact stays ended while the bodies keep
-     * separating; a new approach while still overlapping begins a new contact (the history as
-     * jd_contact_separate leaves it). */
-    const int was_ended = s->flags == (double)JD_S_ENDED;
-    const int still_ended = was_ended & (ddelta <= 0.0);
-    const int restart = was_ended & !still_ended;
-    double flags = restart ? 0.0 : s->flags;
-    double xi[3], theta[3] = {0.0, 0.0, 0.0};
-    for (int d = 0; d < 3; d++) xi[d] = restart ? 0.0 : s->xi[d];
-    if (rolling)
-        for (int d = 0; d < 3; d++) theta[d] = restart ? 0.0 : r->theta[d];
-    double f_prev[3] = {0.0, 0.0, 0.0}, m_prev[3] = {0.0, 0.0, 0.0};
-    double fd_prev = 0.0, u_prev = 0.0, e_damp = 0.0, e_fric = 0.0;
-    if (energy) {
-        for (int d = 0; d < 3; d++) {
-            f_prev[d] = restart ? 0.0 : s->f_prev[d];
-            if (rolling) m_prev[d] = restart ? 0.0 : r->m_prev[d];
-        }
-        fd_prev = restart ? 0.0 : s->fd_prev;
-        /* The restarted contact's normal spring is already compressed.  That energy was booked as
-         * damping at the end of the collision and is stored again now: take it back from
-         * damping, so that the friction term does not see it. */
-        const double u_spring = jd_normal_energy(g->k_n, g->delta);
-        u_prev = restart ? u_spring : s->u_prev;
-        e_damp = restart ? s->e_damp - u_spring : s->e_damp;
-        e_fric = s->e_fric;
-    }
-
-    /* Normal law. */
-    double Kn, Cn;
-    const double fn =
-        jd_normal_force(g->k_n, g->delta, ddelta, damping, damping ? c->gamma : 0.0, g->m_eff, &Kn, &Cn);
-    /* Luding's end of collision (damped contacts only): no tensile force; history resets. */
-    const int ends = damping ? !still_ended & (fn <= 0.0) : 0;
-    const int carries = !still_ended & !ends;
-
-    double f[3] = {fn * g->n[0], fn * g->n[1], fn * g->n[2]};
+    double f[3] = {nl.fn * g->n[0], nl.fn * g->n[1], nl.fn * g->n[2]};
     double m_roll[3] = {0.0, 0.0, 0.0};
     double u_new = energy ? jd_normal_energy(g->k_n, g->delta) : 0.0;
-    double dash = 0.0; /* dashpot share of this step's dissipation [J] */
+    double dash = 0.0; /* the tangential and rolling dashpots' share of the dissipation [J] */
+    if (features & JD_F_FRICTION) jd_law_tangential(features, c, g, &m, &nl, dt, &h, f, &u_new, &dash);
+    if (features & JD_F_ROLLING) jd_law_rolling(features, c, g, &m, &nl, dt, &h, m_roll, &u_new, &dash);
+    jd_contact_energy e = {0.0, h.e_damp, h.e_fric};
+    if (energy) jd_law_energy(features, &m, &nl, &h, f, m_roll, u_new, dash, dt, &e);
 
-    if (friction) {
-        double vt[3], vt_law[3];
-        for (int d = 0; d < 3; d++) vt_law[d] = vt[d] = vrel[d] - vn * g->n[d];
-        if (features & JD_F_MU_R) {
-            /* eq. (76): while sliding only mu_R of the rotational slip acts on the spring. */
-            const int was_sliding = flags == (double)JD_S_SLIDING;
-            const double red = 1.0 - c->mu_r;
-            double wr[3];
-            for (int d = 0; d < 3; d++) wr[d] = wxb[d] - wxa[d];
-            const double wrn = jd_dot(wr, g->n);
-            for (int d = 0; d < 3; d++)
-                vt_law[d] = was_sliding ? vt_law[d] - red * (wr[d] - wrn * g->n[d]) : vt_law[d];
-        }
-        jd_rotate_into_plane(xi, g->n);
-        const double Kt = Kn, Ct = Cn; /* K_t = K_n (Sec. 2.3.2), hence C_t = C_n (eq. 29) */
-        double ft[3];
-        const int sliding = jd_capped_spring(xi, vt_law, Kt, Ct, c->mu * fn, dt, c->xi_limit, ft);
-        flags = sliding ? (double)JD_S_SLIDING : 0.0;
-        for (int d = 0; d < 3; d++) f[d] += ft[d];
-        if (energy) {
-            /* the spring carries the whole force while sliding, -K_t xi while sticking */
-            double fs[3];
-            for (int d = 0; d < 3; d++) fs[d] = sliding ? ft[d] : -Kt * xi[d];
-            u_new += Kt > 0.0 ? 0.5 * jd_dot(fs, fs) / (Kt > 0.0 ? Kt : 1.0) : 0.0;
-            /* the dashpot acts on vt_law, and only while sticking */
-            dash = sliding ? dash : dash + Ct * jd_dot(vt_law, vt) * dt;
-        }
-    }
-
-    if (rolling) {
-        const double Kr = Kn * g->r_roll * g->r_roll; /* K_r = K_t r^2 */
-        const double Cr = damping ? 2.0 * c->gamma * sqrt(g->i_eff * Kr) : 0.0; /* eq. (32) */
-        const int rsl = jd_capped_spring(theta, wrel, Kr, Cr, c->eta * g->r_roll * fn, dt,
-                                         c->xi_limit, m_roll);
-        if (energy) {
-            double ms[3];
-            for (int d = 0; d < 3; d++) ms[d] = rsl ? m_roll[d] : -Kr * theta[d];
-            u_new += Kr > 0.0 ? 0.5 * jd_dot(ms, ms) / (Kr > 0.0 ? Kr : 1.0) : 0.0;
-            dash = rsl ? dash : dash + Cr * jd_dot(wrel, wrel) * dt;
-        }
-    }
-
-    double fd = 0.0, e_damp_new = e_damp, e_fric_new = e_fric;
-    if (energy) {
-        /* Velocity Verlet changes the bodies' kinetic energy by the average of the forces at the
-         * two ends of a step times its displacement (exactly, up to terms that cancel over a
-         * collision), so the contact books the same: work W on the bodies this step, and what it
-         * dissipated is -W less the change of its stored energy.  The normal dashpot's share is
-         * the same trapezoid on its own force; the remainder is the sliders' (friction), or the
-         * dashpot's too when there are no sliders. */
-        double w = jd_dot(f_prev, vrel) + jd_dot(f, vrel);
-        if (rolling) w += jd_dot(m_prev, wrel) + jd_dot(m_roll, wrel);
-        double w_prev = jd_dot(f_prev, vrel); /* the previous step's force alone (Luding's end) */
-        if (rolling) w_prev += jd_dot(m_prev, wrel);
-        fd = Cn * ddelta;
-        dash += 0.5 * (fd_prev + fd) * ddelta * dt;
-        const double diss = -0.5 * w * dt - (u_new - u_prev);
-        if (friction | rolling) {
-            e_damp_new = e_damp + dash;
-            e_fric_new = e_fric + (diss - dash);
-        } else {
-            e_damp_new = e_damp + diss; /* no sliders: all of it is the dashpot's (to O(dt^2)) */
-        }
-        /* At Luding's end the energy still stored in the springs is never returned, so it counts
-         * as dissipated, less the work the previous step's force still does during this step
-         * (the same trapezoid). */
-        if (damping) {
-            e_damp_new = ends ? e_damp + (u_prev - 0.5 * w_prev * dt) : e_damp_new;
-            e_fric_new = ends ? e_fric : e_fric_new;
-        }
-    }
-
-    /* The history after this step: unchanged while still ended, reset (and marked ended) at
-     * Luding's end, else the evaluated one. */
-    s->flags = still_ended ? s->flags : (ends ? (double)JD_S_ENDED : flags);
-    for (int d = 0; d < 3; d++) s->xi[d] = carries ? xi[d] : (still_ended ? s->xi[d] : 0.0);
-    if (rolling)
-        for (int d = 0; d < 3; d++)
-            r->theta[d] = carries ? theta[d] : (still_ended ? r->theta[d] : 0.0);
-    if (energy) {
-        for (int d = 0; d < 3; d++) {
-            s->f_prev[d] = carries ? f[d] : (still_ended ? s->f_prev[d] : 0.0);
-            if (rolling) r->m_prev[d] = carries ? m_roll[d] : (still_ended ? r->m_prev[d] : 0.0);
-        }
-        s->fd_prev = carries ? fd : (still_ended ? s->fd_prev : 0.0);
-        s->u_prev = carries ? u_new : (still_ended ? s->u_prev : 0.0);
-        s->e_damp = still_ended ? s->e_damp : e_damp_new;
-        s->e_fric = still_ended ? s->e_fric : e_fric_new;
-    }
-
-    /* Assemble: force on b, torques about each centre (eq. 19), rolling moment on b (without
-     * rolling resistance nothing is added: the engines' torque sums start from +0, so adding a
-     * +0 moment could only have turned a -0 torque into +0, which their sums never see).  All
-     * zero once the contact has ended. */
-    const double fa[3] = {-f[0], -f[1], -f[2]};
-    double ta[3], tb[3];
-    jd_cross(g->ra, fa, ta);
-    jd_cross(g->rb, f, tb);
-    if (rolling)
-        for (int d = 0; d < 3; d++) {
-            ta[d] -= m_roll[d];
-            tb[d] += m_roll[d];
-        }
-    for (int d = 0; d < 3; d++) {
-        out->f[d] = carries ? f[d] : 0.0;
-        out->ta[d] = carries ? ta[d] : 0.0;
-        out->tb[d] = carries ? tb[d] : 0.0;
-    }
-    out->fn = carries ? fn : 0.0;
-    return carries;
+    jd_contact_commit(features, &h, &nl, f, m_roll, u_new, &e, s, r);
+    jd_contact_assemble(features, g, &nl, f, m_roll, out);
+    return nl.carries;
 }
 
 /* LIGGGHTS evaluates the forces of step 0 (`setup`) without advancing the contact history, and

@@ -1,12 +1,16 @@
 /*
  * jdem_watchdog.h — the limits of the run-time watchdog, shared by both engines (the stepper's
  * stepper/watchdog.c and LIGGGHTS' `fix jdem/watchdog`), so that both stop a run on exactly the
- * same condition.  Pure C11, static inline: no I/O, no allocation, no globals.
+ * same condition, and the messages both print when it trips (jdem_watchdog.c).  Pure C11: no
+ * I/O, no allocation, no globals.
  */
 #ifndef JDEM_KERNEL_WATCHDOG_H
 #define JDEM_KERNEL_WATCHDOG_H
 
 #include <math.h>
+#include <stddef.h>
+
+#include "jdem_observable_names.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -25,6 +29,21 @@ static inline int jd_overlap_excessive(double delta, double Ra, double Rb, doubl
 typedef struct jd_energy_terms {
     double kinetic, rotational, elastic, gravitational, damping, friction, wall_work;
 } jd_energy_terms;
+
+/* The terms from the observables (kernel/jdem_observables.h) [J]: bonds enter as stored
+ * (elastic) energy and as dissipation (their dashpots' and what broken bonds released). */
+static inline jd_energy_terms jd_energy_terms_of(const double obs[], const double bond_obs[]) {
+    const jd_energy_terms e = {
+        .kinetic = obs[JD_OBS_KINETIC],
+        .rotational = obs[JD_OBS_ROTATIONAL],
+        .elastic = obs[JD_OBS_ELASTIC] + bond_obs[JD_OBS_BOND_ELASTIC],
+        .gravitational = obs[JD_OBS_GRAVITATIONAL],
+        .damping = obs[JD_OBS_DAMPING] + bond_obs[JD_OBS_BOND_DAMPING] +
+                   bond_obs[JD_OBS_BOND_BREAKAGE],
+        .friction = obs[JD_OBS_FRICTION],
+        .wall_work = obs[JD_OBS_WALL_WORK]};
+    return e;
+}
 
 /* KE + RE + elastic + gravitational + dissipated - wall work: constant in an exact run. */
 static inline double jd_energy_total(const jd_energy_terms *e) {
@@ -48,6 +67,21 @@ static inline double jd_energy_jump(const jd_energy_terms *a, const jd_energy_te
     const double scale = fmax(jd_energy_scale(a), jd_energy_scale(b));
     return d == 0.0 ? 0.0 : d / scale;
 }
+
+/* The messages of a trip, into msg (len bytes), as both engines print them (LIGGGHTS adds
+ * "jdem: " in front).  Particles are named by their ids. */
+/* The quantities the non-finite check names, in the order it searches them (forces first: a
+ * non-finite force is the cause of the non-finite velocity it produces). */
+#define JD_N_WATCHDOG_QUANTITIES 5
+extern const char *const jd_watchdog_quantities[JD_N_WATCHDOG_QUANTITIES];
+void jd_watchdog_nonfinite_message(char *msg, size_t len, long long step, int quantity,
+                                   double value, long long id);
+/* id_b < 0: the contact is with the wall named wall. */
+void jd_watchdog_overlap_message(char *msg, size_t len, long long step, double fraction,
+                                 long long id_a, long long id_b, const char *wall, double limit);
+void jd_watchdog_energy_message(char *msg, size_t len, long long step, double jump, long long id,
+                                double limit, double total_ref, long long ref_step,
+                                double total_now);
 
 #ifdef __cplusplus
 }

@@ -2,6 +2,8 @@
  * jd_bond() (kernel/jdem_bond.h). */
 #include "fix_bond_jiang.h"
 
+#include "jdem_laws.h"
+
 #include <mpi.h>
 
 #include <cmath>
@@ -166,7 +168,7 @@ void FixBondJiang::pre_neighbor() { check_reach(); }
 void FixBondJiang::init() {
   if (force->newton_pair)
     error->all(FLERR, "fix bond/jiang requires `newton off` (as LIGGGHTS' granular pair styles)");
-  features = (params.gamma > 0.0 ? (unsigned)JD_B_DAMPING : 0u) | (jdem_wants_energy(lmp) ? (unsigned)JD_B_ENERGY : 0u);
+  features = jd_bond_laws(params.gamma) | (jdem_wants_energy(lmp) ? (unsigned)JD_B_ENERGY : 0u);
   /* records only for a dump h5md/jdem that collects them */
   record = false;
   for (int k = 0; k < output->ndump; k++)
@@ -366,18 +368,18 @@ void FixBondJiang::form_by_rule(const Rule &r) {
 /* Evaluating the bonds.                                                                       */
 
 void FixBondJiang::compute(bool commit) {
+#define JD_BOND_LOOP(b) \
+  case (b): loop<(b)>(commit); break;
   switch (features) {
-    case 0u: loop<0u>(commit); break;
-    case JD_B_DAMPING: loop<JD_B_DAMPING>(commit); break;
-    case JD_B_ENERGY: loop<JD_B_ENERGY>(commit); break;
-    default: loop<JD_B_DAMPING | JD_B_ENERGY>(commit); break;
+    JD_BOND_LAW_SETS(JD_BOND_LOOP)
+    default: break;
   }
+#undef JD_BOND_LOOP
 }
 
 /* Atoms ahead whose bond records the loop prefetches.  The records sit in per-atom rows of
- * max_bonds slots, mostly empty, so the hardware's stream prefetchers miss them: on the 20k
- * bonded bench bed the bonds' share of the loop went from 3.3-3.5 s to 1.65-1.70 s (3 runs
- * each; 2, 8 and 16 ahead did the same as 4). */
+ * max_bonds slots, mostly empty, so the hardware's stream prefetchers miss them
+ * (docs/performance.md; 2, 8 and 16 ahead did the same as 4). */
 enum { PREFETCH_AHEAD = 4 };
 /* Every bond stored on a local atom, in storage order.  commit false: the set-up evaluation. */
 template <unsigned F>
@@ -520,16 +522,12 @@ double FixBondJiang::omega2_max() {
   const int nlocal = atom->nlocal, nall = nlocal + atom->nghost, *mask = atom->mask;
   w2.assign(nall, 0.0);
   for (int i = 0; i < nlocal; i++) {
-    const double Ii = jd_sphere_inertia(rmass[i], radius[i]);
     for (int k = 0; k < nbond[i]; k++) {
       const int j = atom->map(partner[i][k]);
       if (j < 0) continue; /* check_reach reports it */
-      const jd_bond_section sec = jd_bond_section_of(params.lambda, radius[i], radius[j]);
       const double d[3] = {x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
-      const double dist = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      const double la = std::fabs(radius[i] - 0.5 * (radius[i] + radius[j] - dist)), lb = std::fabs(dist - la);
-      const double wk = jd_bond_omega2_bound(&params, &sec, rmass[i], rmass[j], Ii,
-                                             jd_sphere_inertia(rmass[j], radius[j]), la, lb);
+      const double wk = jd_bond_omega2_pair(&params, radius[i], radius[j], rmass[i], rmass[j],
+                                            std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
       w2[i] += wk;
       w2[j] += wk;
     }
@@ -537,9 +535,7 @@ double FixBondJiang::omega2_max() {
   for (size_t r = 0; r < rules.size(); r++)
     for (int i = 0; i < nlocal; i++) {
       if (!(mask[i] & rules[r].groupbit)) continue;
-      const double R = radius[i], I = jd_sphere_inertia(rmass[i], R);
-      const jd_bond_section sec = jd_bond_section_of(params.lambda, R, R);
-      w2[i] += 12.0 * jd_bond_omega2_bound(&params, &sec, rmass[i], rmass[i], I, I, R, R);
+      w2[i] += jd_bond_omega2_rule(&params, radius[i], rmass[i]);
     }
   reverse_len = 1;
   comm->reverse_comm_fix(this);

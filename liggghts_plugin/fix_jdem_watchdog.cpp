@@ -132,12 +132,11 @@ static std::string format(const char *fmt, ...) {
 /* Forces first (a non-finite force is the cause of the velocity it produces), then the
  * smallest id: the key quantity * 2^31 + id orders both in one MINLOC. */
 bool FixJdemWatchdog::nonfinite(std::string &msg) {
-  static const char *const names[] = {"force", "torque", "position", "velocity", "angular velocity"};
   double **q[] = {atom->f, atom->torque, atom->x, atom->v, atom->omega};
   const double id_range = 2147483648.0;
   struct { double key; int rank; } mine = {INFINITY, comm->me}, all;
   double value = 0.0;
-  for (int k = 0; k < 5 && mine.key == INFINITY; k++)
+  for (int k = 0; k < JD_N_WATCHDOG_QUANTITIES && mine.key == INFINITY; k++)
     for (int i = 0; i < atom->nlocal; i++)
       for (int d = 0; d < 3; d++)
         if ((atom->mask[i] & groupbit) && !std::isfinite(q[k][i][d]) &&
@@ -149,8 +148,10 @@ bool FixJdemWatchdog::nonfinite(std::string &msg) {
   if (all.key == INFINITY) return false;
   MPI_Bcast(&value, 1, MPI_DOUBLE, all.rank, world);
   const int k = (int)(all.key / id_range);
-  msg = format("jdem: watchdog: step " BIGINT_FORMAT ": %s %g for particle(s) %.0f is not finite",
-               update->ntimestep, names[k], value, all.key - k * id_range);
+  char text[512];
+  jd_watchdog_nonfinite_message(text, sizeof text, (long long)update->ntimestep, k, value,
+                                (long long)(all.key - k * id_range));
+  msg = std::string("jdem: ") + text;
   return true;
 }
 
@@ -165,9 +166,10 @@ bool FixJdemWatchdog::overlap(std::string &msg) {
   if (worst.wall) std::snprintf(wall, sizeof wall, "%s", worst.wall);
   MPI_Bcast(tags, 2, MPI_INT, all.rank, world);
   MPI_Bcast(wall, sizeof wall, MPI_CHAR, all.rank, world);
-  const std::string with = tags[1] ? format(", %d", tags[1]) : format(" against wall '%s'", wall);
-  msg = format("jdem: watchdog: step " BIGINT_FORMAT ": overlap fraction %.6g for particle(s) %d%s "
-               "exceeds %g", update->ntimestep, all.fraction, tags[0], with.c_str(), max_overlap);
+  char text[512];
+  jd_watchdog_overlap_message(text, sizeof text, (long long)update->ntimestep, all.fraction, tags[0],
+                              tags[1] ? tags[1] : -1, wall, max_overlap);
+  msg = std::string("jdem: ") + text;
   return true;
 }
 
@@ -191,23 +193,19 @@ bool FixJdemWatchdog::energy(std::string &msg) {
   double local[JDO_N], sum[JDO_N];
   jdem_local_observables(lmp, groupbit, local);
   MPI_Allreduce(local, sum, JDO_N, MPI_DOUBLE, MPI_SUM, world);
-  jd_energy_terms now;
-  now.kinetic = sum[JDO_KINETIC];
-  now.rotational = sum[JDO_ROTATIONAL];
-  /* bonds (docs/scenes.md "Bonds"): their stored energy is elastic, their dashpots' and what
-   * broken bonds released is dissipated */
-  now.elastic = sum[JDO_ELASTIC] + sum[JDO_BOND_ELASTIC];
-  now.gravitational = sum[JDO_GRAVITATIONAL];
-  now.damping = sum[JDO_DAMPING] + sum[JDO_BOND_DAMPING] + sum[JDO_BOND_BREAKAGE];
-  now.friction = sum[JDO_FRICTION];
-  now.wall_work = sum[JDO_WALL_WORK];
+  double bond[JD_N_BOND_OBSERVABLES] = {0.0};
+  bond[JD_OBS_BOND_ELASTIC] = sum[JDO_BOND_ELASTIC];
+  bond[JD_OBS_BOND_DAMPING] = sum[JDO_BOND_DAMPING];
+  bond[JD_OBS_BOND_BREAKAGE] = sum[JDO_BOND_BREAKAGE];
+  const jd_energy_terms now = jd_energy_terms_of(sum, bond);
   const double jump = has_ref ? jd_energy_jump(&ref, &now) : 0.0;
   if (!(jump <= max_energy_jump)) { /* NaN trips too */
     const int id = most_energetic();
-    msg = format("jdem: watchdog: step " BIGINT_FORMAT ": energy jump %.6g for particle(s) %d exceeds "
-                 "%g (total energy %.9g J at step " BIGINT_FORMAT ", %.9g J now; the particle named "
-                 "has the largest kinetic energy)", update->ntimestep, jump, id, max_energy_jump,
-                 jd_energy_total(&ref), ref_step, jd_energy_total(&now));
+    char text[512];
+    jd_watchdog_energy_message(text, sizeof text, (long long)update->ntimestep, jump, id,
+                               max_energy_jump, jd_energy_total(&ref), (long long)ref_step,
+                               jd_energy_total(&now));
+    msg = std::string("jdem: ") + text;
     return true;
   }
   ref = now;

@@ -173,7 +173,8 @@ void FixWallJiang::refresh_candidates() {
 }
 
 void FixWallJiang::compute(bool commit) {
-#define JD_WALL_LOOP(b) loop<(b)>(commit)
+#define JD_WALL_LOOP(b) \
+  case (b): loop<(b)>(commit); break;
   JD_DISPATCH(pair->features(), JD_WALL_LOOP)
 #undef JD_WALL_LOOP
 }

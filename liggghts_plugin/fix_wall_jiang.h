@@ -34,6 +34,7 @@ namespace LAMMPS_NS {
 
 class FixWallJiang : public Fix {
  public:
+  int wall_type() const { return wtype; } /* the wall's atom type (material) */
   FixWallJiang(class LAMMPS *, int, char **);
   ~FixWallJiang();
   int setmask();

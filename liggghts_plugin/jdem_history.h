@@ -6,7 +6,7 @@
  *  - with the energy accounts (pair_style gran/jiang energy yes): the whole jd_contact_state
  *    (JD_CONTACT_STATE_LEN), then the whole jd_rolling_state when rolling is on;
  *  - without them (energy no): only what the laws carry from one step to the next, xi[3] and
- *    flags (JD_HISTORY_LAWS_LEN), then theta[3] with rolling (JD_ROLLING_LAWS_LEN): 4 or 7
+ *    flags (JD_CONTACT_LAWS_LEN), then theta[3] with rolling (JD_ROLLING_LAWS_LEN): 4 or 7
  *    doubles instead of 11 or 17.  LIGGGHTS' fix contacthistory copies the history of every
  *    neighbour pair at each neighbour build and the pair loop streams all of it every step, so
  *    the shorter record is less memory traffic (docs/liggghts.md, "Cost").
@@ -19,26 +19,25 @@
 #include <cstring>
 
 #include "jdem_kernel.h"
+#include "jdem_laws.h"
 
-/* Law fields at the start of the kernel's states (their layout is checked in
- * pair_gran_jiang.cpp): jd_contact_state's xi[3], flags; jd_rolling_state's theta[3]. */
-#define JD_HISTORY_LAWS_LEN 4
-#define JD_ROLLING_LAWS_LEN 3
-
+/* The laws whose records a contact's history holds: the energy bookkeeping's (keyword energy
+ * yes) and the rolling law's (keyword rolling on).  The layout of each record is the kernel's
+ * (jdem_laws.h): the contact record, then the rolling record. */
+static inline unsigned jd_history_laws(bool energy, bool rolling) {
+  return (energy ? (unsigned)JD_F_ENERGY : 0u) | (rolling ? (unsigned)JD_F_ROLLING : 0u);
+}
 /* Doubles of the contact record, and where the rolling part starts in it. */
 static inline int jd_history_contact_len(bool energy) {
-  return energy ? JD_CONTACT_STATE_LEN : JD_HISTORY_LAWS_LEN;
+  return jd_contact_record_len(jd_history_laws(energy, false));
 }
 static inline int jd_history_len(bool energy, bool rolling) {
-  return jd_history_contact_len(energy) +
-         (rolling ? (energy ? JD_ROLLING_STATE_LEN : JD_ROLLING_LAWS_LEN) : 0);
+  const unsigned laws = jd_history_laws(energy, rolling);
+  return jd_contact_record_len(laws) + jd_rolling_record_len(laws);
 }
-/* LIGGGHTS' sign-flip flag of entry k of the record (1: a vector component that changes sign
- * when i and j swap): the kernel's jd_contact_state_newton / jd_rolling_state_newton, whose
- * first entries are those of the law fields. */
+/* LIGGGHTS' sign-flip flag of entry k of the record (the kernel's). */
 static inline int jd_history_newton(bool energy, int k) {
-  const int nc = jd_history_contact_len(energy);
-  return k < nc ? jd_contact_state_newton[k] : jd_rolling_state_newton[k - nc];
+  return jd_record_newton(jd_history_contact_len(energy), k);
 }
 
 /* Read the full state stored at h (rs: NULL without rolling; energy-accounts layout). */
@@ -87,17 +86,8 @@ struct JdHistory {
       }
       return;
     }
-    std::memset(&st_copy_, 0, sizeof st_copy_);
-    st_copy_.xi[0] = h[0];
-    st_copy_.xi[1] = h[1];
-    st_copy_.xi[2] = h[2];
-    st_copy_.flags = h[3];
-    if (F & JD_F_ROLLING) {
-      std::memset(&rs_copy_, 0, sizeof rs_copy_);
-      rs_copy_.theta[0] = h[roll_at];
-      rs_copy_.theta[1] = h[roll_at + 1];
-      rs_copy_.theta[2] = h[roll_at + 2];
-    }
+    jd_record_load(h, JD_CONTACT_LAWS_LEN, h + roll_at, (F & JD_F_ROLLING) ? JD_ROLLING_LAWS_LEN : 0,
+                   &st_copy_, rs);
   }
   void finish() {
     if (F & JD_F_ENERGY) {
@@ -105,15 +95,8 @@ struct JdHistory {
       return;
     }
     if (!commit_) return;
-    h_[0] = st_copy_.xi[0];
-    h_[1] = st_copy_.xi[1];
-    h_[2] = st_copy_.xi[2];
-    h_[3] = st_copy_.flags;
-    if (F & JD_F_ROLLING) {
-      h_[roll_at_] = rs_copy_.theta[0];
-      h_[roll_at_ + 1] = rs_copy_.theta[1];
-      h_[roll_at_ + 2] = rs_copy_.theta[2];
-    }
+    jd_record_store(h_, JD_CONTACT_LAWS_LEN, h_ + roll_at_,
+                    (F & JD_F_ROLLING) ? JD_ROLLING_LAWS_LEN : 0, &st_copy_, rs);
   }
 
  private:

@@ -7,12 +7,18 @@
 
 #include <string>
 
+#include "jdem_observable_names.h"
+
 namespace LAMMPS_NS {
 class LAMMPS;
 
-/* Indices into the array filled by jdem_local_observables(). */
-enum { JDO_KINETIC = 0, JDO_ROTATIONAL, JDO_GRAVITATIONAL, JDO_ELASTIC, JDO_DAMPING,
-       JDO_FRICTION, JDO_WALL_WORK, JDO_CONTACTS, JDO_WALL_CONTACTS, JDO_BOND_ELASTIC,
+/* Indices into the array filled by jdem_local_observables(): the contact observables in the
+ * kernel's order (jd_observable_names), then the bond energies. */
+enum { JDO_KINETIC = JD_OBS_KINETIC, JDO_ROTATIONAL = JD_OBS_ROTATIONAL,
+       JDO_GRAVITATIONAL = JD_OBS_GRAVITATIONAL, JDO_ELASTIC = JD_OBS_ELASTIC,
+       JDO_DAMPING = JD_OBS_DAMPING, JDO_FRICTION = JD_OBS_FRICTION,
+       JDO_WALL_WORK = JD_OBS_WALL_WORK, JDO_CONTACTS = JD_OBS_CONTACTS,
+       JDO_WALL_CONTACTS = JD_OBS_WALL_CONTACTS, JDO_BOND_ELASTIC = JD_N_OBSERVABLES,
        JDO_BOND_DAMPING, JDO_BOND_BREAKAGE, JDO_N };
 
 /* Sums over this rank's atoms of `groupbit` and its contacts (pairs with a ghost partner count

@@ -19,26 +19,15 @@
 #include "neighbor.h"
 #include "update.h"
 
+#include "fix_wall_jiang.h"
 #include "jdem_dispatch.h"
+#include "jdem_laws.h"
 #include "jdem_history.h"
 #include "jdem_observables.h"
 #include "jdem_geometry.h"
 #include "jdem_watchdog.h"
 
 using namespace LAMMPS_NS;
-
-/* The history lives in LIGGGHTS' double arrays: the kernel's states must be flat doubles. */
-static_assert(sizeof(jd_contact_state) == JD_CONTACT_STATE_LEN * sizeof(double),
-              "jd_contact_state must be JD_CONTACT_STATE_LEN doubles");
-static_assert(sizeof(jd_rolling_state) == JD_ROLLING_STATE_LEN * sizeof(double),
-              "jd_rolling_state must be JD_ROLLING_STATE_LEN doubles");
-/* Without energy accounts the record holds the law fields only (jdem_history.h): they must be
- * the first entries of the states, so that the kernel's sign-flip flags apply to them. */
-static_assert(offsetof(jd_contact_state, flags) == (JD_HISTORY_LAWS_LEN - 1) * sizeof(double),
-              "jd_contact_state must start with xi[3], flags");
-static_assert(offsetof(jd_rolling_state, theta) == 0 &&
-                  sizeof(((jd_rolling_state *)0)->theta) == JD_ROLLING_LAWS_LEN * sizeof(double),
-              "jd_rolling_state must start with theta[3]");
 
 PairGranJiang::PairGranJiang(LAMMPS *lmp)
     : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
@@ -115,36 +104,41 @@ void PairGranJiang::init_granular() {
       "coefficientRestitution", "property/global", "peratomtypepair", nt, nt, me));
   FixPropertyGlobal *fmu = static_cast<FixPropertyGlobal *>(modify->find_fix_property(
       "coefficientFriction", "property/global", "peratomtypepair", nt, nt, me));
-  FixPropertyGlobal *feta = NULL;
-  if (rolling)
-    feta = static_cast<FixPropertyGlobal *>(modify->find_fix_property(
-        "coefficientRollingFriction", "property/global", "peratomtypepair", nt, nt, me));
+  /* read whether or not the rolling keyword is on: the law set depends on the coefficients,
+   * as in the stepper (update_law_set) */
+  FixPropertyGlobal *feta = static_cast<FixPropertyGlobal *>(modify->find_fix_property(
+      "coefficientRollingFriction", "property/global", "peratomtypepair", nt, nt, me, false));
 
   kp_ncalls_ = -1; /* the materials may have changed: recompute the prefactors */
   E_.assign(nt + 1, 0.0);
   nu_.assign(nt + 1, 0.0);
-  coeffs_.assign((nt + 1) * (nt + 1), jd_pair_coeffs());
-  bool any_damp = false, any_fric = false;
   for (int i = 1; i <= nt; i++) {
     E_[i] = fE->compute_vector(i - 1);
     nu_[i] = fnu->compute_vector(i - 1);
     if (!(E_[i] > 0.0) || !(nu_[i] > -1.0 && nu_[i] < 0.5))
       error->all(FLERR, "gran/jiang: youngsModulus must be > 0 and poissonsRatio in (-1, 0.5)");
   }
-  for (int i = 1; i <= nt; i++)
-    for (int j = 1; j <= nt; j++) {
-      jd_pair_coeffs &c = coeffs_[i * (nt + 1) + j];
-      const double e = fe->compute_array(i - 1, j - 1);
-      if (!(e > 0.0 && e <= 1.0)) error->all(FLERR, "gran/jiang: coefficientRestitution must be in (0, 1]");
-      c.gamma = jd_gamma_for(damping_map, e);
-      c.mu = fmu->compute_array(i - 1, j - 1);
-      c.eta = feta ? feta->compute_array(i - 1, j - 1) : 0.0;
-      c.mu_r = mu_r;
-      c.xi_limit = xi_limit;
-      if (c.mu < 0.0 || c.eta < 0.0) error->all(FLERR, "gran/jiang: friction coefficients must be >= 0");
-      if (c.gamma > 0.0) any_damp = true;
-      if (c.mu > 0.0) any_fric = true;
+  /* the type-pair tables, 0-based and row-major as the kernel's rulebook reads them */
+  restitution_.assign(nt * nt, 0.0);
+  friction_.assign(nt * nt, 0.0);
+  rolling_friction_.assign(nt * nt, 0.0);
+  for (int i = 0; i < nt; i++)
+    for (int j = 0; j < nt; j++) {
+      const int k = i * nt + j;
+      restitution_[k] = fe->compute_array(i, j);
+      friction_[k] = fmu->compute_array(i, j);
+      rolling_friction_[k] = feta ? feta->compute_array(i, j) : 0.0;
+      if (!(restitution_[k] > 0.0 && restitution_[k] <= 1.0))
+        error->all(FLERR, "gran/jiang: coefficientRestitution must be in (0, 1]");
+      if (friction_[k] < 0.0 || rolling_friction_[k] < 0.0)
+        error->all(FLERR, "gran/jiang: friction coefficients must be >= 0");
     }
+  std::vector<jd_pair_coeffs> table(nt * nt);
+  jd_pair_coeffs_table(nt, &restitution_[0], &friction_[0], &rolling_friction_[0], damping_map,
+                       mu_r, xi_limit, &table[0]);
+  coeffs_.assign((nt + 1) * (nt + 1), jd_pair_coeffs());
+  for (int i = 1; i <= nt; i++)
+    for (int j = 1; j <= nt; j++) coeffs_[i * (nt + 1) + j] = table[(i - 1) * nt + (j - 1)];
 
   /* Energies only when a dump h5md/jdem records the observables or fix jdem/watchdog checks
    * their balance; without energy accounts in the history neither may ask for them. */
@@ -154,22 +148,49 @@ void PairGranJiang::init_granular() {
                        ", or use pair_style gran/jiang energy yes").c_str());
   energy = !user.empty();
 
-  features_ = 0u;
-  if (any_damp) features_ |= JD_F_DAMPING;
-  if (any_fric) features_ |= JD_F_FRICTION;
-  if (rolling) features_ |= JD_F_ROLLING;
-  if (any_fric && mu_r != 1.0) features_ |= JD_F_MU_R;
-  if (energy) features_ |= JD_F_ENERGY;
+  types_in_use_.assign(nt, 0);
+  update_law_set(true);
 }
 
-/* ---------------------------------------------------------------------------------------- */
+/* The law set of the interactions that can occur (jd_law_set_select, the stepper's rule): the
+ * types of the atoms present on any rank against those types and the walls' (fix wall/jiang).
+ * At set-up, and again after every neighbour build, when atoms of another type may have been
+ * inserted: the set then widens (collective: every rank builds its lists at the same step). */
+void PairGranJiang::update_law_set(bool report) {
+  const int nt = ntypes_;
+  std::vector<int> mine(nt, 0), all(nt, 0);
+  for (int i = 0; i < atom->nlocal; i++) mine[atom->type[i] - 1] = 1;
+  MPI_Allreduce(&mine[0], &all[0], nt, MPI_INT, MPI_MAX, world);
+  bool grew = report;
+  for (int t = 0; t < nt; t++)
+    if (all[t] && !types_in_use_[t]) types_in_use_[t] = 1, grew = true;
+  if (!grew) return;
+  std::vector<unsigned char> walls(nt, 0);
+  for (int k = 0; k < modify->nfix; k++) {
+    FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
+    if (w && w->wall_type() >= 1 && w->wall_type() <= nt) walls[w->wall_type() - 1] = 1;
+  }
+  features_ = jd_law_set_select(nt, &restitution_[0], &friction_[0], &rolling_friction_[0],
+                                &types_in_use_[0], &walls[0], mu_r, energy);
+  if ((features_ & JD_F_ROLLING) && !rolling)
+    error->all(FLERR, "pair_style gran/jiang: coefficientRollingFriction is > 0 for a pair of types "
+                      "in use, which needs the rolling law and its history: add 'rolling on' to "
+                      "pair_style gran/jiang (or set coefficientRollingFriction to 0)");
+  if (report && comm->me == 0) {
+    char laws[96];
+    jd_law_set_describe(features_, laws, sizeof laws);
+    if (screen) std::fprintf(screen, "gran/jiang: law set %s\n", laws);
+    if (logfile) std::fprintf(logfile, "gran/jiang: law set %s\n", laws);
+  }
+}
 
 /* Computed once per atom instead of once per contact.  The atoms (local and ghost) and their
  * radii change only at neighbour builds, unless the radii vary during the run (radvary_flag,
  * e.g. fix adapt): then every step. */
 void PairGranJiang::refresh_prefactors() {
   const int nall = atom->nlocal + atom->nghost;
-  if (neighbor->ncalls == kp_ncalls_ && nall == kp_nall_ && !atom->radvary_flag) return;
+  const bool rebuilt = neighbor->ncalls != kp_ncalls_; /* on every rank at the same step */
+  if (!rebuilt && nall == kp_nall_ && !atom->radvary_flag) return;
   const double *radius = atom->radius;
   const int *type = atom->type;
   kp_.resize(nall > 0 ? nall : 1);
@@ -180,10 +201,13 @@ void PairGranJiang::refresh_prefactors() {
   }
   kp_ncalls_ = neighbor->ncalls;
   kp_nall_ = nall;
+  if (rebuilt) update_law_set(false);
 }
 
 void PairGranJiang::compute_force(int eflag, int vflag, int addflag) {
-#define JD_PAIR_LOOP(b) loop<(b)>(eflag, vflag, addflag)
+  refresh_prefactors(); /* first: a neighbour build may widen the law set */
+#define JD_PAIR_LOOP(b) \
+  case (b): loop<(b)>(eflag, vflag, addflag); break;
   JD_DISPATCH(features_, JD_PAIR_LOOP)
 #undef JD_PAIR_LOOP
 }
@@ -215,7 +239,6 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
   const int *tag = atom->tag;
   overlap_trip = JdOverlapTrip();
 
-  refresh_prefactors();
   const double *kp = pair_prefactors();
 
   for (int ii = 0; ii < inum; ii++) {

@@ -80,9 +80,13 @@ class PairGranJiang : public PairGran {
   template <unsigned F> JD_SPECIALISED void loop(int eflag, int vflag, int addflag);
 
  private:
+  void update_law_set(bool report);
   unsigned features_;
   int ntypes_;
   std::vector<double> E_, nu_;
+  /* type-pair tables (ntypes x ntypes, 0-based): restitution, friction, rolling friction */
+  std::vector<double> restitution_, friction_, rolling_friction_;
+  std::vector<unsigned char> types_in_use_; /* 1 for a type some atom had (update_law_set) */
   std::vector<jd_pair_coeffs> coeffs_;
 
   std::vector<double> kp_, kw_;

@@ -29,7 +29,8 @@ from dataclasses import dataclass, field
 class Unit:
     name: str                   # unique, e.g. "jdem/model2/fill1"
     outputs: list               # final output paths
-    command: list               # argv; "{out0}", "{out1}", ... stand for the outputs being written
+    command: list               # argv; "{out0}", "{out1}", ... stand for the outputs being
+                                # written, "{dir}" for the directory that holds them
     model: str = None
     engine: str = None
     needs: list = field(default_factory=list)  # names of the units whose outputs it reads
@@ -107,6 +108,7 @@ def run_unit(unit):
     os.makedirs(tmp)
     staged = [os.path.join(tmp, os.path.basename(p)) for p in unit.outputs]
     subs = {f"out{i}": p for i, p in enumerate(staged)}
+    subs["dir"] = tmp
     argv = [a.format(**subs) for a in unit.command]
     proc = subprocess.run(argv)
     if proc.returncode != 0:

@@ -42,8 +42,8 @@ EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_IO, EXIT_WATCHDOG, EXIT_MEMORY = 0, 1, 
 ERROR_CLASSES = [
     (re.compile(r"jdem: watchdog:"), EXIT_WATCHDOG),
     (re.compile(r"out of memory|Failed to allocate|std::bad_alloc", re.I), EXIT_MEMORY),
-    (re.compile(r"h5md/jdem|HDF5|cannot (create|write|open|rename)|No space left|Read-only|"
-                r"Permission denied", re.I), EXIT_IO),
+    (re.compile(r"HDF5|cannot (create|write|open|rename)|No space left|Read-only file system|"
+                r"Permission denied|Disk quota", re.I), EXIT_IO),
 ]
 
 

@@ -17,21 +17,6 @@
 #include <omp.h>
 #endif
 
-#if defined(__GNUC__)
-#define JD_ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define JD_ALWAYS_INLINE inline
-#endif
-
-const char *const jd_bond_observable_names[JD_N_BOND_OBSERVABLES] = {
-    "bonds", "fragments", "bond_elastic_energy", "bond_damping_dissipation",
-    "bond_breakage_energy"};
-const int jd_bond_observable_is_energy[JD_N_BOND_OBSERVABLES] = {0, 0, 1, 1, 1};
-_Static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double) &&
-                   offsetof(jd_bond_state, flags) == (JD_BOND_CORE - 1) * sizeof(double) &&
-                   offsetof(jd_bond_state, e_break) == (JD_BOND_STATE_LEN - 1) * sizeof(double),
-               "state_get/state_set: the kernel's bond state is a plain array of doubles, the "
-               "law's fields first");
 
 void sim_bond_observables_values(const jd_bond_observables *o, double out[JD_N_BOND_OBSERVABLES]) {
     const double v[JD_N_BOND_OBSERVABLES] = {o->bonds, o->fragments, o->elastic_energy,
@@ -87,43 +72,14 @@ static void fit(jd_bonds *b) {
     b->cap = c;
 }
 
-/* The state of bond k as the kernel's struct (the energy fields zero when not kept); sw is
- * b->sw, a compile-time constant in the bond loop.  Field by field, not through a double *:
- * GCC then keeps the struct in registers instead of copying it through the stack. */
+/* The state of bond k as the kernel's struct and back (its record, jd_bond_record_load/store);
+ * sw is b->sw, a compile-time constant in the bond loop. */
 static JD_ALWAYS_INLINE jd_bond_state state_get(const jd_bonds *b, const int sw, size_t k) {
-    const double *a = b->state + (size_t)sw * k;
-    jd_bond_state st = {.fn = a[0], .ft = {a[1], a[2], a[3]}, .mn = a[4],
-                        .mt = {a[5], a[6], a[7]}, .flags = a[8]};
-    if (sw == JD_BOND_STATE_LEN) {
-        for (int d = 0; d < 3; d++) {
-            st.f_prev[d] = a[9 + d];
-            st.m_prev[d] = a[12 + d];
-        }
-        st.u_prev = a[15];
-        st.e_damp = a[16];
-        st.e_break = a[17];
-    }
-    return st;
+    return jd_bond_record_load(b->state + (size_t)sw * k, sw);
 }
 
 static JD_ALWAYS_INLINE void state_set(jd_bonds *b, const int sw, size_t k, const jd_bond_state *st) {
-    double *a = b->state + (size_t)sw * k;
-    a[0] = st->fn;
-    a[4] = st->mn;
-    a[8] = st->flags;
-    for (int d = 0; d < 3; d++) {
-        a[1 + d] = st->ft[d];
-        a[5 + d] = st->mt[d];
-    }
-    if (sw == JD_BOND_STATE_LEN) {
-        for (int d = 0; d < 3; d++) {
-            a[9 + d] = st->f_prev[d];
-            a[12 + d] = st->m_prev[d];
-        }
-        a[15] = st->u_prev;
-        a[16] = st->e_damp;
-        a[17] = st->e_break;
-    }
+    jd_bond_record_store(b->state + (size_t)sw * k, sw, st);
 }
 
 /* Room for b->n results of the threaded bond loop (allocated only when it runs). */
@@ -183,10 +139,10 @@ int sim_bonds_init(jd_sim *s, char *err, size_t errlen) {
     jd_bond_params *p = malloc(b->n_types * sizeof *p);
     if (!p) goto oom;
     b->features = sc->energy ? JD_B_ENERGY : 0u;
-    b->sw = sc->energy ? JD_BOND_STATE_LEN : JD_BOND_CORE;
+    b->sw = jd_bond_record_len(b->features);
     for (size_t t = 0; t < b->n_types; t++) {
         p[t] = sc->bond_types[t].p;
-        if (p[t].gamma > 0.0) b->features |= JD_B_DAMPING;
+        b->features |= jd_bond_laws(p[t].gamma);
     }
     b->params = p;
     int one_radius = 1;
@@ -323,7 +279,7 @@ static void record_break(jd_sim *s, size_t k, const jd_bond_result *out, const d
 static JD_ALWAYS_INLINE int bond_eval(jd_sim *s, const unsigned F, const double dt, size_t k,
                                       jd_bond_result *out, double xc[3]) {
     jd_bonds *b = s->bonds;
-    const int sw = (F & JD_B_ENERGY) ? JD_BOND_STATE_LEN : JD_BOND_CORE; /* = b->sw */
+    const int sw = jd_bond_record_len(F); /* = b->sw */
     const int32_t i = b->i[k], j = b->j[k];
     jd_bond_geom g;
     if (!jd_bond_geom_spheres(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
@@ -476,7 +432,7 @@ void sim_bonds_forces(jd_sim *s) {
     while (!s->in_setup && b->next_rule < sc->n_bond_rules &&
            sc->bond_rules[b->next_rule].step <= step)
         apply_rule(s, &sc->bond_rules[b->next_rule++], step);
-    size_t broke;
+    size_t broke = 0;
     if (s->threads > 1 && b->n > 0) {
         if (out_reserve(b) != 0) {
             b->failed = "out of memory for the threaded bond loop";
@@ -493,21 +449,29 @@ void sim_bonds_forces(jd_sim *s) {
 #else
             const int tid = 0;
 #endif
+#define JD_BOND_LOOP_THREADS(bits) \
+    case (bits):                   \
+        bond_loop_threads(s, (bits), tid); \
+        break;
             switch (b->features) {
-            case 0: bond_loop_threads(s, 0u, tid); break;
-            case JD_B_DAMPING: bond_loop_threads(s, JD_B_DAMPING, tid); break;
-            case JD_B_ENERGY: bond_loop_threads(s, JD_B_ENERGY, tid); break;
-            default: bond_loop_threads(s, JD_B_ENERGY | JD_B_DAMPING, tid); break;
+                JD_BOND_LAW_SETS(JD_BOND_LOOP_THREADS)
+            default:
+                break;
             }
+#undef JD_BOND_LOOP_THREADS
         }
         broke = bond_breaks(s, step);
     } else {
+#define JD_BOND_LOOP(bits)                  \
+    case (bits):                            \
+        broke = bond_loop(s, (bits), step); \
+        break;
         switch (b->features) {
-        case 0: broke = bond_loop(s, 0u, step); break;
-        case JD_B_DAMPING: broke = bond_loop(s, JD_B_DAMPING, step); break;
-        case JD_B_ENERGY: broke = bond_loop(s, JD_B_ENERGY, step); break;
-        default: broke = bond_loop(s, JD_B_ENERGY | JD_B_DAMPING, step); break;
+            JD_BOND_LAW_SETS(JD_BOND_LOOP)
+        default:
+            break;
         }
+#undef JD_BOND_LOOP
     }
     if (broke && !s->in_setup) compact(b);
 }
@@ -618,14 +582,10 @@ double sim_bonds_omega2(const jd_scene *sc) {
         const long i = index_of_id(sc, sc->bond_ids[2 * k]), j = index_of_id(sc, sc->bond_ids[2 * k + 1]);
         if (i < 0 || j < 0) continue;
         const jd_bond_params *p = &sc->bond_types[sc->bond_type[k]].p;
-        const double Ri = sc->radius[i], Rj = sc->radius[j];
-        const jd_bond_section sec = jd_bond_section_of(p->lambda, Ri, Rj);
         double dx[3];
         for (int d = 0; d < 3; d++) dx[d] = sc->position[3 * j + d] - sc->position[3 * i + d];
-        const double dist = sqrt(jd_dot(dx, dx)), delta = Ri + Rj - dist;
-        const double la = fabs(Ri - 0.5 * delta), lb = fabs(dist - la);
-        const double wk = jd_bond_omega2_bound(p, &sec, m[i], m[j], jd_sphere_inertia(m[i], Ri),
-                                               jd_sphere_inertia(m[j], Rj), la, lb);
+        const double wk = jd_bond_omega2_pair(p, sc->radius[i], sc->radius[j], m[i], m[j],
+                                              sqrt(jd_dot(dx, dx)));
         w2[i] += wk;
         w2[j] += wk;
     }
@@ -636,9 +596,7 @@ double sim_bonds_omega2(const jd_scene *sc) {
             if (!rule->materials[sc->material[i]] || sc->id[i] < rule->id_range[0] ||
                 sc->id[i] > rule->id_range[1])
                 continue;
-            const double R = sc->radius[i], I = jd_sphere_inertia(m[i], R);
-            const jd_bond_section sec = jd_bond_section_of(p->lambda, R, R);
-            w2[i] += 12.0 * jd_bond_omega2_bound(p, &sec, m[i], m[i], I, I, R, R);
+            w2[i] += jd_bond_omega2_rule(p, sc->radius[i], m[i]);
         }
     }
     double wmax2 = 0.0;

@@ -18,17 +18,18 @@
 
 #include "h5md.h"
 #include "jdem_bond.h"
+#include "jdem_laws.h"
+#include "jdem_observable_names.h"
 
 struct jd_sim;
 struct jd_scene;
 
-/* Bond state doubles without the energy bookkeeping: jd_bond_state's fn, ft[3], mn, mt[3] and
- * flags (its leading fields).  The cross-section and the dashpots' effective masses are not
- * stored: the bond loop computes them from the particles' radii and masses each step (as the
+/* A bond's state is the kernel's record (jdem_laws.h, jd_bond_record_len: without the energy
+ * bookkeeping only the law's fields).  The cross-section and the dashpots' effective masses are
+ * not stored: the bond loop computes them from the particles' radii and masses each step (as the
  * LIGGGHTS plugin does for the masses), which keeps a bond at 84 bytes, 156 with the
  * bookkeeping.  (When all particles share one radius the sections are taken per type:
  * jd_bond_section_of's three divisions cost a fifth of a bond's evaluation.) */
-enum { JD_BOND_CORE = 9 };
 
 /* A failed bond's figures, what its event records (jd_bond_result's). */
 typedef struct jd_bond_failure {
@@ -60,7 +61,7 @@ typedef struct jd_bonds {
     size_t n, cap;             /* intact bonds */
     int32_t *i, *j;            /* particle indices of a and b */
     int32_t *type;             /* index into params */
-    int sw;                    /* doubles of state per bond: JD_BOND_CORE, or JD_BOND_STATE_LEN
+    int sw;                    /* doubles of state per bond: JD_BOND_LAWS_LEN, or JD_BOND_STATE_LEN
                                   with the energy bookkeeping (JD_B_ENERGY) */
     double *state;             /* cap x sw: the leading sw doubles of each bond's jd_bond_state */
     jd_bond_out *out;          /* out_cap results of the threaded bond loop; NULL with one
@@ -87,10 +88,7 @@ typedef struct jd_bond_observables {
     double elastic_energy, damping_dissipation, breakage_energy; /* [J]; 0 without the energy
                                                                     bookkeeping */
 } jd_bond_observables;
-#define JD_N_BOND_OBSERVABLES 5
-extern const char *const jd_bond_observable_names[JD_N_BOND_OBSERVABLES];
-/* 1 for the observables that need the energy bookkeeping (not written with output.energy off) */
-extern const int jd_bond_observable_is_energy[JD_N_BOND_OBSERVABLES];
+/* The values in the order of jd_bond_observable_names (kernel/jdem_observables.h). */
 void sim_bond_observables_values(const jd_bond_observables *o, double out[JD_N_BOND_OBSERVABLES]);
 
 /* Set up s->bonds from the scene (NULL when the scene has no bond types).  0 or -1 with err. */

@@ -1,8 +1,8 @@
 /*
- * forces.c — force loops.  The scene's feature set (JD_F_* bits) is fixed for a run; the loop
- * body is instantiated once per combination with the bits as a literal constant, so that
- * jd_contact() compiles away every law the scene does not use (DESIGN.md: "leave out what a
- * scene does not need").  Order as LIGGGHTS: pair forces in list order (the candidates that
+ * forces.c — force loops.  The scene's law set (JD_F_* bits, kernel/jdem_laws.h) is fixed for a
+ * run; the loop body is instantiated once per law set of the kernel's list with the bits as a
+ * literal constant, so that jd_contact() compiles away every law the scene does not use (a
+ * scene pays only for what it uses).  Order as LIGGGHTS: pair forces in list order (the candidates that
  * touched at the build, then the others: sim.h, jd_contact_list), wall forces, gravity.
  *
  * Threads (sim.h, "Threads"): each thread zeroes the forces of the particles it owns, evaluates
@@ -21,14 +21,10 @@
 #endif
 
 #if defined(__GNUC__)
-#define JD_ALWAYS_INLINE inline __attribute__((always_inline))
 #define JD_NOINLINE __attribute__((noinline))
 #else
-#define JD_ALWAYS_INLINE inline
 #define JD_NOINLINE
 #endif
-/* one copy of the law per specialised loop (kernel/jdem_kernel.h, JD_CONTACT_INLINE) */
-#define JD_CONTACT_INLINE static JD_ALWAYS_INLINE
 
 #include "geometry.h"
 #include "sim.h"
@@ -53,36 +49,27 @@ static acc acc_of(const jd_sim *s, int tid) {
     return (acc){s->f, s->torque, h->ovf, h->ovf + 3 * h->cap, h->p_hi, h->span};
 }
 
-/* History widths of a feature set (sim.h, jd_contact_list), compile-time constants in the
- * specialised loops, and where each field of the kernel's structs sits in an entry. */
-#define HW(F) (((F) & JD_F_ENERGY) ? JD_CONTACT_STATE_LEN : JD_HIST_CORE)
-#define RW(F) (((F) & JD_F_ROLLING) ? (((F) & JD_F_ENERGY) ? JD_ROLLING_STATE_LEN : JD_RHIST_CORE) : 0)
-#define AT(type, field) ((int32_t)(offsetof(type, field) / sizeof(double)))
+/* History widths of a law set (the kernel's records, jdem_laws.h), compile-time constants in the
+ * specialised loops. */
+#define HW(F) jd_contact_record_len(F)
+#define RW(F) jd_rolling_record_len(F)
 
 /* Entry c's history as the kernel's structs, and back (sim_hist_get/set with the widths known
  * at compile time). */
 static JD_ALWAYS_INLINE void hist_load(const jd_contact_list *L, const unsigned F, size_t c,
                                        jd_contact_state *st, jd_rolling_state *rs) {
-    double *a = (double *)st, *b = (double *)rs;
-    for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) a[k] = k < HW(F) ? L->hist[HW(F) * c + (size_t)k] : 0.0;
-    for (int k = 0; k < JD_ROLLING_STATE_LEN; k++) b[k] = k < RW(F) ? L->rhist[RW(F) * c + (size_t)k] : 0.0;
+    jd_record_load(L->hist + (size_t)HW(F) * c, HW(F), L->rhist + (size_t)RW(F) * c, RW(F), st, rs);
 }
 static JD_ALWAYS_INLINE void hist_store(jd_contact_list *L, const unsigned F, size_t c,
                                         const jd_contact_state *st, const jd_rolling_state *rs) {
-    const double *a = (const double *)st, *b = (const double *)rs;
-    for (int k = 0; k < HW(F); k++) L->hist[HW(F) * c + (size_t)k] = a[k];
-    for (int k = 0; k < RW(F); k++) L->rhist[RW(F) * c + (size_t)k] = b[k];
+    jd_record_store(L->hist + (size_t)HW(F) * c, HW(F), L->rhist + (size_t)RW(F) * c, RW(F), st, rs);
 }
 
 /* The pair or wall entry c no longer overlaps: its history as jd_contact_separate leaves it
- * (every field zero but the dissipation accumulators e_damp and e_fric, which the engine sums
- * per entry; test_kernel checks the kernel keeps exactly those), written in place: the list
- * holds many such entries every step. */
+ * (jd_record_separate; test_kernel checks the kernel keeps exactly the accumulators), written in
+ * place: the list holds many such entries every step. */
 static JD_ALWAYS_INLINE void hist_separate(jd_contact_list *L, const unsigned F, size_t c) {
-    double *h = L->hist + (size_t)HW(F) * c, *r = L->rhist + (size_t)RW(F) * c;
-    for (int k = 0; k < HW(F); k++)
-        if (k != AT(jd_contact_state, e_damp) && k != AT(jd_contact_state, e_fric)) h[k] = 0.0;
-    for (int k = 0; k < RW(F); k++) r[k] = 0.0;
+    jd_record_separate(L->hist + (size_t)HW(F) * c, HW(F), L->rhist + (size_t)RW(F) * c, RW(F));
 }
 
 /* Is entry c's history already as hist_separate leaves it (bit for bit: +0, not -0)?  Most
@@ -92,7 +79,7 @@ static JD_ALWAYS_INLINE int hist_separated(const jd_contact_list *L, const unsig
     const double *h = L->hist + (size_t)HW(F) * c, *r = L->rhist + (size_t)RW(F) * c;
     uint64_t bits = 0, u;
     for (int k = 0; k < HW(F); k++)
-        if (k != AT(jd_contact_state, e_damp) && k != AT(jd_contact_state, e_fric)) {
+        if (k != JD_AT(jd_contact_state, e_damp) && k != JD_AT(jd_contact_state, e_fric)) {
             memcpy(&u, h + k, sizeof u);
             bits |= u;
         }
@@ -137,9 +124,7 @@ static JD_ALWAYS_INLINE void lane_law(const unsigned F, batch *restrict B, int b
                                       const jd_pair_coeffs *co, int touch, double dt) {
     jd_contact_state st;
     jd_rolling_state rs;
-    double *sa = (double *)&st, *ra = (double *)&rs;
-    for (int q = 0; q < JD_CONTACT_STATE_LEN; q++) sa[q] = q < HW(F) ? hist[HW(F) * c + q] : 0.0;
-    for (int q = 0; q < JD_ROLLING_STATE_LEN; q++) ra[q] = q < RW(F) ? rhist[RW(F) * c + q] : 0.0;
+    jd_record_load(hist + HW(F) * c, HW(F), rhist + RW(F) * c, RW(F), &st, &rs);
     const double e_damp_in = st.e_damp, e_fric_in = st.e_fric;
     if (F & JD_F_ENERGY)
         for (int d = 0; d < 3; d++) B->f_before[d][b] = st.f_prev[d];
@@ -168,19 +153,19 @@ static JD_ALWAYS_INLINE void lane_law(const unsigned F, batch *restrict B, int b
 static JD_ALWAYS_INLINE void lane_history_write(const unsigned F, const batch *B, int b,
                                                 double *hist, double *rhist, size_t c) {
     double *h = hist + (size_t)HW(F) * c, *r = rhist + (size_t)RW(F) * c;
-    for (int d = 0; d < 3; d++) h[AT(jd_contact_state, xi) + d] = B->xi[d][b];
-    h[AT(jd_contact_state, flags)] = B->flags[b];
+    for (int d = 0; d < 3; d++) h[JD_AT(jd_contact_state, xi) + d] = B->xi[d][b];
+    h[JD_AT(jd_contact_state, flags)] = B->flags[b];
     if (F & JD_F_ENERGY) {
-        for (int d = 0; d < 3; d++) h[AT(jd_contact_state, f_prev) + d] = B->f_prev[d][b];
-        h[AT(jd_contact_state, fd_prev)] = B->fd_prev[b];
-        h[AT(jd_contact_state, u_prev)] = B->u_prev[b];
-        h[AT(jd_contact_state, e_damp)] = B->e_damp[b];
-        h[AT(jd_contact_state, e_fric)] = B->e_fric[b];
+        for (int d = 0; d < 3; d++) h[JD_AT(jd_contact_state, f_prev) + d] = B->f_prev[d][b];
+        h[JD_AT(jd_contact_state, fd_prev)] = B->fd_prev[b];
+        h[JD_AT(jd_contact_state, u_prev)] = B->u_prev[b];
+        h[JD_AT(jd_contact_state, e_damp)] = B->e_damp[b];
+        h[JD_AT(jd_contact_state, e_fric)] = B->e_fric[b];
     }
     if (F & JD_F_ROLLING)
         for (int d = 0; d < 3; d++) {
-            r[AT(jd_rolling_state, theta) + d] = B->theta[d][b];
-            if (F & JD_F_ENERGY) r[AT(jd_rolling_state, m_prev) + d] = B->m_prev[d][b];
+            r[JD_AT(jd_rolling_state, theta) + d] = B->theta[d][b];
+            if (F & JD_F_ENERGY) r[JD_AT(jd_rolling_state, m_prev) + d] = B->m_prev[d][b];
         }
 }
 
@@ -417,24 +402,20 @@ static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, 
  * about one slab of cells (neighbour.c, cell_axes), so a particle's x, v, omega, f and torque
  * are first touched, as a partner, span particles ahead of the rows being evaluated, at
  * scattered j the hardware prefetchers do not follow.  The loop fetches every cache line of the five arrays once,
- * JD_PREFETCH_AHEAD particles ahead of that front.  Measured (docs/performance.md): 320k pair
- * loop 2.7-2.8 s against 3.3-3.7 s, 80k 0.94-1.04 s against 1.07-1.28 s; at 5k and 20k, whose
- * particles stay in cache, the prefetches cost 2-4 %, hence only from JD_PREFETCH_MIN_N
- * particles (the five arrays then hold 7.9 MB). */
+ * JD_PREFETCH_AHEAD particles ahead of that front.  It pays in the large beds only; at 5k and
+ * 20k, whose particles stay in cache, the prefetches cost a little, hence only from
+ * JD_PREFETCH_MIN_N particles (the five arrays then hold 7.9 MB; docs/performance.md). */
 #define JD_PREFETCH_AHEAD 128
 #define JD_PREFETCH_MIN_N 65536
 /* The list's own streams (indices and history, read and written back) cross a 4 KiB page every
  * 100 entries or so, where the hardware prefetchers stop; the pair loop fetches them
- * JD_ENTRIES_AHEAD entries ahead.  Measured (docs/performance.md), alternating runs: 20k pair
- * loop median 0.461 s against 0.474 s, 80k 0.884 s against 0.921 s (8 each); 256 or 1024
- * entries ahead measured the same. */
+ * JD_ENTRIES_AHEAD entries ahead (docs/performance.md; 256 or 1024 measured the same). */
 #define JD_ENTRIES_AHEAD 512
 
 /* Prefetch the five arrays' lines of particles [*done, upto) (x, v, omega to read, f and torque
  * to write), and advance *done.  packed (a literal; the entries that did not touch at the
  * build): x alone, which the sphere test reads for every entry; the few entries that pass it
- * are not worth four more lines per particle (80k pair loop median 0.81 s against 0.89 s, 6
- * alternating runs each, docs/performance.md). */
+ * are not worth four more lines per particle (docs/performance.md). */
 static JD_ALWAYS_INLINE void prefetch_particles(const jd_sim *s, const int packed, size_t *done,
                                                 size_t upto) {
     if (upto > s->n) upto = s->n;
@@ -488,10 +469,7 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int ki
 
 /* The wall loop fetches the particle data of its entries this many entries ahead.  Along a
  * side wall a wall entry's particle is one of a few per row of cells, so in a large bed its
- * lines (ten arrays) have left the cache when the wall loop reaches it: the 320k wall loop
- * took about 70 ns per entry against 24 at 20k.  Measured (docs/performance.md), alternating
- * runs, wall loop medians: 320k 0.32 s against 0.59 s (300 steps), 80k 0.057 s against
- * 0.089 s, 1M 0.119 s against 0.203 s, 20k 0.033 s against 0.036 s; 5k the same. */
+ * lines (ten arrays) have left the cache when the wall loop reaches it (docs/performance.md). */
 #define JD_WALL_AHEAD 16
 
 /* Prefetch what the wall loop reads and writes of particle i. */
@@ -726,24 +704,15 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
     return wall_loop(s, F, h->wall_lo, h->wall_hi, a, trip);
 }
 
-/* One instantiation per combination of the four optional laws and the energy bookkeeping
- * (output.energy) that sim.c can select: mu_R modifies the tangential law only, so JD_F_MU_R
- * comes with JD_F_FRICTION (12 of the 16 law sets).  The switch maps the run-time bits to a
- * literal constant. */
+/* One instantiation per law set (the kernel's list, jdem_laws.h): the switch maps the run-time
+ * bits to a literal constant. */
 #define JD_FORCE_CASE(bits)                                                     \
     case (bits):                                                                \
         work = contact_loops(s, (bits), tid, &t_pairs_end);                     \
         break;
-#define JD_FORCE_CASES(e)                                                                     \
-    JD_FORCE_CASE((e) | 0) JD_FORCE_CASE((e) | 1) JD_FORCE_CASE((e) | 2) JD_FORCE_CASE((e) | 3)     \
-    JD_FORCE_CASE((e) | 4) JD_FORCE_CASE((e) | 5) JD_FORCE_CASE((e) | 6) JD_FORCE_CASE((e) | 7)     \
-    JD_FORCE_CASE((e) | 10) JD_FORCE_CASE((e) | 11) JD_FORCE_CASE((e) | 14) JD_FORCE_CASE((e) | 15)
 
 static double dispatch(jd_sim *s, int tid, double *t_pairs_end_out) {
     double work = 0.0, t_pairs_end = 0.0;
-    _Static_assert(JD_F_DAMPING == 1 && JD_F_FRICTION == 2 && JD_F_ROLLING == 4 && JD_F_MU_R == 8 &&
-                       JD_F_ENERGY == 16,
-                   "the dispatch below enumerates the four optional laws as bits 0-3, energy as 4");
     if (s->opt.plain_loops) {
         work = plain_contact_loops(s, tid, &t_pairs_end);
         if (tid == 0) *t_pairs_end_out = t_pairs_end;
@@ -753,12 +722,11 @@ static double dispatch(jd_sim *s, int tid, double *t_pairs_end_out) {
     /* one copy of the loops, with the features as a run-time value: the sanitizer build
      * (Makefile), where 32 inlined copies of the law under ASan+UBSan take minutes to compile;
      * the same source, hence the same checks */
-    work = contact_loops(s, s->features & 31u, tid, &t_pairs_end);
+    work = contact_loops(s, s->features & JD_F_ALL, tid, &t_pairs_end);
 #else
-    switch (s->features & 31u) {
-        JD_FORCE_CASES(0)
-        JD_FORCE_CASES(16)
-    default: /* a law set sim.c never selects: the reference path serves every set */
+    switch (s->features) {
+        JD_LAW_SETS(JD_FORCE_CASE)
+    default: /* not a law set (jd_law_set_select never returns one): the reference path */
         work = plain_contact_loops(s, tid, &t_pairs_end);
     }
 #endif

@@ -42,7 +42,7 @@ enum { P_TWICE = 1, P_WEIGHT = 2, P_UNIFORM = 4, P_CHECK = 8 };
 
 /* The rebuild check of particle i: 1 when it moved more than half the skin since the last
  * neighbour build (lim = (skin/2)^2; !(<=) so that a NaN position counts as moved). */
-static inline __attribute__((always_inline)) int
+static JD_ALWAYS_INLINE int
 moved_far(const double *restrict x, const double *restrict x0, long i, double lim) {
     const double d[3] = {x[3 * i] - x0[3 * i], x[3 * i + 1] - x0[3 * i + 1],
                          x[3 * i + 2] - x0[3 * i + 2]};
@@ -59,7 +59,7 @@ moved_far(const double *restrict x, const double *restrict x0, long i, double li
  * since the last neighbour build; bit 2 (twice): some v or omega after the first half kick, the
  * last step's state, is not finite.  Without check, *vmax2 is the largest squared speed of the
  * drift instead (NaN if some speed is NaN). */
-static inline __attribute__((always_inline)) int
+static JD_ALWAYS_INLINE int
 kick_drift_pass(long lo, long hi, double *restrict x, double *restrict v, double *restrict w,
                 const double *restrict x0, const double *restrict f, const double *restrict t,
                 const double *restrict dtfm, const double *restrict dtirot,
@@ -91,8 +91,8 @@ kick_drift_pass(long lo, long hi, double *restrict x, double *restrict v, double
             far |= moved_far(x, x0, i, lim);
         } else {
             /* u2 >= +0 (or NaN), whose bits order as the numbers do: an integer maximum, which
-             * GCC vectorises (a floating-point one only with -ffinite-math-only: 5k bed,
-             * integration 0.043 s against 0.020 s) */
+             * GCC vectorises (a floating-point one only with -ffinite-math-only;
+             * docs/performance.md) */
             const double u2 = jd_dot(u, u);
             int64_t ub;
             memcpy(&ub, &u2, sizeof ub);
@@ -105,7 +105,7 @@ kick_drift_pass(long lo, long hi, double *restrict x, double *restrict v, double
 
 /* The particles [lo, hi) of final_integrate; with weight the force gets its weight first, and
  * keeps it (the state is looked at).  Returns 1 when some new v or omega is not finite. */
-static inline __attribute__((always_inline)) int
+static JD_ALWAYS_INLINE int
 kick_pass(long lo, long hi, double *restrict v, double *restrict w, double *restrict f,
           const double *restrict t, const double *restrict dtfm, const double *restrict dtirot,
           const double *restrict mass, const pass_consts *c, const int weight, const int uniform) {
@@ -126,7 +126,7 @@ kick_pass(long lo, long hi, double *restrict v, double *restrict w, double *rest
 }
 
 /* The compiled copies, one per set of flags (a literal each): a run-time flag inside the loop
- * made GCC give up the vectorisation (20k integration 0.069 s against 0.026 s).  Separate
+ * made GCC give up the vectorisation (docs/performance.md).  Separate
  * functions with restrict arrays: inside an OpenMP region the arrays reach the loop through the
  * region's shared data, and their independence is lost. */
 static int kick_drift(int flags, long lo, long hi, double *restrict x, double *restrict v,

@@ -336,6 +336,8 @@ static void print_timing(const jd_sim *s) {
                 {"wall forces", t->walls}, {"integration", t->integration}, {"output", t->output}};
     fprintf(stderr, "jdem: timing of %lld steps, %zu particles, %d thread(s), %lld neighbour builds:\n",
             (long long)s->step, s->n, s->threads, (long long)s->n_builds);
+    char laws[96];
+    fprintf(stderr, "jdem:   law set %s\n", jd_law_set_describe(s->features, laws, sizeof laws));
     for (size_t k = 0; k < sizeof part / sizeof *part; k++)
         fprintf(stderr, "jdem:   %-17s %10.4f s  %5.1f %%\n", part[k].name, part[k].v,
                 total > 0.0 ? 100.0 * part[k].v / total : 0.0);
@@ -436,9 +438,9 @@ static int cmd_run(const cli *c) {
         fprintf(stderr, "jdem: %s\n", err);
         rc = setup_failure(err);
     } else {
-        jd_h5md *h = stop_signal ? NULL : create_output(&sc, &sim, out, &rc);
-        if (stop_signal && !h) rc = stopped_in_setup();
-        else if (h) rc = run_and_close(c, &sim, h, out);
+        jd_h5md *h = NULL;
+        if (stop_signal) rc = stopped_in_setup();
+        else if ((h = create_output(&sc, &sim, out, &rc))) rc = run_and_close(c, &sim, h, out);
         sim_free(&sim);
     }
     scene_free(&sc);

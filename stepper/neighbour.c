@@ -58,9 +58,8 @@ static int list_resize(jd_contact_list *l, size_t cap, int hw, int rw) {
  * capacity. */
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
     const int rolling = (kind & JD_LIST_ROLLING) != 0;
-    const int energy = (kind & JD_LIST_ENERGY) != 0;
-    const int hw = energy ? JD_CONTACT_STATE_LEN : JD_HIST_CORE;
-    const int rw = rolling ? (energy ? JD_ROLLING_STATE_LEN : JD_RHIST_CORE) : 0;
+    const unsigned laws = (rolling ? JD_F_ROLLING : 0u) | ((kind & JD_LIST_ENERGY) ? JD_F_ENERGY : 0u);
+    const int hw = jd_contact_record_len(laws), rw = jd_rolling_record_len(laws);
     const int complete = l->hw == hw && l->rw == rw && (!rolling || l->rhist);
     if (need <= l->cap && complete) return 0;
     size_t cap = l->cap ? l->cap : 256;
@@ -198,8 +197,8 @@ static void sort_segment(int32_t *j, size_t n) { /* insertion sort: a few dozen 
  * two axes, the smallest window (forces.c, prefetch_particles): in a bed 20 cells deep and
  * 128 x 128 wide, a slab of 128 x 20 cells instead of a layer of 128 x 128, which stays in the
  * L2 cache.  Of the other two, the one with more cells is the fastest (the longest contiguous
- * rows), so a flat bed's floor particles come in one run per slab.  Ties keep z, y, x.
- * Measured (docs/performance.md), 320k bed, pair loop medians 2.05 s against 2.50 s. */
+ * rows), so a flat bed's floor particles come in one run per slab.  Ties keep z, y, x
+ * (docs/performance.md). */
 static void cell_axes(const int nc[3], int ax[3]) {
     int slow = 2;
     for (int d = 1; d >= 0; d--)

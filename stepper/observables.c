@@ -6,12 +6,6 @@
 #include "geometry.h"
 #include "sim.h"
 
-const char *const jd_observable_names[JD_N_OBSERVABLES] = {
-    "kinetic_energy", "rotational_energy", "elastic_energy",   "gravitational_energy",
-    "damping_dissipation", "friction_dissipation", "wall_work", "contacts", "wall_contacts"};
-
-const int jd_observable_is_energy[JD_N_OBSERVABLES] = {0, 0, 1, 0, 1, 1, 1, 0, 0};
-
 void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES]) {
     const double v[JD_N_OBSERVABLES] = {o->kinetic_energy,      o->rotational_energy,
                                         o->elastic_energy,      o->gravitational_energy,

@@ -10,6 +10,7 @@
 #include "geometry.h"
 #include "h5md.h"
 #include "hugepages.h"
+#include "jdem_laws.h"
 #include "sim.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -19,63 +20,45 @@
 #define ASAN_UNPOISON_MEMORY_REGION(p, n) ((void)(p), (void)(n))
 #endif
 
-/* Interaction coefficients for every ordered material pair.  gamma costs up to ~50 ms per
- * restitution value with the exact mapping, so each distinct e is mapped once. */
-static int init_coeffs(jd_sim *s) {
-    const jd_scene *sc = s->scene;
-    const size_t nm = sc->n_materials, nn = nm * nm;
-    s->n_materials = nm;
-    s->coeffs = calloc(nn ? nn : 1, sizeof *s->coeffs);
-    double *e_seen = calloc(nn ? nn : 1, sizeof *e_seen);
-    double *gamma_seen = calloc(nn ? nn : 1, sizeof *gamma_seen);
-    int rc = (s->coeffs && e_seen && gamma_seen) ? 0 : -1;
-    size_t n_seen = 0;
-    for (size_t k = 0; rc == 0 && k < nn; k++) {
-        const jd_interaction *in = &sc->interactions[k];
-        size_t q = 0;
-        while (q < n_seen && e_seen[q] != in->restitution) q++;
-        if (q == n_seen) {
-            e_seen[q] = in->restitution;
-            gamma_seen[q] = jd_gamma_for(sc->damping_map, in->restitution);
-            n_seen++;
-        }
-        s->coeffs[k] = (jd_pair_coeffs){.gamma = gamma_seen[q], .mu = in->friction,
-                                        .eta = in->rolling_friction, .mu_r = sc->mu_r,
-                                        .xi_limit = sc->xi_limit};
+/* The scene's interaction tables, as the kernel's rulebook reads them (jdem_laws.h): nm x nm
+ * restitution, friction and rolling friction, row-major, in one block (free the first). */
+static double *interaction_tables(const jd_scene *sc, double **friction, double **rolling) {
+    const size_t nn = sc->n_materials * sc->n_materials;
+    double *e = malloc(3 * (nn ? nn : 1) * sizeof *e);
+    if (!e) return NULL;
+    *friction = e + nn;
+    *rolling = e + 2 * nn;
+    for (size_t k = 0; k < nn; k++) {
+        e[k] = sc->interactions[k].restitution;
+        (*friction)[k] = sc->interactions[k].friction;
+        (*rolling)[k] = sc->interactions[k].rolling_friction;
     }
-    free(e_seen);
-    free(gamma_seen);
-    return rc;
+    return e;
 }
 
-/* The laws some interaction that can occur in this scene needs (particle species pairs and
- * species against wall materials). */
-static unsigned scene_features(const jd_sim *s) {
+/* Interaction coefficients for every ordered material pair (jd_pair_coeffs_table), and the laws
+ * some interaction that can occur in this scene needs (particle materials against particle and
+ * wall materials: jd_law_set_select).  --all-laws: the general loop, every law evaluated. */
+static int init_laws(jd_sim *s) {
     const jd_scene *sc = s->scene;
-    const size_t nm = sc->n_materials;
-    unsigned char *used = calloc(nm ? nm : 1, 1), *wall_used = calloc(nm ? nm : 1, 1);
-    unsigned f = sc->energy ? JD_F_ENERGY : 0u;
-    if (!used || !wall_used || s->opt.all_laws) { /* the general loop: evaluate every law */
-        f |= JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R;
-    } else {
+    const size_t nm = sc->n_materials, nn = nm * nm;
+    double *mu = NULL, *eta = NULL, *e = interaction_tables(sc, &mu, &eta);
+    unsigned char *used = calloc(2 * (nm ? nm : 1), 1), *wall_used = used + nm;
+    s->n_materials = nm;
+    s->coeffs = calloc(nn ? nn : 1, sizeof *s->coeffs);
+    const int rc = (e && used && s->coeffs) ? 0 : -1;
+    if (rc == 0) {
+        jd_pair_coeffs_table(nm, e, mu, eta, sc->damping_map, sc->mu_r, sc->xi_limit, s->coeffs);
         for (size_t i = 0; i < sc->n_particles; i++) used[sc->material[i]] = 1;
         for (size_t w = 0; w < sc->n_walls; w++) wall_used[sc->walls[w].material] = 1;
-        for (size_t a = 0; a < nm; a++) {
-            if (!used[a]) continue;
-            for (size_t b = 0; b < nm; b++) {
-                if (!used[b] && !wall_used[b]) continue;
-                const jd_interaction *in = &sc->interactions[a * nm + b];
-                if (in->restitution < 1.0) f |= JD_F_DAMPING;
-                if (in->friction > 0.0) f |= JD_F_FRICTION;
-                if (in->rolling_friction > 0.0) f |= JD_F_ROLLING;
-            }
-        }
-        /* mu_R only modifies the tangential law */
-        if ((f & JD_F_FRICTION) && sc->mu_r != 1.0) f |= JD_F_MU_R;
+        s->features = s->opt.all_laws
+                          ? JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R |
+                                (sc->energy ? JD_F_ENERGY : 0u)
+                          : jd_law_set_select(nm, e, mu, eta, used, wall_used, sc->mu_r, sc->energy);
     }
+    free(e);
     free(used);
-    free(wall_used);
-    return f;
+    return rc;
 }
 
 /* How alike the particles are (sim.h: pair_row, alike), which lets the pair loop read the
@@ -235,12 +218,11 @@ static int setup_forces(jd_sim *s, char *err, size_t errlen) {
 
 static int setup(jd_sim *s, char *err, size_t errlen) {
     if (init_particles(s, err, errlen) != 0) return -1;
-    if (init_coeffs(s) != 0) {
+    if (init_laws(s) != 0) {
         snprintf(err, errlen, "out of memory");
         return -1;
     }
     init_kinds(s);
-    s->features = scene_features(s);
     if (sim_forces_init(s) != 0) {
         snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads);
         return -1;

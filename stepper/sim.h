@@ -55,6 +55,8 @@
 #include "jdem_geometry.h"
 #include "jdem_guard.h"
 #include "jdem_kernel.h"
+#include "jdem_laws.h"
+#include "jdem_observable_names.h"
 #include "jdem_watchdog.h"
 #include "scene.h"
 
@@ -123,33 +125,19 @@ typedef struct jd_contact_list {
     double *rhist;          /* cap x rw; NULL without rolling resistance */
 } jd_contact_list;
 
-/* History doubles without the energy bookkeeping: jd_contact_state's xi[3] and flags, and
- * jd_rolling_state's theta[3] (the leading fields of the structs). */
-enum { JD_HIST_CORE = 4, JD_RHIST_CORE = 3 };
-_Static_assert(sizeof(jd_contact_state) == JD_CONTACT_STATE_LEN * sizeof(double) &&
-                   sizeof(jd_rolling_state) == JD_ROLLING_STATE_LEN * sizeof(double),
-               "the kernel's history structs are plain arrays of doubles");
-
 /* The history of entry c as the kernel's structs (fields the list does not keep are zero); r may
- * be NULL. */
+ * be NULL.  The records' layout is the kernel's (jdem_laws.h, jd_record_*). */
 static inline void sim_hist_get(const jd_contact_list *l, size_t c, jd_contact_state *st,
                                 jd_rolling_state *r) {
-    double *a = (double *)st;
-    for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) a[k] = k < l->hw ? l->hist[(size_t)l->hw * c + (size_t)k] : 0.0;
-    if (r) {
-        double *b = (double *)r;
-        for (int k = 0; k < JD_ROLLING_STATE_LEN; k++)
-            b[k] = k < l->rw ? l->rhist[(size_t)l->rw * c + (size_t)k] : 0.0;
-    }
+    jd_record_load(l->hist + (size_t)l->hw * c, l->hw, l->rw ? l->rhist + (size_t)l->rw * c : NULL,
+                   l->rw, st, r);
 }
 
 /* Store the kept fields of st (and r, if the list has rolling history) as entry c's history. */
 static inline void sim_hist_set(jd_contact_list *l, size_t c, const jd_contact_state *st,
                                 const jd_rolling_state *r) {
-    const double *a = (const double *)st;
-    for (int k = 0; k < l->hw; k++) l->hist[(size_t)l->hw * c + (size_t)k] = a[k];
-    if (r)
-        for (int k = 0; k < l->rw; k++) l->rhist[(size_t)l->rw * c + (size_t)k] = ((const double *)r)[k];
+    jd_record_store(l->hist + (size_t)l->hw * c, l->hw,
+                    r && l->rw ? l->rhist + (size_t)l->rw * c : NULL, r ? l->rw : 0, st, r);
 }
 
 /* A wall as the engine moves it: the kernel's shape (translated in place) plus what the engine
@@ -361,10 +349,6 @@ typedef struct jd_observables {
     double contacts, wall_contacts;
     jd_bond_observables bond;  /* scenes with bond types only (s->bonds) */
 } jd_observables;
-#define JD_N_OBSERVABLES 9
-extern const char *const jd_observable_names[JD_N_OBSERVABLES];
-/* 1 for the observables that need the energy bookkeeping (not written with output.energy off) */
-extern const int jd_observable_is_energy[JD_N_OBSERVABLES];
 void sim_observables(const jd_sim *s, jd_observables *o);
 void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES]);
 

@@ -24,29 +24,20 @@ static long long id_of(const jd_sim *s, size_t i) { return sim_particle_id(s, i)
 
 static int overlap_message(const jd_sim *s, char *msg, size_t len) {
     const jd_overlap_trip *t = &s->overlap_trip;
-    char with[JD_NAME_MAX + 64];
-    if (t->j >= 0)
-        snprintf(with, sizeof with, ", %lld", id_of(s, (size_t)t->j));
-    else
-        snprintf(with, sizeof with, " against wall '%s'", s->scene->walls[-t->j - 1].name);
-    snprintf(msg, len, "watchdog: step %lld: overlap fraction %.6g for particle(s) %lld%s exceeds "
-             "%g", (long long)s->step, t->fraction, id_of(s, (size_t)t->i), with, s->max_overlap);
+    jd_watchdog_overlap_message(msg, len, (long long)s->step, t->fraction, id_of(s, (size_t)t->i),
+                                t->j >= 0 ? id_of(s, (size_t)t->j) : -1,
+                                t->j >= 0 ? "" : s->scene->walls[-t->j - 1].name, s->max_overlap);
     return JD_RUN_TRIPPED;
 }
 
-/* Name the first non-finite quantity, forces first: a non-finite force is the cause of the
- * non-finite velocity it produces. */
+/* Name the first non-finite quantity, in the kernel's order (jd_watchdog_quantities). */
 static int nonfinite_message(const jd_sim *s, char *msg, size_t len) {
-    const struct {
-        const char *name;
-        const double *v;
-    } q[] = {{"force", s->f}, {"torque", s->torque}, {"position", s->x},
-             {"velocity", s->v}, {"angular velocity", s->omega}};
-    for (size_t k = 0; k < sizeof q / sizeof *q; k++)
+    const double *q[JD_N_WATCHDOG_QUANTITIES] = {s->f, s->torque, s->x, s->v, s->omega};
+    for (int k = 0; k < JD_N_WATCHDOG_QUANTITIES; k++)
         for (size_t c = 0; c < 3 * s->n; c++)
-            if (!isfinite(q[k].v[c])) {
-                snprintf(msg, len, "watchdog: step %lld: %s %g for particle(s) %lld is not finite",
-                         (long long)s->step, q[k].name, q[k].v[c], id_of(s, c / 3));
+            if (!isfinite(q[k][c])) {
+                jd_watchdog_nonfinite_message(msg, len, (long long)s->step, k, q[k][c],
+                                              id_of(s, c / 3));
                 return JD_RUN_TRIPPED;
             }
     /* the probe saw a NaN that is gone from the state: cannot happen, but never pass silently */
@@ -62,15 +53,12 @@ int sim_watchdog_step(const jd_sim *s, char *msg, size_t len) {
     return 0;
 }
 
-/* Bonds enter the balance as stored (elastic) and dissipated (damping) energy. */
+/* The balance's terms by the kernel's rule (jd_energy_terms_of). */
 static void energy_terms(const jd_observables *o, jd_energy_terms *e) {
-    const jd_bond_observables *b = &o->bond;
-    *e = (jd_energy_terms){.kinetic = o->kinetic_energy, .rotational = o->rotational_energy,
-                           .elastic = o->elastic_energy + b->elastic_energy,
-                           .gravitational = o->gravitational_energy,
-                           .damping = o->damping_dissipation + b->damping_dissipation +
-                                      b->breakage_energy,
-                           .friction = o->friction_dissipation, .wall_work = o->wall_work};
+    double v[JD_N_OBSERVABLES], b[JD_N_BOND_OBSERVABLES];
+    sim_observables_values(o, v);
+    sim_bond_observables_values(&o->bond, b);
+    *e = jd_energy_terms_of(v, b);
 }
 
 /* The particle with the largest kinetic energy: where a spurious energy gain usually sits. */
@@ -94,11 +82,9 @@ int sim_watchdog_energy(jd_sim *s, const jd_observables *o, char *msg, size_t le
     const double limit = s->scene->watchdog.max_energy_jump;
     const double jump = s->has_energy_ref ? jd_energy_jump(&s->energy_ref, &now) : 0.0;
     if (!(jump <= limit)) { /* NaN trips too */
-        snprintf(msg, len, "watchdog: step %lld: energy jump %.6g for particle(s) %lld exceeds %g "
-                 "(total energy %.9g J at step %lld, %.9g J now; the particle named has the "
-                 "largest kinetic energy)", (long long)s->step, jump,
-                 id_of(s, most_energetic(s)), limit, jd_energy_total(&s->energy_ref),
-                 (long long)s->energy_ref_step, jd_energy_total(&now));
+        jd_watchdog_energy_message(msg, len, (long long)s->step, jump, id_of(s, most_energetic(s)),
+                                   limit, jd_energy_total(&s->energy_ref),
+                                   (long long)s->energy_ref_step, jd_energy_total(&now));
         return JD_RUN_TRIPPED;
     }
     s->energy_ref = now;

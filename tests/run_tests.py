@@ -34,6 +34,9 @@ SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines",
            for t in ENGINE_TESTS]
 # The two engines on the same scenes (bitwise or 1e-10), and LIGGGHTS on 1 vs 2 MPI ranks.
 SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {})]
+# The law set (kernel/jdem_laws.h) each engine selects, for every scene of reference_runs/ and
+# tests/, and hand-written decks that leave out `rolling on`.
+SUITES += [("law-sets", [PY, "tests/liggghts/check_law_sets.py"], "lines", {})]
 # The watchdog in LIGGGHTS (fix jdem/watchdog): the same trips as the stepper's.
 SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "lines", {})]
 # SIGINT/SIGTERM stop liggghts-jdem cleanly (exit 130/143, OUT.part kept), on 1 and 2 ranks.
@@ -81,9 +84,11 @@ SUITES += [
      "lines", {}),
 ]
 
-# The Ch. 4 mixing analysis (scripts/mixing) on synthetic deposits, and its pictures.
+# The Ch. 4 mixing analysis (scripts/mixing) on synthetic deposits, its pictures, and the
+# generator of the second pass and the cubes (reference_runs/mixing/ch4/generate.py).
 SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py; a=$?; "
-                                f"{PY} tests/mixing/test_pictures.py; b=$?; exit $((a | b))"],
+                                f"{PY} tests/mixing/test_pictures.py; b=$?; "
+                                f"{PY} tests/mixing/test_generate.py; c=$?; exit $((a | b | c))"],
             "lines", {})]
 # The campaign driver (scripts/campaign.py) with dummy units, a killed run resumed.
 SUITES += [("campaign", [PY, "tests/mixing/test_campaign.py"], "lines", {})]

@@ -67,14 +67,16 @@ def inside_box(dep, lo, hi):
 
 
 def keep_box(dep, lo, hi, source="deposit"):
-    """The particles whose centre lies in the box [lo, hi); an error if the box holds none or
-    reaches beyond the deposit's extent."""
+    """The particles whose centre lies in the box [lo, hi); an error if the box reaches beyond
+    the deposit's extent (the particles' outline, min(x - R)..max(x + R)) by more than the
+    largest radius (the slack of a packing against a wall)."""
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
     if np.any(hi <= lo):
         raise DepositError(f"region {lo.tolist()}..{hi.tolist()}: empty; valid: lo < hi")
     ext_lo = dep.position.min(axis=0) - dep.radius.max()
     ext_hi = dep.position.max(axis=0) + dep.radius.max()
-    if np.any(lo < ext_lo - 1e-12) or np.any(hi > ext_hi + 1e-12):
+    slack = dep.radius.max()
+    if np.any(lo < ext_lo - slack) or np.any(hi > ext_hi + slack):
         raise DepositError(f"region {lo.tolist()}..{hi.tolist()} lies outside the {source} "
                            f"(extent {ext_lo.round(6).tolist()}..{ext_hi.round(6).tolist()}); "
                            f"valid: a region inside it")

@@ -52,6 +52,8 @@ import tempfile
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
+from engine_common import Checks as EngineChecks  # noqa: E402
 PY = "/usr/bin/python3"
 JDEM = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
 LIGGGHTS_JDEM = os.environ.get("LIGGGHTS_JDEM", os.path.join(ROOT, "build", "liggghts-jdem"))
@@ -68,25 +70,12 @@ class NotRoot(Exception):
     """Raised by tmpfs/read_only when the suite is not run as root."""
 
 
-class Checks:
-    def __init__(self):
-        self.failed = 0
-
-    def check(self, name, ok, detail=""):
-        if ok:
-            print(f"PASS {name}")
-        else:
-            self.failed += 1
-            print(f"FAIL {name}: {detail}")
-        sys.stdout.flush()
-        return bool(ok)
+class Checks(EngineChecks):
+    """The engine tests' checks (tests/engine/engine_common.py), and skip."""
 
     def skip(self, name, reason):
         print(f"SKIP {name}: {reason}")
         sys.stdout.flush()
-
-    def exit(self):
-        sys.exit(1 if self.failed else 0)
 
 
 def is_root():
@@ -156,7 +145,8 @@ class Result:
         self.rc, self.out, self.err, self.timed_out = rc, out, err, timed_out
 
     def __repr__(self):
-        return f"exit {self.rc}{' (timed out)' if self.timed_out else ''}, stderr {self.err.strip()!r}"
+        timed_out = " (timed out)" if self.timed_out else ""
+        return f"exit {self.rc}{timed_out}, stderr {self.err.strip()!r}"
 
 
 def _limits(mem_bytes):

@@ -13,7 +13,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def main(argv):
-    tests = [os.path.join(HERE, a) for a in argv[1:]] or sorted(glob.glob(os.path.join(HERE, "test_*.py")))
+    tests = ([os.path.join(HERE, a) for a in argv[1:]] or
+             sorted(glob.glob(os.path.join(HERE, "test_*.py"))))
     failed = 0
     for t in tests:
         proc = subprocess.run(["/usr/bin/python3", t], stdout=subprocess.PIPE,

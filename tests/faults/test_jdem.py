@@ -9,13 +9,14 @@ import math
 import os
 import re
 import signal
+import subprocess
 import time
 
 import yaml
 
 from faults_common import (EXIT, JDEM, Checks, expect_files, files, finish, h5_frames,
-                           h5_readable, is_root, read_only, run, scratch, signal_exit, small_scene, start,
-                           tmpfs, wait_for, write_scene)
+                           h5_readable, is_root, read_only, run, scratch, signal_exit,
+                           small_scene, start, tmpfs, wait_for, write_scene)
 
 c = Checks()
 VALID_NAME = ("valid: 1 to 63 characters from A-Z a-z 0-9 _ . + -, the first a letter, a digit "
@@ -49,21 +50,16 @@ def scene_with(**fields):
 # ---- names are data ---------------------------------------------------------------------
 
 def hostile_names():
-    refused("name_newline_shell", scene_with(name="a\nshell touch PWNED"),
-            f"2: key 'name': the name 'a' has byte 0x0a at character 2, not allowed in a name; "
-            f"{VALID_NAME}")
-    refused("name_traversal", scene_with(name="../../esc"),
-            f"2: key 'name': the name '' has '.' at character 1, not allowed in a name; "
-            f"{VALID_NAME}")
-    refused("name_slash", scene_with(name="a/b"),
-            f"2: key 'name': the name 'a' has '/' at character 2, not allowed in a name; "
-            f"{VALID_NAME}")
-    refused("name_dollar_hash_space", scene_with(name="x$(id)"),
-            f"2: key 'name': the name 'x' has '$' at character 2, not allowed in a name; "
-            f"{VALID_NAME}")
-    refused("name_nul", scene_with(name="ab\0cd"),
-            f"2: key 'name': the name 'ab' has byte 0x00 at character 3, not allowed in a name; "
-            f"{VALID_NAME}")
+    # (check, top-level key, value, line, the valid prefix quoted, the character, its position)
+    for name, key, value, line, prefix, what, pos in (
+            ("name_newline_shell", "name", "a\nshell touch PWNED", 2, "a", "byte 0x0a", 2),
+            ("name_traversal", "name", "../../esc", 2, "", "'.'", 1),
+            ("name_slash", "name", "a/b", 2, "a", "'/'", 2),
+            ("name_dollar", "name", "x$(id)", 2, "x", "'$'", 2),
+            ("name_nul", "name", "ab\0cd", 2, "ab", "byte 0x00", 3)):
+        refused(name, scene_with(**{key: value}),
+                f"{line}: key '{key}': the name '{prefix}' has {what} at character {pos}, not "
+                f"allowed in a name; {VALID_NAME}")
     long_name = "a" * 1000
     refused("name_1000_chars_keeps_reason", scene_with(name=long_name),
             f"2: key 'name': the name '{'a' * 32}...' is too long (1000 characters); "
@@ -75,6 +71,16 @@ def hostile_names():
     refused("material_semicolon", scene_with(materials={"gl;ass": mats["glass"]}),
             f"9: key 'materials': the name 'gl' has ';' at character 3, not allowed in a name; "
             f"{VALID_NAME}")
+    refused("wall_hash", small_scene() + (
+        "walls:\n  - {name: 'w#1', type: plane, material: glass, corners: [[-1, -1, -1], [1, -1, "
+        "-1], [1, 1, -1], [-1, 1, -1]]}\n"),
+        f"11: key 'walls.0.name': the name 'w' has '#' at character 2, not allowed in a name; "
+        f"{VALID_NAME}")
+    refused("bond_type_quote", small_scene() + (
+        "bond_types:\n  \"c'x\": {normal_stiffness: 1.0, shear_stiffness: 1.0, tensile_strength: "
+        "1.0, shear_strength: 1.0}\n"),
+        f"11: key 'bond_types': the name 'c' has ''' at character 2, not allowed in a "
+        f"name; {VALID_NAME}")
     sweep = [{"axis": "speed", "values": {"v1": {}, "v 2\nshell touch PWNED": {}}}]
     refused("sweep_value_newline", scene_with(sweep=sweep),
             f"40: key 'sweep.0.values': the name 'v' has byte 0x20 at character 2, not allowed "
@@ -215,7 +221,8 @@ particles:
   - {{id: 1, material: clay, radius: 0.001, position: [0, 0, 0]}}
   - {{id: 2, material: clay, radius: 0.001, position: [0.002, 0, 0]}}
 bond_types:
-  cement: {{normal_stiffness: 2.0e12, shear_stiffness: 1.0e12, tensile_strength: 5.0e6, shear_strength: 5.0e6}}
+  cement: {{normal_stiffness: 2.0e12, shear_stiffness: 1.0e12, tensile_strength: 5.0e6,
+           shear_strength: 5.0e6}}
 bond_rules:
   - {{type: cement, time: 1.0e-5}}
   - {{type: cement, step: 2}}
@@ -390,6 +397,11 @@ def exit_codes():
     r = run([JDEM, "run", small, "-o", os.path.join(blocker, "sub", "x.h5"), "--quiet"])
     c.check("exit_output_dir_cannot_be_made_is_io", r.rc == EXIT["io"] and
             r.err == f"jdem: cannot create directory {blocker}/sub: Not a directory\n", repr(r))
+    with open("/dev/full", "w") as full:
+        p = subprocess.run([JDEM, "resolve", small], stdout=full, stderr=subprocess.PIPE, text=True)
+    c.check("exit_resolve_to_full_disk_is_io", p.returncode == EXIT["io"] and
+            p.stderr == "jdem: cannot write the resolved scene\n",
+            f"exit {p.returncode}, {p.stderr!r}")
     h = run([JDEM, "--help"])
     c.check("help_lists_exit_codes", all(f"  {k}  " in h.out or f"  {k}        " in h.out
                                          for k in ("0", "1", "2", "3", "4", "5")) and

@@ -127,6 +127,25 @@ def test_validation_and_selection():
     check("list", r.stdout.split("\n")[:3] == ["done a", "done b", "done c"], r.stdout)
 
 
+def test_ch4_plan():
+    """The plan of make mixing (docs/mixing.md §4): 2 engines x 6 models x (2 fills, 1 second-
+    pass scene, 2 x (1 cube-scene unit + 9 compressions)) = 276 units, unique names, and every
+    need an earlier unit."""
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    from mixing import plan_ch4
+    units = plan_ch4.units([])
+    seen = set()
+    order_ok = True
+    for u in units:
+        order_ok &= all(n in seen for n in u.needs)
+        seen.add(u.name)
+    check("ch4_plan_units", len(units) == 276 and len(seen) == 276, f"{len(units)} units")
+    check("ch4_plan_needs_come_first", order_ok, "a need after its unit")
+    m3 = [u.name for u in units if u.model == "model3" and u.engine == "liggghts-jdem"]
+    check("ch4_plan_model_engine", len(m3) == 23 and m3[0] == "liggghts-jdem/model3/fill1", f"{m3[:3]}")
+
+
 test_killed_run_resumes()
 test_validation_and_selection()
+test_ch4_plan()
 finish()

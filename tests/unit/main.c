@@ -7,6 +7,7 @@ int run_servo_tests(void);
 int main(void) {
     int failed = 0;
     failed += run_kernel_tests();
+    failed += run_laws_tests();
     failed += run_geometry_tests();
     failed += run_h5md_tests();
     failed += run_watchdog_tests();

@@ -591,11 +591,129 @@ static void test_errors(void **state) {
     tdir_remove(&t);
 }
 
+static void write_text(const char *path, const char *text) {
+    FILE *fp = fopen(path, "w");
+    assert_non_null(fp);
+    fputs(text, fp);
+    assert_int_equal(fclose(fp), 0);
+}
+
+static void assert_text(const char *path, const char *text) {
+    char buf[64] = "";
+    FILE *fp = fopen(path, "r");
+    assert_non_null(fp);
+    size_t n = fread(buf, 1, sizeof buf - 1, fp);
+    fclose(fp);
+    buf[n] = 0;
+    assert_string_equal(buf, text);
+}
+
+static hsize_t frames_in(const char *path) {
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(f >= 0);
+    hid_t d = H5Dopen2(f, "/particles/all/position/step", H5P_DEFAULT);
+    hid_t sp = H5Dget_space(d);
+    hsize_t n = (hsize_t)H5Sget_simple_extent_npoints(sp);
+    H5Sclose(sp);
+    H5Dclose(d);
+    H5Fclose(f);
+    return n;
+}
+
+/* A link at PATH.part is refused and its target left alone; so is a directory at PATH. */
+static void test_part_links_refused(void **state) {
+    (void)state;
+    tdir t;
+    tdir_make(&t);
+    char victim[160], err[256] = "";
+    snprintf(victim, sizeof victim, "%s/victim.txt", t.dir);
+    write_text(victim, "keep");
+    assert_int_equal(symlink(victim, t.part), 0);
+    assert_null(open_writer(t.h5, err, sizeof err));
+    char want[512];
+    snprintf(want, sizeof want, "'%s' is a symbolic link; a trajectory is never written through "
+             "one (remove it or choose another output path)", t.part);
+    assert_string_equal(err, want);
+    assert_text(victim, "keep");
+    unlink(t.part);
+    assert_int_equal(link(victim, t.part), 0);
+    assert_null(open_writer(t.h5, err, sizeof err));
+    snprintf(want, sizeof want, "cannot write '%s': it has other hard links, whose contents would "
+             "be destroyed (remove it or choose another output path)", t.part);
+    assert_string_equal(err, want);
+    assert_text(victim, "keep");
+    unlink(t.part);
+    unlink(victim);
+    assert_int_equal(mkdir(t.h5, 0777), 0);
+    assert_null(open_writer(t.h5, err, sizeof err));
+    snprintf(want, sizeof want, "output path '%s' is a directory (give a file name, e.g. "
+             "'%s/run.h5')", t.h5, t.h5);
+    assert_string_equal(err, want);
+    assert_false(exists(t.part));
+    rmdir(t.h5);
+    tdir_remove(&t);
+}
+
+/* A second writer on a live PATH.part fails before it truncates anything; the first one ends
+ * normally with its own frames. */
+static void test_second_run_locked_out(void **state) {
+    (void)state;
+    tdir t;
+    tdir_make(&t);
+    char err[256] = "", want[512];
+    jd_h5md *a = open_writer(t.h5, err, sizeof err);
+    if (!a) fail_msg("create: %s", err);
+    write_frames(a, 3, 31u);
+    assert_null(open_writer(t.h5, err, sizeof err));
+    snprintf(want, sizeof want, "'%s' is being written by another run (it holds the file's lock); "
+             "choose another output path or wait for it to end", t.part);
+    assert_string_equal(err, want);
+    assert_true(exists(t.part));
+    write_frames(a, 1, 31u);
+    assert_int_equal(jd_h5md_close(a, 1, err, sizeof err), 0);
+    assert_int_equal(frames_in(t.h5), 1 + 3);
+    /* the lock went with the writer: the next run on the path works */
+    a = open_writer(t.h5, err, sizeof err);
+    if (!a) fail_msg("create: %s", err);
+    assert_int_equal(jd_h5md_close(a, 0, err, sizeof err), 0);
+    tdir_remove(&t);
+}
+
+/* A sidecar that cannot be written leaves the previous .h5 and .xdmf pair as it was. */
+static void test_failed_sidecar_keeps_previous_pair(void **state) {
+    (void)state;
+    tdir t;
+    tdir_make(&t);
+    char err[256] = "", blocker[160], inside[200], want[512];
+    jd_h5md *h = open_writer(t.h5, err, sizeof err);
+    if (!h) fail_msg("create: %s", err);
+    write_frames(h, 2, 1u);
+    assert_int_equal(jd_h5md_close(h, 1, err, sizeof err), 0);
+    snprintf(blocker, sizeof blocker, "%s.part", t.xdmf);
+    assert_int_equal(mkdir(blocker, 0777), 0);
+    snprintf(inside, sizeof inside, "%s/x", blocker);
+    write_text(inside, "x");
+    h = open_writer(t.h5, err, sizeof err);
+    if (!h) fail_msg("create: %s", err);
+    write_frames(h, 3, 1u);
+    assert_int_equal(jd_h5md_close(h, 1, err, sizeof err), -1);
+    snprintf(want, sizeof want, "cannot create '%s': File exists", blocker);
+    assert_string_equal(err, want);
+    assert_int_equal(frames_in(t.h5), 2);
+    assert_true(exists(t.part)); /* the new, complete run stays under PATH.part */
+    assert_int_equal(frames_in(t.part), 3);
+    unlink(inside);
+    rmdir(blocker);
+    tdir_remove(&t);
+}
+
 int run_h5md_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_roundtrip_layout),  cmocka_unit_test(test_xdmf_sidecar),
         cmocka_unit_test(test_abort_keeps_part),  cmocka_unit_test(test_killed_run_readable),
         cmocka_unit_test(test_two_writers),       cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_part_links_refused), cmocka_unit_test(test_second_run_locked_out),
+        cmocka_unit_test(test_failed_sidecar_keeps_previous_pair),
     };
     return cmocka_run_group_tests_name("h5md", tests, NULL, NULL);
 }

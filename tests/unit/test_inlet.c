@@ -13,7 +13,7 @@ static jd_inlet_spec one_sphere(const double *rel, const double *radius, const i
         .origin = {-0.0505, 0.5, 1.8}, .velocity = {1.0, 0.0, 0.0},
         .plane_point = {0.0, 0.0, 0.0}, .plane_normal = {1.0, 0.0, 0.0},
         .period = 0.2, .offset = 0.0, .dt = 1e-3, .first_id = 7,
-        .max_sections = 0, .stop_step = JD_INLET_NO_STOP,
+        .max_sections = 0, .stop_step = JD_INLET_NO_STOP, .overlap_tol = JD_INLET_OVERLAP_TOL,
     };
     return s;
 }
@@ -237,7 +237,7 @@ static void jiang_section_period(void **state) {
         .origin = {-0.13005, 0.5, 1.8}, .velocity = {1.0, 0.0, 0.0},
         .plane_point = {0.0, 0.0, 0.0}, .plane_normal = {1.0, 0.0, 0.0},
         .period = 0.24, .offset = 0.0, .dt = 1e-4, .first_id = 1,
-        .max_sections = 80, .stop_step = JD_INLET_NO_STOP,
+        .max_sections = 80, .stop_step = JD_INLET_NO_STOP, .overlap_tol = JD_INLET_OVERLAP_TOL,
     };
     char msg[256];
     assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_OK);
@@ -293,6 +293,8 @@ static void check_messages(void **state) {
     assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_OVERLAP);
     assert_string_equal(msg, "section particles 0 and 1 overlap by 0.005 m; valid: spheres that "
                              "do not overlap");
+    s.overlap_tol = 0.6; /* a deposit's cells keep their contacts' overlaps: 0.005 < 0.6 R */
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_OK);
     s.n = 0;
     assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_EMPTY);
 }

@@ -27,6 +27,7 @@ int run_h5md_tests(void);
 int run_watchdog_tests(void);
 int run_guard_tests(void);
 int run_bond_tests(void);
+int run_laws_tests(void);
 int run_h5md_bonds_tests(void);
 int run_hugepages_tests(void);
 

@@ -1,0 +1,83 @@
+/*
+ * jdem_laws.c — the set-up half of the rulebook (jdem_laws.h): law-set selection, the pair
+ * coefficient table, the names of the laws.
+ */
+#include "jdem_laws.h"
+
+#include <string.h>
+
+_Static_assert(sizeof(jd_contact_state) == JD_CONTACT_STATE_LEN * sizeof(double) &&
+                   sizeof(jd_rolling_state) == JD_ROLLING_STATE_LEN * sizeof(double),
+               "the kernel's history structs are plain arrays of doubles");
+_Static_assert(JD_AT(jd_contact_state, xi) == 0 &&
+                   JD_AT(jd_contact_state, flags) == JD_CONTACT_LAWS_LEN - 1 &&
+                   JD_AT(jd_rolling_state, theta) == 0 &&
+                   sizeof(((jd_rolling_state *)0)->theta) == JD_ROLLING_LAWS_LEN * sizeof(double),
+               "the fields the laws carry lead the history structs (the short records)");
+
+_Static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double) &&
+                   JD_AT(jd_bond_state, flags) == JD_BOND_LAWS_LEN - 1 &&
+                   JD_AT(jd_bond_state, e_break) == JD_BOND_STATE_LEN - 1,
+               "the kernel's bond state is a plain array of doubles, the law's fields first");
+
+const char *const jd_law_names[JD_N_LAWS] = {"damping", "friction", "rolling", "mu_r", "energy"};
+
+#define JD_LAW_SET_CASE(bits) \
+    case (bits):              \
+        return 1;
+int jd_law_set_valid(unsigned bits) {
+    switch (bits) {
+        JD_LAW_SETS(JD_LAW_SET_CASE)
+    default:
+        return 0;
+    }
+}
+#undef JD_LAW_SET_CASE
+
+char *jd_law_set_describe(unsigned bits, char *buf, size_t len) {
+    if (!len) return buf;
+    buf[0] = '\0';
+    const char *parts[JD_N_LAWS + 1];
+    int n = 0;
+    for (int k = 0; k < JD_N_LAWS; k++)
+        if (bits & (1u << k)) parts[n++] = jd_law_names[k];
+    if (n == 0) parts[n++] = "elastic";
+    size_t at = 0;
+    for (int k = 0; k < n; k++) {
+        const char *p = parts[k];
+        if (k > 0 && at + 1 < len) buf[at++] = '+';
+        for (; *p && at + 1 < len; p++) buf[at++] = *p;
+    }
+    buf[at] = '\0';
+    return buf;
+}
+
+unsigned jd_law_set_select(size_t nm, const double *restitution, const double *friction,
+                           const double *rolling_friction, const unsigned char *in_particles,
+                           const unsigned char *in_walls, double mu_r, int energy) {
+    unsigned laws = 0u;
+    for (size_t a = 0; a < nm; a++) {
+        if (!in_particles[a]) continue;
+        for (size_t b = 0; b < nm; b++) {
+            if (!in_particles[b] && !(in_walls && in_walls[b])) continue;
+            const size_t k = a * nm + b;
+            laws |= jd_interaction_laws(restitution[k], friction[k], rolling_friction[k]);
+        }
+    }
+    if ((laws & JD_F_FRICTION) && mu_r != 1.0) laws |= JD_F_MU_R;
+    if (energy) laws |= JD_F_ENERGY;
+    return laws;
+}
+
+void jd_pair_coeffs_table(size_t nm, const double *restitution, const double *friction,
+                          const double *rolling_friction, int damping_map, double mu_r,
+                          int xi_limit, jd_pair_coeffs *out) {
+    const size_t nn = nm * nm;
+    for (size_t k = 0; k < nn; k++) {
+        size_t q = 0;
+        while (q < k && restitution[q] != restitution[k]) q++;
+        const double gamma = q < k ? out[q].gamma : jd_gamma_for(damping_map, restitution[k]);
+        out[k] = (jd_pair_coeffs){.gamma = gamma, .mu = friction[k], .eta = rolling_friction[k],
+                                  .mu_r = mu_r, .xi_limit = xi_limit};
+    }
+}

@@ -1,0 +1,204 @@
+/*
+ * jdem_laws.h — the rulebook both engines apply around the contact law (docs/adding_a_law.md):
+ *   - the list of valid law sets, which every force-loop dispatcher expands (JD_LAW_SETS);
+ *   - which law set a run needs, from the interactions that can occur (jd_law_set_select);
+ *   - the coefficients of every pair of materials (jd_pair_coeffs_table);
+ *   - the layout of the per-contact history record a law set keeps (jd_record_*).
+ * The stepper (stepper/sim.c, forces.c) and the LIGGGHTS styles (liggghts_plugin/) call these
+ * and decide nothing of their own.  Pure C11: no I/O, no allocation, no globals.
+ */
+#ifndef JDEM_KERNEL_LAWS_H
+#define JDEM_KERNEL_LAWS_H
+
+#include <stddef.h>
+
+#include "jdem_bond.h"
+#include "jdem_kernel.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------------------------ */
+/* The valid law sets.  X(bits) once per set, bits a constant expression of JD_F_* flags; a    */
+/* dispatcher expands JD_LAW_SETS(X) into its cases (a switch, template instantiations), so    */
+/* that each set has one specialised copy of the force loops and no other copy is compiled.   */
+/* A new law set is one line of JD_LAW_SETS_WITH.  mu_R modifies the tangential law only, so   */
+/* JD_F_MU_R comes with JD_F_FRICTION; every set exists with and without the energy            */
+/* bookkeeping.                                                                                */
+/* ------------------------------------------------------------------------------------------ */
+#define JD_LAW_SETS_WITH(X, E)                                                 \
+    X((E) | 0u)                                                                \
+    X((E) | JD_F_DAMPING)                                                      \
+    X((E) | JD_F_FRICTION)                                                     \
+    X((E) | JD_F_DAMPING | JD_F_FRICTION)                                      \
+    X((E) | JD_F_ROLLING)                                                      \
+    X((E) | JD_F_DAMPING | JD_F_ROLLING)                                       \
+    X((E) | JD_F_FRICTION | JD_F_ROLLING)                                      \
+    X((E) | JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING)                       \
+    X((E) | JD_F_FRICTION | JD_F_MU_R)                                         \
+    X((E) | JD_F_DAMPING | JD_F_FRICTION | JD_F_MU_R)                          \
+    X((E) | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R)                          \
+    X((E) | JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R)
+#define JD_LAW_SETS(X) JD_LAW_SETS_WITH(X, 0u) JD_LAW_SETS_WITH(X, JD_F_ENERGY)
+
+/* Every JD_F_* bit, for masking a law set. */
+#define JD_F_ALL (JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY)
+
+/* The bond law's sets (kernel/jdem_bond.h, JD_B_*), expanded the same way by the bond loops. */
+#define JD_BOND_LAW_SETS(X) X(0u) X(JD_B_DAMPING) X(JD_B_ENERGY) X(JD_B_DAMPING | JD_B_ENERGY)
+
+/* 1 when bits is one of JD_LAW_SETS, else 0. */
+int jd_law_set_valid(unsigned bits);
+
+/* The names of the JD_F_* bits, in bit order, as the engines report a law set ("damping",
+ * "friction", "rolling", "mu_r", "energy"). */
+#define JD_N_LAWS 5
+extern const char *const jd_law_names[JD_N_LAWS];
+
+/* The law set as text: the names of its bits joined by '+', or "elastic" for none; into buf
+ * (len bytes, always terminated; truncated if too short).  Returns buf. */
+char *jd_law_set_describe(unsigned bits, char *buf, size_t len);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Which laws a run evaluates.                                                                 */
+/* ------------------------------------------------------------------------------------------ */
+
+/* The laws one interaction needs, from the inputs both engines read: the dashpots and Luding's
+ * end when its restitution is below 1, the tangential law when its friction is above 0, the
+ * rolling law when its rolling friction is above 0. */
+static inline unsigned jd_interaction_laws(double restitution, double friction,
+                                           double rolling_friction) {
+    return (restitution < 1.0 ? (unsigned)JD_F_DAMPING : 0u) |
+           (friction > 0.0 ? (unsigned)JD_F_FRICTION : 0u) |
+           (rolling_friction > 0.0 ? (unsigned)JD_F_ROLLING : 0u);
+}
+
+/* The law set of a run over nm materials: the union of the laws of every interaction that can
+ * occur, that is of a material a that some particle has (in_particles[a] != 0) against a
+ * material b that some particle or wall has (in_particles[b] or in_walls[b]; in_walls may be
+ * NULL: no walls); restitution, friction and rolling_friction are nm x nm, row-major.  Then
+ * JD_F_MU_R when the run has friction and mu_r != 1, and JD_F_ENERGY when energy is set.  The
+ * result is always one of JD_LAW_SETS. */
+unsigned jd_law_set_select(size_t nm, const double *restitution, const double *friction,
+                           const double *rolling_friction, const unsigned char *in_particles,
+                           const unsigned char *in_walls, double mu_r, int energy);
+
+/* The coefficients of every ordered pair of nm materials into out (nm x nm, row-major, like the
+ * three input tables): gamma from the restitution by the damping map (jd_gamma_for, mapped once
+ * per distinct value: the exact mapping costs up to ~50 ms), mu, eta, and the run's mu_r and
+ * xi_limit. */
+void jd_pair_coeffs_table(size_t nm, const double *restitution, const double *friction,
+                          const double *rolling_friction, int damping_map, double mu_r,
+                          int xi_limit, jd_pair_coeffs *out);
+
+/* ------------------------------------------------------------------------------------------ */
+/* The history record a law set keeps per contact.                                             */
+/* A contact record is jd_contact_state whole with JD_F_ENERGY, else only the fields the laws  */
+/* carry from step to step, which lead the struct (xi[3], flags); a rolling record (only with  */
+/* JD_F_ROLLING) is jd_rolling_state whole with JD_F_ENERGY, else its leading theta[3].  The   */
+/* stepper keeps the two in separate arrays; LIGGGHTS in one per-contact array, the rolling    */
+/* record after the contact record.                                                            */
+/* ------------------------------------------------------------------------------------------ */
+#define JD_CONTACT_LAWS_LEN 4 /* xi[3], flags */
+#define JD_ROLLING_LAWS_LEN 3 /* theta[3] */
+
+/* The index of a field in a history struct of doubles. */
+#define JD_AT(type, field) ((int)(offsetof(type, field) / sizeof(double)))
+
+static inline int jd_contact_record_len(unsigned features) {
+    return (features & JD_F_ENERGY) ? JD_CONTACT_STATE_LEN : JD_CONTACT_LAWS_LEN;
+}
+static inline int jd_rolling_record_len(unsigned features) {
+    return (features & JD_F_ROLLING)
+               ? ((features & JD_F_ENERGY) ? JD_ROLLING_STATE_LEN : JD_ROLLING_LAWS_LEN)
+               : 0;
+}
+
+/* LIGGGHTS' sign-flip flag of entry k of a combined record whose contact record holds hw
+ * doubles (1: a vector component that changes sign when the bodies swap). */
+static inline int jd_record_newton(int hw, int k) {
+    return k < hw ? jd_contact_state_newton[k] : jd_rolling_state_newton[k - hw];
+}
+
+/* A contact's records (h: hw doubles; r: rw doubles, may be NULL when rw is 0) as the kernel's
+ * structs, the fields they do not keep zero (rs may be NULL: no rolling struct wanted). */
+static JD_ALWAYS_INLINE void jd_record_load(const double *h, int hw, const double *r, int rw,
+                                            jd_contact_state *st, jd_rolling_state *rs) {
+    double *a = (double *)st;
+    for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) a[k] = k < hw ? h[k] : 0.0;
+    if (rs) {
+        double *b = (double *)rs;
+        for (int k = 0; k < JD_ROLLING_STATE_LEN; k++) b[k] = k < rw ? r[k] : 0.0;
+    }
+}
+
+/* The kept fields of st (and of rs, when rw > 0) into the records. */
+static JD_ALWAYS_INLINE void jd_record_store(double *h, int hw, double *r, int rw,
+                                             const jd_contact_state *st,
+                                             const jd_rolling_state *rs) {
+    const double *a = (const double *)st, *b = (const double *)rs;
+    for (int k = 0; k < hw; k++) h[k] = a[k];
+    for (int k = 0; k < rw; k++) r[k] = b[k];
+}
+
+/* The records of a contact whose bodies separated, as jd_contact_separate leaves the structs
+ * (every field zero but the dissipation accumulators e_damp and e_fric, which the engines
+ * harvest), written in place. */
+static JD_ALWAYS_INLINE void jd_record_separate(double *h, int hw, double *r, int rw) {
+    for (int k = 0; k < hw; k++)
+        if (k != JD_AT(jd_contact_state, e_damp) && k != JD_AT(jd_contact_state, e_fric)) h[k] = 0.0;
+    for (int k = 0; k < rw; k++) r[k] = 0.0;
+}
+
+/* A bond's record: jd_bond_state whole with JD_B_ENERGY, else its leading law fields (fn, ft,
+ * mn, mt, flags). */
+#define JD_BOND_LAWS_LEN 9
+static inline int jd_bond_record_len(unsigned bond_features) {
+    return (bond_features & JD_B_ENERGY) ? JD_BOND_STATE_LEN : JD_BOND_LAWS_LEN;
+}
+
+/* A bond record of sw doubles as the kernel's struct (the energy fields zero when not kept), and
+ * back.  Field by field, not through a double *: GCC then keeps the struct in registers instead
+ * of copying it through the stack. */
+static JD_ALWAYS_INLINE jd_bond_state jd_bond_record_load(const double *a, int sw) {
+    const int full = sw == JD_BOND_STATE_LEN;
+    jd_bond_state st;
+    st.fn = a[JD_AT(jd_bond_state, fn)];
+    st.mn = a[JD_AT(jd_bond_state, mn)];
+    st.flags = a[JD_AT(jd_bond_state, flags)];
+    for (int d = 0; d < 3; d++) {
+        st.ft[d] = a[JD_AT(jd_bond_state, ft) + d];
+        st.mt[d] = a[JD_AT(jd_bond_state, mt) + d];
+        st.f_prev[d] = full ? a[JD_AT(jd_bond_state, f_prev) + d] : 0.0;
+        st.m_prev[d] = full ? a[JD_AT(jd_bond_state, m_prev) + d] : 0.0;
+    }
+    st.u_prev = full ? a[JD_AT(jd_bond_state, u_prev)] : 0.0;
+    st.e_damp = full ? a[JD_AT(jd_bond_state, e_damp)] : 0.0;
+    st.e_break = full ? a[JD_AT(jd_bond_state, e_break)] : 0.0;
+    return st;
+}
+
+static JD_ALWAYS_INLINE void jd_bond_record_store(double *a, int sw, const jd_bond_state *st) {
+    a[JD_AT(jd_bond_state, fn)] = st->fn;
+    a[JD_AT(jd_bond_state, mn)] = st->mn;
+    a[JD_AT(jd_bond_state, flags)] = st->flags;
+    for (int d = 0; d < 3; d++) {
+        a[JD_AT(jd_bond_state, ft) + d] = st->ft[d];
+        a[JD_AT(jd_bond_state, mt) + d] = st->mt[d];
+    }
+    if (sw == JD_BOND_STATE_LEN) {
+        for (int d = 0; d < 3; d++) {
+            a[JD_AT(jd_bond_state, f_prev) + d] = st->f_prev[d];
+            a[JD_AT(jd_bond_state, m_prev) + d] = st->m_prev[d];
+        }
+        a[JD_AT(jd_bond_state, u_prev)] = st->u_prev;
+        a[JD_AT(jd_bond_state, e_damp)] = st->e_damp;
+        a[JD_AT(jd_bond_state, e_break)] = st->e_break;
+    }
+}
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* JDEM_KERNEL_LAWS_H */

@@ -1,0 +1,50 @@
+/*
+ * jdem_observable_names.h — the names of the /observables of docs/scenes.md, one list for both
+ * engines (the stepper's observables.c and bonds.c, the plugin's jdem_observables and its dump),
+ * with which of them need the energy bookkeeping (not written with output.energy off).
+ * Pure C11: constants only.
+ */
+#ifndef JDEM_KERNEL_OBSERVABLES_H
+#define JDEM_KERNEL_OBSERVABLES_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The contact observables, in the order the trajectory lists them. */
+enum {
+    JD_OBS_KINETIC,       /* kinetic_energy [J]                                  */
+    JD_OBS_ROTATIONAL,    /* rotational_energy [J]                               */
+    JD_OBS_ELASTIC,       /* elastic_energy: stored in the contacts [J]           */
+    JD_OBS_GRAVITATIONAL, /* gravitational_energy [J]                            */
+    JD_OBS_DAMPING,       /* damping_dissipation [J]                             */
+    JD_OBS_FRICTION,      /* friction_dissipation [J]                            */
+    JD_OBS_WALL_WORK,     /* wall_work: done on the particles by the walls [J]    */
+    JD_OBS_CONTACTS,      /* contacts: particle pairs carrying force [-]          */
+    JD_OBS_WALL_CONTACTS, /* wall_contacts [-]                                    */
+    JD_N_OBSERVABLES
+};
+static const char *const jd_observable_names[JD_N_OBSERVABLES] = {
+    "kinetic_energy",      "rotational_energy",    "elastic_energy",
+    "gravitational_energy", "damping_dissipation", "friction_dissipation",
+    "wall_work",           "contacts",             "wall_contacts"};
+static const int jd_observable_is_energy[JD_N_OBSERVABLES] = {0, 0, 1, 0, 1, 1, 1, 0, 0};
+
+/* The bond observables (scenes with bond types). */
+enum {
+    JD_OBS_BONDS,         /* bonds: intact [-]                                    */
+    JD_OBS_FRAGMENTS,     /* fragments: connected groups of bonded particles [-]  */
+    JD_OBS_BOND_ELASTIC,  /* bond_elastic_energy [J]                              */
+    JD_OBS_BOND_DAMPING,  /* bond_damping_dissipation [J]                         */
+    JD_OBS_BOND_BREAKAGE, /* bond_breakage_energy [J]                             */
+    JD_N_BOND_OBSERVABLES
+};
+static const char *const jd_bond_observable_names[JD_N_BOND_OBSERVABLES] = {
+    "bonds", "fragments", "bond_elastic_energy", "bond_damping_dissipation",
+    "bond_breakage_energy"};
+static const int jd_bond_observable_is_energy[JD_N_BOND_OBSERVABLES] = {0, 0, 1, 1, 1};
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* JDEM_KERNEL_OBSERVABLES_H */

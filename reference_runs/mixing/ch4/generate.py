@@ -1,0 +1,159 @@
+#!/usr/bin/python3
+"""generate.py — the scenes of the second mixing pass and of the compression cubes, cut from a
+first- or second-pass deposit (docs/mixing.md §1, §2).  TARGET SCHEMA: the scenes it writes use
+`inlets:`, `particles_from:` and `servo:`, which the engines are to implement.
+
+    generate.py second-pass DEPOSIT.h5 --case modelM -o PASS2.yaml [--gap 0.06]
+    generate.py cubes DEPOSIT.h5 --case modelM -o DIR     (writes DIR/cubeK.yaml, K = 1..9)
+
+second-pass: the bottom 1 m of the deposit's last frame (centres with 0 <= z < 1) is cut into
+1 x 2 x 4 cells of 1 (x) x 0.5 (y) x 0.25 (z) m; cell q = 2 layer + half (bottom to top, y < 0.5
+first) is queued on the belt q (1 + gap) m behind the first, each keeping its orientation, its
+bottom at z = 1.8 and centred at y = 0.5; one section inserted once.  The cells are
+`from_deposit` entries (region + translation), so the scene names the deposit, not its particles.
+cubes: a 0.2 m cube at each Table 4-2 point keeps the particles whose centres lie inside; five
+fixed walls at its faces and a servo top wall at the cube top (1000 Pa +- 10 Pa).
+Both check every region against the deposit (scripts/mixing/deposit.py) before writing.
+"""
+import argparse
+import copy
+import os
+import sys
+
+import yaml
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "..", "scripts"))
+from mixing import deposit, params  # noqa: E402
+
+MODELS = os.path.join(HERE, "models.yaml")
+CELL = (1.0, 0.5, 0.25)   # [RECON] orientation, spec §1.7
+DEPTH = 1.0               # [TEXT] L1539
+CUBE = 0.2                # [TEXT] spec §2.4
+SERVO = {"target": 1000.0, "gain": 1.0e-4, "tolerance": 10.0, "max_speed": 0.02, "hold": 0.05}
+
+
+def override(doc, path, value):
+    """The sweep's dotted-path override (docs/scenes.md "Cases")."""
+    keys = path.split(".")
+    node = doc
+    for k in keys[:-1]:
+        node = node[int(k)] if isinstance(node, list) else node[k]
+    last = keys[-1]
+    if isinstance(node, list):
+        node[int(last)] = value
+    else:
+        node[last] = value
+
+
+def case_scene(case):
+    """models.yaml with the overrides of one case applied and the sweep removed."""
+    with open(MODELS) as f:
+        doc = yaml.safe_load(f)
+    values = doc.pop("sweep")[0]["values"]
+    if case not in values:
+        sys.exit(f"generate.py: case '{case}' is not in {MODELS}; valid: {', '.join(values)}")
+    for path, value in values[case].items():
+        override(doc, path, value)
+    doc["case"] = case
+    return doc
+
+
+def cells(dep, deposit_path, gap):
+    """The from_deposit entries of the second pass, in queue order."""
+    belt = []
+    plane_x = 0.05
+    for q in range(8):
+        layer, half = divmod(q, 2)
+        lo = [0.0, CELL[1] * half, CELL[2] * layer]
+        hi = [CELL[0], lo[1] + CELL[1], lo[2] + CELL[2]]
+        cut = deposit.keep_box(dep, lo, hi, source=deposit_path)
+        if len(cut.id) == 0:
+            sys.exit(f"generate.py: {deposit_path}: cell {q} {lo}..{hi} holds no particle")
+        shift = [plane_x - 0.005 - CELL[0] - q * (CELL[0] + gap), 0.25 - lo[1], 1.8 - lo[2]]
+        belt.append({"file": os.path.abspath(deposit_path), "frame": -1,
+                     "region": {"lo": lo, "hi": hi}, "translate": shift})
+    return belt
+
+
+def second_pass(args):
+    dep = deposit.read_frame(args.deposit)
+    if deposit.deposit_height(dep) < DEPTH:
+        sys.exit(f"generate.py: {args.deposit}: the deposit is {deposit.deposit_height(dep):.3f} m "
+                 f"deep; valid: at least {DEPTH} m for the second pass")
+    doc = case_scene(args.case)
+    doc["name"] = "mixing_ch4_pass2"
+    doc["description"] = f"Jiang (2021) Ch. 4 second mixing pass, {args.case} (Fig. 4-9)"
+    inlet = doc["inlets"][0]
+    inlet["section"] = {"from_deposit": cells(dep, args.deposit, args.gap)}
+    inlet["origin"] = [0.0, 0.0, 0.0]  # the translations place the cells
+    inlet["stop"] = {"sections": 1}
+    inlet.pop("period")
+    write(args.out, doc, f"second pass of {args.deposit} ({args.case}), gap {args.gap} m")
+
+
+def cube_walls(lo, hi):
+    """Five fixed walls and the servo top, corners counter-clockwise seen from inside."""
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    quad = {
+        "floor": [[x0, y0, z0], [x1, y0, z0], [x1, y1, z0], [x0, y1, z0]],
+        "left": [[x0, y0, z0], [x0, y1, z0], [x0, y1, z1], [x0, y0, z1]],
+        "right": [[x1, y0, z0], [x1, y0, z1], [x1, y1, z1], [x1, y1, z0]],
+        "front": [[x0, y0, z0], [x0, y0, z1], [x1, y0, z1], [x1, y0, z0]],
+        "back": [[x0, y1, z0], [x1, y1, z0], [x1, y1, z1], [x0, y1, z1]],
+        "top": [[x0, y0, z1], [x0, y1, z1], [x1, y1, z1], [x1, y0, z1]],
+    }
+    walls = [{"name": n, "type": "plane", "corners": c, "material": "wall"} for n, c in quad.items()]
+    walls[-1]["servo"] = dict(SERVO)
+    return walls
+
+
+def cubes(args):
+    dep = deposit.read_frame(args.deposit)
+    os.makedirs(args.out, exist_ok=True)
+    for k, c in enumerate(params.POINTS_TABLE_4_2, start=1):
+        lo, hi = (c - CUBE / 2).round(12).tolist(), (c + CUBE / 2).round(12).tolist()
+        deposit.keep_box(dep, lo, hi, source=args.deposit)
+        doc = case_scene(args.case)
+        doc["name"] = f"mixing_ch4_cube{k}"
+        doc["description"] = f"Jiang (2021) Ch. 4 compression test, cube {k} (Table 4-2)"
+        doc.pop("inlets")
+        doc["walls"] = cube_walls(lo, hi)
+        doc["particles_from"] = [{"file": os.path.abspath(args.deposit), "frame": -1,
+                                  "region": {"lo": lo, "hi": hi}}]
+        doc["time"] = {"dt": doc["time"]["dt"], "end_time": 10.0,
+                       "max_impact_speed": doc["time"]["max_impact_speed"]}
+        doc["output"] = {"every": 1000, "observables_every": 100}
+        write(os.path.join(args.out, f"cube{k}.yaml"), doc,
+              f"compression cube {k} at {c.tolist()} of {args.deposit} ({args.case})")
+
+
+def write(path, doc, what):
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(f"# Generated by reference_runs/mixing/ch4/generate.py: {what}.\n"
+                f"# TARGET SCHEMA (docs/mixing.md §2): does not run until the engines implement it.\n")
+        yaml.safe_dump(doc, f, sort_keys=False, default_flow_style=None)
+    os.replace(tmp, path)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    sub = ap.add_subparsers(dest="what", required=True)
+    for name in ("second-pass", "cubes"):
+        p = sub.add_parser(name)
+        p.add_argument("deposit")
+        p.add_argument("--case", required=True)
+        p.add_argument("-o", "--out", required=True)
+        if name == "second-pass":
+            p.add_argument("--gap", type=float, default=0.06,
+                           help="[RECON] gap between queued cells [m], default 2 R_big")
+    args = ap.parse_args()
+    try:
+        (second_pass if args.what == "second-pass" else cubes)(args)
+    except deposit.DepositError as e:
+        sys.exit(f"generate.py: {e}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,86 @@
+#!/usr/bin/python3
+"""reference_runs/mixing/ch4/generate.py on a synthetic deposit: the second pass's 8 cells
+(regions, order, queue on the belt) and the 9 cubes (regions, walls, servo), and its messages."""
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+import h5py
+import numpy as np
+import yaml
+
+from common import ROOT, check, finish
+
+GEN = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "generate.py")
+
+
+def write_deposit(path, top):
+    """A simple-cubic bed of small spheres over the 1 x 1 m floor, `top` m deep."""
+    g = np.arange(0.015, 1.0, 0.03)
+    x = np.array(np.meshgrid(g, g, np.arange(0.015, top, 0.03), indexing="ij")).reshape(3, -1).T
+    n = len(x)
+    r = np.full(n, 0.015)
+    with h5py.File(path, "w") as f:
+        p = f.create_group("particles/all")
+        p["id"] = np.arange(1, n + 1)
+        p["species"] = np.zeros(n, np.int32)
+        p["radius"] = r
+        p["mass"] = 4000 * 4 / 3 * math.pi * r ** 3
+        p["position/value"] = x[None]
+        p["position/step"] = np.array([0])
+        p["position/time"] = np.array([0.0])
+
+
+def gen(*args):
+    return subprocess.run([sys.executable, GEN, *args], capture_output=True, text=True)
+
+
+tmp = tempfile.mkdtemp()
+dep = os.path.join(tmp, "dep.h5")
+write_deposit(dep, 1.1)
+out = os.path.join(tmp, "pass2.yaml")
+r = gen("second-pass", dep, "--case", "model5", "-o", out)
+check("second_pass_runs", r.returncode == 0, r.stderr)
+doc = yaml.safe_load(open(out))
+cells = doc["inlets"][0]["section"]["from_deposit"]
+los = [tuple(c["region"]["lo"]) for c in cells]
+want = [(0.0, 0.5 * (q % 2), 0.25 * (q // 2)) for q in range(8)]
+check("second_pass_cells_bottom_to_top", los == want, f"{los}")
+# queued end to end with the 0.06 m gap, the first front 0.005 m behind the plane x = 0.05,
+# every cell's bottom at z = 1.8 and centred at y = 0.5
+tx = [c["translate"][0] for c in cells]
+ok = all(abs(tx[q] - (0.05 - 0.005 - 1.0 - 1.06 * q)) < 1e-12 for q in range(8))
+ok &= all(abs(c["translate"][2] + c["region"]["lo"][2] - 1.8) < 1e-12 for c in cells)
+ok &= all(abs(c["translate"][1] + c["region"]["lo"][1] + 0.25 - 0.5) < 1e-12 for c in cells)
+check("second_pass_queue", ok, f"{[c['translate'] for c in cells]}")
+check("second_pass_inserted_once", doc["inlets"][0]["stop"] == {"sections": 1}
+      and "period" not in doc["inlets"][0], f"{doc['inlets'][0]}")
+check("second_pass_keeps_model", doc["walls"][5]["present"] and doc["walls"][6]["axis"][0][0] == 0.7,
+      f"{doc['walls'][5:]}")
+r = gen("cubes", dep, "--case", "model2", "-o", os.path.join(tmp, "cubes"))
+check("cubes_run", r.returncode == 0, r.stderr)
+c5 = yaml.safe_load(open(os.path.join(tmp, "cubes", "cube5.yaml")))
+region = c5["particles_from"][0]["region"]
+check("cube5_region", region == {"lo": [0.4, 0.4, 0.4], "hi": [0.6, 0.6, 0.6]}, f"{region}")
+top = c5["walls"][-1]
+normal = np.cross(np.subtract(top["corners"][1], top["corners"][0]),
+                  np.subtract(top["corners"][2], top["corners"][0]))
+check("cube_servo_top_faces_down", top["name"] == "top" and normal[2] < 0
+      and top["servo"]["target"] == 1000.0 and top["servo"]["tolerance"] == 10.0, f"{top}")
+shallow = os.path.join(tmp, "shallow.h5")
+write_deposit(shallow, 0.5)
+r = gen("second-pass", shallow, "--case", "model1", "-o", os.path.join(tmp, "x.yaml"))
+check("second_pass_too_shallow", r.returncode != 0 and r.stderr.strip() ==
+      f"generate.py: {shallow}: the deposit is 0.510 m deep; valid: at least 1.0 m for the "
+      f"second pass", r.stderr)
+r = gen("cubes", shallow, "--case", "model1", "-o", os.path.join(tmp, "c"))
+check("cube_outside_deposit", r.returncode != 0 and "region [0.15, 0.4, 0.4]..[0.35, 0.6, 0.6] "
+      "lies outside the" in r.stderr, r.stderr)
+r = gen("cubes", os.path.join(tmp, "none.h5"), "--case", "model1", "-o", os.path.join(tmp, "c"))
+check("deposit_missing", r.returncode != 0 and "none.h5: no such file" in r.stderr, r.stderr)
+r = gen("cubes", dep, "--case", "model7", "-o", os.path.join(tmp, "c"))
+check("case_unknown", r.returncode != 0 and "case 'model7' is not in" in r.stderr
+      and "valid: model1, model2, model3, model4, model5, model6" in r.stderr, r.stderr)
+finish()

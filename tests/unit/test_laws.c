@@ -1,0 +1,355 @@
+/*
+ * test_laws.c — the laws jd_contact is composed of, each alone against its closed form, and the
+ * rulebook both engines call (jdem_laws.h): law-set selection, the list of law sets, the pair
+ * coefficients, the history records; and the laws jd_bond is composed of, with the bonds'
+ * frequency bound.
+ */
+#include <string.h>
+
+#include "unit.h"
+
+#include "jdem_bond.h"
+#include "jdem_guard.h"
+#include "jdem_kernel.h"
+#include "jdem_laws.h"
+
+enum { ALL = JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY };
+
+/* Two spheres along z, a at the origin, overlapping by delta. */
+static jd_contact_geom geom_z(double delta, double R, double k_n, double m_eff) {
+    jd_contact_geom g = {.n = {0, 0, 1}, .delta = delta, .k_n = k_n, .m_eff = m_eff,
+                         .i_eff = 0.2 * m_eff * R * R, .r_roll = 0.5 * R};
+    g.ra[2] = R - 0.5 * delta;
+    g.rb[2] = -(R - 0.5 * delta);
+    return g;
+}
+
+static void kinematics_is_eq6(void **state) {
+    (void)state;
+    const jd_contact_geom g = geom_z(1e-4, 0.01, 1e9, 1e-3);
+    const jd_kinematics k = {.va = {0.1, 0, 0.2}, .wa = {0, 3, 0}, .vb = {0, 0.4, -0.1},
+                             .wb = {1, 0, 0}};
+    jd_contact_motion m;
+    jd_contact_kinematics(JD_F_ROLLING, &g, &k, &m);
+    const double la = 0.01 - 0.5e-4;
+    /* w_a x r_a = (0,3,0) x (0,0,la) = (3 la, 0, 0); w_b x r_b = (1,0,0) x (0,0,-la) = (0, la, 0) */
+    assert_rel(m.vrel[0], 0.0 - (0.1 + 3 * la), 1e-15);
+    assert_rel(m.vrel[1], 0.4 + la, 1e-15);
+    assert_rel(m.vrel[2], -0.1 - 0.2, 1e-15);
+    assert_rel(m.vn, -0.3, 1e-15);
+    assert_rel(m.ddelta, 0.3, 1e-15);
+    assert_rel(m.wrel[0], 1.0, 0.0);
+    assert_rel(m.wrel[1], -3.0, 0.0);
+    jd_contact_kinematics(0u, &g, &k, &m); /* without rolling the relative spin is not computed */
+    assert_true(m.wrel[0] == 0.0 && m.wrel[1] == 0.0 && m.wrel[2] == 0.0);
+}
+
+static void normal_law_with_damping_and_luding_end(void **state) {
+    (void)state;
+    const double k = 1e9, d = 2e-5, m = 0.01;
+    const jd_contact_geom g = geom_z(d, 0.01, k, m);
+    const jd_pair_coeffs c = {.gamma = 0.2, .mu = 0.5, .mu_r = 1.0};
+    jd_normal nl;
+    jd_law_normal(0u, &c, &g, 0.7, 0, &nl); /* undamped: Hertz alone, gamma ignored */
+    assert_rel(nl.fn, k * pow(d, 1.5), 1e-14);
+    assert_rel(nl.Kn, k * sqrt(d), 1e-14);
+    assert_true(nl.Cn == 0.0 && nl.carries && !nl.ends);
+    jd_law_normal(JD_F_DAMPING, &c, &g, 0.7, 0, &nl); /* eq. (29), (31) */
+    assert_rel(nl.Cn, 2.0 * 0.2 * sqrt(m * k * sqrt(d)), 1e-14);
+    assert_rel(nl.fn, k * pow(d, 1.5) + nl.Cn * 0.7, 1e-14);
+    /* unloading so fast that the dashpot outpulls the spring: Luding's end, no force */
+    const double fast = -2.0 * k * pow(d, 1.5) / nl.Cn;
+    jd_law_normal(JD_F_DAMPING, &c, &g, fast, 0, &nl);
+    assert_true(nl.fn < 0.0 && nl.ends && !nl.carries);
+    jd_law_normal(0u, &c, &g, fast, 0, &nl); /* without damping a contact never ends so */
+    assert_true(nl.carries && !nl.ends);
+    jd_law_normal(JD_F_DAMPING, &c, &g, -1e-3, 1, &nl); /* still ended: carries nothing */
+    assert_true(!nl.carries && !nl.ends);
+}
+
+static void contact_begin_restarts_an_ended_contact(void **state) {
+    (void)state;
+    const jd_contact_geom g = geom_z(1e-4, 0.01, 1e9, 1e-3);
+    jd_contact_state s = {.xi = {1e-6, 0, 0}, .flags = JD_S_ENDED, .u_prev = 5.0, .e_damp = 2.0,
+                          .e_fric = 1.0};
+    jd_contact_step h;
+    jd_contact_begin(JD_F_ENERGY, &g, &s, NULL, -0.1, &h); /* still separating */
+    assert_true(h.still_ended && !h.restart && h.xi[0] == 1e-6 && h.u_prev == 5.0);
+    jd_contact_begin(JD_F_ENERGY, &g, &s, NULL, 0.1, &h); /* approaching again: a new contact */
+    const double u = 0.4 * 1e9 * pow(1e-4, 2.5);
+    assert_true(!h.still_ended && h.restart && h.xi[0] == 0.0 && h.flags == 0.0);
+    assert_rel(h.u_prev, u, 1e-14);        /* the compressed spring is stored again */
+    assert_rel(h.e_damp, 2.0 - u, 1e-14);  /* and taken back from damping */
+    assert_rel(h.e_fric, 1.0, 0.0);
+}
+
+static void tangential_law_sticks_then_slides(void **state) {
+    (void)state;
+    const double k = 1e9, d = 1e-4, dt = 1e-6;
+    const jd_contact_geom g = geom_z(d, 0.01, k, 1e-3);
+    const jd_pair_coeffs c = {.gamma = 0.0, .mu = 0.3, .mu_r = 1.0, .xi_limit = JD_XI_COULOMB};
+    jd_normal nl;
+    jd_law_normal(0u, &c, &g, 0.0, 0, &nl);
+    jd_contact_motion m = {.vrel = {0.01, 0, 0}, .vn = 0.0};
+    jd_contact_step h = {0};
+    double f[3] = {0, 0, nl.fn}, u = 0.0, dash = 0.0;
+    jd_law_tangential(JD_F_FRICTION | JD_F_ENERGY, &c, &g, &m, &nl, dt, &h, f, &u, &dash);
+    const double Kt = k * sqrt(d); /* K_t = K_n */
+    assert_rel(f[0], -Kt * 0.01 * dt, 1e-14);
+    assert_rel(h.xi[0], 0.01 * dt, 1e-14);
+    assert_rel(u, 0.5 * Kt * (0.01 * dt) * (0.01 * dt), 1e-13);
+    assert_true(h.flags == 0.0 && dash == 0.0);
+    /* a slip far beyond mu F_n / K_t: the force is capped and xi reset to it (Coulomb) */
+    m.vrel[0] = 1e3;
+    f[0] = 0.0;
+    jd_law_tangential(JD_F_FRICTION, &c, &g, &m, &nl, dt, &h, f, &u, &dash);
+    assert_rel(f[0], -0.3 * nl.fn, 1e-14);
+    assert_rel(h.xi[0], 0.3 * nl.fn / Kt, 1e-14);
+    assert_true(h.flags == (double)JD_S_SLIDING);
+}
+
+static void rolling_law_spring_and_cap(void **state) {
+    (void)state;
+    const double k = 1e9, d = 1e-4, dt = 1e-6, R = 0.01;
+    const jd_contact_geom g = geom_z(d, R, k, 1e-3);
+    const jd_pair_coeffs c = {.gamma = 0.1, .eta = 0.05, .mu_r = 1.0, .xi_limit = JD_XI_COULOMB};
+    jd_normal nl;
+    jd_law_normal(JD_F_DAMPING, &c, &g, 0.0, 0, &nl);
+    const jd_contact_motion m = {.wrel = {0, 2.0, 0}};
+    jd_contact_step h = {0};
+    double mr[3], u = 0.0, dash = 0.0;
+    jd_law_rolling(JD_F_ROLLING | JD_F_DAMPING, &c, &g, &m, &nl, dt, &h, mr, &u, &dash);
+    const double Kr = k * sqrt(d) * g.r_roll * g.r_roll, Cr = 2.0 * 0.1 * sqrt(g.i_eff * Kr);
+    const double free_moment = Kr * 2.0 * dt + Cr * 2.0, cap = 0.05 * g.r_roll * nl.fn;
+    /* eq. (32): the spring-dashpot moment, or the cap eta r F_n when it is smaller */
+    assert_rel(-mr[1], free_moment < cap ? free_moment : cap, 1e-13);
+    assert_rel(h.theta[1], free_moment < cap ? 2.0 * dt : cap / Kr, 1e-13);
+}
+
+static void energy_law_books_work_and_luding_end(void **state) {
+    (void)state;
+    const double dt = 1e-6;
+    const jd_contact_motion m = {.vrel = {0, 0, -0.5}, .ddelta = 0.5};
+    jd_normal nl = {.fn = 10.0, .Cn = 2.0, .carries = 1};
+    const jd_contact_step h = {.f_prev = {0, 0, 8.0}, .fd_prev = 0.6, .u_prev = 1e-3,
+                               .e_damp = 0.25, .e_fric = 0.125};
+    const double f[3] = {0, 0, 10.0}, mr[3] = {0, 0, 0}, u_new = 1.5e-3;
+    jd_contact_energy e;
+    jd_law_energy(JD_F_DAMPING | JD_F_ENERGY, &m, &nl, &h, f, mr, u_new, 0.0, dt, &e);
+    /* trapezoidal work on the bodies, W = -(8 + 10)/2 * 0.5 dt; dissipated = -W - dU, all of it
+     * the dashpot's without sliders */
+    const double W = 0.5 * (8.0 * -0.5 + 10.0 * -0.5) * dt;
+    assert_rel(e.fd, 2.0 * 0.5, 0.0);
+    assert_rel(e.e_damp, 0.25 + (-W - (u_new - 1e-3)), 1e-14);
+    assert_rel(e.e_fric, 0.125, 0.0);
+    /* at Luding's end the stored energy is lost, less the previous force's work this step */
+    nl.ends = 1;
+    nl.carries = 0;
+    jd_law_energy(JD_F_DAMPING | JD_F_ENERGY, &m, &nl, &h, f, mr, u_new, 0.0, dt, &e);
+    assert_rel(e.e_damp, 0.25 + (1e-3 - 0.5 * (8.0 * -0.5) * dt), 1e-14);
+    /* with a slider the dashpots' share stays damping and the rest is friction */
+    nl.ends = 0;
+    jd_law_energy(JD_F_FRICTION | JD_F_ENERGY, &m, &nl, &h, f, mr, u_new, 1e-7, dt, &e);
+    const double dash = 1e-7 + 0.5 * (0.6 + 1.0) * 0.5 * dt;
+    assert_rel(e.e_damp, 0.25 + dash, 1e-14);
+    assert_rel(e.e_fric, 0.125 + ((-W - (u_new - 1e-3)) - dash), 1e-13);
+}
+
+static void law_sets_are_the_combinations_with_mu_r_only_with_friction(void **state) {
+    (void)state;
+    int n = 0;
+    for (unsigned b = 0; b <= ALL; b++) {
+        const int expected = !((b & JD_F_MU_R) && !(b & JD_F_FRICTION));
+        assert_int_equal(jd_law_set_valid(b), expected);
+        n += jd_law_set_valid(b);
+    }
+    assert_int_equal(n, 24);
+    assert_int_equal(jd_law_set_valid(ALL + 1), 0);
+}
+
+static void law_set_select_counts_only_interactions_that_occur(void **state) {
+    (void)state;
+    /* materials: 0 and 1 for particles, 2 for walls only, 3 unused */
+    enum { NM = 4 };
+    double e[NM * NM], mu[NM * NM], eta[NM * NM];
+    for (int k = 0; k < NM * NM; k++) e[k] = 1.0, mu[k] = 0.0, eta[k] = 0.0;
+    const unsigned char parts[NM] = {1, 1, 0, 0}, walls[NM] = {0, 0, 1, 0};
+    mu[3 * NM + 3] = 0.5;  /* unused against unused */
+    e[2 * NM + 2] = 0.5;   /* wall against wall: never occurs */
+    eta[3 * NM + 0] = 0.1; /* unused against a particle material */
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, 0), 0u);
+    e[1 * NM + 2] = 0.9; /* particle against wall */
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, 0), JD_F_DAMPING);
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, NULL, 1.0, 0), 0u);
+    eta[0 * NM + 1] = 0.1; /* particle against particle */
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 0.5, 1),
+                     JD_F_DAMPING | JD_F_ROLLING | JD_F_ENERGY); /* mu_R needs friction */
+    mu[1 * NM + 0] = 0.3;
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 0.5, 0),
+                     JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R);
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, 0),
+                     JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING);
+}
+
+static void law_set_names(void **state) {
+    (void)state;
+    char buf[96];
+    assert_string_equal(jd_law_set_describe(0u, buf, sizeof buf), "elastic");
+    assert_string_equal(jd_law_set_describe(JD_F_DAMPING | JD_F_FRICTION | JD_F_ENERGY, buf, sizeof buf),
+                        "damping+friction+energy");
+    assert_string_equal(jd_law_set_describe(ALL, buf, sizeof buf),
+                        "damping+friction+rolling+mu_r+energy");
+    assert_string_equal(jd_law_set_describe(ALL, buf, 8), "damping"); /* truncated, terminated */
+}
+
+static void pair_coeffs_table_maps_each_restitution(void **state) {
+    (void)state;
+    const double e[4] = {0.5, 0.9, 0.9, 1.0}, mu[4] = {0.1, 0.2, 0.3, 0.4}, eta[4] = {0, 0.01, 0.02, 0};
+    jd_pair_coeffs t[4];
+    jd_pair_coeffs_table(2, e, mu, eta, JD_DAMP_JIANG2021, 0.7, JD_XI_UNCONSTRAINED, t);
+    for (int k = 0; k < 4; k++) {
+        /* eq. (30) */
+        const double le = log(e[k]), gamma = -le / sqrt(3.14159265358979323846 * 3.14159265358979323846 + le * le);
+        assert_rel(t[k].gamma, gamma, 1e-15);
+        assert_true(t[k].mu == mu[k] && t[k].eta == eta[k] && t[k].mu_r == 0.7);
+        assert_int_equal(t[k].xi_limit, JD_XI_UNCONSTRAINED);
+    }
+    assert_true(t[3].gamma == 0.0);
+}
+
+static void records_keep_the_law_fields_or_everything(void **state) {
+    (void)state;
+    assert_int_equal(jd_contact_record_len(0u), 4);
+    assert_int_equal(jd_contact_record_len(JD_F_ENERGY), JD_CONTACT_STATE_LEN);
+    assert_int_equal(jd_rolling_record_len(JD_F_ENERGY), 0);
+    assert_int_equal(jd_rolling_record_len(JD_F_ROLLING), 3);
+    assert_int_equal(jd_rolling_record_len(JD_F_ROLLING | JD_F_ENERGY), JD_ROLLING_STATE_LEN);
+    double h[JD_CONTACT_STATE_LEN], r[JD_ROLLING_STATE_LEN];
+    for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) h[k] = k + 1.0;
+    for (int k = 0; k < JD_ROLLING_STATE_LEN; k++) r[k] = -(k + 1.0);
+    jd_contact_state st;
+    jd_rolling_state rs;
+    jd_record_load(h, 4, r, 3, &st, &rs); /* the short records: the rest reads as zero */
+    assert_true(st.xi[0] == 1.0 && st.xi[2] == 3.0 && st.flags == 4.0 && st.f_prev[0] == 0.0 &&
+                st.e_fric == 0.0 && rs.theta[2] == -3.0 && rs.m_prev[0] == 0.0);
+    jd_record_load(h, JD_CONTACT_STATE_LEN, NULL, 0, &st, &rs);
+    assert_true(st.e_damp == 10.0 && st.e_fric == 11.0 && rs.theta[0] == 0.0);
+    double h2[JD_CONTACT_STATE_LEN] = {0}, r2[JD_ROLLING_STATE_LEN] = {0};
+    jd_record_store(h2, 4, r2, 0, &st, &rs);
+    assert_true(h2[3] == 4.0 && h2[4] == 0.0 && r2[0] == 0.0);
+    /* separation: everything zero but the dissipation accumulators, as jd_contact_separate */
+    jd_record_separate(h, JD_CONTACT_STATE_LEN, r, JD_ROLLING_STATE_LEN);
+    jd_contact_state ref;
+    jd_rolling_state rref;
+    memcpy(&ref, (double[JD_CONTACT_STATE_LEN]){1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}, sizeof ref);
+    memcpy(&rref, r, sizeof rref);
+    rref.theta[0] = 1.0;
+    jd_contact_separate(&ref, &rref);
+    assert_memory_equal(h, &ref, sizeof h);
+    assert_memory_equal(r, &rref, sizeof r);
+    /* LIGGGHTS' sign flags of a combined record: the contact record's, then the rolling one's */
+    assert_int_equal(jd_record_newton(4, 3), 0);
+    assert_int_equal(jd_record_newton(4, 4), 1);
+    assert_int_equal(jd_record_newton(JD_CONTACT_STATE_LEN, 7), jd_contact_state_newton[7]);
+}
+
+static void bond_frequency_bounds(void **state) {
+    (void)state;
+    jd_bond_params p = {0};
+    p.lambda = 0.8;
+    p.kn = 1e12;
+    p.kt = 4e11;
+    const double R = 1e-3, m = jd_sphere_mass(R, 2500.0), I = jd_sphere_inertia(m, R);
+    const jd_bond_section sec = jd_bond_section_of(p.lambda, R, R);
+    const double one = jd_bond_omega2_bound(&p, &sec, m, m, I, I, R, R);
+    /* a rule bonds a particle to up to 12 equal neighbours at contact */
+    assert_rel(jd_bond_omega2_rule(&p, R, m), 12.0 * one, 1e-15);
+    assert_rel(JD_GUARD_DEFAULT_COORDINATION, 12.0, 0.0);
+    /* two equal spheres touching: lever arms R, the same bound */
+    assert_rel(jd_bond_omega2_pair(&p, R, R, m, m, 2.0 * R), one, 1e-15);
+    assert_int_equal(jd_bond_laws(0.0), 0);
+    assert_int_equal(jd_bond_laws(0.1), JD_B_DAMPING);
+}
+
+/* A bond of unit section along z (A = 1, I = 1/4, J = 1/2 as for rbar = 1, scaled by pi). */
+static jd_bond_params bond_params(void) {
+    jd_bond_params p = {0};
+    p.kn = 2e9;
+    p.kt = 1e9;
+    p.sigma_c = 1e6;
+    p.tau_c = 2e6;
+    p.gamma = 0.1;
+    p.lambda = 1.0;
+    p.bending = JD_BOND_BEND_I;
+    return p;
+}
+
+static void bond_springs_are_eq16(void **state) {
+    (void)state;
+    const jd_bond_params p = bond_params();
+    jd_bond_geom g = {.n = {0, 0, 1}, .ra = {0, 0, 1e-3}, .rb = {0, 0, -1e-3}};
+    g.sec = jd_bond_section_of(1.0, 1e-3, 1e-3);
+    const jd_kinematics k = {.vb = {0.1, 0, -0.2}, .wb = {0, 0, 3.0}};
+    jd_bond_motion m;
+    jd_bond_kinematics(&g, &k, &m);
+    assert_rel(m.vn, -0.2, 1e-15);
+    assert_rel(m.wn, 3.0, 1e-15);
+    assert_rel(m.vt[0], 0.1, 1e-15);
+    const jd_bond_stiffness K = jd_bond_stiffness_of(&p, &g.sec);
+    assert_rel(K.Kn, p.kn * g.sec.A, 1e-15);
+    assert_rel(K.Kb, p.kn * g.sec.I, 1e-15); /* bending on I (Potyondy & Cundall) */
+    assert_rel(K.Ktw, p.kt * g.sec.J, 1e-15);
+    jd_bond_state s = {.flags = JD_BS_INTACT};
+    const double dt = 1e-7;
+    jd_bond_springs(&K, &g, &m, dt, &s);
+    assert_rel(s.fn, K.Kn * 0.2 * dt, 1e-14);   /* approaching: compression grows */
+    assert_rel(s.ft[0], -K.Kt * 0.1 * dt, 1e-14);
+    assert_rel(s.mn, -K.Ktw * 3.0 * dt, 1e-14);
+    /* the load on b: springs minus the dashpots 2 gamma sqrt(m K) */
+    g.m_eff = 1e-5;
+    g.i_eff = 1e-12;
+    double f[3], mo[3];
+    jd_bond_load(JD_B_DAMPING, &p, &K, &g, &m, &s, f, mo);
+    assert_rel(f[2], s.fn - 2.0 * 0.1 * sqrt(1e-5 * K.Kn) * -0.2, 1e-14);
+    assert_rel(f[0], s.ft[0] - 2.0 * 0.1 * sqrt(1e-5 * K.Kt) * 0.1, 1e-14);
+    assert_rel(mo[2], s.mn - 2.0 * 0.1 * sqrt(1e-12 * K.Ktw) * 3.0, 1e-14);
+}
+
+static void bond_strength_and_break(void **state) {
+    (void)state;
+    const jd_bond_params p = bond_params();
+    const jd_bond_section sec = jd_bond_section_of(1.0, 1e-3, 1e-3);
+    jd_bond_state s = {.fn = -0.5 * p.sigma_c * sec.A, .mt = {0.25 * p.sigma_c * sec.I / sec.rbar, 0, 0},
+                       .flags = JD_BS_INTACT, .u_prev = 3e-6, .e_damp = 1e-6, .f_prev = {0, 0, 2.0}};
+    jd_bond_result out;
+    /* eq. (17): sigma = -F_n/A + |M_t| rbar/I = 0.75 sigma_c: intact */
+    assert_int_equal(jd_bond_strength(&p, &sec, &s, &out), JD_BOND_INTACT);
+    assert_rel(out.sigma_max, 0.75 * p.sigma_c, 1e-12);
+    s.fn *= 2.0; /* 1.25 sigma_c in tension, no shear: breaks in tension */
+    assert_int_equal(jd_bond_strength(&p, &sec, &s, &out), JD_BOND_BROKE_TENSION);
+    const jd_bond_motion m = {.vrel = {0, 0, 0.5}};
+    jd_bond_break(JD_B_ENERGY, &m, 1e-7, &s, &out);
+    assert_rel(s.e_break, 3e-6 - 0.5 * (2.0 * 0.5) * 1e-7, 1e-14);
+    assert_true(s.flags == (double)JD_BS_BROKEN && s.fn == 0.0 && s.mt[0] == 0.0 &&
+                s.u_prev == 0.0 && s.e_damp == 1e-6 && out.f[2] == 0.0);
+}
+
+int run_laws_tests(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(kinematics_is_eq6),
+        cmocka_unit_test(normal_law_with_damping_and_luding_end),
+        cmocka_unit_test(contact_begin_restarts_an_ended_contact),
+        cmocka_unit_test(tangential_law_sticks_then_slides),
+        cmocka_unit_test(rolling_law_spring_and_cap),
+        cmocka_unit_test(energy_law_books_work_and_luding_end),
+        cmocka_unit_test(law_sets_are_the_combinations_with_mu_r_only_with_friction),
+        cmocka_unit_test(law_set_select_counts_only_interactions_that_occur),
+        cmocka_unit_test(law_set_names),
+        cmocka_unit_test(pair_coeffs_table_maps_each_restitution),
+        cmocka_unit_test(records_keep_the_law_fields_or_everything),
+        cmocka_unit_test(bond_frequency_bounds),
+        cmocka_unit_test(bond_springs_are_eq16),
+        cmocka_unit_test(bond_strength_and_break),
+    };
+    return cmocka_run_group_tests_name("laws", tests, NULL, NULL);
+}
