@@ -8,7 +8,8 @@ the exit status, the message and what is on disk:
   paths           -o with '#', a space, '$' works at exactly that path; '*' is refused
   concurrent      a second wrapper on the same OUT is refused (exit 3), the first completes
   typo            a bad scene leaves the earlier OUT.h5 and OUT.xdmf as they were
-  sigterm         SIGTERM to the wrapper stops LIGGGHTS (143, OUT.h5.part kept, nothing left running)
+  sigterm         SIGTERM to the wrapper stops LIGGGHTS or mpirun (143, OUT.h5.part kept, nothing
+                  left running), on 1 and 2 ranks
   rank errors     an error on one rank (Error::one) reaches stderr and the log, stdout a pipe,
                   on 1 and 2 ranks; no garbage line after a LIGGGHTS error
   bad files       bond file, loads file and scene_yaml: directory, /dev/zero, empty, binary,
@@ -253,21 +254,23 @@ def processes_in(directory):
 
 
 def sigterm(c, d):
-    scene = resting(d, "long", steps=LONG_STEPS, every=LONG_STEPS // 6)
-    out = os.path.join(d, "w.h5")
-    proc = start([PY, RUN, scene, "-o", out])
-    if not c.check("sigterm_started", wait_for_file(out + ".part", 60), "no w.h5.part after 60 s"):
-        proc.kill()
-        return
-    proc.send_signal(signal.SIGTERM)
-    r = finish(proc, 60)
-    c.check("sigterm_exit", r.rc == signal_exit(signal.SIGTERM), repr(r))
-    c.check("sigterm_message", "terminated (SIGTERM)" in r.err and out + ".part" in r.err, r.err[-1500:])
-    left = processes_in(os.path.join(d, "w.deck"))
-    c.check("sigterm_child_gone", not left, "still running in the deck: %s" % left)
-    time.sleep(1.0)
-    c.check("sigterm_no_output_later", not os.path.exists(out), "w.h5 appeared after the wrapper exited")
-    c.check("sigterm_part_readable", h5_readable(out + ".part") is None, str(h5_readable(out + ".part")))
+    for np_ in (1, 2):  # liggghts-jdem itself, and mpirun (which forwards the signal to its ranks)
+        name = "sigterm_np%d" % np_
+        scene = resting(d, "long%d" % np_, steps=LONG_STEPS, every=LONG_STEPS // 6)
+        out = os.path.join(d, "w%d.h5" % np_)
+        proc = start([PY, RUN, scene, "-o", out, "--np", str(np_)])
+        if not c.check(name + "_started", wait_for_file(out + ".part", 60), "no .part after 60 s"):
+            proc.kill()
+            continue
+        proc.send_signal(signal.SIGTERM)
+        r = finish(proc, 60)
+        c.check(name + "_exit", r.rc == signal_exit(signal.SIGTERM), repr(r))
+        c.check(name + "_message", "terminated (SIGTERM)" in r.err and out + ".part" in r.err, r.err[-1500:])
+        left = processes_in(os.path.join(d, "w%d.deck" % np_))
+        c.check(name + "_child_gone", not left, "still running in the deck: %s" % left)
+        time.sleep(1.0)
+        c.check(name + "_no_output_later", not os.path.exists(out), "the trajectory appeared after the wrapper exited")
+        c.check(name + "_part_readable", h5_readable(out + ".part") is None, str(h5_readable(out + ".part")))
 
 
 # ---- liggghts-jdem: errors on a rank, bad files, the set-up watchdog --------------------------
