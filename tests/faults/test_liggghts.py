@@ -3,8 +3,9 @@
 (scripts/liggghts_run.py) and the input handling of liggghts-jdem's styles.  Each case asserts
 the exit status, the message and what is on disk:
 
-  injection       names with a line break reach no LIGGGHTS command (no `shell` runs); names
-                  with '#', '$', '&' and quotes are written literally and land in /parameters
+  injection       names with a line break, another control character or a quote are refused by
+                  the generator (no `shell` runs); names with '#', '$', '&' are written
+                  literally and land in /parameters as they are
   paths           -o with '#', a space, '$' works at exactly that path; '*' is refused
   concurrent      a second wrapper on the same OUT is refused (exit 3), the first completes
   typo            a bad scene leaves the earlier OUT.h5 and OUT.xdmf as they were
