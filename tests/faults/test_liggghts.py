@@ -163,6 +163,10 @@ def injection(c, d):
             ("single_quote", ["name"], "it's", "holds a quote character"),
             ("double_quote", ["case"], 'say "x"', "holds a quote character"),
             ("wall_rule", ["model", "wall_rule"], "hertz\nshell touch PWNED", "model.wall_rule is"),
+            # found by tests/fuzz/fuzz_deck.py: a short Velocities line segfaulted read_data
+            ("short_vector", ["particles", 1, "angular_velocity"], [0, 0],
+             "expected a vector of three numbers, got [0, 0]"),
+            ("radius_zero", ["particles", 0, "radius"], 0.0, "particle 1: radius must be a finite number > 0"),
     ):
         generator_refuses(c, d, label, where, value, expect)
 
