@@ -9,6 +9,7 @@ the exit status, the message and what is on disk:
   paths           -o with '#', a space, '$' works at exactly that path; '*' is refused
   concurrent      a second wrapper on the same OUT is refused (exit 3), the first completes
   typo            a bad scene leaves the earlier OUT.h5 and OUT.xdmf as they were
+  watchdog        a watchdog trip through the wrapper exits 4, OUT.h5.part kept
   sigterm         SIGTERM to the wrapper stops LIGGGHTS or mpirun (143, OUT.h5.part kept, nothing
                   left running), on 1 and 2 ranks
   rank errors     an error on one rank (Error::one) reaches stderr and the log, stdout a pipe,
@@ -245,6 +246,16 @@ def typo_keeps_result(c, d):
     c.check("typo_keeps_h5_and_xdmf", after == before, "changed: %s" % [f for f in before if after[f] != before[f]])
 
 
+def watchdog_class(c, d):
+    """A watchdog trip through the wrapper exits 4 (jdem's class), OUT.h5.part kept."""
+    out = os.path.join(d, "wd.h5")
+    r = wrapper(os.path.join(ROOT, "tests", "engine", "scenes", "watchdog_blowup.yaml"), out, "--case", "overlap",
+                "--force")
+    c.check("watchdog_exit", r.rc == EXIT["watchdog"], repr(r)[-800:])
+    c.check("watchdog_message", "jdem: watchdog: step" in r.err, r.err[-800:])
+    c.check("watchdog_files", not os.path.exists(out) and h5_readable(out + ".part") is None, files(d))
+
+
 def processes_in(directory):
     """Pids of the processes whose working directory is DIRECTORY."""
     pids = []
@@ -365,7 +376,7 @@ def main():
     c = Checks()
     d = scratch("jdem_faults_liggghts_")
     for name, case in (("injection", injection), ("paths", paths), ("concurrent", concurrent),
-                       ("typo", typo_keeps_result), ("sigterm", sigterm), ("rank_errors", rank_errors),
+                       ("typo", typo_keeps_result), ("watchdog", watchdog_class), ("sigterm", sigterm), ("rank_errors", rank_errors),
                        ("bad_files", bad_files), ("setup_watchdog", setup_watchdog)):
         sub = os.path.join(d, name)
         os.makedirs(sub)
