@@ -54,6 +54,7 @@ typedef struct jd_h5md_meta {
     const char *case_name;
     const char *scene_yaml;      /* the resolved scene text, stored as /parameters/scene */
     double dt;                   /* [s] */
+    const char *author;          /* /h5md/author/name; NULL: $JDEM_AUTHOR, else the user name */
 } jd_h5md_meta;
 
 /* One frame of per-particle data, each an array of 3n doubles (x0 y0 z0 x1 ...), sorted by id.

@@ -45,6 +45,13 @@ static size_t value_size(const column *c) {
     return c->is_int == 2 ? sizeof(int32_t) : c->is_int ? sizeof(int64_t) : sizeof(double);
 }
 
+/* H5MD tuple list: particles_group is an object reference to the particles' group. */
+static int particles_group_ref(hid_t d) {
+    hobj_ref_t ref;
+    if (H5Rcreate(&ref, d, "/particles/all", H5R_OBJECT, -1) < 0) return -1;
+    return h5md_attr_write(d, "particles_group", H5T_STD_REF_OBJ, H5T_STD_REF_OBJ, 0, NULL, &ref);
+}
+
 /* Open the column's dataset in group g, creating it (with its attributes) if absent. */
 static hid_t open_column(hid_t g, const column *c, int mark_particles) {
     if (H5Lexists(g, c->name, H5P_DEFAULT) > 0) return H5Dopen2(g, c->name, H5P_DEFAULT);
@@ -55,7 +62,7 @@ static hid_t open_column(hid_t g, const column *c, int mark_particles) {
     hid_t d = h5md_dset_extendible(g, c->name, ftype, c->width > 1 ? 2 : 1, rest, chunk);
     if (d < 0) return d;
     if ((c->unit && h5md_attr_str(d, "unit", c->unit) < 0) ||
-        (mark_particles && c->width == 2 && h5md_attr_str(d, "particles_group", "/particles/all") < 0)) {
+        (mark_particles && c->width == 2 && particles_group_ref(d) < 0)) {
         H5Dclose(d);
         return H5I_INVALID_HID;
     }
@@ -92,7 +99,7 @@ static int append_table(jd_h5md *h, const char *path, const column *cols, size_t
         const size_t vs = value_size(c) * (size_t)c->width;
         for (size_t i = 0; i < n; i++)
             memcpy(buf + i * vs, (const unsigned char *)recs + i * rec_size + c->offset, vs);
-        hid_t d = open_column(g, c, cols == bond_cols);
+        hid_t d = open_column(g, c, 1); /* the id pairs of either table are tuple lists */
         if (d < 0) goto fail;
         const hid_t mtype = c->is_int == 2 ? H5T_NATIVE_INT32 : c->is_int ? H5T_NATIVE_INT64
                                                                           : H5T_NATIVE_DOUBLE;

@@ -72,15 +72,24 @@ static void connectivity_roundtrip(void **state) {
         assert_int_equal(types[i], b[i].type);
         assert_int_equal(steps[i], b[i].formed_step);
     }
-    char attr[64] = "";
-    hid_t a = H5Aopen_by_name(f, "/connectivity/bonds", "particles_group", H5P_DEFAULT,
-                              H5P_DEFAULT);
-    assert_true(a >= 0);
-    hid_t t = H5Aget_type(a);
-    assert_true(H5Aread(a, t, attr) >= 0);
-    H5Tclose(t);
-    H5Aclose(a);
-    assert_string_equal(attr, "/particles/all");
+    /* H5MD tuple lists: particles_group is an object reference to /particles/all */
+    for (int k = 0; k < 2; ++k) {
+        const char *list = k ? "/connectivity/broken_bonds/ids" : "/connectivity/bonds";
+        hid_t a = H5Aopen_by_name(f, list, "particles_group", H5P_DEFAULT, H5P_DEFAULT);
+        assert_true(a >= 0);
+        hid_t t = H5Aget_type(a);
+        assert_true(H5Tequal(t, H5T_STD_REF_OBJ) > 0);
+        hobj_ref_t ref;
+        assert_true(H5Aread(a, H5T_STD_REF_OBJ, &ref) >= 0);
+        H5Tclose(t);
+        H5Aclose(a);
+        char name[64] = "";
+        hid_t g = H5Rdereference2(f, H5P_DEFAULT, H5R_OBJECT, &ref);
+        assert_true(g >= 0);
+        assert_true(H5Iget_name(g, name, sizeof name) > 0);
+        H5Oclose(g);
+        assert_string_equal(name, "/particles/all");
+    }
     assert_int_equal(rows(f, "/connectivity/broken_bonds/position", &rank), 1);
     assert_int_equal(rank, 2);
     double pos[3], v;
