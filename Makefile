@@ -57,7 +57,11 @@ PLUGIN_SRC  := $(wildcard liggghts_plugin/*.cpp)
 UNIT_SRC    := $(wildcard tests/unit/*.c) stepper/hugepages.c # and the engine's block allocator
 HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)
 
-.PHONY: all deps test demo chung-ooi stability unit clean
+# ParaView for the paraview suite only (about 440 MB installed): kept out of `make deps` so that
+# `make demo` stays light; .ci/run installs it before `make test`.
+PARAVIEW_PACKAGES := paraview python3-paraview xvfb xauth
+
+.PHONY: all deps paraview-deps test demo chung-ooi stability unit clean
 all: build/jdem build/liggghts-jdem
 
 # ---------------------------------------------------------------------------------------------
@@ -72,6 +76,9 @@ deps:
 	  echo "deps: installing $$(echo $$missing)"; \
 	  export DEBIAN_FRONTEND=noninteractive; apt-get update -qq && $$cmd -qq >/dev/null; \
 	else echo "deps: missing packages; run as root:  apt-get update && $$cmd"; exit 1; fi
+
+paraview-deps:
+	@$(MAKE) --no-print-directory deps DEB_PACKAGES="$(PARAVIEW_PACKAGES)"
 
 # ---------------------------------------------------------------------------------------------
 # Standalone engine (C11) and its sanitizer twin

@@ -60,6 +60,9 @@ SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--engines", "jde
                       "--out", "out/test/bonds"], "lines", {}),
            ("bonds-sanitized", [PY, "scripts/bond_checks.py", "--quick", "--out",
                                 "out/test/bonds-san"], "lines", SANITIZED)]
+# ParaView (Debian's, `make paraview-deps`) opens both engines' sidecars with its default reader:
+# points, cells, arrays and time steps against the .h5, and a rendered PNG with content.
+SUITES += [("paraview", [PY, "tests/paraview/test_paraview.py"], "lines", {})]
 # The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
 # `make demo` runs the full sweeps.
 CHUNG_OOI = "out/test/chung_ooi"
