@@ -542,7 +542,7 @@ int sim_bonds_output(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
         b->formed = NULL;
         b->formed_cap = 0;
     }
-    return rc;
+    return rc ? JD_RUN_OUTPUT : 0;
 }
 
 static int32_t find(int32_t *parent, int32_t x) {

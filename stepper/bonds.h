@@ -107,8 +107,8 @@ size_t sim_bonds_memory_bytes(const jd_bonds *b, size_t n_particles);
 void sim_bonds_forces(struct jd_sim *s);
 
 /* Write the bonds formed and the bonds broken since the last call to /connectivity (h may be
- * NULL: only forget them).  0, or -1 with err (a write error, or the bond loop ran out of
- * memory). */
+ * NULL: only forget them).  0; JD_RUN_OUTPUT with err on a write error; -1 with err when the
+ * bond loop ran out of memory. */
 int sim_bonds_output(struct jd_sim *s, jd_h5md *h, char *err, size_t errlen);
 
 void sim_bonds_observables(const struct jd_sim *s, jd_bond_observables *o);

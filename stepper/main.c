@@ -1,11 +1,11 @@
 /*
  * main.c — the `jdem` command line (docs/scenes.md).
  *
- * Exit status: 0 success, 2 usage or input error (bad option, bad scene, unsafe time step),
- * 1 runtime failure (cannot write the output, simulation diverged, watchdog, out of memory),
- * 128 + N when stopped by signal N (SIGINT 130, SIGTERM 143).  A failed or stopped run never
- * leaves a file under the final output name: the writer works on OUT.part and renames it only
- * at a successful close; a stopped run closes OUT.part properly, so it stays readable.
+ * Exit status by failure class (the `exit status` paragraph of the help below): 0 success,
+ * 2 bad input, 3 I/O failure, 4 the simulation failed (watchdog, diverged), 5 out of memory,
+ * 1 internal error, 128 + N stopped by signal N.  A failed or stopped run never leaves a file
+ * under the final output name: the writer works on OUT.part and renames it only at a
+ * successful close; a stopped run closes OUT.part properly, so it stays readable.
  */
 #include <errno.h>
 #include <signal.h>
@@ -22,7 +22,7 @@
 #define JDEM_VERSION "unknown"
 #endif
 
-enum { EXIT_RUNTIME = 1, EXIT_USAGE = 2 };
+enum { EXIT_INTERNAL = 1, EXIT_INPUT = 2, EXIT_IO = 3, EXIT_FAILED_RUN = 4, EXIT_NO_MEMORY = 5 };
 
 static const char usage_text[] =
     "usage: jdem COMMAND SCENE [OPTIONS]\n"
@@ -79,13 +79,22 @@ static const char usage_text[] =
     "\n"
     "watchdog (run, scene key watchdog:): a non-finite state, an overlap beyond\n"
     "max_overlap_fraction of the smaller radius, or a jump of the total energy beyond\n"
-    "max_energy_jump between observable samples stops the run (exit status 1).\n"
+    "max_energy_jump between observable samples stops the run (exit status 4).\n"
     "\n"
     "signals (run): SIGINT or SIGTERM stops the run at the next step (a second one at once);\n"
-    "the frame of that step is written and the trajectory closed, as OUT.h5.part.\n"
+    "the frame of that step is written and the trajectory closed, as OUT.h5.part.  A signal\n"
+    "during set-up stops the run before anything is written; one during the final write lets\n"
+    "the complete run finish (exit status 0).\n"
     "\n"
-    "exit status: 0 success, 1 runtime failure or watchdog, 2 usage or input error,\n"
-    "128 + N stopped by signal N (130 SIGINT, 143 SIGTERM).\n";
+    "exit status:\n"
+    "  0        success (cases: every case is valid; run: OUT.h5 is complete)\n"
+    "  1        internal error (a bug in jdem)\n"
+    "  2        bad input: command line, scene file (including unsafe names), unsafe time step\n"
+    "  3        I/O failure: the output cannot be created or written (disk full, read-only,\n"
+    "           in use by another run)\n"
+    "  4        the simulation failed: the watchdog stopped it or its state diverged\n"
+    "  5        out of memory\n"
+    "  128 + N  stopped by signal N (130 SIGINT, 143 SIGTERM)\n";
 
 typedef struct cli {
     const char *command, *scene, *case_name, *output;
@@ -103,7 +112,7 @@ static int thread_count(const char *s) {
 static int usage_error(const char *msg, const char *arg) {
     fprintf(stderr, "jdem: %s%s%s\n", msg, arg ? ": " : "", arg ? arg : "");
     fprintf(stderr, "Try 'jdem --help'.\n");
-    return EXIT_USAGE;
+    return EXIT_INPUT;
 }
 
 /* Returns 0, or an exit status. */
@@ -163,26 +172,35 @@ static int parse(int argc, char **argv, cli *c) {
     return 0;
 }
 
+/* The exit status of a failed scene_list_cases / scene_load, after printing its message. */
+static int scene_failure(int rc, const char *err) {
+    fprintf(stderr, "jdem: %s\n", err);
+    return rc == SCENE_NO_MEMORY ? EXIT_NO_MEMORY : EXIT_INPUT;
+}
+
+/* The names are printed only once every case has loaded: a scene that cannot run is refused
+ * here, not at the run of its first bad case. */
 static int cmd_cases(const cli *c) {
     char err[1024];
     char **names = NULL;
     const int n = scene_list_cases(c->scene, &names, err, sizeof err);
-    if (n < 0) {
-        fprintf(stderr, "jdem: %s\n", err);
-        return EXIT_USAGE;
+    if (n < 0) return scene_failure(n, err);
+    int rc = 0;
+    for (int k = 0; k < n && !rc; k++) {
+        jd_scene sc;
+        const int loaded = scene_load(c->scene, names[k], &sc, err, sizeof err);
+        if (loaded != 0) rc = scene_failure(loaded, err);
+        else scene_free(&sc);
     }
-    for (int k = 0; k < n; k++) printf("%s\n", names[k]);
+    for (int k = 0; k < n && !rc; k++) printf("%s\n", names[k]);
     scene_free_names(names, n);
-    return 0;
+    return rc;
 }
 
 static int load(const cli *c, jd_scene *sc) {
     char err[1024];
-    if (scene_load(c->scene, c->case_name, sc, err, sizeof err) != 0) {
-        fprintf(stderr, "jdem: %s\n", err);
-        return EXIT_USAGE;
-    }
-    return 0;
+    const int rc = scene_load(c->scene, c->case_name, sc, err, sizeof err);
+    return rc ? scene_failure(rc, err) : 0;
 }
 
 static int cmd_resolve(const cli *c) {
@@ -191,7 +209,7 @@ static int cmd_resolve(const cli *c) {
     if (rc) return rc;
     if (scene_emit_yaml(&sc, stdout) != 0 || fflush(stdout) != 0) {
         fprintf(stderr, "jdem: cannot write the resolved scene\n");
-        rc = EXIT_RUNTIME;
+        rc = EXIT_IO;
     }
     scene_free(&sc);
     return rc;
@@ -224,7 +242,7 @@ static int check_time_step(const jd_scene *sc, const cli *c) {
     jd_guard_result g;
     if (sim_guard(sc, &in, &species, &g) != 0) {
         fprintf(stderr, "jdem: out of memory in the time-step guard\n");
-        return EXIT_RUNTIME;
+        return EXIT_NO_MEMORY;
     }
     free(species);
     if (!c->quiet) {
@@ -247,7 +265,7 @@ static int check_time_step(const jd_scene *sc, const cli *c) {
     if (!c->force) {
         jd_guard_refusal(&in, &g, "Use --force to run anyway.", msg, sizeof msg);
         fprintf(stderr, "jdem: %s\n", msg);
-        return EXIT_USAGE;
+        return EXIT_INPUT;
     }
     jd_guard_warning(&in, &g, "--force", msg, sizeof msg);
     fprintf(stderr, "jdem: %s\n", msg);
@@ -260,7 +278,8 @@ static volatile sig_atomic_t stop_signal;
 static void on_stop_signal(int sig) { stop_signal = sig; }
 
 /* SA_RESETHAND: a second signal takes the default action, for a run that does not get to its
- * next step.  SA_RESTART: HDF5's writes are not cut short by the first one. */
+ * next step.  SA_RESTART: HDF5's writes are not cut short by the first one.  Installed before
+ * the scene is read, so that no signal finds OUT.part created but not yet watched. */
 static void catch_stop_signals(void) {
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -271,21 +290,39 @@ static void catch_stop_signals(void) {
     sigaction(SIGTERM, &sa, NULL);
 }
 
-/* The message of a run that did not complete; returns the exit status.  The file was closed
+static const char *stop_signal_text(void) {
+    return stop_signal == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)";
+}
+
+/* A signal before the trajectory is created: stop with nothing written. */
+static int stopped_in_setup(void) {
+    fprintf(stderr, "jdem: %s during set-up; nothing was written\n", stop_signal_text());
+    return 128 + stop_signal;
+}
+
+/* The engine reports every allocation failure as "out of memory ..." (sim.c, neighbour.c,
+ * reorder.c, bonds.c); its other set-up failures come from the scene (a loads file, walls). */
+static int setup_failure(const char *err) {
+    return strstr(err, "out of memory") ? EXIT_NO_MEMORY : EXIT_INPUT;
+}
+
+/* The exit status of a run that did not complete, after its message.  The file was closed
  * with ok = 0: readable, and kept as OUT.part, never under the name of a complete run. */
 static int report_unfinished(int rc, const jd_sim *sim, const char *err, const char *out) {
     if (rc == JD_RUN_STOPPED) {
         fprintf(stderr, "jdem: %s at step %lld; the trajectory up to step %lld is kept, closed, "
-                "as %s.part\n", stop_signal == SIGINT ? "interrupted (SIGINT)" : "terminated "
-                "(SIGTERM)", (long long)sim->step, (long long)sim->frame_step, out);
+                "as %s.part\n", stop_signal_text(), (long long)sim->step,
+                (long long)sim->frame_step, out);
         return 128 + stop_signal;
     }
-    if (rc == JD_RUN_TRIPPED)
+    if (rc == JD_RUN_TRIPPED) {
         fprintf(stderr, "jdem: %s; the trajectory up to step %lld is kept, closed, as %s.part "
                 "(the run failed)\n", err, (long long)sim->frame_step, out);
-    else
-        fprintf(stderr, "jdem: %s; the partial trajectory is in %s.part\n", err, out);
-    return EXIT_RUNTIME;
+        return EXIT_FAILED_RUN;
+    }
+    fprintf(stderr, "jdem: %s; the partial trajectory is in %s.part\n", err, out);
+    if (rc == JD_RUN_OUTPUT) return EXIT_IO;
+    return strstr(err, "out of memory") ? EXIT_NO_MEMORY : EXIT_FAILED_RUN;
 }
 
 /* One line per part of the time loop, and a machine-readable summary line (scripts/bench.py). */
@@ -314,73 +351,96 @@ static void print_timing(const jd_sim *s) {
             (long long)s->n_builds, s->threads, s->pairs.n, s->wall_pairs.n, sim_memory_bytes(s));
 }
 
-static int cmd_run(const cli *c) {
-    jd_scene sc;
-    int rc = load(c, &sc);
-    if (rc) return rc;
+/* The output path: -o, or out/SCENE_NAME/CASE.jdem.h5.  The names are checked by the scene
+ * reader (no '/', never "." or ".."), so the default path stays inside out/. */
+static int output_path(const cli *c, const jd_scene *sc, char *out, size_t size) {
+    const int k = c->output ? snprintf(out, size, "%s", c->output)
+                            : snprintf(out, size, "out/%s/%s.jdem.h5", sc->name, sc->case_name);
+    if (k < 0 || (size_t)k >= size - sizeof ".part") {
+        fprintf(stderr, "jdem: the output path is too long; valid: at most %zu characters\n",
+                size - sizeof ".part" - 1);
+        return EXIT_INPUT;
+    }
+    return 0;
+}
+
+/* Open the trajectory of a set-up run; NULL after reporting, with the exit status in *rc. */
+static jd_h5md *create_output(const jd_scene *sc, const jd_sim *sim, const char *out, int *rc) {
     char err[1024] = "";
-    char out[4096];
-    jd_sim sim;
-    int sim_ok = 0;
-    jd_h5md *h = NULL;
-    char *yaml = NULL;
-    double *mass = NULL;
-    if ((rc = check_time_step(&sc, c)) != 0) goto done;
-    rc = EXIT_RUNTIME;
-    if (c->output)
-        snprintf(out, sizeof out, "%s", c->output);
-    else if (snprintf(out, sizeof out, "out/%s/%s.jdem.h5", sc.name, sc.case_name) >= (int)sizeof out)
-        goto fail;
-    if (make_parent_dirs(out, err, sizeof err) != 0) goto fail;
-    const jd_sim_options opt = {
-        .allpairs = getenv("JDEM_NEIGHBOUR") && !strcmp(getenv("JDEM_NEIGHBOUR"), "allpairs"),
-        .no_sort = c->no_sort, .all_laws = c->all_laws, .plain_loops = c->plain_loops,
-        .threads = c->threads ? c->threads : 1};
-    if (sim_init(&sim, &sc, &opt, err, sizeof err) != 0) goto fail;
-    sim_ok = 1;
-    yaml = scene_yaml_string(&sc);
-    if (!yaml) {
-        snprintf(err, sizeof err, "out of memory writing the resolved scene");
-        goto fail;
-    }
-    const jd_h5md_meta meta = {.creator = "jdem", .creator_version = JDEM_VERSION,
-                               .scene_name = sc.name, .case_name = sc.case_name,
-                               .scene_yaml = yaml, .dt = sc.dt};
+    char *yaml = scene_yaml_string(sc);
     /* the particles' constants in scene order (the engine may have renumbered them) */
-    if (!(mass = malloc((sc.n_particles ? sc.n_particles : 1) * sizeof *mass))) {
-        snprintf(err, sizeof err, "out of memory");
-        goto fail;
+    double *mass = malloc((sc->n_particles ? sc->n_particles : 1) * sizeof *mass);
+    jd_h5md *h = NULL;
+    *rc = EXIT_NO_MEMORY;
+    if (!yaml || !mass) {
+        fprintf(stderr, "jdem: out of memory preparing the output\n");
+    } else {
+        sim_scalars_in_scene_order(sim, sim->mass, mass);
+        const jd_h5md_meta meta = {.creator = "jdem", .creator_version = JDEM_VERSION,
+                                   .scene_name = sc->name, .case_name = sc->case_name,
+                                   .scene_yaml = yaml, .dt = sc->dt};
+        const jd_h5md_particles parts = {.n = sc->n_particles, .id = sc->id,
+                                         .species = sc->material, .radius = sc->radius,
+                                         .mass = mass};
+        if (!(h = jd_h5md_create(out, &meta, &parts, err, sizeof err))) {
+            fprintf(stderr, "jdem: %s\n", err);
+            *rc = EXIT_IO;
+        }
     }
-    sim_scalars_in_scene_order(&sim, sim.mass, mass);
-    const jd_h5md_particles parts = {.n = sc.n_particles, .id = sc.id, .species = sc.material,
-                                     .radius = sc.radius, .mass = mass};
-    h = jd_h5md_create(out, &meta, &parts, err, sizeof err);
+    free(yaml);
     free(mass);
-    mass = NULL;
-    if (!h) goto fail;
-    sim.stop = &stop_signal;
-    catch_stop_signals();
-    const int run_rc = sim_run(&sim, h, !c->quiet, err, sizeof err);
-    if (c->timing) print_timing(&sim);
+    return h;
+}
+
+/* Run the set-up sim into h and close it; returns the exit status. */
+static int run_and_close(const cli *c, jd_sim *sim, jd_h5md *h, const char *out) {
+    char err[1024] = "";
+    sim->stop = &stop_signal;
+    const int run_rc = sim_run(sim, h, !c->quiet, err, sizeof err);
+    if (c->timing) print_timing(sim);
     if (run_rc != 0) {
         char err2[256];
         if (jd_h5md_close(h, 0, err2, sizeof err2) != 0)
             fprintf(stderr, "jdem: closing %s.part failed: %s\n", out, err2);
-        rc = report_unfinished(run_rc, &sim, err, out);
-        goto done;
+        return report_unfinished(run_rc, sim, err, out);
     }
-    if (jd_h5md_close(h, 1, err, sizeof err) != 0) goto fail;
+    if (jd_h5md_close(h, 1, err, sizeof err) != 0) {
+        fprintf(stderr, "jdem: %s\n", err);
+        return EXIT_IO;
+    }
     if (!c->quiet)
         fprintf(stderr, "jdem: wrote %s (%lld steps, %lld neighbour builds)\n", out,
-                (long long)sim.step, (long long)sim.n_builds);
-    rc = 0;
-    goto done;
-fail:
-    fprintf(stderr, "jdem: %s\n", err[0] ? err : "output path too long");
-done:
-    free(yaml);
-    free(mass);
-    if (sim_ok) sim_free(&sim);
+                (long long)sim->step, (long long)sim->n_builds);
+    return 0;
+}
+
+static int cmd_run(const cli *c) {
+    catch_stop_signals();
+    jd_scene sc;
+    int rc = load(c, &sc);
+    if (rc) return rc;
+    char out[4096], err[1024] = "";
+    jd_sim sim;
+    const jd_sim_options opt = {
+        .allpairs = getenv("JDEM_NEIGHBOUR") && !strcmp(getenv("JDEM_NEIGHBOUR"), "allpairs"),
+        .no_sort = c->no_sort, .all_laws = c->all_laws, .plain_loops = c->plain_loops,
+        .threads = c->threads ? c->threads : 1};
+    if ((rc = check_time_step(&sc, c)) || (rc = output_path(c, &sc, out, sizeof out))) {
+        scene_free(&sc);
+        return rc;
+    }
+    if (make_parent_dirs(out, err, sizeof err) != 0) {
+        fprintf(stderr, "jdem: %s\n", err);
+        rc = EXIT_IO;
+    } else if (sim_init(&sim, &sc, &opt, err, sizeof err) != 0) {
+        fprintf(stderr, "jdem: %s\n", err);
+        rc = setup_failure(err);
+    } else {
+        jd_h5md *h = NULL;
+        if (stop_signal) rc = stopped_in_setup();
+        else if ((h = create_output(&sc, &sim, out, &rc))) rc = run_and_close(c, &sim, h, out);
+        sim_free(&sim);
+    }
     scene_free(&sc);
     return rc;
 }

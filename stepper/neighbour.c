@@ -242,6 +242,12 @@ static int bin_particles(jd_sim *s, double h, const double lo[3], const int nc[3
     return 0;
 }
 
+static double grid_cells(const double lo[3], const double hi[3], double h) {
+    double cells = 1.0;
+    for (int d = 0; d < 3; d++) cells *= floor((hi[d] - lo[d]) / h) + 1.0;
+    return cells;
+}
+
 /* The cell grid over the particles' bounding box: cell edge h >= the largest interaction
  * range, grown if the box would need more than about 8 cells per particle (sparse or scattered
  * systems).  Fails on a non-finite position. */
@@ -265,9 +271,11 @@ static int cell_grid(const jd_sim *s, double *h_out, double lo[3], int nc[3], ch
     }
     double h = 2.0 * rmax + s->skin;
     const double max_cells = 8.0 * (double)s->n + 64.0;
-    double cells = 1.0;
-    for (int d = 0; d < 3; d++) cells *= floor((hi[d] - lo[d]) / h) + 1.0;
+    const double cells = grid_cells(lo, hi, h);
     if (cells > max_cells) h *= cbrt(cells / max_cells) * 1.01;
+    /* the cube root fits a box spread in three dimensions; a flat one (one particle far away
+     * along one axis) can keep far more cells than that, without bound: cap them at 8x */
+    while (grid_cells(lo, hi, h) > 8.0 * max_cells && isfinite(h)) h *= 2.0;
     for (int d = 0; d < 3; d++) nc[d] = (int)floor((hi[d] - lo[d]) / h) + 1;
     *h_out = h;
     return 0;

@@ -59,30 +59,34 @@ static const yaml_node_t *section(loader *L, const char *key, const char *const 
 /* ---------------------------------------------------------------------------------------- */
 /* Header, time, output, gravity, model                                                      */
 
-static void file_stem(const char *path, char *out, size_t size) {
-    const char *base = strrchr(path, '/');
-    base = base ? base + 1 : path;
+/* The default name: the file name without directory and extension, checked as a name. */
+static int file_stem(sd_ctx *c, const yaml_node_t *root, char *out, size_t size) {
+    const char *base = strrchr(c->file, '/');
+    base = base ? base + 1 : c->file;
     const char *dot = strrchr(base, '.');
-    size_t len = dot && dot != base ? (size_t)(dot - base) : strlen(base);
-    if (len >= size) len = size - 1;
+    const size_t len = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+    if (sd_check_name(c, root, "name", base, len, size)) {
+        const size_t used = strlen(c->err);
+        snprintf(c->err + used, c->errlen - used, " (the default name is the file name: give "
+                 "name:)");
+        return -1;
+    }
     memcpy(out, base, len);
     out[len] = '\0';
+    return 0;
 }
 
 /* name (default: the file stem) and, for a file without sweep, the case name (default: name). */
 static int read_names(sd_ctx *c, const yaml_node_t *root, char name[JD_NAME_MAX],
                       char case_name[2 * JD_NAME_MAX]) {
     const yaml_node_t *n = sd_get(c, root, "name");
-    if (n) {
-        if (sd_str(c, n, "name", name, JD_NAME_MAX)) return -1;
-    } else {
-        file_stem(c->file, name, JD_NAME_MAX);
-    }
+    if (n ? sd_name(c, n, "name", name, JD_NAME_MAX) : file_stem(c, root, name, JD_NAME_MAX))
+        return -1;
     const yaml_node_t *cn = sd_get(c, root, "case");
     if (cn && sd_get(c, root, "sweep"))
         return sd_fail(c, cn, "case", "a scene with a sweep names its cases by the sweep; valid: "
                        "case only without sweep");
-    if (cn) return sd_str(c, cn, "case", case_name, 2 * JD_NAME_MAX);
+    if (cn) return sd_name(c, cn, "case", case_name, 2 * JD_NAME_MAX);
     snprintf(case_name, 2 * JD_NAME_MAX, "%s", name);
     return 0;
 }
@@ -152,13 +156,13 @@ static int auto_dt(loader *L) {
     jd_guard_species *species;
     jd_guard_result g;
     if (sim_guard(L->s, &in, &species, &g) != 0)
-        return sd_fail(&L->c, L->time, "time.dt", "auto: out of memory in the time-step guard");
+        return sd_no_memory(&L->c, L->time, "time.dt");
     free(species);
     if (!(g.safe_dt > 0.0 && isfinite(g.safe_dt)))
         return sd_fail(&L->c, L->time, "time.dt", "auto: the time-step guard finds no bound (%g s); "
                        "valid: a number > 0", g.safe_dt);
     L->s->dt = JD_DT_AUTO_FACTOR * g.safe_dt;
-    return read_steps(L, L->time);
+    return read_steps(L, L->time) || scene_bond_rule_steps(L);
 }
 
 static int read_time(loader *L) {
@@ -279,7 +283,7 @@ static double fall_height(const jd_scene *s, const double ghat[3]) {
 static int default_impact_speed(loader *L) {
     jd_scene *s = L->s;
     vel *u = malloc(s->n_particles * sizeof *u);
-    if (!u) return sd_fail(&L->c, L->root, NULL, "out of memory");
+    if (!u) return sd_no_memory(&L->c, L->root, NULL);
     double v = max_relative_speed(s, u);
     free(u);
     for (size_t i = 0; i < s->n_particles; i++)
@@ -339,8 +343,8 @@ static int pick_case(sd_ctx *c, char **names, int n, const char *case_name) {
     if (!case_name)
         return sd_fail(c, sweep, "sweep", "the scene has %d cases, choose one; valid: %s", n,
                        valid);
-    return sd_fail(c, sweep ? sweep : root, sweep ? "sweep" : NULL, "no case '%s'; valid: %s",
-                   case_name, valid);
+    return sd_fail(c, sweep ? sweep : root, sweep ? "sweep" : NULL,
+                   "no case " SD_QUOTE "; valid: %s", case_name, valid);
 }
 
 /* Load the document and list its cases; the document is kept (caller deletes it). */
@@ -360,7 +364,8 @@ int scene_list_cases(const char *path, char ***names, char *err, size_t errlen) 
     yaml_document_t doc;
     char name[JD_NAME_MAX], case_name[2 * JD_NAME_MAX];
     int n;
-    if (open_cases(&c, path, &doc, name, case_name, names, &n)) return -1;
+    if (open_cases(&c, path, &doc, name, case_name, names, &n))
+        return c.no_memory ? SCENE_NO_MEMORY : SCENE_BAD_INPUT;
     yaml_document_delete(&doc);
     return n;
 }
@@ -379,7 +384,8 @@ int scene_load(const char *path, const char *case_name, jd_scene *scene, char *e
         return -1;
     }
     snprintf(scene->path, sizeof scene->path, "%s", path);
-    if (open_cases(&L.c, path, &doc, scene->name, scene->case_name, &names, &n)) return -1;
+    if (open_cases(&L.c, path, &doc, scene->name, scene->case_name, &names, &n))
+        return L.c.no_memory ? SCENE_NO_MEMORY : SCENE_BAD_INPUT;
     int k = pick_case(&L.c, names, n, case_name);
     int rc = k < 0 ? -1 : sd_apply_case(&L.c, k);
     if (rc == 0) {
@@ -397,7 +403,7 @@ int scene_load(const char *path, const char *case_name, jd_scene *scene, char *e
     sd_free_names(names, n);
     yaml_document_delete(&doc);
     if (rc) scene_free(scene);
-    return rc ? -1 : 0;
+    return !rc ? 0 : L.c.no_memory ? SCENE_NO_MEMORY : SCENE_BAD_INPUT;
 }
 
 void scene_free(jd_scene *scene) {

@@ -70,6 +70,8 @@ typedef struct jd_bond_rule {
     unsigned char *materials; /* n_materials flags: 1 = particles of that material take part */
     int64_t id_range[2];      /* ids in [first, last] take part */
     double max_gap;           /* surface gap <= max_gap x the smaller radius [-] */
+    double time;              /* the rule's `time` [s] (NAN if given by step); with an auto dt,
+                                 step is set from it once dt is known */
 } jd_bond_rule;
 
 typedef struct jd_scene {
@@ -135,13 +137,19 @@ typedef struct jd_scene {
     jd_bond_rule *bond_rules; /* sorted by step (stable) */
 } jd_scene;
 
+/* The failures of scene_list_cases and scene_load: the file is not a valid scene (or cannot be
+ * read), or memory ran out while reading it.  Either way err holds the message. */
+enum { SCENE_BAD_INPUT = -1, SCENE_NO_MEMORY = -2 };
+
 /* List the case names of a scene file.  Returns the number of cases (>= 1) and an array of
- * names in *names (free with scene_free_names), or -1 with a message in err. */
+ * names in *names (free with scene_free_names), or SCENE_BAD_INPUT / SCENE_NO_MEMORY with a
+ * message in err. */
 int scene_list_cases(const char *path, char ***names, char *err, size_t errlen);
 void scene_free_names(char **names, int n);
 
-/* Load one case (case_name NULL: the scene must have exactly one case).  Returns 0, or -1 with
- * a message "FILE:LINE: key 'a.b.c': what is wrong; what would be valid" in err. */
+/* Load one case (case_name NULL: the scene must have exactly one case).  Returns 0, or
+ * SCENE_BAD_INPUT with a message "FILE:LINE: key 'a.b.c': what is wrong; what would be valid"
+ * in err, or SCENE_NO_MEMORY. */
 int scene_load(const char *path, const char *case_name, jd_scene *scene, char *err, size_t errlen);
 
 /* Write the resolved scene as YAML in the scene-file schema (no sweep, no generate, every

@@ -131,7 +131,7 @@ static int sphere(loader *L, const yaml_node_t *g, const char *path, int32_t gen
                        D / b.radius);
     const size_t w = (size_t)(2 * m + 1);
     int64_t *idx = malloc(w * w * w * sizeof *idx); /* lattice index -> id, 0: no site */
-    if (!idx) return sd_fail(&L->c, g, path, "out of memory");
+    if (!idx) return sd_no_memory(&L->c, g, path);
     int rc = 0;
 #define AT(i, j, k) idx[((size_t)((k) + m) * w + (size_t)((j) + m)) * w + (size_t)((i) + m)]
     for (int64_t k = -m; k <= m && rc == 0; k++)

@@ -39,20 +39,20 @@ static int read_strength(loader *L, const yaml_node_t *m, const char *path, cons
     char *end = NULL;
     const double v = s ? strtod(s, &end) : NAN;
     if (!s || end == s || *end != '\0' || !isfinite(v) || !(v > 0.0))
-        return sd_fail(&L->c, n, sub, "'%s' is not a strength; valid: a number > 0 [Pa], or .inf",
-                       s ? s : sd_kind(n));
+        return sd_fail(&L->c, n, sub, SD_QUOTE " is not a strength; valid: a number > 0 [Pa], "
+                       "or .inf", s ? s : sd_kind(n));
     *out = v;
     return 0;
 }
 
 static int read_type(loader *L, const yaml_node_pair_t *p, jd_bond_type *t) {
-    const char *name = sd_scalar(sd_node(&L->c, p->key));
+    const yaml_node_t *key = sd_node(&L->c, p->key);
+    const char *name = sd_scalar(key);
     const yaml_node_t *m = sd_node(&L->c, p->value);
+    if (sd_check_name(&L->c, key, "bond_types", name, key->data.scalar.length, JD_NAME_MAX))
+        return -1;
     char path[SD_PATH_MAX];
     sd_join(path, "bond_types", name);
-    if (strlen(name) >= JD_NAME_MAX)
-        return sd_fail(&L->c, sd_node(&L->c, p->key), path, "name too long; valid: at most %d "
-                       "characters", JD_NAME_MAX - 1);
     snprintf(t->name, sizeof t->name, "%s", name);
     t->p = (jd_bond_params){.lambda = 1.0, .gamma = 0.0, .bending = JD_BOND_BEND_I};
     return sd_keys(&L->c, m, path, TYPE_KEYS) ||
@@ -74,7 +74,7 @@ int scene_read_bond_types(loader *L) {
     if (sd_keys(&L->c, m, "bond_types", NULL)) return -1;
     size_t n = (size_t)(m->data.mapping.pairs.top - m->data.mapping.pairs.start);
     s->bond_types = calloc(n ? n : 1, sizeof *s->bond_types);
-    if (!s->bond_types) return sd_fail(&L->c, m, "bond_types", "out of memory");
+    if (!s->bond_types) return sd_no_memory(&L->c, m, "bond_types");
     s->n_bond_types = n;
     for (size_t i = 0; i < n; i++)
         if (read_type(L, &m->data.mapping.pairs.start[i], &s->bond_types[i])) return -1;
@@ -94,7 +94,7 @@ int scene_req_bond_type(loader *L, const yaml_node_t *map, const char *path, con
     if (!L->s->n_bond_types) snprintf(valid, sizeof valid, "a name defined under bond_types");
     if (!n) return sd_missing(&L->c, map, path, key, valid);
     sd_join(sub, path, key);
-    if (sd_str(&L->c, n, sub, name, sizeof name)) return -1;
+    if (sd_name(&L->c, n, sub, name, sizeof name)) return -1;
     for (size_t i = 0; i < L->s->n_bond_types; i++)
         if (strcmp(L->s->bond_types[i].name, name) == 0) {
             *out = (int)i;
@@ -116,7 +116,7 @@ int scene_add_bond(loader *L, const yaml_node_t *node, int64_t a, int64_t b, int
         if (ty) s->bond_type = ty;
         const yaml_node_t **bn = realloc(L->bnode, cap * sizeof *bn);
         if (bn) L->bnode = bn;
-        if (!ids || !ty || !bn) return sd_fail(&L->c, node, "bonds", "out of memory");
+        if (!ids || !ty || !bn) return sd_no_memory(&L->c, node, "bonds");
         L->bond_cap = cap;
     }
     const size_t k = s->n_bonds++;
@@ -149,16 +149,28 @@ static int read_bond(loader *L, const yaml_node_t *b, const char *path) {
     return scene_add_bond(L, b, id[0], id[1], type);
 }
 
+/* A rule's time [s] -> step ceil(time/dt - 1e-9) (as end_time). */
+static int time_to_step(loader *L, const yaml_node_t *at, const char *path, double time,
+                        int64_t *step) {
+    const double steps = ceil(time / L->s->dt - 1e-9);
+    if (!(steps < 9.0e18))
+        return sd_fail(&L->c, at, path, "time/dt gives %g steps (dt = %g s); valid: at most 9e18",
+                       steps, L->s->dt);
+    *step = steps > 0.0 ? (int64_t)steps : 0;
+    return 0;
+}
+
 /* The rule's group: materials (default all) and id_range (default: the whole id range, set
  * after the sort in scene_resolve_bonds when absent: marked by id_range[0] > id_range[1]). */
 static int read_rule(loader *L, const yaml_node_t *r, const char *path, jd_bond_rule *rule) {
     jd_scene *s = L->s;
     char sub[SD_PATH_MAX], item[SD_PATH_MAX];
     rule->max_gap = DEFAULT_MAX_GAP;
+    rule->time = NAN;
     rule->id_range[0] = 1;
     rule->id_range[1] = 0;
     rule->materials = calloc(s->n_materials, 1);
-    if (!rule->materials) return sd_fail(&L->c, r, path, "out of memory");
+    if (!rule->materials) return sd_no_memory(&L->c, r, path);
     if (sd_keys(&L->c, r, path, RULE_KEYS) || scene_req_bond_type(L, r, path, "type", &rule->type) ||
         sd_opt_num(&L->c, r, path, "max_gap", SD_NONNEGATIVE, &rule->max_gap))
         return -1;
@@ -171,13 +183,12 @@ static int read_rule(loader *L, const yaml_node_t *r, const char *path, jd_bond_
         sd_join(sub, path, "step");
         if (sd_int(&L->c, st, sub, 0, &rule->step)) return -1;
     } else {
-        double time;
         sd_join(sub, path, "time");
-        if (sd_num(&L->c, t, sub, SD_NONNEGATIVE, &time)) return -1;
-        const double steps = ceil(time / s->dt - 1e-9);
-        if (!(steps < 9.0e18))
-            return sd_fail(&L->c, t, sub, "time/dt gives %g steps; valid: at most 9e18", steps);
-        rule->step = steps > 0.0 ? (int64_t)steps : 0;
+        if (sd_num(&L->c, t, sub, SD_NONNEGATIVE, &rule->time)) return -1;
+        /* an auto dt is known only once the whole scene is (scene_bond_rule_steps); a later
+         * rule stays a later rule meanwhile */
+        if (s->dt_auto) rule->step = rule->time > 0.0;
+        else if (time_to_step(L, t, sub, rule->time, &rule->step)) return -1;
     }
     const yaml_node_t *m = sd_get(&L->c, r, "materials");
     if (!m) {
@@ -229,7 +240,7 @@ int scene_read_bonds(loader *L) {
         return -1;
     const size_t n = sd_len(rules);
     s->bond_rules = calloc(n ? n : 1, sizeof *s->bond_rules);
-    if (!s->bond_rules) return sd_fail(&L->c, rules, "bond_rules", "out of memory");
+    if (!s->bond_rules) return sd_no_memory(&L->c, rules, "bond_rules");
     for (size_t k = 0; k < n; k++) {
         sd_join_index(path, "bond_rules", k);
         s->n_bond_rules = k + 1; /* so that scene_free frees its material flags */
@@ -277,7 +288,7 @@ static int sort_bonds(loader *L) {
     const yaml_node_t **bn = malloc((n ? n : 1) * sizeof *bn);
     int rc = 0;
     if (!perm || !ids || !ty || !bn) {
-        rc = sd_fail(&L->c, L->root, "bonds", "out of memory");
+        rc = sd_no_memory(&L->c, L->root, "bonds");
         goto done;
     }
     for (size_t k = 0; k < n; k++) perm[k] = k;
@@ -320,6 +331,16 @@ done:
     return rc;
 }
 
+/* By step; rules of one step keep their order (insertion sort is stable; lists are short). */
+static void sort_rules(jd_scene *s) {
+    for (size_t i = 1; i < s->n_bond_rules; i++)
+        for (size_t j = i; j > 0 && s->bond_rules[j - 1].step > s->bond_rules[j].step; j--) {
+            const jd_bond_rule t = s->bond_rules[j];
+            s->bond_rules[j] = s->bond_rules[j - 1];
+            s->bond_rules[j - 1] = t;
+        }
+}
+
 int scene_resolve_bonds(loader *L) {
     jd_scene *s = L->s;
     for (size_t k = 0; k < s->n_bonds; k++)
@@ -343,7 +364,7 @@ int scene_resolve_bonds(loader *L) {
         }
         int32_t *pairs = NULL;
         const long np = jd_bond_rule_pairs(s, rule, s->position, &pairs);
-        if (np < 0) return sd_fail(&L->c, L->root, "bond_rules", "out of memory");
+        if (np < 0) return sd_no_memory(&L->c, L->root, "bond_rules");
         char path[SD_PATH_MAX];
         sd_join_index(path, "bond_rules", r);
         const yaml_node_t *node = sd_item(&L->c, sd_get(&L->c, L->root, "bond_rules"), r);
@@ -359,12 +380,17 @@ int scene_resolve_bonds(loader *L) {
         }
     }
     s->n_bond_rules = kept;
-    /* by step; rules of one step keep their order (insertion sort is stable; lists are short) */
-    for (size_t i = 1; i < kept; i++)
-        for (size_t j = i; j > 0 && s->bond_rules[j - 1].step > s->bond_rules[j].step; j--) {
-            const jd_bond_rule t = s->bond_rules[j];
-            s->bond_rules[j] = s->bond_rules[j - 1];
-            s->bond_rules[j - 1] = t;
-        }
+    sort_rules(s);
     return sort_bonds(L);
+}
+
+int scene_bond_rule_steps(loader *L) {
+    jd_scene *s = L->s;
+    for (size_t r = 0; r < s->n_bond_rules; r++)
+        if (!isnan(s->bond_rules[r].time) &&
+            time_to_step(L, sd_get(&L->c, L->root, "bond_rules"), "bond_rules",
+                         s->bond_rules[r].time, &s->bond_rules[r].step))
+            return -1;
+    sort_rules(s);
+    return 0;
 }

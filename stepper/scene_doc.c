@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "scene.h"
 
@@ -39,6 +40,15 @@ int sd_fail(sd_ctx *c, const yaml_node_t *at, const char *path, const char *fmt,
         va_end(ap);
     }
     return -1;
+}
+
+int sd_no_memory(sd_ctx *c, const yaml_node_t *at, const char *path) {
+    c->no_memory = 1;
+    if (!at) {
+        snprintf(c->err, c->errlen, "%s: out of memory reading the scene", c->file);
+        return -1;
+    }
+    return sd_fail(c, at, path, "out of memory reading the scene");
 }
 
 const char *sd_kind(const yaml_node_t *n) {
@@ -99,6 +109,9 @@ static void range_text(sd_range r, char *out, size_t size) {
 /* Loading                                                                                   */
 
 static int parser_fail(sd_ctx *c, const yaml_parser_t *p) {
+    if (p->error == YAML_MEMORY_ERROR) return sd_no_memory(c, NULL, NULL);
+    if (p->error == YAML_READER_ERROR && ferror(c->in))
+        return snprintf(c->err, c->errlen, "%s: cannot read: %s", c->file, strerror(errno)), -1;
     snprintf(c->err, c->errlen, "%s:%zu: invalid YAML: %s%s%s; valid: a YAML document", c->file,
              p->problem_mark.line + 1, p->problem ? p->problem : "parse error",
              p->context ? " " : "", p->context ? p->context : "");
@@ -117,21 +130,62 @@ static int check_single_document(sd_ctx *c, yaml_parser_t *p) {
     return rc;
 }
 
+/* libyaml's scanner takes time quadratic in the nesting depth (0.5 MB of brackets: a minute),
+ * and no scene nests deeper than a few levels: a pass over the event stream refuses a deeper
+ * file before the tree is built, in time linear in its size. */
+static int check_depth(sd_ctx *c) {
+    yaml_parser_t p;
+    if (!yaml_parser_initialize(&p)) return sd_no_memory(c, NULL, NULL);
+    yaml_parser_set_input_file(&p, c->in);
+    int depth = 0, rc = 0;
+    for (yaml_event_type_t type = YAML_NO_EVENT; rc == 0 && type != YAML_STREAM_END_EVENT;) {
+        yaml_event_t e;
+        if (!yaml_parser_parse(&p, &e)) {
+            rc = parser_fail(c, &p);
+            break;
+        }
+        type = e.type;
+        if (type == YAML_MAPPING_START_EVENT || type == YAML_SEQUENCE_START_EVENT) depth++;
+        if (type == YAML_MAPPING_END_EVENT || type == YAML_SEQUENCE_END_EVENT) depth--;
+        if (depth > SD_MAX_DEPTH)
+            rc = sd_fail(c, &(yaml_node_t){.start_mark = e.start_mark}, NULL, "nested more than "
+                         "%d levels deep; valid: at most %d nested mappings and sequences",
+                         SD_MAX_DEPTH, SD_MAX_DEPTH);
+        yaml_event_delete(&e);
+    }
+    yaml_parser_delete(&p);
+    return rc;
+}
+
+/* The scene file, open for reading: a regular file (a directory or a device is refused). */
+static int open_scene(sd_ctx *c, const char *file) {
+    struct stat st;
+    if (!(c->in = fopen(file, "rb")))
+        return snprintf(c->err, c->errlen, "%s: cannot open: %s", file, strerror(errno)), -1;
+    if (fstat(fileno(c->in), &st) != 0 || !S_ISREG(st.st_mode)) {
+        fclose(c->in);
+        c->in = NULL;
+        return snprintf(c->err, c->errlen, "%s: cannot read: not a regular file; valid: a YAML "
+                        "file", file), -1;
+    }
+    return 0;
+}
+
 int sd_load(sd_ctx *c, const char *file, yaml_document_t *doc) {
     c->file = file;
     c->doc = NULL;
-    FILE *f = fopen(file, "rb");
-    if (!f) {
-        snprintf(c->err, c->errlen, "%s: cannot open: %s", file, strerror(errno));
-        return -1;
-    }
+    if (open_scene(c, file)) return -1;
     yaml_parser_t p;
-    if (!yaml_parser_initialize(&p)) {
-        fclose(f);
-        snprintf(c->err, c->errlen, "%s: cannot initialise the YAML parser", file);
+    int ready = check_depth(c) == 0;
+    if (ready && fseek(c->in, 0, SEEK_SET) != 0)
+        ready = snprintf(c->err, c->errlen, "%s: cannot read: %s", file, strerror(errno)) < 0;
+    if (ready && !yaml_parser_initialize(&p)) ready = sd_no_memory(c, NULL, NULL) == 0;
+    if (!ready) {
+        fclose(c->in);
+        c->in = NULL;
         return -1;
     }
-    yaml_parser_set_input_file(&p, f);
+    yaml_parser_set_input_file(&p, c->in);
     int rc = -1;
     if (!yaml_parser_load(&p, doc)) {
         parser_fail(c, &p);
@@ -151,7 +205,8 @@ int sd_load(sd_ctx *c, const char *file, yaml_document_t *doc) {
         }
     }
     yaml_parser_delete(&p);
-    fclose(f);
+    fclose(c->in);
+    c->in = NULL;
     return rc;
 }
 
@@ -272,14 +327,14 @@ int sd_num(sd_ctx *c, const yaml_node_t *n, const char *path, sd_range r, double
     const char *s = plain_text(c, n, path, "a number", valid);
     if (!s) return -1;
     if (yaml_nonfinite(s))
-        return sd_fail(c, n, path, "'%s' is not a finite number; valid: %s", s, valid);
+        return sd_fail(c, n, path, SD_QUOTE " is not a finite number; valid: %s", s, valid);
     char *end;
     errno = 0;
     double v = strtod(s, &end);
     if (end == s || *end != '\0')
-        return sd_fail(c, n, path, "'%s' is not a number; valid: %s", s, valid);
+        return sd_fail(c, n, path, SD_QUOTE " is not a number; valid: %s", s, valid);
     if (!isfinite(v))
-        return sd_fail(c, n, path, "'%s' is not a finite number; valid: %s", s, valid);
+        return sd_fail(c, n, path, SD_QUOTE " is not a finite number; valid: %s", s, valid);
     if (!in_range(v, r)) return sd_fail(c, n, path, "%s is out of range; valid: %s", s, valid);
     *out = v;
     return 0;
@@ -294,7 +349,7 @@ int sd_int(sd_ctx *c, const yaml_node_t *n, const char *path, int64_t lo, int64_
     errno = 0;
     long long v = strtoll(s, &end, 10);
     if (end == s || *end != '\0' || errno == ERANGE)
-        return sd_fail(c, n, path, "'%s' is not an integer; valid: %s", s, valid);
+        return sd_fail(c, n, path, SD_QUOTE " is not an integer; valid: %s", s, valid);
     if (v < lo) return sd_fail(c, n, path, "%s is out of range; valid: %s", s, valid);
     *out = (int64_t)v;
     return 0;
@@ -338,14 +393,48 @@ int sd_points(sd_ctx *c, const yaml_node_t *n, const char *path, size_t count, d
     return 0;
 }
 
-int sd_str(sd_ctx *c, const yaml_node_t *n, const char *path, char *out, size_t size) {
-    if (!n || n->type != YAML_SCALAR_NODE || n->data.scalar.length == 0)
+/* A name is data that ends up in file names, LIGGGHTS identifiers and HDF5 attributes: only
+ * characters that no shell, deck or path gives a meaning to, and never "." or ".." (the first
+ * character is not a dot).  A message quotes at most the first NAME_QUOTE characters of a
+ * rejected name, and only the valid ones, so that the reason always fits and stays one line. */
+#define NAME_QUOTE 32
+
+static int name_char_ok(unsigned char ch, int first) {
+    return (ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') ||
+           ch == '_' || (!first && (ch == '.' || ch == '+' || ch == '-'));
+}
+
+int sd_check_name(sd_ctx *c, const yaml_node_t *at, const char *path, const char *s, size_t len,
+                  size_t size) {
+    size_t bad = 0;
+    while (bad < len && name_char_ok((unsigned char)s[bad], bad == 0)) bad++;
+    const int quoted = (int)(bad < NAME_QUOTE ? bad : NAME_QUOTE);
+    const char *more = bad > NAME_QUOTE ? "..." : "";
+    char valid[160];
+    snprintf(valid, sizeof valid, "valid: 1 to %zu characters from A-Z a-z 0-9 _ . + -, the first "
+             "a letter, a digit or _", size - 1);
+    if (len == 0) return sd_fail(c, at, path, "expected a name, got an empty value; %s", valid);
+    if (bad < len) {
+        const unsigned char ch = (unsigned char)s[bad];
+        char what[24];
+        if (ch > ' ' && ch < 0x7f) snprintf(what, sizeof what, "'%c'", ch);
+        else snprintf(what, sizeof what, "byte 0x%02x", ch);
+        return sd_fail(c, at, path, "the name '%.*s%s' has %s at character %zu, not allowed in a "
+                       "name; %s", quoted, s, more, what, bad + 1, valid);
+    }
+    if (len >= size)
+        return sd_fail(c, at, path, "the name '%.*s%s' is too long (%zu characters); %s", quoted,
+                       s, more, len, valid);
+    return 0;
+}
+
+int sd_name(sd_ctx *c, const yaml_node_t *n, const char *path, char *out, size_t size) {
+    if (!n || n->type != YAML_SCALAR_NODE)
         return sd_fail(c, n, path, "expected a name, got %s; valid: a non-empty string",
                        sd_kind(n));
-    if (n->data.scalar.length >= size)
-        return sd_fail(c, n, path, "'%s' is too long; valid: at most %zu characters",
-                       (const char *)n->data.scalar.value, size - 1);
-    memcpy(out, n->data.scalar.value, n->data.scalar.length + 1);
+    const char *s = (const char *)n->data.scalar.value;
+    if (sd_check_name(c, n, path, s, n->data.scalar.length, size)) return -1;
+    memcpy(out, s, n->data.scalar.length + 1);
     return 0;
 }
 
@@ -361,7 +450,7 @@ int sd_enum(sd_ctx *c, const yaml_node_t *n, const char *path, const char *const
             *out = i;
             return 0;
         }
-    return sd_fail(c, n, path, "unknown value '%s'; valid: %s", s, valid);
+    return sd_fail(c, n, path, "unknown value " SD_QUOTE "; valid: %s", s, valid);
 }
 
 int sd_opt_num(sd_ctx *c, const yaml_node_t *map, const char *path, const char *key, sd_range r,
@@ -418,7 +507,7 @@ static int check_axis(sd_ctx *c, const yaml_node_t *axis, const char *path, size
     sd_join(sub, path, "axis");
     const yaml_node_t *an = sd_get(c, axis, "axis");
     if (!an) return sd_missing(c, axis, path, "axis", "a name");
-    if (sd_str(c, an, sub, name, sizeof name)) return -1;
+    if (sd_name(c, an, sub, name, sizeof name)) return -1;
     const yaml_node_t *values = sd_get(c, axis, "values");
     sd_join(sub, path, "values");
     if (!values) return sd_missing(c, axis, path, "values", "{VALUE_NAME: {PATH: VALUE}, ...}");
@@ -427,6 +516,9 @@ static int check_axis(sd_ctx *c, const yaml_node_t *axis, const char *path, size
     if (*count == 0) return sd_fail(c, values, sub, "no values; valid: at least one value");
     for (size_t i = 0; i < *count; i++) {
         const yaml_node_pair_t *p = &values->data.mapping.pairs.start[i];
+        const yaml_node_t *vn = sd_node(c, p->key);
+        if (sd_check_name(c, vn, sub, sd_scalar(vn), vn->data.scalar.length, JD_NAME_MAX))
+            return -1;
         char vpath[SD_PATH_MAX];
         sd_join(vpath, sub, sd_scalar(sd_node(c, p->key)));
         if (sd_keys(c, sd_node(c, p->value), vpath, NULL)) return -1;
@@ -461,7 +553,7 @@ static int case_name(sd_ctx *c, const yaml_node_t *sweep, const size_t *pick, ch
         used += (size_t)k;
     }
     *out = strdup(name);
-    return *out ? 0 : sd_fail(c, sweep, "sweep", "out of memory");
+    return *out ? 0 : sd_no_memory(c, sweep, "sweep");
 }
 
 static int compare_names(const void *a, const void *b) {
@@ -473,7 +565,7 @@ static int compare_names(const void *a, const void *b) {
 static int sweep_names(sd_ctx *c, const yaml_node_t *sweep, char **names, size_t total) {
     size_t *pick = calloc(sd_len(sweep), sizeof *pick);
     char **sorted = malloc((total ? total : 1) * sizeof *sorted);
-    int rc = (pick && sorted) ? 0 : sd_fail(c, sweep, "sweep", "out of memory");
+    int rc = (pick && sorted) ? 0 : sd_no_memory(c, sweep, "sweep");
     for (size_t i = 0; i < total && rc == 0; i++) {
         decompose(c, sweep, i, pick);
         rc = case_name(c, sweep, pick, &names[i]);
@@ -513,12 +605,12 @@ int sd_cases(sd_ctx *c, const char *fallback, char ***names, int *n) {
     size_t total = 1;
     if (sweep && sweep_size(c, sweep, &total)) return -1;
     char **list = calloc(total, sizeof *list);
-    if (!list) return sd_fail(c, sweep, "sweep", "out of memory");
+    if (!list) return sd_no_memory(c, sweep, "sweep");
     int rc = 0;
     if (sweep) {
         rc = sweep_names(c, sweep, list, total);
     } else if (!(list[0] = strdup(fallback))) {
-        rc = sd_fail(c, NULL, NULL, "out of memory");
+        rc = sd_no_memory(c, NULL, NULL);
     }
     if (rc) {
         sd_free_names(list, (int)total);
@@ -601,7 +693,7 @@ static int override_set(sd_ctx *c, const override_at *o, int parent_id, const ch
         int key = yaml_document_add_scalar(c->doc, NULL, (yaml_char_t *)comp, (int)strlen(comp),
                                            YAML_PLAIN_SCALAR_STYLE);
         if (!key || !yaml_document_append_mapping_pair(c->doc, parent_id, key, value))
-            return sd_fail(c, o->key, o->path, "out of memory");
+            return sd_no_memory(c, o->key, o->path);
         return 0;
     }
     long i = parent->type == YAML_SEQUENCE_NODE ? seq_index(comp, parent) : -1;
@@ -653,7 +745,7 @@ int sd_apply_case(sd_ctx *c, int index) {
     if (!sweep) return 0;
     size_t naxes = sd_len(sweep);
     size_t *pick = calloc(naxes, sizeof *pick);
-    if (!pick) return sd_fail(c, sweep, "sweep", "out of memory");
+    if (!pick) return sd_no_memory(c, sweep, "sweep");
     decompose(c, sweep, (size_t)index, pick);
     /* Node pointers are re-fetched by id throughout: adding a key grows the document's node
      * array, which may move it (scalar texts stay put). */

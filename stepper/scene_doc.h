@@ -12,15 +12,21 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <yaml.h>
 
 #define SD_PATH_MAX 256
 
+/* Deepest nesting of mappings and sequences accepted in a scene file. */
+#define SD_MAX_DEPTH 64
+
 typedef struct sd_ctx {
     const char *file;
+    FILE *in;            /* the scene file while sd_load reads it */
     yaml_document_t *doc;
     char *err;
     size_t errlen;
+    int no_memory;       /* the error in err is "out of memory" (not the scene's fault) */
 } sd_ctx;
 
 /* Allowed interval of a number; the "valid:" text of messages is derived from it. */
@@ -31,14 +37,19 @@ typedef struct sd_range {
 
 extern const sd_range SD_ANY, SD_POSITIVE, SD_NONNEGATIVE, SD_AT_LEAST_ONE;
 
-/* Errors. */
+/* Errors.  A message quotes a scalar of the file as SD_QUOTE (its first 64 characters), so that
+ * what is wrong and what would be valid always fit after it. */
+#define SD_QUOTE "'%.64s'"
+
 int sd_fail(sd_ctx *c, const yaml_node_t *at, const char *path, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
+int sd_no_memory(sd_ctx *c, const yaml_node_t *at, const char *path); /* sets no_memory */
 const char *sd_kind(const yaml_node_t *n); /* "a mapping", "a sequence", ... for messages */
 void sd_join(char out[SD_PATH_MAX], const char *parent, const char *key);
 void sd_join_index(char out[SD_PATH_MAX], const char *parent, size_t index);
 
-/* Loading: the first document of FILE (a second one is an error); the root must be a mapping. */
+/* Loading: the first document of FILE (a second one is an error); the root must be a mapping,
+ * the file a regular file nested at most SD_MAX_DEPTH levels. */
 int sd_load(sd_ctx *c, const char *file, yaml_document_t *doc);
 
 /* Tree access. */
@@ -61,7 +72,12 @@ int sd_num(sd_ctx *c, const yaml_node_t *n, const char *path, sd_range r, double
 int sd_int(sd_ctx *c, const yaml_node_t *n, const char *path, int64_t lo, int64_t *out);
 int sd_vec(sd_ctx *c, const yaml_node_t *n, const char *path, size_t dim, double *out);
 int sd_points(sd_ctx *c, const yaml_node_t *n, const char *path, size_t count, double *out);
-int sd_str(sd_ctx *c, const yaml_node_t *n, const char *path, char *out, size_t size);
+/* Names (scene, case, material, bond type, wall, sweep axis and value): 1 to size - 1
+ * characters from [A-Za-z0-9_.+-], the first from [A-Za-z0-9_].  sd_check_name checks LEN bytes
+ * at S (reported at node AT); sd_name checks a scalar node and copies it into out[size]. */
+int sd_check_name(sd_ctx *c, const yaml_node_t *at, const char *path, const char *s, size_t len,
+                  size_t size);
+int sd_name(sd_ctx *c, const yaml_node_t *n, const char *path, char *out, size_t size);
 int sd_enum(sd_ctx *c, const yaml_node_t *n, const char *path, const char *const *names,
             int *out);
 

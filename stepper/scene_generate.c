@@ -162,7 +162,7 @@ static int generate_lattice(loader *L, const yaml_node_t *lat, int32_t gen, latt
     jd_scene *s = L->s;
     size_t n = (size_t)(g->counts[0] * g->counts[1] * g->counts[2]);
     unsigned char *which = calloc(n, 1);
-    if (!which) return sd_fail(&L->c, lat, NULL, "out of memory");
+    if (!which) return sd_no_memory(&L->c, lat, NULL);
     uint64_t rng = (uint64_t)g->seed;
     assign_radii(g, n, &rng, which);
     double rmax = 0.0;

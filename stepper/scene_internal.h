@@ -90,6 +90,7 @@ int scene_req_bond_type(loader *L, const yaml_node_t *map, const char *path, con
 int scene_add_bond(loader *L, const yaml_node_t *node, int64_t a, int64_t b, int type);
 int scene_read_bonds(loader *L);      /* bonds and bond_rules; before the sort */
 int scene_resolve_bonds(loader *L);   /* after the sort: ids exist, step-0 rules, duplicates */
+int scene_bond_rule_steps(loader *L); /* an auto dt's rules: their times -> steps, once dt is set */
 
 /* scene_bond_generators.c: one generator entry (key is "bonded_block" or "bonded_sphere"). */
 int scene_generate_bonded(loader *L, const yaml_node_t *g, const char *key, const char *path,

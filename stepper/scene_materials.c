@@ -37,7 +37,7 @@ static void material_names(const jd_scene *s, char *out, size_t size) {
 /* Material index named by scalar node n, or -1 after reporting. */
 static int material_ref(loader *L, const yaml_node_t *n, const char *path) {
     char name[JD_NAME_MAX];
-    if (sd_str(&L->c, n, path, name, sizeof name)) return -1;
+    if (sd_name(&L->c, n, path, name, sizeof name)) return -1;
     for (size_t i = 0; i < L->s->n_materials; i++)
         if (strcmp(L->s->materials[i].name, name) == 0) return (int)i;
     char valid[512];
@@ -86,13 +86,13 @@ static int read_elastic(loader *L, const yaml_node_t *m, const char *path, jd_ma
 }
 
 static int read_material(loader *L, const yaml_node_pair_t *p, jd_material *mat) {
-    const char *name = sd_scalar(sd_node(&L->c, p->key));
+    const yaml_node_t *key = sd_node(&L->c, p->key);
+    const char *name = sd_scalar(key);
     const yaml_node_t *m = sd_node(&L->c, p->value);
+    if (sd_check_name(&L->c, key, "materials", name, key->data.scalar.length, JD_NAME_MAX))
+        return -1;
     char path[SD_PATH_MAX];
     sd_join(path, "materials", name);
-    if (strlen(name) >= JD_NAME_MAX)
-        return sd_fail(&L->c, sd_node(&L->c, p->key), path, "name too long; valid: at most %d "
-                       "characters", JD_NAME_MAX - 1);
     snprintf(mat->name, sizeof mat->name, "%s", name);
     mat->restitution = 1.0;
     if (sd_keys(&L->c, m, path, MATERIAL_KEYS) || read_elastic(L, m, path, mat)) return -1;
@@ -117,7 +117,7 @@ int scene_read_materials(loader *L) {
     L->by_particle = calloc(n, 1);
     L->by_wall = calloc(n, 1);
     if (!s->materials || !s->interactions || !L->by_particle || !L->by_wall)
-        return sd_fail(&L->c, m, "materials", "out of memory");
+        return sd_no_memory(&L->c, m, "materials");
     s->n_materials = n;
     for (size_t i = 0; i < n; i++)
         if (read_material(L, &m->data.mapping.pairs.start[i], &s->materials[i])) return -1;
@@ -190,7 +190,7 @@ int scene_read_interactions(loader *L) {
     unsigned char *given = calloc(n * n, N_COEF);
     const yaml_node_t **first = calloc(n * n, sizeof *first);
     const yaml_node_t *list = sd_get(&L->c, L->root, "interactions");
-    int rc = (!given || !first) ? sd_fail(&L->c, list, "interactions", "out of memory") : 0;
+    int rc = (!given || !first) ? sd_no_memory(&L->c, list, "interactions") : 0;
     if (!rc && list)
         rc = sd_sequence(&L->c, list, "interactions", "a list of {materials: [A, B], "
                          "restitution, friction, rolling_friction}");

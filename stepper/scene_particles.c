@@ -27,7 +27,7 @@ static int grow_particles(loader *L, size_t need) {
 #define GROW(p, k)                                                    \
     do {                                                              \
         void *q = realloc((p), cap * (k) * sizeof *(p));              \
-        if (!q) return sd_fail(&L->c, L->root, NULL, "out of memory"); \
+        if (!q) return sd_no_memory(&L->c, L->root, NULL);            \
         (p) = q;                                                      \
     } while (0)
     GROW(s->id, 1);
@@ -136,7 +136,7 @@ static int permute(loader *L, const id_index *perm) {
     jd_scene *s = L->s;
     size_t n = s->n_particles;
     void *tmp = malloc(n * 3 * sizeof(double));
-    if (!tmp) return sd_fail(&L->c, L->root, NULL, "out of memory");
+    if (!tmp) return sd_no_memory(&L->c, L->root, NULL);
 #define PERMUTE(arr, k)                                                              \
     do {                                                                             \
         for (size_t i = 0; i < n; i++)                                               \
@@ -162,7 +162,7 @@ static int permute(loader *L, const id_index *perm) {
 int scene_sort_particles(loader *L) {
     size_t n = L->s->n_particles;
     id_index *perm = malloc(n * sizeof *perm);
-    if (!perm) return sd_fail(&L->c, L->root, NULL, "out of memory");
+    if (!perm) return sd_no_memory(&L->c, L->root, NULL);
     for (size_t i = 0; i < n; i++) perm[i] = (id_index){L->s->id[i], i};
     qsort(perm, n, sizeof *perm, by_id);
     int rc = 0;
@@ -287,7 +287,7 @@ int scene_check_overlaps(loader *L) {
     const jd_scene *s = L->s;
     grid g;
     if (s->n_particles < 2) return 0;
-    if (build_grid(s, &g)) return sd_fail(&L->c, L->root, NULL, "out of memory");
+    if (build_grid(s, &g)) return sd_no_memory(&L->c, L->root, NULL);
     int rc = 0;
     for (size_t i = 0; i < s->n_particles && rc == 0; i++) {
         double by = 0.0;

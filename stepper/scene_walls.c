@@ -76,10 +76,17 @@ static int read_cylinder(loader *L, const yaml_node_t *w, const char *path, jd_w
         return -1;
     double d[3];
     sub3(wall->axis[1], wall->axis[0], d);
-    double scale = fmax(wall->radius, fmax(norm3(wall->axis[0]), norm3(wall->axis[1])));
-    if (!(norm3(d) > GEOM_TOL * scale))
+    const double length = norm3(d);
+    if (!(length > GEOM_TOL * fmax(norm3(wall->axis[0]), norm3(wall->axis[1]))))
         return sd_fail(&L->c, axis, sub, "the axis has zero length; valid: two distinct end "
                        "points");
+    /* the axis' direction carries the round-off of its end points to the distance R away */
+    sd_join(sub, path, "radius");
+    if (!(length > GEOM_TOL * wall->radius))
+        return sd_fail(&L->c, sd_get(&L->c, w, "radius"), sub, "the radius %g m is more than "
+                       "%g times the axis length %g m; valid: a radius of at most %g m for this "
+                       "axis (or a longer axis)",
+                       wall->radius, 1.0 / GEOM_TOL, length, length / GEOM_TOL);
     return 0;
 }
 
@@ -95,7 +102,7 @@ static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t i
     if (sd_keys(&L->c, w, path, plane ? PLANE_KEYS : CYLINDER_KEYS)) return -1;
     sd_join(sub, path, "name");
     if (!name) return sd_missing(&L->c, w, path, "name", "a unique name");
-    if (sd_str(&L->c, name, sub, wall->name, sizeof wall->name)) return -1;
+    if (sd_name(&L->c, name, sub, wall->name, sizeof wall->name)) return -1;
     for (size_t k = 0; k < index; k++)
         if (strcmp(L->s->walls[k].name, wall->name) == 0)
             return sd_fail(&L->c, name, sub, "duplicate wall name '%s' (also walls.%zu); valid: "
@@ -117,7 +124,7 @@ int scene_read_walls(loader *L) {
     if (!list) return 0;
     if (sd_sequence(&L->c, list, "walls", "a list of {name, type, material, ...}")) return -1;
     L->s->walls = calloc(sd_len(list) ? sd_len(list) : 1, sizeof *L->s->walls);
-    if (!L->s->walls) return sd_fail(&L->c, list, "walls", "out of memory");
+    if (!L->s->walls) return sd_no_memory(&L->c, list, "walls");
     L->s->n_walls = sd_len(list);
     for (size_t i = 0; i < sd_len(list); i++) {
         char path[SD_PATH_MAX];

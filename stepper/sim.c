@@ -326,7 +326,7 @@ static int write_frame(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
                               .torque = s->torque};
     const int rc = jd_h5md_write_frame(h, &fr, err, errlen);
     sim_vectors_to_sim_order(s);
-    return rc;
+    return rc ? JD_RUN_OUTPUT : 0;
 }
 
 /* One observable sample: written when there is output, and always seen by the watchdog. */
@@ -339,7 +339,7 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
         if ((s->scene->energy || !jd_observable_is_energy[k]) &&
             jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->dt,
                                      val[k], err, errlen) != 0)
-            return JD_RUN_ERROR;
+            return JD_RUN_OUTPUT;
     if (s->bonds) {
         double bv[JD_N_BOND_OBSERVABLES];
         sim_bond_observables_values(&o.bond, bv);
@@ -347,7 +347,7 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
             if ((s->scene->energy || !jd_bond_observable_is_energy[k]) &&
                 jd_h5md_write_observable(h, jd_bond_observable_names[k], s->step,
                                          (double)s->step * s->dt, bv[k], err, errlen) != 0)
-                return JD_RUN_ERROR;
+                return JD_RUN_OUTPUT;
     }
     return sim_watchdog_energy(s, &o, err, errlen);
 }

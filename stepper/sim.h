@@ -272,8 +272,8 @@ typedef struct jd_sim {
     const volatile sig_atomic_t *stop;
 } jd_sim;
 
-/* Results of sim_run besides 0. */
-enum { JD_RUN_ERROR = -1, JD_RUN_TRIPPED = -2, JD_RUN_STOPPED = -3 };
+/* Results of sim_run besides 0.  JD_RUN_OUTPUT: the trajectory writer failed (jd_h5md_*). */
+enum { JD_RUN_ERROR = -1, JD_RUN_TRIPPED = -2, JD_RUN_STOPPED = -3, JD_RUN_OUTPUT = -4 };
 
 /* sim.c */
 /* Set up from a loaded scene (kept by pointer; it must outlive the sim) and compute the forces
@@ -285,9 +285,10 @@ void sim_free(jd_sim *s);
 struct jd_h5md;
 /* Run scene->steps steps writing frames and observables to h (which may be NULL: no output).
  * show_progress: print the progress line on stderr.  Returns 0; JD_RUN_ERROR with a reason in
- * err; JD_RUN_TRIPPED when the watchdog stopped the run (its message in err); JD_RUN_STOPPED when
- * *s->stop was set.  On the last two the frame of the step reached is written (unless its state
- * is not finite), so the trajectory ends where the run stopped. */
+ * err (a diverged state, or "out of memory ..."); JD_RUN_OUTPUT when a write failed (its
+ * message in err); JD_RUN_TRIPPED when the watchdog stopped the run (its message in err);
+ * JD_RUN_STOPPED when *s->stop was set.  On the last two the frame of the step reached is
+ * written (unless its state is not finite), so the trajectory ends where the run stopped. */
 int sim_run(jd_sim *s, struct jd_h5md *h, int show_progress, char *err, size_t errlen);
 
 /* Bytes the engine holds for the run (particle arrays, contact lists at their capacity, cells,

@@ -63,6 +63,9 @@ SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--engines", "jde
 # ParaView (Debian's, `make paraview-deps`) opens both engines' sidecars with its default reader:
 # points, cells, arrays and time steps against the .h5, and a rendered PNG with content.
 SUITES += [("paraview", [PY, "tests/paraview/test_paraview.py"], "lines", {})]
+# Fault injection (tests/faults/, run as root in CI: tmpfs, read-only mounts, ulimit -v):
+# hostile names, signals at each phase, disk full, memory limits; exit code, message, files left.
+SUITES += [("faults", [PY, "tests/faults/run_faults.py"], "lines", {})]
 # The Chung–Ooi benchmark, a representative subset of every test in both engines (--quick);
 # `make demo` runs the full sweeps.
 CHUNG_OOI = "out/test/chung_ooi"

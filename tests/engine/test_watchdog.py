@@ -3,7 +3,7 @@
 
 A run that goes wrong on purpose (scenes/watchdog_blowup.yaml, dt ~100x too large, --force) must
 stop at step 1 with "jdem: watchdog: step 1: overlap fraction ... for particle(s) 1, 2 exceeds
-0.1", exit status 1, and leave a readable, closed OUT.part (nothing under OUT) whose last frame is
+0.1", exit status 4, and leave a readable, closed OUT.part (nothing under OUT) whose last frame is
 step 1 with finite values; with the overlap limit lifted the energy jump trips instead.  A
 position that overflows (scenes/watchdog_nonfinite.yaml) stops the run at step 1 with "position
 inf for particle(s) 1 is not finite", the trajectory ending at step 0.  A resolved impact
@@ -42,7 +42,7 @@ def check_part(case, out, last_step):
 
 def check_trip(case, quantity, ids, limit):
     p, out = run("watchdog_blowup", "--case", case, "--force", check=False)
-    c.check(f"{case}_exit_1", p.returncode == 1, f"exit {p.returncode}: {p.stderr.strip()!r}")
+    c.check(f"{case}_exit_4", p.returncode == 4, f"exit {p.returncode}: {p.stderr.strip()!r}")
     m = re.search(PATTERN.format(quantity=quantity), p.stderr)
     if not c.check(f"{case}_message", m is not None, f"stderr: {p.stderr.strip()!r}"):
         return
@@ -57,7 +57,7 @@ check_trip("overlap", "overlap fraction", "1, 2", 0.1)
 check_trip("energy", "energy jump", "1", 0.05)
 
 p, out = run("watchdog_nonfinite", "--force", check=False)
-c.check("nonfinite_exit_1", p.returncode == 1, f"exit {p.returncode}: {p.stderr.strip()!r}")
+c.check("nonfinite_exit_4", p.returncode == 4, f"exit {p.returncode}: {p.stderr.strip()!r}")
 c.check("nonfinite_message", "jdem: watchdog: step 1: position inf for particle(s) 1 is not finite; "
         f"the trajectory up to step 0 is kept, closed, as {out}.part" in p.stderr,
         f"stderr: {p.stderr.strip()!r}")

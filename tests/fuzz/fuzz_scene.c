@@ -6,7 +6,9 @@
  *   - the reader never crashes, leaks or hits undefined behaviour (the sanitizers);
  *   - a refused input always comes with a message (the reader's contract: first error, named);
  *   - a case that loads resolves to YAML that loads back and resolves to the same text (the
- *     `jdem resolve` contract the LIGGGHTS deck generator relies on).
+ *     `jdem resolve` contract the LIGGGHTS deck generator relies on);
+ *   - every name of a loaded case (scene, case, materials, bond types, walls) is safe to put in
+ *     a path or a LIGGGHTS deck: [A-Za-z0-9_.+-], the first not '.', '+' or '-'.
  *
  * The reader takes a path (it names the file in every message), so each input is written to one
  * temporary file on tmpfs, reused for the whole run: cheaper than any change to the reader.
@@ -75,6 +77,26 @@ static void check_round_trip(const jd_scene *s) {
     scene_free(&back);
 }
 
+static void require_safe_name(const char *what, const char *name) {
+    int ok = name[0] != '\0' && !strchr(".+-", name[0]);
+    for (const char *p = name; ok && *p; p++)
+        ok = (*p >= 'A' && *p <= 'Z') || (*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') ||
+             strchr("_.+-", *p);
+    if (!ok) {
+        fprintf(stderr, "a loaded %s name is not safe: '%s'\n", what, name);
+        abort();
+    }
+}
+
+static void check_names(const jd_scene *s) {
+    require_safe_name("scene", s->name);
+    require_safe_name("case", s->case_name);
+    for (size_t k = 0; k < s->n_materials; k++) require_safe_name("material", s->materials[k].name);
+    for (size_t k = 0; k < s->n_bond_types; k++)
+        require_safe_name("bond type", s->bond_types[k].name);
+    for (size_t k = 0; k < s->n_walls; k++) require_safe_name("wall", s->walls[k].name);
+}
+
 static void require_message(const char *err) {
     if (err[0] == '\0') {
         fprintf(stderr, "refused without a message\n");
@@ -98,6 +120,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             require_message(err);
             continue;
         }
+        check_names(&s);
         check_round_trip(&s);
         scene_free(&s);
     }

@@ -108,7 +108,7 @@ def main():
         r = subprocess.run([JDEM, "run", SCENE, "--case", case, "--force", "--quiet", "-o", out],
                            capture_output=True, text=True)
         m = TRIP.search(r.stderr)
-        if not check("jdem_%s_trips" % case, r.returncode == 1 and m, "exit %d: %r" % (r.returncode, r.stderr)):
+        if not check("jdem_%s_trips" % case, r.returncode == 4 and m, "exit %d: %r" % (r.returncode, r.stderr)):
             continue
         for n in ranks:
             name = "liggghts_%s_np%d" % (case, n)
