@@ -57,7 +57,11 @@ PLUGIN_SRC  := $(wildcard liggghts_plugin/*.cpp)
 UNIT_SRC    := $(wildcard tests/unit/*.c) stepper/hugepages.c # and the engine's block allocator
 HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)
 
-.PHONY: all deps test demo chung-ooi stability unit clean
+# ParaView for the paraview suite only (about 440 MB installed): kept out of `make deps` so that
+# `make demo` stays light; .ci/run installs it before `make test`.
+PARAVIEW_PACKAGES := paraview python3-paraview xvfb xauth
+
+.PHONY: all deps paraview-deps test demo chung-ooi stability unit clean
 all: build/jdem build/liggghts-jdem
 -include $(shell find build -name '*.d' 2>/dev/null)
 
@@ -73,6 +77,9 @@ deps:
 	  echo "deps: installing $$(echo $$missing)"; \
 	  export DEBIAN_FRONTEND=noninteractive; apt-get update -qq && $$cmd -qq >/dev/null; \
 	else echo "deps: missing packages; run as root:  apt-get update && $$cmd"; exit 1; fi
+
+paraview-deps:
+	@$(MAKE) --no-print-directory deps DEB_PACKAGES="$(PARAVIEW_PACKAGES)"
 
 # ---------------------------------------------------------------------------------------------
 # Standalone engine (C11) and its sanitizer twin
@@ -192,14 +199,19 @@ clean:
 # Fuzzing the scene reader with libFuzzer (clang): `make fuzz [FUZZ_SECONDS=600]`.  The seed
 # corpus tests/fuzz/corpus/ is read only; inputs that grow coverage collect in build/fuzz/corpus
 # (fold the useful ones back with `build/fuzz_scene -merge=1 tests/fuzz/corpus build/fuzz/corpus`)
-# and a crashing input is written to build/fuzz/ (the run then fails).
+# and a crashing input is written to build/fuzz/ (the run then fails).  Then the LIGGGHTS side,
+# FUZZ_SECONDS each: the deck generator against hostile resolved scenes (tests/fuzz/fuzz_deck.py)
+# and our styles' argument parsers in liggghts-jdem (tests/fuzz/fuzz_styles.py); their failing
+# inputs go to build/fuzz/ too.
 FUZZ_SECONDS ?= 60
 .PHONY: fuzz
 build/fuzz_scene: tests/fuzz/fuzz_scene.c $(SCENE_SRC) $(HEADERS)
 	@mkdir -p build
 	clang $(CFLAGS) -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
 	    tests/fuzz/fuzz_scene.c $(SCENE_SRC) -o $@ $(PKG_LIBS)
-fuzz: build/fuzz_scene
+fuzz: build/fuzz_scene build/jdem build/liggghts-jdem
 	@mkdir -p build/fuzz/corpus
 	build/fuzz_scene -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 \
 	    -dict=tests/fuzz/scene.dict -artifact_prefix=build/fuzz/ build/fuzz/corpus tests/fuzz/corpus
+	$(PY) tests/fuzz/fuzz_deck.py --seconds $(FUZZ_SECONDS) --out build/fuzz
+	$(PY) tests/fuzz/fuzz_styles.py --seconds $(FUZZ_SECONDS) --out build/fuzz

@@ -38,6 +38,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <pwd.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -118,6 +119,32 @@ static void free_handle(jd_h5md *h) {
     free(h);
 }
 
+/* /h5md/author/name: the scene's author, else $JDEM_AUTHOR, else the user running the program. */
+static const char *author_name(const jd_h5md_meta *meta) {
+    if (meta && meta->author && *meta->author) return meta->author;
+    const char *env = getenv("JDEM_AUTHOR");
+    if (env && *env) return env;
+    const struct passwd *pw = getpwuid(getuid());
+    if (pw && pw->pw_name && *pw->pw_name) return pw->pw_name;
+    env = getenv("USER");
+    return env && *env ? env : "unknown";
+}
+
+/* /jdem/vertex_index [N] = 0..N-1: the sidecar's Polyvertex connectivity (Xdmf3 makes no cells
+ * of its own), 8 bytes a particle. */
+static int write_vertex_index(hid_t file, size_t n) {
+    int64_t *idx = malloc((n ? n : 1) * sizeof *idx);
+    if (!idx) return -1;
+    for (size_t i = 0; i < n; ++i) idx[i] = (int64_t)i;
+    hid_t g = h5md_group_create(file, "jdem");
+    int rc = g >= 0 ? h5md_dset_fixed(g, "vertex_index", H5T_STD_I64LE, H5T_NATIVE_INT64, n, idx,
+                                      NULL)
+                    : -1;
+    h5md_close_id(&g);
+    free(idx);
+    return rc;
+}
+
 static int write_header(jd_h5md *h, const jd_h5md_meta *meta, const jd_h5md_particles *p,
                         char *err, size_t errlen) {
     const char *creator = (meta && meta->creator) ? meta->creator : "jdem";
@@ -136,7 +163,18 @@ static int write_header(jd_h5md *h, const jd_h5md_meta *meta, const jd_h5md_part
     }
     where = "/h5md/author";
     g2 = H5Gcreate2(g, "author", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (g2 < 0 || h5md_attr_str(g2, "name", "jdem developers") < 0) goto fail;
+    if (g2 < 0 || h5md_attr_str(g2, "name", author_name(meta)) < 0) goto fail;
+    h5md_close_id(&g2);
+    /* the units module: every `unit` attribute is an SI unit string of that module */
+    where = "/h5md/modules/units";
+    g2 = h5md_group_create(g, "modules/units");
+    if (g2 < 0 || h5md_attr_str(g2, "system", "SI") < 0) goto fail;
+    {
+        int version[2] = {1, 0};
+        hsize_t two = 2;
+        if (h5md_attr_write(g2, "version", H5T_STD_I32LE, H5T_NATIVE_INT, 1, &two, version) < 0)
+            goto fail;
+    }
     h5md_close_id(&g2);
     where = "/h5md/creator";
     g2 = H5Gcreate2(g, "creator", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
@@ -206,6 +244,8 @@ static int write_header(jd_h5md *h, const jd_h5md_meta *meta, const jd_h5md_part
     where = "/particles/all/mass";
     if (h5md_dset_fixed(h->all, "mass", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, p->n, p->mass, "kg") < 0)
         goto fail;
+    where = "/jdem/vertex_index";
+    if (write_vertex_index(h->file, p->n) < 0) goto fail;
     return 0;
 
 fail:

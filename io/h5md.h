@@ -3,9 +3,11 @@
  * LIGGGHTS dump style `h5md/jdem`).  C11 on top of the HDF5 C library; it writes the H5MD 1.1
  * layout fixed in DESIGN.md plus an XDMF sidecar so that ParaView opens the file directly.
  *
- * Layout (all floating-point data float64, SI units; N particles sorted by id; F frames):
- *   /h5md                       attrs version = [1, 1]; groups author (attr name), creator
- *                               (attrs name, version)
+ * Layout (all floating-point data float64, SI units; N particles sorted by id; F frames;
+ * docs/output.md describes it for readers):
+ *   /h5md                       attrs version = [1, 1]; groups author (attr name: meta.author,
+ *                               else $JDEM_AUTHOR, else the user name), creator (attrs name,
+ *                               version), modules/units (attrs version = [1, 0], system = "SI")
  *   /parameters                 attrs engine, scene_name, case_name, dt [s]; dataset "scene"
  *                               (variable-length string: the resolved scene, YAML) when given
  *   /particles/all/box          attrs dimension = 3, boundary = ["none","none","none"]
@@ -13,17 +15,24 @@
  *   /particles/all/{position,velocity,angular_velocity,force,torque}/{step,time,value}
  *                               step [F] int64, time [F] f64, value [F][N][3] f64
  *   /observables/NAME/{step,time,value}            value [F] f64 (counts stored as f64 too)
- *   /connectivity/bonds         [B][2] int64 ids of every bond formed, in formation order (attr
- *                               particles_group = "/particles/all"), with bond_type [B] int32
- *                               and bond_formed_step [B] int64 (jd_h5md_write_bonds)
- *   /connectivity/broken_bonds/{step,time,ids,mode,position,normal_force,shear_force,
+ *   /jdem/vertex_index          [N] int64 0..N-1: the sidecar's vertex connectivity
+ *   /jdem/bonds/{ids,type,formed_step}             every bond formed, in formation order
+ *                               (jd_h5md_write_bonds); ids [B][2] int64 is also the H5MD tuple
+ *                               list /connectivity/bonds (particles_group: object reference)
+ *   /jdem/broken_bonds/{step,time,ids,mode,position,normal_force,shear_force,
  *                               twisting_moment,bending_moment,sigma_max,tau_max}
- *                               one row per broken bond (jd_h5md_write_bond_breaks);
- *                               docs/scenes.md "Bonds" gives units and meaning
+ *                               one row per broken bond (jd_h5md_write_bond_breaks); ids is
+ *                               also the tuple list /connectivity/broken_bonds; docs/scenes.md
+ *                               "Bonds" gives units and meaning
  *
- * Fault safety: the file is written as PATH.part and renamed to PATH by jd_h5md_close(ok = 1);
- * every frame is flushed, so a run that dies leaves a readable PATH.part with every frame so far.
- * jd_h5md_close(ok = 0) keeps it under PATH.part (an aborted run never masquerades as complete).
+ * Fault safety: the file is written as PATH.part, which is locked (a second run on the same
+ * path fails without touching it) and never written through a link; jd_h5md_close(ok = 1)
+ * writes the sidecar as SIDECAR.part, then renames PATH.part to PATH and the sidecar into
+ * place, so the previous pair stays until both new files are complete.  Every frame is
+ * flushed, so a run that dies leaves a readable PATH.part with every frame so far.
+ * jd_h5md_close(ok = 0) keeps it under PATH.part (an aborted run never masquerades as
+ * complete); after a failed write or close, PATH.part is kept only if it can be read, else it
+ * is removed and err says that nothing could be kept.
  */
 #ifndef JDEM_IO_H5MD_H
 #define JDEM_IO_H5MD_H
@@ -54,6 +63,7 @@ typedef struct jd_h5md_meta {
     const char *case_name;
     const char *scene_yaml;      /* the resolved scene text, stored as /parameters/scene */
     double dt;                   /* [s] */
+    const char *author;          /* /h5md/author/name; NULL: $JDEM_AUTHOR, else the user name */
 } jd_h5md_meta;
 
 /* One frame of per-particle data, each an array of 3n doubles (x0 y0 z0 x1 ...), sorted by id.
@@ -114,8 +124,9 @@ typedef struct jd_h5md_bond_break {
 int jd_h5md_write_bond_breaks(jd_h5md *h, size_t n, const jd_h5md_bond_break *events, char *err,
                               size_t errlen);
 
-/* Close the file.  ok = 1: rename PATH.part to PATH and write the XDMF sidecar (PATH with its
- * extension replaced by .xdmf).  ok = 0: leave PATH.part.  Returns 0 or -1 with err. */
+/* Close the file.  ok = 1: write the XDMF sidecar (PATH with its extension replaced by .xdmf)
+ * and rename both into place.  ok = 0: leave PATH.part.  Returns 0 or -1 with err (then
+ * PATH.part is kept if readable, else removed, and err says which). */
 int jd_h5md_close(jd_h5md *h, int ok, char *err, size_t errlen);
 
 #ifdef __cplusplus

@@ -1,11 +1,14 @@
 /*
- * h5md_bonds.c — /connectivity of the H5MD writer (io/h5md.h): the bonds formed in a run and the
+ * h5md_bonds.c — the bonds of the H5MD writer (io/h5md.h): the bonds formed in a run and the
  * broken-bond events, appended as they happen.  Both engines call these two functions, so the
  * layout is written in one place.
  *
- * Each record type is a table of columns; a call gathers each column of the n records into a
- * contiguous buffer and appends it to that column's extendible dataset (created by the first
- * call, so a run with bonds always has the datasets, possibly empty).
+ * Each record type is a table of columns in a group of ours, /jdem/bonds and
+ * /jdem/broken_bonds; a call gathers each column of the n records into a contiguous buffer and
+ * appends it to that column's extendible dataset (created by the first call, so a run with bonds
+ * always has the datasets, possibly empty).  The id pairs of each table are also H5MD 1.1 tuple
+ * lists, /connectivity/bonds and /connectivity/broken_bonds (hard links to the same datasets),
+ * so that /connectivity holds nothing else.
  */
 #include <stddef.h>
 #include <stdlib.h>
@@ -22,9 +25,9 @@ typedef struct column {
 } column;
 
 static const column bond_cols[] = {
-    {"bonds", 1, 2, offsetof(jd_h5md_bond, id), NULL},
-    {"bond_type", 2, 1, offsetof(jd_h5md_bond, type), NULL},
-    {"bond_formed_step", 1, 1, offsetof(jd_h5md_bond, formed_step), NULL},
+    {"ids", 1, 2, offsetof(jd_h5md_bond, id), NULL},
+    {"type", 2, 1, offsetof(jd_h5md_bond, type), NULL},
+    {"formed_step", 1, 1, offsetof(jd_h5md_bond, formed_step), NULL},
 };
 
 static const column break_cols[] = {
@@ -45,8 +48,26 @@ static size_t value_size(const column *c) {
     return c->is_int == 2 ? sizeof(int32_t) : c->is_int ? sizeof(int64_t) : sizeof(double);
 }
 
-/* Open the column's dataset in group g, creating it (with its attributes) if absent. */
-static hid_t open_column(hid_t g, const column *c, int mark_particles) {
+/* H5MD tuple list: particles_group is an object reference to the particles' group. */
+static int particles_group_ref(hid_t d) {
+    hobj_ref_t ref;
+    if (H5Rcreate(&ref, d, "/particles/all", H5R_OBJECT, -1) < 0) return -1;
+    return h5md_attr_write(d, "particles_group", H5T_STD_REF_OBJ, H5T_STD_REF_OBJ, 0, NULL, &ref);
+}
+
+static int link_tuple_list(hid_t d, const char *tuples) {
+    hid_t lcpl = H5Pcreate(H5P_LINK_CREATE);
+    int rc = -1;
+    if (lcpl >= 0 && H5Pset_create_intermediate_group(lcpl, 1) >= 0 &&
+        H5Lcreate_hard(d, ".", d, tuples, lcpl, H5P_DEFAULT) >= 0)
+        rc = 0;
+    if (lcpl >= 0) H5Pclose(lcpl);
+    return rc;
+}
+
+/* Open the column's dataset in group g, creating it (with its attributes) if absent.  The id
+ * pairs are also the H5MD tuple list TUPLES (a hard link: one dataset, two names). */
+static hid_t open_column(hid_t g, const column *c, const char *tuples) {
     if (H5Lexists(g, c->name, H5P_DEFAULT) > 0) return H5Dopen2(g, c->name, H5P_DEFAULT);
     const hid_t ftype = c->is_int == 2 ? H5T_STD_I32LE : c->is_int ? H5T_STD_I64LE
                                                                    : H5T_IEEE_F64LE;
@@ -54,8 +75,9 @@ static hid_t open_column(hid_t g, const column *c, int mark_particles) {
     const hsize_t chunk[2] = {256, (hsize_t)c->width};
     hid_t d = h5md_dset_extendible(g, c->name, ftype, c->width > 1 ? 2 : 1, rest, chunk);
     if (d < 0) return d;
+    const int pairs = c->width == 2;
     if ((c->unit && h5md_attr_str(d, "unit", c->unit) < 0) ||
-        (mark_particles && c->width == 2 && h5md_attr_str(d, "particles_group", "/particles/all") < 0)) {
+        (pairs && (particles_group_ref(d) < 0 || link_tuple_list(d, tuples) < 0))) {
         H5Dclose(d);
         return H5I_INVALID_HID;
     }
@@ -63,8 +85,9 @@ static hid_t open_column(hid_t g, const column *c, int mark_particles) {
 }
 
 /* Append n records of size rec_size to the columns under group path. */
-static int append_table(jd_h5md *h, const char *path, const column *cols, size_t ncols,
-                        const void *recs, size_t rec_size, size_t n, char *err, size_t errlen) {
+static int append_table(jd_h5md *h, const char *path, const char *tuples, const column *cols,
+                        size_t ncols, const void *recs, size_t rec_size, size_t n, char *err,
+                        size_t errlen) {
     if (!h) {
         h5md_set_err(err, errlen, "h5md: no writer");
         return -1;
@@ -92,7 +115,7 @@ static int append_table(jd_h5md *h, const char *path, const column *cols, size_t
         const size_t vs = value_size(c) * (size_t)c->width;
         for (size_t i = 0; i < n; i++)
             memcpy(buf + i * vs, (const unsigned char *)recs + i * rec_size + c->offset, vs);
-        hid_t d = open_column(g, c, cols == bond_cols);
+        hid_t d = open_column(g, c, tuples);
         if (d < 0) goto fail;
         const hid_t mtype = c->is_int == 2 ? H5T_NATIVE_INT32 : c->is_int ? H5T_NATIVE_INT64
                                                                           : H5T_NATIVE_DOUBLE;
@@ -127,13 +150,13 @@ fail:
 
 int jd_h5md_write_bonds(jd_h5md *h, size_t n, const jd_h5md_bond *bonds, char *err,
                         size_t errlen) {
-    return append_table(h, "connectivity", bond_cols, sizeof bond_cols / sizeof *bond_cols, bonds,
+    return append_table(h, "jdem/bonds", "/connectivity/bonds", bond_cols, sizeof bond_cols / sizeof *bond_cols, bonds,
                         sizeof *bonds, n, err, errlen);
 }
 
 int jd_h5md_write_bond_breaks(jd_h5md *h, size_t n, const jd_h5md_bond_break *events, char *err,
                               size_t errlen) {
-    return append_table(h, "connectivity/broken_bonds", break_cols,
+    return append_table(h, "jdem/broken_bonds", "/connectivity/broken_bonds", break_cols,
                         sizeof break_cols / sizeof *break_cols, events, sizeof *events, n, err,
                         errlen);
 }

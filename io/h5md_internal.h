@@ -29,6 +29,7 @@ void h5md_close_id(hid_t *id);
 /* h5md_util.c: small HDF5 helpers; each returns 0 / -1 (or an invalid id) and leaves the HDF5
  * error stack for h5md_err */
 hid_t h5md_str_type(size_t len);
+hid_t h5md_str_type_cset(size_t len, H5T_cset_t cset);
 int h5md_attr_write(hid_t obj, const char *name, hid_t ftype, hid_t mtype, int rank,
                     const hsize_t *dims, const void *buf);
 int h5md_attr_str(hid_t obj, const char *name, const char *s);

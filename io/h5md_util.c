@@ -94,10 +94,14 @@ void h5md_close_id(hid_t *id) {
 /* small HDF5 helpers; each returns 0 / -1 and leaves the HDF5 error stack for h5md_err */
 
 hid_t h5md_str_type(size_t len) {
+    return h5md_str_type_cset(len, H5T_CSET_UTF8);
+}
+
+hid_t h5md_str_type_cset(size_t len, H5T_cset_t cset) {
     hid_t t = H5Tcopy(H5T_C_S1);
     if (t < 0) return t;
     if (H5Tset_size(t, len + 1) < 0 || H5Tset_strpad(t, H5T_STR_NULLTERM) < 0 ||
-        H5Tset_cset(t, H5T_CSET_UTF8) < 0) {
+        H5Tset_cset(t, cset) < 0) {
         H5Tclose(t);
         return H5I_INVALID_HID;
     }
@@ -115,8 +119,12 @@ int h5md_attr_write(hid_t obj, const char *name, hid_t ftype, hid_t mtype, int r
     return rc;
 }
 
+/* ASCII when the text is (the units module requires ASCII unit strings), else UTF-8. */
 int h5md_attr_str(hid_t obj, const char *name, const char *s) {
-    hid_t t = h5md_str_type(strlen(s));
+    H5T_cset_t cset = H5T_CSET_ASCII;
+    for (const unsigned char *p = (const unsigned char *)s; *p; ++p)
+        if (*p >= 0x80) cset = H5T_CSET_UTF8;
+    hid_t t = h5md_str_type_cset(strlen(s), cset);
     if (t < 0) return -1;
     int rc = h5md_attr_write(obj, name, t, t, 0, NULL, s);
     H5Tclose(t);

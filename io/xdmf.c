@@ -1,10 +1,15 @@
 /*
- * xdmf.c — the XDMF 3 sidecar of an H5MD file (written by jd_h5md_close once the .h5 is final).
+ * xdmf.c — the XDMF 3 sidecar of an H5MD file (written by jd_h5md_close before the .h5 and the
+ * sidecar are renamed into place).
  *
- * Xdmf3 (unlike the old Xdmf2 reader) does not invent connectivity for a Polyvertex topology, so
- * the 0..N-1 list is written inline once, in the first frame's grid, and the other frames
- * xi:include that Topology.  Geometry and the vector attributes are HyperSlabs [frame, 0, 0] x
- * [1, N, 3] of the .h5 (referenced by basename).
+ * Written for ParaView's default reader, Xdmf3ReaderS.  It does not evaluate the
+ * ItemType="HyperSlab" items the old Xdmf2 reader needs (0 points, "Skipping unrecognized array
+ * type [None]"), but it reads a selection written into an HDF item's content:
+ * "file.h5:/dataset|start:stride:count:dataspace".  A temporal collection needs one grid per
+ * time (Xdmf3 has no item that indexes a dataset by the time step), so each frame is one short
+ * block: Polyvertex connectivity from /jdem/vertex_index (Xdmf3 makes no cells of its own),
+ * the frame's positions and vector arrays, and radius, id and species whole.  The .h5 is
+ * referenced by its basename, so the pair can move together.
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -41,27 +46,25 @@ char *xdmf_path(const char *path) {
     return x;
 }
 
+/* An HDF DataItem; with a selection ("start:stride:count:dataspace", Xdmf3's own hyperslab
+ * syntax inside the content, which its reader evaluates) or the whole dataset (sel NULL). */
 static void xdmf_hdf_item(FILE *fp, const char *file, const char *dset, const char *dims,
-                          const char *ntype, int prec) {
+                          const char *ntype, int prec, const char *sel) {
     fprintf(fp, "<DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" Format=\"HDF\">",
             dims, ntype, prec);
     xml_escaped(fp, file);
-    fprintf(fp, ":%s</DataItem>", dset);
+    fprintf(fp, ":%s%s%s</DataItem>", dset, sel ? "|" : "", sel ? sel : "");
 }
 
+/* Frame `frame` of /particles/all/GROUP/value [F][N][3]. */
 static void xdmf_slab(FILE *fp, const xdmf_info *h, const char *file, const char *group,
                       hsize_t frame) {
-    char dims[64], full[96], dset[96];
+    char dims[64], dset[96], sel[160];
     snprintf(dims, sizeof dims, "%zu 3", h->n);
-    snprintf(full, sizeof full, "%llu %zu 3", (unsigned long long)h->nframes, h->n);
     snprintf(dset, sizeof dset, "/particles/all/%s/value", group);
-    fprintf(fp,
-            "\n          <DataItem ItemType=\"HyperSlab\" Type=\"HyperSlab\" Dimensions=\"%s\">\n"
-            "            <DataItem Dimensions=\"3 3\" NumberType=\"UInt\" Format=\"XML\">"
-            "%llu 0 0 1 1 1 1 %zu 3</DataItem>\n            ",
-            dims, (unsigned long long)frame, h->n);
-    xdmf_hdf_item(fp, file, dset, full, "Float", 8);
-    fprintf(fp, "\n          </DataItem>\n        ");
+    snprintf(sel, sizeof sel, "%llu 0 0:1 1 1:1 %zu 3:%llu %zu 3", (unsigned long long)frame,
+             h->n, (unsigned long long)h->nframes, h->n);
+    xdmf_hdf_item(fp, file, dset, dims, "Float", 8, sel);
 }
 
 int xdmf_write(const xdmf_info *h, const char *tmp, char *err, size_t errlen) {
@@ -77,53 +80,41 @@ int xdmf_write(const xdmf_info *h, const char *tmp, char *err, size_t errlen) {
     }
     char n1[32];
     snprintf(n1, sizeof n1, "%zu", h->n);
-    fprintf(fp, "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
-                "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
+    fprintf(fp, "<?xml version=\"1.0\" ?>\n"
+                "<Xdmf Version=\"3.0\">\n"
                 "  <Domain>\n"
                 "    <Grid Name=\"particles\" GridType=\"Collection\" "
                 "CollectionType=\"Temporal\">\n");
     static const char *const vec[] = {"velocity", "angular_velocity", "force", "torque"};
     static const int veck[] = {TD_VELOCITY, TD_ANGVEL, TD_FORCE, TD_TORQUE};
+    static const struct {
+        const char *name, *ntype;
+        int prec;
+    } fixed[] = {{"radius", "Float", 8}, {"id", "Int", 8}, {"species", "Int", 4}};
     for (hsize_t i = 0; i < h->nframes; ++i) {
-        fprintf(fp,
-                "      <Grid Name=\"frame_%06llu\" GridType=\"Uniform\">\n"
-                "        <Time Value=\"%.17g\"/>\n",
+        fprintf(fp, "<Grid Name=\"frame_%llu\"><Time Value=\"%.17g\"/>\n",
                 (unsigned long long)i, h->times[i]);
-        if (i == 0) {
-            /* Xdmf3 needs explicit connectivity for Polyvertex; written once, included below */
-            fprintf(fp,
-                    "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
-                    "NodesPerElement=\"1\">\n          <DataItem Dimensions=\"%zu\" "
-                    "NumberType=\"Int\" Precision=\"8\" Format=\"XML\">",
-                    h->n, h->n);
-            for (size_t j = 0; j < h->n; ++j)
-                fprintf(fp, (j % 16 == 15) ? "%zu\n" : "%zu ", j);
-            fprintf(fp, "</DataItem>\n        </Topology>\n");
-        } else {
-            fprintf(fp, "        <xi:include xpointer=\"xpointer(/Xdmf/Domain/Grid/Grid[1]/"
-                        "Topology)\"/>\n");
-        }
-        fprintf(fp, "        <Geometry GeometryType=\"XYZ\">");
+        fprintf(fp, "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
+                    "NodesPerElement=\"1\">", h->n);
+        xdmf_hdf_item(fp, file, "/jdem/vertex_index", n1, "Int", 8, NULL);
+        fprintf(fp, "</Topology>\n<Geometry GeometryType=\"XYZ\">");
         xdmf_slab(fp, h, file, "position", i);
         fprintf(fp, "</Geometry>\n");
-        fprintf(fp, "        <Attribute Name=\"radius\" AttributeType=\"Scalar\" "
-                    "Center=\"Node\">");
-        xdmf_hdf_item(fp, file, "/particles/all/radius", n1, "Float", 8);
-        fprintf(fp, "</Attribute>\n        <Attribute Name=\"id\" AttributeType=\"Scalar\" "
-                    "Center=\"Node\">");
-        xdmf_hdf_item(fp, file, "/particles/all/id", n1, "Int", 8);
-        fprintf(fp, "</Attribute>\n        <Attribute Name=\"species\" AttributeType=\"Scalar\" "
-                    "Center=\"Node\">");
-        xdmf_hdf_item(fp, file, "/particles/all/species", n1, "Int", 4);
-        fprintf(fp, "</Attribute>\n");
+        for (size_t k = 0; k < sizeof fixed / sizeof *fixed; ++k) {
+            char dset[64];
+            snprintf(dset, sizeof dset, "/particles/all/%s", fixed[k].name);
+            fprintf(fp, "<Attribute Name=\"%s\" Center=\"Node\">", fixed[k].name);
+            xdmf_hdf_item(fp, file, dset, n1, fixed[k].ntype, fixed[k].prec, NULL);
+            fprintf(fp, "</Attribute>\n");
+        }
         for (int v = 0; v < 4; ++v) {
             if (!h->present[veck[v]]) continue;
-            fprintf(fp, "        <Attribute Name=\"%s\" AttributeType=\"Vector\" "
-                        "Center=\"Node\">", vec[v]);
+            fprintf(fp, "<Attribute Name=\"%s\" AttributeType=\"Vector\" Center=\"Node\">",
+                    vec[v]);
             xdmf_slab(fp, h, file, vec[v], i);
             fprintf(fp, "</Attribute>\n");
         }
-        fprintf(fp, "      </Grid>\n");
+        fprintf(fp, "</Grid>\n");
     }
     fprintf(fp, "    </Grid>\n  </Domain>\n</Xdmf>\n");
     int bad = ferror(fp);

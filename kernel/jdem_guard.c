@@ -135,3 +135,12 @@ int jd_guard_warning(const jd_guard_input *in, const jd_guard_result *r, const c
     return snprintf(buf, len, "warning: time step %g s exceeds %s; running anyway (%s)", in->dt,
                     what, how);
 }
+
+double jd_guard_damping_ratio(const jd_guard_species *species, size_t n_species,
+                              const double *restitution, int damping_map) {
+    double z = 0.0;
+    for (size_t a = 0; a < n_species; a++)
+        for (size_t b = 0; species[a].count && b < n_species; b++)
+            z = fmax(z, jd_gamma_for(damping_map, restitution[a * n_species + b]));
+    return z;
+}

@@ -54,6 +54,12 @@ typedef struct jd_guard_input {
     double dt;               /* the time step to judge [s] */
 } jd_guard_input;
 
+/* The guard's damping ratio: the largest gamma (jd_gamma_for with damping_map) of any pair of
+ * species of which the first has particles (species[a].count > 0); restitution is n_species x
+ * n_species, row-major [-]. */
+double jd_guard_damping_ratio(const jd_guard_species *species, size_t n_species,
+                              const double *restitution, int damping_map);
+
 typedef enum {
     JD_GUARD_SAFE = 0,
     JD_GUARD_RAYLEIGH = 1,

@@ -73,14 +73,12 @@ void FixJdemGuard::setup(int) {
   MPI_Allreduce(rho.data(), g_rho.data(), nt, MPI_DOUBLE, MPI_MAX, world);
 
   std::vector<jd_guard_species> sp(nt);
-  double zeta = 0.0;
   for (int t = 0; t < nt; t++) {
     sp[t].count = (size_t)g_count[t];
     sp[t].rmin = g_count[t] > 0.0 ? g_rmin[t] : 0.0;
     sp[t].density = g_rho[t];
     sp[t].E = pair->youngs(t + 1);
     sp[t].nu = pair->poisson(t + 1);
-    for (int u = 0; u < nt && sp[t].count; u++) zeta = std::fmax(zeta, pair->coeffs(t + 1, u + 1).gamma);
   }
   bool walls = false;
   for (int k = 0; k < modify->nfix; k++) walls = walls || dynamic_cast<FixWallJiang *>(modify->fix[k]);
@@ -92,7 +90,8 @@ void FixJdemGuard::setup(int) {
   in.wall_rule = pair->wall_rule;
   in.max_impact_speed = vmax;
   in.coordination = coordination;
-  in.damping_ratio = zeta;
+  in.damping_ratio = jd_guard_damping_ratio(sp.data(), (size_t)nt, pair->restitution_table(),
+                                            pair->damping_map);
   in.bond_omega2 = 0.0; /* bonds of several types add up on an atom: a sum of bounds bounds it */
   for (int k = 0; k < modify->nfix; k++) {
     FixBondJiang *b = dynamic_cast<FixBondJiang *>(modify->fix[k]);

@@ -1,8 +1,9 @@
 /* jdem_bond_output.h — what dump h5md/jdem writes about bonds (docs/scenes.md "Bonds"): the
  * bonds formed and broken since the previous frame of every fix bond/jiang, gathered on rank 0
- * and appended to /connectivity through io/h5md.h, and the observables bonds and fragments.
+ * and appended to /jdem/bonds, /jdem/broken_bonds (and their tuple lists in /connectivity)
+ * through io/h5md.h, and the observables bonds and fragments.
  *
- * /connectivity/bonds is ordered by step, rule (explicit bonds first), ids; broken_bonds by step,
+ * The bonds are ordered by step, rule (explicit bonds first), ids; broken_bonds by step,
  * ids.  fragments counts the connected components of the intact-bond graph over the particles
  * that were ever bonded (1 for an intact aggregate). */
 #ifndef JDEM_BOND_OUTPUT_H

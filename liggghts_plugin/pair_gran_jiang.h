@@ -53,6 +53,8 @@ class PairGranJiang : public PairGran {
   double youngs(int t) const { return E_[t]; }
   double poisson(int t) const { return nu_[t]; }
   const jd_pair_coeffs &coeffs(int it, int jt) const { return coeffs_[it * (ntypes_ + 1) + jt]; }
+  /* coefficientRestitution, ntypes x ntypes, 0-based, row-major (the kernel's tables) */
+  const double *restitution_table() const { return &restitution_[0]; }
   /* Per-atom stiffness prefactors [N/m^1.5] of the local and ghost atoms (they depend on the
    * atom's type and radius only): jd_hertz_prefactor for pairs, jd_kn_wall (wall_rule) against
    * a wall.  refresh_prefactors() brings them up to date (the pair loop calls it every step;

@@ -500,9 +500,9 @@ def resolved_scene(scene, bed_path, d):
             raise RuntimeError("jdem run %s failed:\n%s" % (one, r.stderr))
         names = list(sc["bond_types"])
         with h5py.File(h5, "r") as f:
-            g = f["connectivity"]
-            step0 = g["bond_formed_step"][...] == 0
-            ids, types = g["bonds"][...][step0], g["bond_type"][...][step0]
+            g = f["jdem/bonds"]
+            step0 = g["formed_step"][...] == 0
+            ids, types = g["ids"][...][step0], g["type"][...][step0]
         sc["bonds"] = [{"ids": [int(a), int(b)], "type": names[t]} for (a, b), t in zip(ids.tolist(), types.tolist())]
         for f in (one, h5, h5[:-3] + ".xdmf"):
             os.remove(f)

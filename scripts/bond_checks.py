@@ -143,8 +143,8 @@ class Trajectory:
             c = f.get("connectivity")
             self.bonds = c["bonds"][()] if c is not None else np.zeros((0, 2), int)
             self.breaks = {}
-            if c is not None and "broken_bonds" in c:
-                self.breaks = {k: c["broken_bonds"][k][()] for k in c["broken_bonds"]}
+            if "jdem/broken_bonds" in f:
+                self.breaks = {k: v[()] for k, v in f["jdem/broken_bonds"].items()}
 
     def index(self, pid):
         return int(np.nonzero(self.ids == pid)[0][0])
@@ -339,7 +339,7 @@ def check_rule(runner, engine, quick):
                extra={"bond_rules": [{"type": "cement", "time": 40 * dt}]})
     t = runner.run(engine, "rule", sc)
     with h5py.File(os.path.join(runner.out, "rule", "%s.h5" % engine), "r") as f:
-        formed = f["connectivity/bond_formed_step"][()]
+        formed = f["jdem/bonds/formed_step"][()]
     ok = len(t.bonds) == 1 and tuple(t.bonds[0]) == (1, 2) and list(formed) == [40]
     return [record("rule_bonds", engine, float(len(t.bonds)), 1.0, 0.0, ok=ok,
                    detail="bonds %s formed at %s" % (t.bonds.tolist(), formed.tolist()))]

@@ -22,7 +22,19 @@ def num(x):
 
 
 def vec(v):
+    """A vector's three numbers.  LIGGGHTS' read_data reads a short Velocities line past its end
+    (a segfault in AtomVecSphere::data_vel), so anything but three components is refused."""
+    if not isinstance(v, (list, tuple)) or len(v) != 3:
+        raise ValueError("expected a vector of three numbers, got %r" % (v,))
     return " ".join(num(c) for c in v)
+
+
+def positive(x, what):
+    """X as a finite float > 0 (a radius, a density)."""
+    value = float(x)
+    if not (0.0 < value < math.inf):
+        raise ValueError("%s must be a finite number > 0, got %r" % (what, x))
+    return value
 
 
 class ParticleStream:
@@ -49,10 +61,14 @@ class ParticleStream:
                 raise KeyError("materials (a resolved scene lists them before the particles)")
             self.tid = {n: i + 1 for i, n in enumerate(scene["materials"])}
             self.mats = scene["materials"]
-        pid, mat, r, pos = int(p["id"]), p["material"], float(p["radius"]), p["position"]
+        pid, mat, pos = int(p["id"]), p["material"], p["position"]
+        r = positive(p["radius"], "particle %d: radius" % pid)
+        if not 1 <= pid <= 2 ** 31 - 1:  # LIGGGHTS' atom ids are ints
+            raise ValueError("particle id %d: LIGGGHTS needs 1 <= id <= 2147483647" % pid)
         vel, omega = p.get("velocity", [0, 0, 0]), p.get("angular_velocity", [0, 0, 0])
         self.files["atoms"].write("%d %d %s %s %s\n" % (pid, self.tid[mat], num(2.0 * r),
-                                                       num(self.mats[mat]["density"]), vec(pos)))
+                                                       num(positive(self.mats[mat]["density"], "material %s: density" % mat)),
+                                                       vec(pos)))
         self.files["velocities"].write("%d %s %s\n" % (pid, vec(vel), vec(omega)))
         force = p.get("force", [0, 0, 0])
         if p.get("fixed") or any(float(c) != 0.0 for c in force):

@@ -198,6 +198,8 @@ def main():
         return EXIT_OK
     if rc >= 128:
         status = rc
+    elif child.signal:  # mpirun exits 1 when its ranks stopped on the forwarded signal
+        status = 128 + child.signal
     elif rc == 0:
         status = EXIT_INTERNAL  # exit 0 without the trajectory
     else:

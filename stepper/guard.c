@@ -9,14 +9,15 @@
 
 #include "sim.h"
 
-/* Largest damping ratio of a pair with at least one material that has particles (the rule
- * LIGGGHTS' fix jdem/guard applies to its atom types, so that both judge alike). */
+/* The guard's damping ratio (jd_guard_damping_ratio, the rule LIGGGHTS' fix jdem/guard applies to
+ * its atom types). */
 static double damping_ratio(const jd_scene *sc, const jd_guard_species *sp) {
-    double z = 0.0;
-    for (size_t a = 0; a < sc->n_materials; a++)
-        for (size_t b = 0; sp[a].count && b < sc->n_materials; b++)
-            z = fmax(z, jd_gamma_for(sc->damping_map,
-                                     sc->interactions[a * sc->n_materials + b].restitution));
+    const size_t nn = sc->n_materials * sc->n_materials;
+    double *e = malloc((nn ? nn : 1) * sizeof *e);
+    if (!e) return INFINITY; /* cannot assess: report as unsafe */
+    for (size_t k = 0; k < nn; k++) e[k] = sc->interactions[k].restitution;
+    const double z = jd_guard_damping_ratio(sp, sc->n_materials, e, sc->damping_map);
+    free(e);
     return z;
 }
 

@@ -63,6 +63,9 @@ SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--engines", "jde
                       "--out", "out/test/bonds"], "lines", {}),
            ("bonds-sanitized", [PY, "scripts/bond_checks.py", "--quick", "--out",
                                 "out/test/bonds-san"], "lines", SANITIZED)]
+# ParaView (Debian's, `make paraview-deps`) opens both engines' sidecars with its default reader:
+# points, cells, arrays and time steps against the .h5, and a rendered PNG with content.
+SUITES += [("paraview", [PY, "tests/paraview/test_paraview.py"], "lines", {})]
 # Fault injection (tests/faults/, run as root in CI: tmpfs, read-only mounts, ulimit -v):
 # hostile names, signals at each phase, disk full, memory limits; exit code, message, files left.
 SUITES += [("faults", [PY, "tests/faults/run_faults.py"], "lines", {})]

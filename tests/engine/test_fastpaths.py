@@ -312,7 +312,7 @@ block = variant(yaml.safe_dump(resolved, sort_keys=False), "block_drop")
 
 def breaks(path):
     with h5py.File(path, "r") as f:
-        g = f.get("connectivity/broken_bonds")
+        g = f.get("jdem/broken_bonds")
         return [] if g is None else sorted(map(tuple, np.column_stack((g["step"][()], g["ids"][()])).tolist()))
 
 

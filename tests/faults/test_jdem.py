@@ -173,6 +173,7 @@ def parse_out_of_memory():
     c.check("parse_oom_exit_memory", r.rc == EXIT["memory"], repr(r))
     c.check("parse_oom_message", r.err == want, f"{r!r}, want {want!r}")
     expect_files(c, "parse_oom_nothing_written", d, ["big.yaml"])
+    os.unlink(path)
 
 
 def run_under_ulimit():
@@ -273,6 +274,7 @@ def signal_while_reading():
         c.check(f"{name}_exit", r.rc == signal_exit(sig), repr(r))
         c.check(f"{name}_message", r.err == want, f"{r!r}, want {want!r}")
         expect_files(c, f"{name}_nothing_written", d, ["big.yaml"])
+    os.unlink(path)  # 30 MB
 
 
 def signal_mid_run():

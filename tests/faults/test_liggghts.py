@@ -3,12 +3,15 @@
 (scripts/liggghts_run.py) and the input handling of liggghts-jdem's styles.  Each case asserts
 the exit status, the message and what is on disk:
 
-  injection       names with a line break reach no LIGGGHTS command (no `shell` runs); names
-                  with '#', '$', '&' and quotes are written literally and land in /parameters
+  injection       names with a line break, another control character or a quote are refused by
+                  the generator (no `shell` runs); names with '#', '$', '&' are written
+                  literally and land in /parameters as they are
   paths           -o with '#', a space, '$' works at exactly that path; '*' is refused
   concurrent      a second wrapper on the same OUT is refused (exit 3), the first completes
   typo            a bad scene leaves the earlier OUT.h5 and OUT.xdmf as they were
-  sigterm         SIGTERM to the wrapper stops LIGGGHTS (143, OUT.h5.part kept, nothing left running)
+  watchdog        a watchdog trip through the wrapper exits 4, OUT.h5.part kept
+  sigterm         SIGTERM to the wrapper stops LIGGGHTS or mpirun (143, OUT.h5.part kept, nothing
+                  left running), on 1 and 2 ranks
   rank errors     an error on one rank (Error::one) reaches stderr and the log, stdout a pipe,
                   on 1 and 2 ranks; no garbage line after a LIGGGHTS error
   bad files       bond file, loads file and scene_yaml: directory, /dev/zero, empty, binary,
@@ -161,6 +164,10 @@ def injection(c, d):
             ("single_quote", ["name"], "it's", "holds a quote character"),
             ("double_quote", ["case"], 'say "x"', "holds a quote character"),
             ("wall_rule", ["model", "wall_rule"], "hertz\nshell touch PWNED", "model.wall_rule is"),
+            # found by tests/fuzz/fuzz_deck.py: a short Velocities line segfaulted read_data
+            ("short_vector", ["particles", 1, "angular_velocity"], [0, 0],
+             "expected a vector of three numbers, got [0, 0]"),
+            ("radius_zero", ["particles", 0, "radius"], 0.0, "particle 1: radius must be a finite number > 0"),
     ):
         generator_refuses(c, d, label, where, value, expect)
 
@@ -239,6 +246,16 @@ def typo_keeps_result(c, d):
     c.check("typo_keeps_h5_and_xdmf", after == before, "changed: %s" % [f for f in before if after[f] != before[f]])
 
 
+def watchdog_class(c, d):
+    """A watchdog trip through the wrapper exits 4 (jdem's class), OUT.h5.part kept."""
+    out = os.path.join(d, "wd.h5")
+    r = wrapper(os.path.join(ROOT, "tests", "engine", "scenes", "watchdog_blowup.yaml"), out, "--case", "overlap",
+                "--force")
+    c.check("watchdog_exit", r.rc == EXIT["watchdog"], repr(r)[-800:])
+    c.check("watchdog_message", "jdem: watchdog: step" in r.err, r.err[-800:])
+    c.check("watchdog_files", not os.path.exists(out) and h5_readable(out + ".part") is None, files(d))
+
+
 def processes_in(directory):
     """Pids of the processes whose working directory is DIRECTORY."""
     pids = []
@@ -253,21 +270,23 @@ def processes_in(directory):
 
 
 def sigterm(c, d):
-    scene = resting(d, "long", steps=LONG_STEPS, every=LONG_STEPS // 6)
-    out = os.path.join(d, "w.h5")
-    proc = start([PY, RUN, scene, "-o", out])
-    if not c.check("sigterm_started", wait_for_file(out + ".part", 60), "no w.h5.part after 60 s"):
-        proc.kill()
-        return
-    proc.send_signal(signal.SIGTERM)
-    r = finish(proc, 60)
-    c.check("sigterm_exit", r.rc == signal_exit(signal.SIGTERM), repr(r))
-    c.check("sigterm_message", "terminated (SIGTERM)" in r.err and out + ".part" in r.err, r.err[-1500:])
-    left = processes_in(os.path.join(d, "w.deck"))
-    c.check("sigterm_child_gone", not left, "still running in the deck: %s" % left)
-    time.sleep(1.0)
-    c.check("sigterm_no_output_later", not os.path.exists(out), "w.h5 appeared after the wrapper exited")
-    c.check("sigterm_part_readable", h5_readable(out + ".part") is None, str(h5_readable(out + ".part")))
+    for np_ in (1, 2):  # liggghts-jdem itself, and mpirun (which forwards the signal to its ranks)
+        name = "sigterm_np%d" % np_
+        scene = resting(d, "long%d" % np_, steps=LONG_STEPS, every=LONG_STEPS // 6)
+        out = os.path.join(d, "w%d.h5" % np_)
+        proc = start([PY, RUN, scene, "-o", out, "--np", str(np_)])
+        if not c.check(name + "_started", wait_for_file(out + ".part", 60), "no .part after 60 s"):
+            proc.kill()
+            continue
+        proc.send_signal(signal.SIGTERM)
+        r = finish(proc, 60)
+        c.check(name + "_exit", r.rc == signal_exit(signal.SIGTERM), repr(r))
+        c.check(name + "_message", "terminated (SIGTERM)" in r.err and out + ".part" in r.err, r.err[-1500:])
+        left = processes_in(os.path.join(d, "w%d.deck" % np_))
+        c.check(name + "_child_gone", not left, "still running in the deck: %s" % left)
+        time.sleep(1.0)
+        c.check(name + "_no_output_later", not os.path.exists(out), "the trajectory appeared after the wrapper exited")
+        c.check(name + "_part_readable", h5_readable(out + ".part") is None, str(h5_readable(out + ".part")))
 
 
 # ---- liggghts-jdem: errors on a rank, bad files, the set-up watchdog --------------------------
@@ -357,7 +376,7 @@ def main():
     c = Checks()
     d = scratch("jdem_faults_liggghts_")
     for name, case in (("injection", injection), ("paths", paths), ("concurrent", concurrent),
-                       ("typo", typo_keeps_result), ("sigterm", sigterm), ("rank_errors", rank_errors),
+                       ("typo", typo_keeps_result), ("watchdog", watchdog_class), ("sigterm", sigterm), ("rank_errors", rank_errors),
                        ("bad_files", bad_files), ("setup_watchdog", setup_watchdog)):
         sub = os.path.join(d, name)
         os.makedirs(sub)

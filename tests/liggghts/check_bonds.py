@@ -76,7 +76,7 @@ def compare(name, a, b, until=None):
 
 def events(path):
     with h5py.File(path, "r") as f:
-        g = f["connectivity/broken_bonds"]
+        g = f["jdem/broken_bonds"]
         return [(int(s), int(i[0]), int(i[1]), int(m)) for s, i, m in zip(g["step"][()], g["ids"][()], g["mode"][()])]
 
 
@@ -85,7 +85,7 @@ def fragment_sizes(path):
     ever bonded, largest first: /connectivity/bonds minus /connectivity/broken_bonds."""
     with h5py.File(path, "r") as f:
         formed = [tuple(int(v) for v in ids) for ids in f["connectivity/bonds"][()]]
-        broken = [tuple(int(v) for v in ids) for ids in f["connectivity/broken_bonds/ids"][()]]
+        broken = [tuple(int(v) for v in ids) for ids in f["connectivity/broken_bonds"][()]]
     intact = list(formed)
     for b in broken:
         intact.remove(b)

@@ -65,7 +65,7 @@ static int exists(const char *p) {
 }
 
 static jd_h5md *open_writer(const char *path, char *err, size_t errlen) {
-    jd_h5md_meta meta = {"jdem", "0.1.0", "glass", "chung_ooi_1", t_scene, 1e-6};
+    jd_h5md_meta meta = {"jdem", "0.1.0", "glass", "chung_ooi_1", t_scene, 1e-6, "A. Tester"};
     jd_h5md_particles p = {NP, t_id, t_species, t_radius, t_mass};
     return jd_h5md_create(path, &meta, &p, err, errlen);
 }
@@ -251,7 +251,23 @@ static void test_roundtrip_layout(void **state) {
     }
     char s[128];
     attr_string(f, "/h5md/author", "name", s, sizeof s);
-    assert_string_equal(s, "jdem developers");
+    assert_string_equal(s, "A. Tester");
+    /* the units module (H5MD units module 1.0): version [1, 0], system "SI", ASCII units */
+    attr_string(f, "/h5md/modules/units", "system", s, sizeof s);
+    assert_string_equal(s, "SI");
+    {
+        int uv[2] = {0, 0};
+        hid_t a = H5Aopen_by_name(f, "/h5md/modules/units", "version", H5P_DEFAULT, H5P_DEFAULT);
+        assert_true(a >= 0 && H5Aread(a, H5T_NATIVE_INT, uv) >= 0);
+        H5Aclose(a);
+        assert_int_equal(uv[0], 1);
+        assert_int_equal(uv[1], 0);
+        a = H5Aopen_by_name(f, "/particles/all/position/value", "unit", H5P_DEFAULT, H5P_DEFAULT);
+        hid_t ty = H5Aget_type(a);
+        assert_int_equal(H5Tget_cset(ty), H5T_CSET_ASCII);
+        H5Tclose(ty);
+        H5Aclose(a);
+    }
     attr_string(f, "/h5md/creator", "name", s, sizeof s);
     assert_string_equal(s, "jdem");
     attr_string(f, "/h5md/creator", "version", s, sizeof s);
@@ -389,14 +405,14 @@ static void test_xdmf_sidecar(void **state) {
     fclose(fp);
     text[n] = 0;
     int grids = 0, times = 0;
-    for (const char *p = text; (p = strstr(p, "GridType=\"Uniform\"")); ++p) ++grids;
+    for (const char *p = text; (p = strstr(p, "<Grid Name=\"frame_")); ++p) ++grids;
     for (const char *p = text; (p = strstr(p, "<Time Value=")); ++p) ++times;
     assert_int_equal(grids, NF);
     assert_int_equal(times, NF);
     assert_non_null(strstr(text, "CollectionType=\"Temporal\""));
     assert_non_null(strstr(text, "TopologyType=\"Polyvertex\""));
     /* relative reference to the .h5, never the directory or the .part name */
-    assert_non_null(strstr(text, ">glass.jdem.h5:/particles/all/position/value<"));
+    assert_non_null(strstr(text, ">glass.jdem.h5:/particles/all/position/value|"));
     assert_null(strstr(text, t.dir));
     assert_null(strstr(text, ".part"));
     assert_non_null(strstr(text, "Name=\"velocity\""));
@@ -404,10 +420,14 @@ static void test_xdmf_sidecar(void **state) {
     assert_non_null(strstr(text, "Name=\"radius\""));
     assert_non_null(strstr(text, "Name=\"species\""));
     assert_null(strstr(text, "Name=\"angular_velocity\"")); /* not written in this run */
-    /* last frame's hyperslab starts at frame NF-1 */
-    char slab[64];
-    snprintf(slab, sizeof slab, ">%d 0 0 1 1 1 1 %d 3<", NF - 1, NP);
+    /* the last frame's selection, in Xdmf3's start:stride:count:dataspace syntax (the
+     * HyperSlab items of before showed 0 points in ParaView's default reader) */
+    char slab[96];
+    snprintf(slab, sizeof slab, "position/value|%d 0 0:1 1 1:1 %d 3:%d %d 3<", NF - 1, NP, NF,
+             NP);
     assert_non_null(strstr(text, slab));
+    assert_null(strstr(text, "HyperSlab"));
+    assert_non_null(strstr(text, ">glass.jdem.h5:/jdem/vertex_index</DataItem></Topology>"));
     tdir_remove(&t);
 }
 

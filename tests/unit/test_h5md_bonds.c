@@ -64,40 +64,66 @@ static void connectivity_roundtrip(void **state) {
     int64_t ids[6], steps[3];
     int32_t types[3];
     read_all(f, "/connectivity/bonds", H5T_NATIVE_INT64, ids);
-    read_all(f, "/connectivity/bond_type", H5T_NATIVE_INT32, types);
-    read_all(f, "/connectivity/bond_formed_step", H5T_NATIVE_INT64, steps);
+    read_all(f, "/jdem/bonds/type", H5T_NATIVE_INT32, types);
+    read_all(f, "/jdem/bonds/formed_step", H5T_NATIVE_INT64, steps);
     for (int i = 0; i < 3; i++) {
         assert_int_equal(ids[2 * i], b[i].id[0]);
         assert_int_equal(ids[2 * i + 1], b[i].id[1]);
         assert_int_equal(types[i], b[i].type);
         assert_int_equal(steps[i], b[i].formed_step);
     }
-    char attr[64] = "";
-    hid_t a = H5Aopen_by_name(f, "/connectivity/bonds", "particles_group", H5P_DEFAULT,
-                              H5P_DEFAULT);
-    assert_true(a >= 0);
-    hid_t t = H5Aget_type(a);
-    assert_true(H5Aread(a, t, attr) >= 0);
-    H5Tclose(t);
-    H5Aclose(a);
-    assert_string_equal(attr, "/particles/all");
-    assert_int_equal(rows(f, "/connectivity/broken_bonds/position", &rank), 1);
+    /* H5MD tuple lists: particles_group is an object reference to /particles/all */
+    for (int k = 0; k < 2; ++k) {
+        const char *list = k ? "/connectivity/broken_bonds" : "/connectivity/bonds";
+        hid_t a = H5Aopen_by_name(f, list, "particles_group", H5P_DEFAULT, H5P_DEFAULT);
+        assert_true(a >= 0);
+        hid_t t = H5Aget_type(a);
+        assert_true(H5Tequal(t, H5T_STD_REF_OBJ) > 0);
+        hobj_ref_t ref;
+        assert_true(H5Aread(a, H5T_STD_REF_OBJ, &ref) >= 0);
+        H5Tclose(t);
+        H5Aclose(a);
+        char name[64] = "";
+        hid_t g = H5Rdereference2(f, H5P_DEFAULT, H5R_OBJECT, &ref);
+        assert_true(g >= 0);
+        assert_true(H5Iget_name(g, name, sizeof name) > 0);
+        H5Oclose(g);
+        assert_string_equal(name, "/particles/all");
+    }
+    /* the tuple lists are the tables' id columns themselves (hard links) */
+    {
+        H5O_info_t a, b;
+        assert_true(H5Oget_info_by_name(f, "/connectivity/bonds", &a, H5P_DEFAULT) >= 0);
+        assert_true(H5Oget_info_by_name(f, "/jdem/bonds/ids", &b, H5P_DEFAULT) >= 0);
+        assert_true(a.addr == b.addr);
+        assert_true(H5Oget_info_by_name(f, "/connectivity/broken_bonds", &a, H5P_DEFAULT) >= 0);
+        assert_true(H5Oget_info_by_name(f, "/jdem/broken_bonds/ids", &b, H5P_DEFAULT) >= 0);
+        assert_true(a.addr == b.addr);
+        hsize_t nlinks = 0;
+        hid_t c = H5Gopen2(f, "/connectivity", H5P_DEFAULT);
+        H5G_info_t gi;
+        assert_true(H5Gget_info(c, &gi) >= 0);
+        nlinks = gi.nlinks;
+        H5Gclose(c);
+        assert_int_equal(nlinks, 2);
+    }
+    assert_int_equal(rows(f, "/jdem/broken_bonds/position", &rank), 1);
     assert_int_equal(rank, 2);
     double pos[3], v;
     int64_t eid[2];
     int32_t mode;
-    read_all(f, "/connectivity/broken_bonds/position", H5T_NATIVE_DOUBLE, pos);
-    read_all(f, "/connectivity/broken_bonds/ids", H5T_NATIVE_INT64, eid);
-    read_all(f, "/connectivity/broken_bonds/mode", H5T_NATIVE_INT32, &mode);
+    read_all(f, "/jdem/broken_bonds/position", H5T_NATIVE_DOUBLE, pos);
+    read_all(f, "/jdem/broken_bonds/ids", H5T_NATIVE_INT64, eid);
+    read_all(f, "/jdem/broken_bonds/mode", H5T_NATIVE_INT32, &mode);
     assert_int_equal(eid[0], 2);
     assert_int_equal(eid[1], 3);
     assert_int_equal(mode, 2);
     assert_rel(pos[2], 0.125, 0.0);
-    read_all(f, "/connectivity/broken_bonds/tau_max", H5T_NATIVE_DOUBLE, &v);
+    read_all(f, "/jdem/broken_bonds/tau_max", H5T_NATIVE_DOUBLE, &v);
     assert_rel(v, 6.5, 0.0);
-    read_all(f, "/connectivity/broken_bonds/normal_force", H5T_NATIVE_DOUBLE, &v);
+    read_all(f, "/jdem/broken_bonds/normal_force", H5T_NATIVE_DOUBLE, &v);
     assert_rel(v, -1.5, 0.0);
-    read_all(f, "/connectivity/broken_bonds/step", H5T_NATIVE_INT64, eid);
+    read_all(f, "/jdem/broken_bonds/step", H5T_NATIVE_INT64, eid);
     assert_int_equal(eid[0], 70);
     H5Fclose(f);
     unlink(path);

@@ -18,6 +18,16 @@ static jd_inlet_spec one_sphere(const double *rel, const double *radius, const i
     return s;
 }
 
+/* n spheres in a row along the belt (rel: their positions), origin 0, L = 0.3, ids from 1. */
+static jd_inlet_spec row(size_t n, const double *rel, const double *radius, const int32_t *species) {
+    jd_inlet_spec s = one_sphere(rel, radius, species);
+    s.n = n;
+    s.origin[0] = 0.0;
+    s.period = 0.3;
+    s.first_id = 1;
+    return s;
+}
+
 static const double ORIGIN_REL[3] = {0.0, 0.0, 0.0};
 static const double R1[1] = {0.01};
 static const int32_t SP1[1] = {2};
@@ -104,12 +114,8 @@ static void stream_order_ids_and_steps(void **state) {
     const double rel[9] = {-0.1005, 0, 0, -0.0505, 0, 0.05, -0.1505, 0.0, -0.05};
     const double radius[3] = {0.01, 0.01, 0.02};
     const int32_t species[3] = {0, 0, 1};
-    jd_inlet_spec s = one_sphere(rel, radius, species);
-    s.n = 3;
-    s.origin[0] = 0.0;
-    s.period = 0.3;
+    jd_inlet_spec s = row(3, rel, radius, species);
     s.max_sections = 4;
-    s.first_id = 1;
     char msg[256];
     assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_OK);
     jd_inlet_cursor cur[3];
@@ -149,12 +155,8 @@ static void stop_step_keeps_whole_sections(void **state) {
     const double rel[6] = {-0.0505, 0, 0, -0.1505, 0, 0};
     const double radius[2] = {0.01, 0.01};
     const int32_t species[2] = {0, 0};
-    jd_inlet_spec s = one_sphere(rel, radius, species);
-    s.n = 2;
-    s.origin[0] = 0.0;
-    s.period = 0.3;
+    jd_inlet_spec s = row(2, rel, radius, species);
     s.stop_step = 400;
-    s.first_id = 1;
     jd_inlet_cursor cur[2];
     jd_inlet_stream st;
     jd_inlet_stream_init(&s, &st, cur);

@@ -334,6 +334,13 @@ static void bond_strength_and_break(void **state) {
                 s.u_prev == 0.0 && s.e_damp == 1e-6 && out.f[2] == 0.0);
 }
 
+static void guard_damping_ratio_over_species_with_particles(void **state) {
+    (void)state;
+    const jd_guard_species sp[2] = {{.count = 3}, {.count = 0}};
+    const double e[4] = {0.9, 0.5, 0.1, 0.1}; /* (1, *) is not read: species 1 has no particles */
+    assert_rel(jd_guard_damping_ratio(sp, 2, e, JD_DAMP_JIANG2021), jd_gamma_jiang2021(0.5), 0.0);
+}
+
 int run_laws_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(kinematics_is_eq6),
@@ -350,6 +357,7 @@ int run_laws_tests(void) {
         cmocka_unit_test(bond_frequency_bounds),
         cmocka_unit_test(bond_springs_are_eq16),
         cmocka_unit_test(bond_strength_and_break),
+        cmocka_unit_test(guard_damping_ratio_over_species_with_particles),
     };
     return cmocka_run_group_tests_name("laws", tests, NULL, NULL);
 }

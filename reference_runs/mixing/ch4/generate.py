@@ -16,7 +16,6 @@ fixed walls at its faces and a servo top wall at the cube top (1000 Pa +- 10 Pa)
 Both check every region against the deposit (scripts/mixing/deposit.py) before writing.
 """
 import argparse
-import copy
 import os
 import sys
 
@@ -25,25 +24,13 @@ import yaml
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "..", "scripts"))
 from mixing import deposit, params  # noqa: E402
+from stability_scenes import set_path  # noqa: E402  (the sweep's dotted-path override)
 
 MODELS = os.path.join(HERE, "models.yaml")
 CELL = (1.0, 0.5, 0.25)   # [RECON] orientation, spec §1.7
 DEPTH = 1.0               # [TEXT] L1539
 CUBE = 0.2                # [TEXT] spec §2.4
 SERVO = {"target": 1000.0, "gain": 1.0e-4, "tolerance": 10.0, "max_speed": 0.02, "hold": 0.05}
-
-
-def override(doc, path, value):
-    """The sweep's dotted-path override (docs/scenes.md "Cases")."""
-    keys = path.split(".")
-    node = doc
-    for k in keys[:-1]:
-        node = node[int(k)] if isinstance(node, list) else node[k]
-    last = keys[-1]
-    if isinstance(node, list):
-        node[int(last)] = value
-    else:
-        node[last] = value
 
 
 def case_scene(case):
@@ -54,7 +41,7 @@ def case_scene(case):
     if case not in values:
         sys.exit(f"generate.py: case '{case}' is not in {MODELS}; valid: {', '.join(values)}")
     for path, value in values[case].items():
-        override(doc, path, value)
+        set_path(doc, path, value)
     doc["case"] = case
     return doc
 
