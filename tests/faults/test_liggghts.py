@@ -28,6 +28,8 @@ import subprocess
 import sys
 import time
 
+import yaml
+
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from faults_common import (EXIT, JDEM, LIGGGHTS_JDEM, PY, ROOT, Checks, files, h5_frames,  # noqa: E402
                            h5_readable, run, scratch, signal_exit, start, finish, wait_for,
@@ -128,7 +130,6 @@ def liggghts(deck, np_=1, timeout=120):
 def generator_refuses(c, d, label, path_in_scene, value, expect):
     """A resolved scene with VALUE at PATH_IN_SCENE (keys): the generator exits 2 with EXPECT in
     its message and writes no in.jdem; nothing named PWNED appears."""
-    import yaml
     scene = yaml.safe_load(resolved_text(resting(d, "inj_" + label)))
     node = scene
     for k in path_in_scene[:-1]:
@@ -180,13 +181,28 @@ def injection(c, d):
     c.check("wrapper_injection_nothing_ran", not any("PWNED" in f for f in files(w)), files(w))
     c.check("wrapper_injection_no_output", not os.path.exists(os.path.join(w, "i.h5")), files(w))
 
-    # names LIGGGHTS would cut ('#'), substitute ('$') or continue ('&' at the end):
-    # written literally, and stored as they are
+    # names LIGGGHTS would cut ('#'), substitute ('$') or continue ('&' at the end): the scene
+    # reader refuses them (names are data: a safe character set) ...
     name = "odd #name $x ${y} $(1+1) &"
     scene = write_scene(w, "odd", RESTING.format(name='"%s"' % name, steps=20, every=10))
     out = os.path.join(w, "odd.h5")
     r = wrapper(scene, out, cwd=w)
-    if c.check("odd_name_runs", r.rc == 0 and h5_readable(out) is None, repr(r)[-1500:]):
+    c.check("odd_name_refused_by_reader", r.rc == EXIT["input"] and "not allowed in a name" in r.err,
+            repr(r)[-1500:])
+    c.check("odd_name_no_output", not os.path.exists(out) and not os.path.exists(out + ".part"), files(w))
+    # ... and a resolved scene that holds one anyway (hand-edited) is written literally by the deck
+    # generator, and stored as it is
+    resolved = yaml.safe_load(resolved_text(resting(w, "odd_ok", steps=20, every=10)))
+    resolved["name"] = name
+    deck = os.path.join(w, "odd_deck")
+    os.makedirs(deck)
+    with open(os.path.join(deck, "resolved.yaml"), "w") as f:
+        yaml.safe_dump(resolved, f)
+    out = os.path.join(deck, "out.h5")
+    g = run([PY, GEN, os.path.join(deck, "resolved.yaml"), "-o", os.path.join(deck, "in.jdem"),
+             "--trajectory", out])
+    r, _ = liggghts(deck) if g.rc == 0 else (g, "")
+    if c.check("odd_name_deck_runs", g.rc == 0 and r.rc == 0 and h5_readable(out) is None, repr(r)[-1500:]):
         import h5py
         with h5py.File(out, "r") as f:
             got = f["parameters"].attrs.get("scene_name")
