@@ -12,7 +12,8 @@ of this test are made from its last frame.  Checks:
     particle set) gives only the occupied slots of the frame;
   - ids: renumber gives the kept particles consecutive ids after the scene's own particles;
   - the other engine: the LIGGGHTS deck made from the resolved scene (scene_to_liggghts.py) runs
-    the same particles, and its trajectory matches build/jdem's (compare_trajectories.py);
+    the same particles, and its trajectory matches build/jdem's (compare_trajectories.py); a
+    scene started from liggghts-jdem's trajectory gets its last frame bit for bit;
   - bad input: the exact message of each (a missing file, a frame that does not exist, a file
     that is not HDF5, an HDF5 file that is not H5MD, an empty region, a region outside the
     deposit with the wording of scripts/mixing/deposit.py, a region that keeps nothing, a
@@ -156,6 +157,14 @@ def check_liggghts(c, work, path, jdem_h5):
                        capture_output=True, text=True)
     lines = [l for l in (p.stdout + p.stderr).strip().splitlines() if l.strip()]
     c.check("deposit_liggghts_trajectory", p.returncode == 0, lines[-1] if lines else "")
+    rc, out, err = resolve(write_scene(work, "from_liggghts", "{file: %s, velocities: keep}" % lig_h5))
+    if c.check("deposit_from_liggghts_resolve", rc == 0, err):
+        got = resolved_particles(out)
+        ids, _, _, pos, vel, _ = source_frame(lig_h5)
+        c.check("deposit_from_liggghts_bitwise", [p["id"] for p in got] == ids.tolist() and
+                np.array_equal(np.array([p["position"] for p in got]), pos) and
+                np.array_equal(np.array([p["velocity"] for p in got]), vel),
+                "the particles differ from liggghts-jdem's last frame")
 
 
 def bad_cases(work, src):
