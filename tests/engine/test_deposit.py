@@ -15,7 +15,7 @@ of this test are made from its last frame.  Checks:
     the same particles, and its trajectory matches build/jdem's (compare_trajectories.py); a
     scene started from liggghts-jdem's trajectory gets its last frame bit for bit;
   - bad input: the exact message of each (a missing file, a frame that does not exist, a file
-    that is not HDF5, an HDF5 file that is not H5MD, an empty region, a region outside the
+    that is not HDF5, an HDF5 file that is not H5MD, an H5MD file without particles, an empty region, a region outside the
     deposit with the wording of scripts/mixing/deposit.py, a region that keeps nothing, a
     material the scene lacks), each with exit status 2.
 """
@@ -176,6 +176,9 @@ def bad_cases(work, src):
     plain = os.path.join(work, "plain.h5")
     with h5py.File(plain, "w") as f:
         f["x"] = np.zeros(3)
+    no_particles = os.path.join(work, "no_particles.h5")
+    with h5py.File(no_particles, "w") as f:
+        f.create_group("h5md")
     outside_hi = [0.01, 0.0, 0.3]
     try:
         deposit.keep_box(dep, LO, outside_hi)
@@ -193,6 +196,8 @@ def bad_cases(work, src):
          k % "frame" + "%s: frame 4 does not exist; valid: -4 to 3 (4 frames)" % src),
         ("not_hdf5", "{file: %s}" % text, k % "file" + "%s: not an HDF5 file; %s" % (text, valid)),
         ("not_h5md", "{file: %s}" % plain, k % "file" + "%s: no /h5md group (not an H5MD file); %s" % (plain, valid)),
+        ("no_particles", "{file: %s}" % no_particles,
+         k % "file" + "%s: no /particles/all/position; %s" % (no_particles, valid)),
         ("empty_region", "{file: %s, region: {lo: [0, 0, 0], hi: [0.01, 0, 0.01]}}" % src,
          k % "region" + "region [0.0, 0.0, 0.0]..[0.01, 0.0, 0.01]: empty; valid: lo < hi"),
         ("region_outside", "{file: %s, region: {lo: %s, hi: %s}}" % (src, LO, outside_hi), k % "region" + outside),
