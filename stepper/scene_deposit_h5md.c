@@ -182,6 +182,8 @@ static int read_frame_fields(hid_t f, const char *file, int64_t frame, int veloc
             bad = "parameters";
         if (!bad)
             rc = 0;
+        else if (strcmp(bad, "memory") == 0)
+            snprintf(msg, len, "%s: out of memory for %zu particles", file, fr->n);
         else if (strcmp(bad, "parameters") == 0)
             snprintf(msg, len, "%s: no readable /parameters/scene with materials; " VALID_H5MD,
                      file);
