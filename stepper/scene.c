@@ -20,7 +20,8 @@
 static const char *const TOP_KEYS[] = {"jdem_scene", "name", "case", "description", "time",
                                        "output", "gravity", "model", "materials", "interactions",
                                        "particles", "generate", "walls", "watchdog", "sweep",
-                                       "bond_types", "bonds", "bond_rules", NULL};
+                                       "bond_types", "bonds", "bond_rules", "particles_from",
+                                       NULL};
 static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_speed",
                                          "coordination_number", NULL};
 static const char *const OUTPUT_KEYS[] = {"every", "observables_every", "compare_tolerance",
@@ -313,6 +314,7 @@ static int read_scene(loader *L) {
         read_output(L) || sd_opt_vec3(&L->c, L->root, NULL, "gravity", s->gravity) ||
         read_model(L) || read_watchdog(L) || scene_read_materials(L) ||
         scene_read_bond_types(L) || scene_read_particles(L) || scene_read_generators(L) ||
+        scene_read_deposits(L) ||
         scene_read_walls(L) || scene_read_bonds(L))
         return -1;
     if (s->n_particles == 0) {

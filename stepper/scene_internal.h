@@ -8,6 +8,7 @@
  *   scene_particles.c   explicit particles, the sort by id (duplicate ids), the start-overlap check
  *   scene_generate.c    the lattice generator
  *   scene_walls.c       walls and their geometry checks
+ *   scene_deposit.c     particles_from (scene_deposit_h5md.c reads the trajectory's frame)
  *   scene_bonds.c       bond_types, explicit bonds, bond_rules; their resolution after the sort
  *   scene_bond_generators.c   the bonded_block and bonded_sphere generators
  *   scene_bond_rules.c  the pair test of a bond rule (shared with the stepper, scene.h)
@@ -74,6 +75,12 @@ int scene_check_wall_overlaps(loader *L);
 
 /* scene_generate.c */
 int scene_read_generators(loader *L);
+
+/* scene_deposit.c: particles_from, after particles and generate.  Its particles' psrc is
+ * PSRC_DEPOSIT(entry index). */
+#define PSRC_DEPOSIT(k) (INT32_MIN + (int32_t)(k))
+#define PSRC_IS_DEPOSIT(src) ((src) < INT32_MIN / 2)
+int scene_read_deposits(loader *L);
 
 /* scene_walls.c */
 int scene_read_walls(loader *L);

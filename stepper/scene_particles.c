@@ -127,6 +127,8 @@ static int by_id(const void *a, const void *b) {
 static void particle_path(const loader *L, size_t i, char out[SD_PATH_MAX]) {
     if (L->psrc[i] >= 0)
         sd_join_index(out, "particles", (size_t)L->psrc[i]);
+    else if (PSRC_IS_DEPOSIT(L->psrc[i]))
+        sd_join_index(out, "particles_from", (size_t)(L->psrc[i] - INT32_MIN));
     else
         snprintf(out, SD_PATH_MAX, "generate.%d.lattice", -L->psrc[i] - 1);
 }
