@@ -177,7 +177,7 @@ void sim_inlets_log(jd_sim *s, FILE *log) {
 /* One inserted particle at index n, which is also its scene index (n_scene + the particles
  * inserted before it): its state, its constants, and the energy it brings.  Its force is its
  * weight, the force an ordinary particle alone would carry into the next step's first half
- * kick (none when the kicks add the weight themselves). */
+ * kick (after sim_finish_step every force holds the weight, also when the kicks add it). */
 static void append(jd_sim *s, const jd_inlet_particle *p) {
     jd_sim_inlets *in = s->inlets;
     const size_t i = s->n++;
@@ -186,12 +186,11 @@ static void append(jd_sim *s, const jd_inlet_particle *p) {
     in->id[i] = p->id;
     const jd_row *hit = bsearch(&p->id, in->rows, in->cap, sizeof *in->rows, by_id);
     in->slot[i] = (int32_t)(hit - in->rows);
-    const int gravity_in_f = !s->weight_in_kick;
     for (int d = 0; d < 3; d++) {
         s->x[3 * i + d] = p->position[d];
         s->v[3 * i + d] = p->velocity[d];
         s->omega[3 * i + d] = 0.0;
-        s->f[3 * i + d] = gravity_in_f ? s->mass[i] * s->g[d] : 0.0;
+        s->f[3 * i + d] = s->mass[i] * s->g[d];
         s->torque[3 * i + d] = 0.0;
     }
     in->energy_in += 0.5 * s->mass[i] * jd_dot(p->velocity, p->velocity) -
