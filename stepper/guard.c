@@ -21,6 +21,11 @@ static double damping_ratio(const jd_scene *sc, const jd_guard_species *sp) {
     return z;
 }
 
+static void add_particle(jd_guard_species *p, double radius) {
+    p->rmin = p->count ? fmin(p->rmin, radius) : radius;
+    p->count++;
+}
+
 int sim_guard(const jd_scene *sc, jd_guard_input *in, jd_guard_species **species,
               jd_guard_result *r) {
     jd_guard_species *sp = calloc(sc->n_materials ? sc->n_materials : 1, sizeof *sp);
@@ -30,11 +35,10 @@ int sim_guard(const jd_scene *sc, jd_guard_input *in, jd_guard_species **species
         sp[a] = (jd_guard_species){.density = m->density, .E = m->youngs_modulus,
                                    .nu = m->poisson_ratio};
     }
-    for (size_t i = 0; i < sc->n_particles; i++) {
-        jd_guard_species *p = &sp[sc->material[i]];
-        p->rmin = p->count ? fmin(p->rmin, sc->radius[i]) : sc->radius[i];
-        p->count++;
-    }
+    for (size_t i = 0; i < sc->n_particles; i++) add_particle(&sp[sc->material[i]], sc->radius[i]);
+    for (size_t k = 0; k < sc->n_inlets; k++) /* the sections' particles take part once inserted */
+        for (size_t p = 0; p < sc->inlets[k].n; p++)
+            add_particle(&sp[sc->inlets[k].material[p]], sc->inlets[k].radius[p]);
     *in = (jd_guard_input){.species = sp, .n_species = sc->n_materials,
                            .has_walls = sc->n_walls > 0, .wall_rule = sc->wall_rule,
                            .max_impact_speed = sc->max_impact_speed,

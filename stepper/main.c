@@ -60,6 +60,8 @@ static const char usage_text[] =
     "  --all-laws               evaluate every contact law even where the scene's\n"
     "                           coefficients switch it off (run; the general force loop, a\n"
     "                           reference for the scene-specialised ones: same trajectory)\n"
+    "  --inlet-record FILE      write every particle an inlet inserts as a CSV line\n"
+    "                           id,step,x,y,z,vx,vy,vz (17 digits: exact) to FILE (run)\n"
     "  --plain-loops            evaluate one contact at a time instead of in SIMD batches,\n"
     "                           gravity in a pass of its own, the integration constants per\n"
     "                           particle and the rebuild check at every step (run; the\n"
@@ -97,7 +99,7 @@ static const char usage_text[] =
     "  128 + N  stopped by signal N (130 SIGINT, 143 SIGTERM)\n";
 
 typedef struct cli {
-    const char *command, *scene, *case_name, *output;
+    const char *command, *scene, *case_name, *output, *inlet_record;
     int force, quiet, timing, no_sort, all_laws, plain_loops, threads;
 } cli;
 
@@ -127,6 +129,9 @@ static int parse(int argc, char **argv, cli *c) {
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (!has_value) return usage_error("-o needs a value", NULL);
             c->output = argv[++k];
+        } else if (!strcmp(a, "--inlet-record")) {
+            if (!has_value) return usage_error("--inlet-record needs a value", NULL);
+            c->inlet_record = argv[++k];
         } else if (!strcmp(a, "--force")) {
             c->force = 1;
         } else if (!strcmp(a, "--quiet")) {
@@ -159,9 +164,9 @@ static int parse(int argc, char **argv, cli *c) {
     if (!c->scene) return usage_error("missing SCENE", NULL);
     if (strcmp(c->command, "run") &&
         (c->output || c->force || c->quiet || c->timing || c->no_sort || c->all_laws ||
-         c->plain_loops || c->threads))
-        return usage_error("-o, --force, --quiet, --threads, --timing, --no-sort, --all-laws and "
-                           "--plain-loops apply to 'run' only", NULL);
+         c->plain_loops || c->threads || c->inlet_record))
+        return usage_error("-o, --force, --quiet, --threads, --timing, --no-sort, --all-laws, "
+                           "--plain-loops and --inlet-record apply to 'run' only", NULL);
     if (!c->threads && getenv("OMP_NUM_THREADS")) {
         if (!(c->threads = thread_count(getenv("OMP_NUM_THREADS"))))
             return usage_error("OMP_NUM_THREADS must be a whole number from 1 to 1024",
@@ -351,6 +356,11 @@ static void print_timing(const jd_sim *s) {
             "engine_bytes=%zu\n",
             t->neighbour, t->pairs, t->walls, t->integration, t->output, t->loop, (long long)s->step,
             (long long)s->n_builds, s->threads, s->pairs.n, s->wall_pairs.n, sim_memory_bytes(s));
+    const int64_t inserted = sim_inlets_inserted(s);
+    if (inserted > 0)
+        fprintf(stderr, "jdem-inlets: inserted=%lld seconds=%.6f ns_per_particle=%.1f\n",
+                (long long)inserted, sim_inlets_seconds(s),
+                1e9 * sim_inlets_seconds(s) / (double)inserted);
 }
 
 /* The output path: -o, or out/SCENE_NAME/CASE.jdem.h5.  The names are checked by the scene
@@ -366,31 +376,51 @@ static int output_path(const cli *c, const jd_scene *sc, char *out, size_t size)
     return 0;
 }
 
+/* The trajectory's particle set in scene order (the engine may have renumbered the particles;
+ * with inlets every particle the run can hold).  Arrays of *n entries in one block (free id). */
+static int output_particles(const jd_scene *sc, const jd_sim *sim, jd_h5md_particles *p) {
+    const size_t n = sim_inlets_rows(sim), n1 = n ? n : 1;
+    int64_t *id = malloc(n1 * sizeof *id);
+    int32_t *species = malloc(n1 * sizeof *species);
+    double *radius = malloc(2 * n1 * sizeof *radius);
+    *p = (jd_h5md_particles){.n = n, .id = id, .species = species, .radius = radius,
+                             .mass = radius ? radius + n1 : NULL};
+    if (!id || !species || !radius) return -1;
+    if (sim->inlets) return sim_inlets_particles(sim, id, species, radius, radius + n1);
+    memcpy(id, sc->id, n * sizeof *id);
+    memcpy(species, sc->material, n * sizeof *species);
+    memcpy(radius, sc->radius, n * sizeof *radius);
+    sim_scalars_in_scene_order(sim, sim->mass, radius + n1);
+    return 0;
+}
+
+static void free_output_particles(jd_h5md_particles *p) {
+    free((void *)p->id);
+    free((void *)p->species);
+    free((void *)p->radius);
+}
+
 /* Open the trajectory of a set-up run; NULL after reporting, with the exit status in *rc. */
 static jd_h5md *create_output(const jd_scene *sc, const jd_sim *sim, const char *out, int *rc) {
     char err[1024] = "";
     char *yaml = scene_yaml_string(sc);
-    /* the particles' constants in scene order (the engine may have renumbered them) */
-    double *mass = malloc((sc->n_particles ? sc->n_particles : 1) * sizeof *mass);
+    jd_h5md_particles parts;
+    const int parts_ok = output_particles(sc, sim, &parts) == 0;
     jd_h5md *h = NULL;
     *rc = EXIT_NO_MEMORY;
-    if (!yaml || !mass) {
+    if (!yaml || !parts_ok) {
         fprintf(stderr, "jdem: out of memory preparing the output\n");
     } else {
-        sim_scalars_in_scene_order(sim, sim->mass, mass);
         const jd_h5md_meta meta = {.creator = "jdem", .creator_version = JDEM_VERSION,
                                    .scene_name = sc->name, .case_name = sc->case_name,
                                    .scene_yaml = yaml, .dt = sc->dt};
-        const jd_h5md_particles parts = {.n = sc->n_particles, .id = sc->id,
-                                         .species = sc->material, .radius = sc->radius,
-                                         .mass = mass};
         if (!(h = jd_h5md_create(out, &meta, &parts, err, sizeof err))) {
             fprintf(stderr, "jdem: %s\n", err);
             *rc = EXIT_IO;
         }
     }
     free(yaml);
-    free(mass);
+    free_output_particles(&parts);
     return h;
 }
 
@@ -439,8 +469,21 @@ static int cmd_run(const cli *c) {
         rc = setup_failure(err);
     } else {
         jd_h5md *h = NULL;
-        if (stop_signal) rc = stopped_in_setup();
-        else if ((h = create_output(&sc, &sim, out, &rc))) rc = run_and_close(c, &sim, h, out);
+        FILE *record = c->inlet_record ? fopen(c->inlet_record, "w") : NULL;
+        if (c->inlet_record && !record) {
+            fprintf(stderr, "jdem: %s: %s\n", c->inlet_record, strerror(errno));
+            rc = EXIT_IO;
+        } else if (stop_signal) {
+            rc = stopped_in_setup();
+        } else if ((h = create_output(&sc, &sim, out, &rc))) {
+            if (record) fprintf(record, "id,step,x,y,z,vx,vy,vz\n");
+            sim_inlets_log(&sim, record);
+            rc = run_and_close(c, &sim, h, out);
+        }
+        if (record && fclose(record) != 0 && rc == 0) {
+            fprintf(stderr, "jdem: %s: %s\n", c->inlet_record, strerror(errno));
+            rc = EXIT_IO;
+        }
         sim_free(&sim);
     }
     scene_free(&sc);

@@ -21,7 +21,7 @@ static const char *const TOP_KEYS[] = {"jdem_scene", "name", "case", "descriptio
                                        "output", "gravity", "model", "materials", "interactions",
                                        "particles", "generate", "walls", "watchdog", "sweep",
                                        "bond_types", "bonds", "bond_rules", "particles_from",
-                                       NULL};
+                                       "inlets", NULL};
 static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_speed",
                                          "coordination_number", NULL};
 static const char *const OUTPUT_KEYS[] = {"every", "observables_every", "compare_tolerance",
@@ -270,7 +270,9 @@ static double max_relative_speed(const jd_scene *s, vel *u) {
     return best;
 }
 
-/* Height of the initial bounding box (centres +- radius) along gravity. */
+/* Height of the initial bounding box (centres +- radius) along gravity, with the inlets'
+ * sections at their origins (they enter at that height) and, with inlets, the walls' corners
+ * and axis ends (the floor the stream falls onto). */
 static double fall_height(const jd_scene *s, const double ghat[3]) {
     double lo = INFINITY, hi = -INFINITY;
     for (size_t i = 0; i < s->n_particles; i++) {
@@ -278,12 +280,42 @@ static double fall_height(const jd_scene *s, const double ghat[3]) {
         lo = fmin(lo, h - s->radius[i]);
         hi = fmax(hi, h + s->radius[i]);
     }
+    for (size_t k = 0; k < s->n_inlets; k++)
+        for (size_t p = 0; p < s->inlets[k].n; p++) {
+            double x[3];
+            for (int d = 0; d < 3; d++) x[d] = s->inlets[k].origin[d] + s->inlets[k].rel[3 * p + d];
+            lo = fmin(lo, jd_dot(x, ghat) - s->inlets[k].radius[p]);
+            hi = fmax(hi, jd_dot(x, ghat) + s->inlets[k].radius[p]);
+        }
+    for (size_t w = 0; s->n_inlets && w < s->n_walls; w++) {
+        const jd_wall *wl = &s->walls[w];
+        const int np = wl->type == JD_WALL_PLANE ? 4 : 2;
+        for (int c = 0; c < np; c++) {
+            const double h = jd_dot(wl->type == JD_WALL_PLANE ? wl->corners[c] : wl->axis[c], ghat);
+            lo = fmin(lo, h);
+            hi = fmax(hi, h);
+        }
+    }
     return hi - lo;
+}
+
+/* The largest belt speed relative to a wall, or to a resting particle. */
+static double inlet_speed(const jd_scene *s) {
+    double v = 0.0;
+    for (size_t k = 0; k < s->n_inlets; k++) {
+        v = fmax(v, norm3(s->inlets[k].velocity));
+        for (size_t w = 0; w < s->n_walls; w++) {
+            double d[3];
+            sub3(s->inlets[k].velocity, s->walls[w].velocity, d);
+            v = fmax(v, norm3(d));
+        }
+    }
+    return v;
 }
 
 static int default_impact_speed(loader *L) {
     jd_scene *s = L->s;
-    vel *u = malloc(s->n_particles * sizeof *u);
+    vel *u = malloc((s->n_particles ? s->n_particles : 1) * sizeof *u);
     if (!u) return sd_no_memory(&L->c, L->root, NULL);
     double v = max_relative_speed(s, u);
     free(u);
@@ -294,6 +326,7 @@ static int default_impact_speed(loader *L) {
             v = fmax(v, norm3(d));
         }
     if (s->n_particles == 1 && s->n_walls == 0) v = norm3(s->velocity);
+    v = fmax(v, inlet_speed(s));
     double g = norm3(s->gravity);
     if (g > 0.0) {
         const double ghat[3] = {s->gravity[0] / g, s->gravity[1] / g, s->gravity[2] / g};
@@ -315,9 +348,12 @@ static int read_scene(loader *L) {
         read_model(L) || read_watchdog(L) || scene_read_materials(L) ||
         scene_read_bond_types(L) || scene_read_particles(L) || scene_read_generators(L) ||
         scene_read_deposits(L) ||
-        scene_read_walls(L) || scene_read_bonds(L))
+        scene_read_inlets(L) || scene_read_walls(L) || scene_read_bonds(L))
         return -1;
-    if (s->n_particles == 0) {
+    if (s->n_inlets && s->n_bond_types)
+        return sd_fail(&L->c, sd_get(&L->c, L->root, "bond_types"), "bond_types", "bonds "
+                       "together with inlets; valid: one of the two");
+    if (s->n_particles == 0 && s->n_inlets == 0) {
         const yaml_node_t *p = sd_get(&L->c, L->root, "particles");
         return sd_fail(&L->c, p ? p : L->root, "particles", "no particles; valid: at least one "
                        "particle in particles or generate");
@@ -326,7 +362,7 @@ static int read_scene(loader *L) {
         scene_check_wall_overlaps(L) || scene_resolve_bonds(L))
         return -1;
     if (!L->max_impact_given && default_impact_speed(L)) return -1;
-    return L->s->dt_auto ? auto_dt(L) : 0;
+    return (L->s->dt_auto && auto_dt(L)) || scene_check_inlets(L);
 }
 
 /* Index of case_name among the cases (NULL: the only one), or -1 after reporting. */
@@ -402,6 +438,7 @@ int scene_load(const char *path, const char *case_name, jd_scene *scene, char *e
     free(L.by_particle);
     free(L.by_wall);
     free(L.bnode);
+    free(L.inode);
     sd_free_names(names, n);
     yaml_document_delete(&doc);
     if (rc) scene_free(scene);
@@ -426,5 +463,11 @@ void scene_free(jd_scene *scene) {
     free(scene->bond_type);
     for (size_t r = 0; r < scene->n_bond_rules; r++) free(scene->bond_rules[r].materials);
     free(scene->bond_rules);
+    for (size_t k = 0; k < scene->n_inlets; k++) {
+        free(scene->inlets[k].rel);
+        free(scene->inlets[k].radius);
+        free(scene->inlets[k].material);
+    }
+    free(scene->inlets);
     memset(scene, 0, sizeof *scene);
 }

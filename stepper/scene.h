@@ -74,6 +74,32 @@ typedef struct jd_bond_rule {
                                  step is set from it once dt is known */
 } jd_bond_rule;
 
+/* How an inlet's stream stops (docs/mixing.md 2.1, `inlets[].stop`). */
+typedef enum { JD_INLET_STOP_SECTIONS = 0, JD_INLET_STOP_TIME = 1, JD_INLET_STOP_HEIGHT = 2 } jd_inlet_stop;
+
+/* A conveyor inlet (`inlets:` entry): a section of n particles that rides a belt and enters the
+ * run particle by particle as each centre crosses the inlet plane (kernel/jdem_inlet.h). */
+typedef struct jd_inlet {
+    char name[JD_NAME_MAX];
+    size_t n;                 /* particles per section, >= 1 */
+    double *rel;              /* 3n positions relative to the section origin [m] */
+    double *radius;           /* n radii [m] */
+    int32_t *material;        /* n indices into materials */
+    double origin[3];         /* copy 0's origin at t = 0 [m] */
+    double velocity[3];       /* belt velocity [m/s] */
+    double plane_point[3];    /* [m] */
+    double plane_normal[3];   /* towards the domain, any length > 0 [-] */
+    double period;            /* L [m] */
+    double offset;            /* copy 0 set back along the belt [m] */
+    int64_t first_id;         /* id of particle 0 of copy 0 */
+    int stop;                 /* jd_inlet_stop */
+    int64_t sections;         /* JD_INLET_STOP_SECTIONS: copies, >= 1 */
+    double stop_time;         /* JD_INLET_STOP_TIME: no copy starts at or after ceil(time/dt) [s] */
+    double height;            /* JD_INLET_STOP_HEIGHT: deposit top z + R that stops the stream [m] */
+    double below_speed;       /* JD_INLET_STOP_HEIGHT: only particles slower than this count [m/s] */
+    int64_t every;            /* JD_INLET_STOP_HEIGHT: steps between checks, >= 1 */
+} jd_inlet;
+
 typedef struct jd_scene {
     char path[1024];          /* the scene file */
     char name[JD_NAME_MAX];   /* scene name */
@@ -135,6 +161,9 @@ typedef struct jd_scene {
     int32_t *bond_type;       /* n_bonds indices into bond_types */
     size_t n_bond_rules;
     jd_bond_rule *bond_rules; /* sorted by step (stable) */
+
+    size_t n_inlets;          /* conveyor inlets (docs/mixing.md 2.1), in file order */
+    jd_inlet *inlets;
 } jd_scene;
 
 /* The failures of scene_list_cases and scene_load: the file is not a valid scene (or cannot be
@@ -160,6 +189,12 @@ int scene_emit_yaml(const jd_scene *scene, FILE *out);
 char *scene_yaml_string(const jd_scene *scene);
 
 void scene_free(jd_scene *scene);
+
+struct jd_inlet_spec;
+/* The kernel's description of inlet k of the scene (kernel/jdem_inlet.h; its arrays point into
+ * the scene).  The stepper builds its stream from this (scene_inlets.c); the LIGGGHTS fix
+ * builds the same one from the resolved scene's values. */
+void scene_inlet_spec(const jd_scene *scene, size_t k, struct jd_inlet_spec *out);
 
 /* The pairs a bond rule bonds at positions x (3 n_particles [m], in the scene's order): particles
  * i < j (indices) both in the rule's group (material flag set, id in id_range) with

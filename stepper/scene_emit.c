@@ -247,6 +247,45 @@ static int emit_bonds(yaml_emitter_t *e, const jd_scene *s) {
     return seq_end(e);
 }
 
+static int emit_inlet_stop(yaml_emitter_t *e, const jd_inlet *in) {
+    if (str(e, "stop") || map_start(e, 1)) return 1;
+    if (in->stop == JD_INLET_STOP_SECTIONS) {
+        if (key_int(e, "sections", in->sections)) return 1;
+    } else if (in->stop == JD_INLET_STOP_TIME) {
+        if (key_num(e, "time", in->stop_time)) return 1;
+    } else if (str(e, "deposit_height") || map_start(e, 1) || key_num(e, "height", in->height) ||
+               key_num(e, "below_speed", in->below_speed) || key_int(e, "every", in->every) ||
+               map_end(e)) {
+        return 1;
+    }
+    return map_end(e);
+}
+
+/* Inlets (docs/mixing.md 2.1): the section as explicit particles, every default explicit; only
+ * for scenes with inlets, so the others resolve as before. */
+static int emit_inlets(yaml_emitter_t *e, const jd_scene *s) {
+    if (!s->n_inlets) return 0;
+    if (str(e, "inlets") || seq_start(e, 0)) return 1;
+    for (size_t k = 0; k < s->n_inlets; k++) {
+        const jd_inlet *in = &s->inlets[k];
+        if (map_start(e, 0) || key_str(e, "name", in->name) || str(e, "section") ||
+            map_start(e, 0) || str(e, "particles") || seq_start(e, 0))
+            return 1;
+        for (size_t p = 0; p < in->n; p++)
+            if (map_start(e, 1) || key_str(e, "material", s->materials[in->material[p]].name) ||
+                key_num(e, "radius", in->radius[p]) || key_vec(e, "position", &in->rel[3 * p]) ||
+                map_end(e))
+                return 1;
+        if (seq_end(e) || map_end(e) || key_vec(e, "origin", in->origin) ||
+            key_vec(e, "velocity", in->velocity) || str(e, "plane") || map_start(e, 1) ||
+            key_vec(e, "point", in->plane_point) || key_vec(e, "normal", in->plane_normal) ||
+            map_end(e) || key_num(e, "period", in->period) || key_num(e, "offset", in->offset) ||
+            key_int(e, "first_id", in->first_id) || emit_inlet_stop(e, in) || map_end(e))
+            return 1;
+    }
+    return seq_end(e);
+}
+
 static int emit_scene(yaml_emitter_t *e, const jd_scene *s) {
     yaml_event_t ev;
     if (emit(e, &ev, yaml_stream_start_event_initialize(&ev, YAML_UTF8_ENCODING)) ||
@@ -260,7 +299,7 @@ static int emit_scene(yaml_emitter_t *e, const jd_scene *s) {
         return 1;
     for (size_t i = 0; i < s->n_walls; i++)
         if (emit_wall(e, s, &s->walls[i])) return 1;
-    return seq_end(e) || emit_bonds(e, s) || map_end(e) ||
+    return seq_end(e) || emit_bonds(e, s) || emit_inlets(e, s) || map_end(e) ||
            emit(e, &ev, yaml_document_end_event_initialize(&ev, 1)) ||
            emit(e, &ev, yaml_stream_end_event_initialize(&ev)) || !yaml_emitter_flush(e);
 }

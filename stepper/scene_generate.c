@@ -7,6 +7,7 @@
 #include "scene_internal.h"
 
 static const char *const GENERATOR_KEYS[] = {"lattice", "bonded_block", "bonded_sphere", NULL};
+static const char *const LATTICE_ONLY_KEYS[] = {"lattice", NULL};
 static const char *const LATTICE_KEYS[] = {"material", "radius", "radii", "origin", "spacing",
                                            "counts", "jitter", "velocity", "seed", NULL};
 static const char *const RADII_KEYS[] = {"values", "fractions", NULL};
@@ -191,20 +192,18 @@ static int generate_lattice(loader *L, const yaml_node_t *lat, int32_t gen, latt
     return rc;
 }
 
-int scene_read_generators(loader *L) {
-    const yaml_node_t *list = sd_get(&L->c, L->root, "generate");
-    if (!list) return 0;
-    if (sd_sequence(&L->c, list, "generate",
-                    "a list of {lattice: {...}}, {bonded_block: {...}}, {bonded_sphere: {...}}"))
+int scene_generate_list(loader *L, const yaml_node_t *list, const char *prefix,
+                        int lattice_only, int64_t *next_id) {
+    if (sd_sequence(&L->c, list, prefix,
+                    lattice_only ? "a list of {lattice: {...}}"
+                                 : "a list of {lattice: {...}}, {bonded_block: {...}}, "
+                                   "{bonded_sphere: {...}}"))
         return -1;
-    int64_t next_id = 1;
-    for (size_t i = 0; i < L->s->n_particles; i++)
-        next_id = L->s->id[i] >= next_id ? L->s->id[i] + 1 : next_id;
     for (size_t k = 0; k < sd_len(list); k++) {
         char path[SD_PATH_MAX], sub[SD_PATH_MAX];
-        sd_join_index(path, "generate", k);
+        sd_join_index(path, prefix, k);
         const yaml_node_t *e = sd_item(&L->c, list, k);
-        if (sd_keys(&L->c, e, path, GENERATOR_KEYS)) return -1;
+        if (sd_keys(&L->c, e, path, lattice_only ? LATTICE_ONLY_KEYS : GENERATOR_KEYS)) return -1;
         if (e->data.mapping.pairs.top - e->data.mapping.pairs.start > 1)
             return sd_fail(&L->c, e, path, "more than one generator in one entry; valid: one of "
                            "lattice, bonded_block, bonded_sphere per list item");
@@ -216,13 +215,22 @@ int scene_read_generators(loader *L) {
                 return sd_missing(&L->c, e, path, "lattice", "one of lattice, bonded_block, "
                                   "bonded_sphere");
             sd_join(sub, path, key);
-            if (scene_generate_bonded(L, b, key, sub, (int32_t)k, &next_id)) return -1;
+            if (scene_generate_bonded(L, b, key, sub, (int32_t)k, next_id)) return -1;
             continue;
         }
         sd_join(sub, path, "lattice");
         lattice g = {0};
-        if (read_lattice(L, lat, sub, &g) || generate_lattice(L, lat, (int32_t)k, &g, &next_id))
+        if (read_lattice(L, lat, sub, &g) || generate_lattice(L, lat, (int32_t)k, &g, next_id))
             return -1;
     }
     return 0;
+}
+
+int scene_read_generators(loader *L) {
+    const yaml_node_t *list = sd_get(&L->c, L->root, "generate");
+    if (!list) return 0;
+    int64_t next_id = 1;
+    for (size_t i = 0; i < L->s->n_particles; i++)
+        next_id = L->s->id[i] >= next_id ? L->s->id[i] + 1 : next_id;
+    return scene_generate_list(L, list, "generate", 0, &next_id);
 }

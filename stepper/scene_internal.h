@@ -9,6 +9,7 @@
  *   scene_generate.c    the lattice generator
  *   scene_walls.c       walls and their geometry checks
  *   scene_deposit.c     particles_from (scene_deposit_h5md.c reads the trajectory's frame)
+ *   scene_inlets.c      the conveyor inlets (docs/mixing.md 2.1) and the kernel's check of them
  *   scene_bonds.c       bond_types, explicit bonds, bond_rules; their resolution after the sort
  *   scene_bond_generators.c   the bonded_block and bonded_sphere generators
  *   scene_bond_rules.c  the pair test of a bond rule (shared with the stepper, scene.h)
@@ -46,6 +47,7 @@ typedef struct loader {
     size_t bond_cap;            /* allocated bonds */
     const yaml_node_t **bnode;  /* per bond: the node that made it (for messages) */
     const yaml_node_t *time;    /* the time mapping: steps from end_time wait for an auto dt */
+    const yaml_node_t **inode;  /* per inlet: its mapping (messages of the check after dt) */
 } loader;
 
 static inline double norm3(const double v[3]) { return sqrt(jd_dot(v, v)); }
@@ -75,6 +77,15 @@ int scene_check_wall_overlaps(loader *L);
 
 /* scene_generate.c */
 int scene_read_generators(loader *L);
+/* The generator list `list` at `prefix` (lattice_only: no bonded generators), appending
+ * particles with ids from *next_id on. */
+int scene_generate_list(loader *L, const yaml_node_t *list, const char *prefix,
+                        int lattice_only, int64_t *next_id);
+
+/* scene_inlets.c: the inlets section (after the particles and generators, before the sort),
+ * and its kernel check once dt is final. */
+int scene_read_inlets(loader *L);
+int scene_check_inlets(loader *L);
 
 /* scene_deposit.c: particles_from, after particles and generate.  Its particles' psrc is
  * PSRC_DEPOSIT(entry index). */

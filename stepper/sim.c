@@ -50,6 +50,8 @@ static int init_laws(jd_sim *s) {
     if (rc == 0) {
         jd_pair_coeffs_table(nm, e, mu, eta, sc->damping_map, sc->mu_r, sc->xi_limit, s->coeffs);
         for (size_t i = 0; i < sc->n_particles; i++) used[sc->material[i]] = 1;
+        for (size_t k = 0; k < sc->n_inlets; k++)
+            for (size_t p = 0; p < sc->inlets[k].n; p++) used[sc->inlets[k].material[p]] = 1;
         for (size_t w = 0; w < sc->n_walls; w++) wall_used[sc->walls[w].material] = 1;
         s->features = s->opt.all_laws
                           ? JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R |
@@ -63,7 +65,7 @@ static int init_laws(jd_sim *s) {
 
 /* How alike the particles are (sim.h: pair_row, alike), which lets the pair loop read the
  * coefficients, or also the pair constants and radii, once instead of per pair. */
-static void init_kinds(jd_sim *s) {
+void sim_particle_kinds(jd_sim *s) {
     s->pair_row = s->n ? s->species[0] * (int32_t)(s->n_materials + 1) : -1;
     s->alike = s->n > 0;
     for (size_t i = 1; i < s->n; i++) {
@@ -130,14 +132,27 @@ static int alloc_particle_arrays(jd_sim *s, size_t n) {
     return 0;
 }
 
+void sim_particle_constants(jd_sim *s, size_t i, int32_t material, double r) {
+    const jd_scene *sc = s->scene;
+    const jd_material *m = &sc->materials[material];
+    const double dtfrotate = 0.5 * s->dt / 0.4; /* fix nve/sphere: dtfrotate, then dtirotate */
+    s->species[i] = material;
+    s->radius[i] = r;
+    s->mass[i] = jd_sphere_mass(r, m->density);
+    s->inertia[i] = jd_sphere_inertia(s->mass[i], r);
+    s->kp[i] = jd_hertz_prefactor(m->youngs_modulus, m->poisson_ratio, r);
+    s->kw[i] = jd_kn_wall(sc->wall_rule, m->youngs_modulus, m->poisson_ratio, r);
+    s->dtfm[i] = 0.5 * s->dt / s->mass[i];
+    s->dtirot[i] = dtfrotate / (r * r * s->mass[i]);
+}
+
 static int init_particles(jd_sim *s, char *err, size_t errlen) {
     const jd_scene *sc = s->scene;
-    const size_t n = sc->n_particles, n1 = n ? n : 1;
+    const size_t n = sc->n_particles, cap = sim_inlets_capacity(sc), n1 = cap ? cap : 1;
     if (alloc_particle_arrays(s, n1) != 0) goto oom;
     memcpy(s->x, sc->position, 3 * n * sizeof(double));
     memcpy(s->v, sc->velocity, 3 * n * sizeof(double));
     memcpy(s->omega, sc->angular_velocity, 3 * n * sizeof(double));
-    const double dtfrotate = 0.5 * s->dt / 0.4; /* fix nve/sphere: dtfrotate, then dtirotate */
     double rmax = 0.0;
     for (size_t i = 0; i < n; i++) {
         const jd_material *m = &sc->materials[sc->material[i]];
@@ -146,25 +161,19 @@ static int init_particles(jd_sim *s, char *err, size_t errlen) {
                      (long long)sc->id[i], m->name);
             return -1;
         }
-        const double r = sc->radius[i];
         s->orig[i] = (int32_t)i;
-        s->species[i] = sc->material[i];
-        s->radius[i] = r;
-        s->mass[i] = jd_sphere_mass(r, m->density);
-        s->inertia[i] = jd_sphere_inertia(s->mass[i], r);
-        s->kp[i] = jd_hertz_prefactor(m->youngs_modulus, m->poisson_ratio, r);
-        s->kw[i] = jd_kn_wall(sc->wall_rule, m->youngs_modulus, m->poisson_ratio, r);
-        s->dtfm[i] = 0.5 * s->dt / s->mass[i];
-        s->dtirot[i] = dtfrotate / (r * r * s->mass[i]);
-        rmax = fmax(rmax, r);
+        sim_particle_constants(s, i, sc->material[i], sc->radius[i]);
+        rmax = fmax(rmax, sc->radius[i]);
     }
+    for (size_t k = 0; k < sc->n_inlets; k++)
+        for (size_t p = 0; p < sc->inlets[k].n; p++) rmax = fmax(rmax, sc->inlets[k].radius[p]);
     /* Skin 0.1 x the largest diameter: the list then holds ~(1.1)^3 = 1.33x the touching pairs
      * of a dense packing, and a rebuild is due only after some particle moved 5 % of a
      * diameter (~100 steps at typical granular speeds and time steps). */
     s->skin = 0.2 * rmax;
     return 0;
 oom:
-    snprintf(err, errlen, "out of memory for %zu particles", n);
+    snprintf(err, errlen, "out of memory for %zu particles", n1);
     return -1;
 }
 
@@ -222,13 +231,15 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
         snprintf(err, errlen, "out of memory");
         return -1;
     }
-    init_kinds(s);
+    sim_particle_kinds(s);
     if (sim_forces_init(s) != 0) {
         snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads);
         return -1;
     }
     if (sim_walls_init(s, err, errlen) != 0) return -1;
-    if (sim_bonds_init(s, err, errlen) != 0 || sim_loads_init(s, err, errlen) != 0) return -1;
+    if (sim_bonds_init(s, err, errlen) != 0 || sim_loads_init(s, err, errlen) != 0 ||
+        sim_inlets_init(s, err, errlen) != 0)
+        return -1;
     s->weight_in_kick = !s->loads && !s->opt.plain_loops &&
                         (s->g[0] != 0.0 || s->g[1] != 0.0 || s->g[2] != 0.0);
     if (sim_neighbour_build(s, err, errlen) != 0) return -1;
@@ -240,6 +251,7 @@ int sim_init(jd_sim *s, const jd_scene *scene, const jd_sim_options *opt, char *
     memset(s, 0, sizeof *s);
     s->scene = scene;
     s->n = scene->n_particles;
+    s->ids = scene->id;
     s->dt = scene->dt;
     if (opt) s->opt = *opt;
     s->allpairs = s->opt.allpairs;
@@ -267,6 +279,7 @@ void sim_free(jd_sim *s) {
     sim_contact_list_free(&s->spare);
     sim_bonds_free(s);
     sim_loads_free(s);
+    sim_inlets_free(s);
     memset(s, 0, sizeof *s);
 }
 
@@ -303,9 +316,15 @@ static int write_frame(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     if (check_finite(s, err, errlen) != 0) return -1;
     if (!h) return 0;
     sim_vectors_to_scene_order(s);
-    const jd_h5md_frame fr = {.step = s->step, .time = (double)s->step * s->dt, .position = s->x,
-                              .velocity = s->v, .angular_velocity = s->omega, .force = s->f,
-                              .torque = s->torque};
+    jd_h5md_frame fr = {.step = s->step, .time = (double)s->step * s->dt, .position = s->x,
+                        .velocity = s->v, .angular_velocity = s->omega, .force = s->f,
+                        .torque = s->torque};
+    if (s->inlets) { /* the rows of every particle the run can hold, NaN until inserted */
+        const double *const vec[JD_INLET_FRAME_VECTORS] = {s->x, s->v, s->omega, s->f, s->torque};
+        const double **dst[JD_INLET_FRAME_VECTORS] = {&fr.position, &fr.velocity,
+                                                      &fr.angular_velocity, &fr.force, &fr.torque};
+        for (int k = 0; k < JD_INLET_FRAME_VECTORS; k++) *dst[k] = sim_inlets_frame_rows(s, k, vec[k]);
+    }
     const int rc = jd_h5md_write_frame(h, &fr, err, errlen);
     sim_vectors_to_sim_order(s);
     return rc ? JD_RUN_OUTPUT : 0;
@@ -322,6 +341,10 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
             jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->dt,
                                      val[k], err, errlen) != 0)
             return JD_RUN_OUTPUT;
+    if (h && s->inlets && jd_h5md_write_observable(h, "inlet_energy", s->step,
+                                                   (double)s->step * s->dt,
+                                                   sim_inlets_energy(s), err, errlen) != 0)
+        return JD_RUN_OUTPUT;
     if (s->bonds) {
         double bv[JD_N_BOND_OBSERVABLES];
         sim_bond_observables_values(&o.bond, bv);
@@ -358,6 +381,7 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
         /* the bonds formed and broken by the last step, also when the watchdog stops here */
         if (s->bonds && (rc = sim_bonds_output(s, h, err, errlen)) != 0) break;
         if ((rc = sim_watchdog_step(s, err, errlen)) != 0) break;
+        if (s->inlets && (rc = sim_inlets_step(s, err, errlen)) != 0) break;
         const double t0 = sim_clock();
         if (due(s->step, sc->output_every, last)) {
             if ((rc = write_frame(s, h, err, errlen)) != 0) break;

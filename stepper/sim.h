@@ -50,6 +50,7 @@
 #include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "bonds.h"
 #include "jdem_geometry.h"
@@ -256,6 +257,11 @@ typedef struct jd_sim {
     jd_energy_terms energy_ref;
     int64_t energy_ref_step;
 
+    /* conveyor inlets (inlet.c); NULL without.  The per-particle arrays then have room for
+     * every particle the run can hold, and n counts the active prefix */
+    struct jd_sim_inlets *inlets;
+    const int64_t *ids;         /* id of each scene index: scene->id, or the inlets' table */
+
     /* set by the caller (e.g. a signal handler) to stop the run at the next step; NULL: never */
     const volatile sig_atomic_t *stop;
 } jd_sim;
@@ -283,6 +289,36 @@ int sim_run(jd_sim *s, struct jd_h5md *h, int show_progress, char *err, size_t e
  * thread buffers, bonds): its memory apart from the scene and the libraries. */
 size_t sim_memory_bytes(const jd_sim *s);
 
+/* Per-particle constants of particle i (mass, inertia, Hertz and wall prefactors, the
+ * integration factors) from its material and radius. */
+void sim_particle_constants(jd_sim *s, size_t i, int32_t material, double radius);
+/* How alike the particles are (pair_row, alike, uniform_mass), after the set changed. */
+void sim_particle_kinds(jd_sim *s);
+
+/* inlet.c: the conveyor inlets (docs/mixing.md 2.1). */
+typedef struct jd_sim_inlets jd_sim_inlets;
+enum { JD_INLET_FRAME_VECTORS = 5 }; /* position, velocity, angular velocity, force, torque */
+/* Particles the run can hold: the scene's plus every copy that starts by the last step. */
+size_t sim_inlets_capacity(const jd_scene *scene);
+int sim_inlets_init(jd_sim *s, char *err, size_t errlen); /* 0, or -1 (out of memory) */
+void sim_inlets_free(jd_sim *s);
+/* Record every insertion as a CSV line "id,step,x,y,z,vx,vy,vz" (%.17g) on log (NULL: none). */
+void sim_inlets_log(jd_sim *s, FILE *log);
+/* Before the step s->step + 1: the deposit-height rule, and the particles due at s->step
+ * (appended, then a neighbour build).  0, or -1 with err. */
+int sim_inlets_step(jd_sim *s, char *err, size_t errlen);
+int64_t sim_inlets_inserted(const jd_sim *s);
+double sim_inlets_seconds(const jd_sim *s); /* wall time of the insertions [s] */
+double sim_inlets_energy(const jd_sim *s);  /* kinetic + gravitational energy brought in [J] */
+/* The trajectory's rows (every particle the run can hold, sorted by id) and their constants
+ * (arrays of sim_inlets_rows entries). */
+size_t sim_inlets_rows(const jd_sim *s);
+int sim_inlets_particles(const jd_sim *s, int64_t *id, int32_t *species, double *radius,
+                         double *mass);
+/* Vector k of a frame (3 per active particle, scene order) spread onto the rows, NaN for the
+ * particles not inserted (yet). */
+double *sim_inlets_frame_rows(const jd_sim *s, int k, const double *scene_ordered);
+
 /* neighbour.c */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
 /* 1 when some wall moved more than skin/2 since the last build (the particles' part of the
@@ -306,7 +342,7 @@ void sim_vectors_to_sim_order(jd_sim *s);
 void sim_scalars_in_scene_order(const jd_sim *s, const double *a, double *out);
 /* Scene id of the particle at index i. */
 static inline long long sim_particle_id(const jd_sim *s, size_t i) {
-    return (long long)s->scene->id[s->orig[i]];
+    return (long long)s->ids[s->orig[i]];
 }
 
 /* walls.c */

@@ -54,11 +54,14 @@ int sim_watchdog_step(const jd_sim *s, char *msg, size_t len) {
 }
 
 /* The balance's terms by the kernel's rule (jd_energy_terms_of). */
-static void energy_terms(const jd_observables *o, jd_energy_terms *e) {
+/* The energy the inlets brought in is booked as work done on the particles, so the balance
+ * closes while the set grows. */
+static void energy_terms(const jd_sim *s, const jd_observables *o, jd_energy_terms *e) {
     double v[JD_N_OBSERVABLES], b[JD_N_BOND_OBSERVABLES];
     sim_observables_values(o, v);
     sim_bond_observables_values(&o->bond, b);
     *e = jd_energy_terms_of(v, b);
+    e->wall_work += sim_inlets_energy(s);
 }
 
 /* The particle with the largest kinetic energy: where a spurious energy gain usually sits. */
@@ -78,7 +81,7 @@ static size_t most_energetic(const jd_sim *s) {
 int sim_watchdog_energy(jd_sim *s, const jd_observables *o, char *msg, size_t len) {
     if (!s->scene->watchdog.enabled || !s->scene->energy) return 0; /* no energies to check */
     jd_energy_terms now;
-    energy_terms(o, &now);
+    energy_terms(s, o, &now);
     const double limit = s->scene->watchdog.max_energy_jump;
     const double jump = s->has_energy_ref ? jd_energy_jump(&s->energy_ref, &now) : 0.0;
     if (!(jump <= limit)) { /* NaN trips too */

@@ -32,6 +32,8 @@ SUITES = [
 SUITES += [(f"engine-{t}", [PY, f"tests/engine/test_{t}.py"], "lines", {}) for t in ENGINE_TESTS]
 SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines", SANITIZED)
            for t in ENGINE_TESTS]
+# The conveyor inlet: the stream against its closed form, the growing trajectory, the energy.
+SUITES += [("inlet", [PY, "tests/inlet/test_inlet.py"], "lines", {})]
 # The two engines on the same scenes (bitwise or 1e-10), and LIGGGHTS on 1 vs 2 MPI ranks.
 SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {})]
 # The law set (kernel/jdem_laws.h) each engine selects, for every scene of reference_runs/ and

@@ -145,6 +145,29 @@ static const char *diff_wall(const jd_wall *a, const jd_wall *b) {
     return NULL;
 }
 
+/* The first field in which two inlets differ, or NULL. */
+static const char *diff_inlet(const jd_inlet *a, const jd_inlet *b) {
+    if (strcmp(a->name, b->name)) return "inlets.name";
+    SAME(n);
+    SAME_ARRAY(rel, 3 * a->n);
+    SAME_ARRAY(radius, a->n);
+    SAME_ARRAY(material, a->n);
+    SAME(origin);
+    SAME(velocity);
+    SAME(plane_point);
+    SAME(plane_normal);
+    SAME(period);
+    SAME(offset);
+    SAME(first_id);
+    SAME(stop);
+    SAME(sections);
+    SAME(stop_time);
+    SAME(height);
+    SAME(below_speed);
+    SAME(every);
+    return NULL;
+}
+
 /* The first field in which two scenes differ (the path excepted), or NULL. */
 static const char *diff_scenes(const jd_scene *a, const jd_scene *b) {
     if (strcmp(a->name, b->name) || strcmp(a->case_name, b->case_name)) return "name";
@@ -198,6 +221,11 @@ static const char *diff_scenes(const jd_scene *a, const jd_scene *b) {
     }
     for (size_t i = 0; i < a->n_walls; i++) {
         const char *d = diff_wall(&a->walls[i], &b->walls[i]);
+        if (d) return d;
+    }
+    SAME(n_inlets);
+    for (size_t k = 0; k < a->n_inlets; k++) {
+        const char *d = diff_inlet(&a->inlets[k], &b->inlets[k]);
         if (d) return d;
     }
     return NULL;

@@ -1,0 +1,277 @@
+/*
+ * inlet.c — the conveyor inlets (docs/mixing.md 2.1) in the stepper: the kernel's stream
+ * (kernel/jdem_inlet.h) turned into particles appended to the run.
+ *
+ * Capacity.  The particle arrays are allocated once for every particle the run can hold: the
+ * scene's plus every copy of every section that starts by the last step (or the stop rule);
+ * the run uses their active prefix [0, n).  A fixed capacity keeps the pointers of the
+ * per-particle block stable (the force loops, the thread shares and the huge-page block hold
+ * them), costs no copy when particles arrive, and is known exactly up front because the stream
+ * is a rigid motion.
+ *
+ * Order.  Scene index (orig) n_scene + k is the k-th inserted particle.  The trajectory holds
+ * the whole capacity set, sorted by id, with a NaN position (and velocities) for each particle
+ * not yet inserted: slot[] maps a scene index to its row.  A deposit-height rule may end the
+ * stream before the capacity is reached; the rows of the particles never inserted stay NaN.
+ *
+ * Cost.  Before each step the run loop compares the step with next_step (the smallest cursor
+ * step over the inlets); only at a step where particles are due does it pop them, append them
+ * and rebuild the neighbour list.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "jdem_inlet.h"
+#include "sim.h"
+
+typedef struct inlet_run {
+    jd_inlet_spec spec;
+    jd_inlet_stream st;
+    jd_inlet_cursor *cursor;
+    int64_t copies;        /* copies that start by the last step (capacity) */
+    int64_t next_check;    /* deposit-height rule: the next step it is checked */
+} inlet_run;
+
+/* A trajectory row: id first, so that bsearch on an id finds it. */
+typedef struct jd_row {
+    int64_t id;
+    int32_t species;
+    double radius, mass;   /* [m], [kg] */
+} jd_row;
+
+struct jd_sim_inlets {
+    size_t n_inlets;
+    inlet_run *run;
+    size_t n_scene, cap;   /* the scene's particles; all the run can hold */
+    int64_t *id;           /* [cap] id of each scene index */
+    int32_t *slot;         /* [cap] row of each scene index in the trajectory (sorted by id) */
+    jd_row *rows;          /* [cap] the trajectory's rows, sorted by id */
+    double *frame;         /* [5 x 3 cap] the vectors of a frame in row order */
+    jd_inlet_particle *buf;
+    size_t buf_cap;
+    int64_t next_step;     /* the smallest next_step of the streams */
+    double energy_in;      /* kinetic + gravitational energy the inserted particles brought [J] */
+    double seconds;        /* wall time spent inserting [s] */
+    FILE *log;             /* the insertion record (sim_inlets_log), or NULL */
+};
+
+/* Copies of stream r that start at or before `last` and are admitted by its limits. */
+static int64_t copies_by(const jd_inlet_spec *sp, int64_t last) {
+    const int64_t lim = sp->stop_step == JD_INLET_NO_STOP ? last : (sp->stop_step - 1 < last
+                                                                         ? sp->stop_step - 1
+                                                                         : last);
+    if (jd_inlet_section_start(sp, 0) > lim) return 0;
+    int64_t lo = 1, hi = 1; /* copies [0, lo) start by lim; find hi that does not */
+    while ((sp->max_sections == 0 || hi < sp->max_sections) && jd_inlet_section_start(sp, hi) <= lim) {
+        lo = hi + 1;
+        hi *= 2;
+        if (sp->max_sections && hi > sp->max_sections) hi = sp->max_sections;
+    }
+    if (sp->max_sections && hi >= sp->max_sections && jd_inlet_section_start(sp, sp->max_sections - 1) <= lim)
+        return sp->max_sections;
+    while (lo < hi) { /* copy lo - 1 starts by lim, copy hi does not */
+        const int64_t mid = lo + (hi - lo) / 2;
+        if (jd_inlet_section_start(sp, mid) <= lim) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+}
+
+static int by_id(const void *a, const void *b) {
+    const int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static jd_row row_of(const jd_scene *sc, int64_t id, int32_t material, double radius) {
+    return (jd_row){.id = id, .species = material, .radius = radius,
+                    .mass = jd_sphere_mass(radius, sc->materials[material].density)};
+}
+
+/* The trajectory rows: every particle the run can hold, sorted by id; slot[] of each scene
+ * particle. */
+static void make_rows(jd_sim_inlets *in, const jd_scene *sc) {
+    size_t at = 0;
+    for (size_t i = 0; i < in->n_scene; i++) {
+        in->id[i] = sc->id[i];
+        in->rows[at++] = row_of(sc, sc->id[i], sc->material[i], sc->radius[i]);
+    }
+    for (size_t k = 0; k < in->n_inlets; k++) {
+        const inlet_run *r = &in->run[k];
+        for (int64_t c = 0; c < r->copies; c++)
+            for (size_t p = 0; p < r->spec.n; p++)
+                in->rows[at++] = row_of(sc, r->spec.first_id + c * (int64_t)r->spec.n + (int64_t)p,
+                                        r->spec.species[p], r->spec.radius[p]);
+    }
+    qsort(in->rows, in->cap, sizeof *in->rows, by_id);
+    for (size_t i = 0; i < in->n_scene; i++) {
+        const jd_row *hit = bsearch(&sc->id[i], in->rows, in->cap, sizeof *in->rows, by_id);
+        in->slot[i] = (int32_t)(hit - in->rows);
+    }
+}
+
+size_t sim_inlets_capacity(const jd_scene *sc) {
+    size_t cap = sc->n_particles;
+    for (size_t k = 0; k < sc->n_inlets; k++) {
+        jd_inlet_spec sp;
+        scene_inlet_spec(sc, k, &sp);
+        cap += (size_t)copies_by(&sp, sc->steps) * sp.n;
+    }
+    return cap;
+}
+
+int sim_inlets_init(jd_sim *s, char *err, size_t errlen) {
+    const jd_scene *sc = s->scene;
+    if (!sc->n_inlets) return 0;
+    jd_sim_inlets *in = calloc(1, sizeof *in);
+    if (!in) goto oom;
+    s->inlets = in;
+    in->n_inlets = sc->n_inlets;
+    in->n_scene = sc->n_particles;
+    in->cap = sim_inlets_capacity(sc);
+    in->run = calloc(sc->n_inlets, sizeof *in->run);
+    in->id = malloc((in->cap ? in->cap : 1) * sizeof *in->id);
+    in->slot = malloc((in->cap ? in->cap : 1) * sizeof *in->slot);
+    in->rows = malloc((in->cap ? in->cap : 1) * sizeof *in->rows);
+    in->frame = malloc(JD_INLET_FRAME_VECTORS * 3 * (in->cap ? in->cap : 1) * sizeof *in->frame);
+    if (!in->run || !in->id || !in->slot || !in->rows || !in->frame) goto oom;
+    in->next_step = JD_INLET_NEVER;
+    for (size_t k = 0; k < sc->n_inlets; k++) {
+        inlet_run *r = &in->run[k];
+        scene_inlet_spec(sc, k, &r->spec);
+        r->copies = copies_by(&r->spec, sc->steps);
+        r->cursor = malloc(r->spec.n * sizeof *r->cursor);
+        if (!r->cursor) goto oom;
+        jd_inlet_stream_init(&r->spec, &r->st, r->cursor);
+        r->next_check = sc->inlets[k].every;
+        in->next_step = r->st.next_step < in->next_step ? r->st.next_step : in->next_step;
+        if (r->spec.n > in->buf_cap) in->buf_cap = r->spec.n;
+    }
+    in->buf = malloc(in->buf_cap * sizeof *in->buf);
+    if (!in->buf) goto oom;
+    make_rows(in, sc);
+    s->ids = in->id;
+    return 0;
+oom:
+    snprintf(err, errlen, "out of memory for the inlets");
+    return -1;
+}
+
+void sim_inlets_free(jd_sim *s) {
+    jd_sim_inlets *in = s->inlets;
+    if (!in) return;
+    for (size_t k = 0; in->run && k < in->n_inlets; k++) free(in->run[k].cursor);
+    free(in->run);
+    free(in->id);
+    free(in->slot);
+    free(in->rows);
+    free(in->frame);
+    free(in->buf);
+    free(in);
+    s->inlets = NULL;
+}
+
+void sim_inlets_log(jd_sim *s, FILE *log) {
+    if (s->inlets) s->inlets->log = log;
+}
+
+/* One inserted particle at index n, which is also its scene index (n_scene + the particles
+ * inserted before it): its state, its constants, and the energy it brings.  Its force is its
+ * weight, the force an ordinary particle alone would carry into the next step's first half
+ * kick (after sim_finish_step every force holds the weight, also when the kicks add it). */
+static void append(jd_sim *s, const jd_inlet_particle *p) {
+    jd_sim_inlets *in = s->inlets;
+    const size_t i = s->n++;
+    sim_particle_constants(s, i, p->species, p->radius);
+    s->orig[i] = (int32_t)i;
+    in->id[i] = p->id;
+    const jd_row *hit = bsearch(&p->id, in->rows, in->cap, sizeof *in->rows, by_id);
+    in->slot[i] = (int32_t)(hit - in->rows);
+    for (int d = 0; d < 3; d++) {
+        s->x[3 * i + d] = p->position[d];
+        s->v[3 * i + d] = p->velocity[d];
+        s->omega[3 * i + d] = 0.0;
+        s->f[3 * i + d] = s->mass[i] * s->g[d];
+        s->torque[3 * i + d] = 0.0;
+    }
+    in->energy_in += 0.5 * s->mass[i] * jd_dot(p->velocity, p->velocity) -
+                     s->mass[i] * jd_dot(s->g, p->position);
+    if (in->log)
+        fprintf(in->log, "%lld,%lld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", (long long)p->id,
+                (long long)p->step, p->position[0], p->position[1], p->position[2],
+                p->velocity[0], p->velocity[1], p->velocity[2]);
+}
+
+/* The deposit-height rule: the top z + R of the particles slower than below_speed. */
+static void check_height(jd_sim *s, size_t k) {
+    inlet_run *r = &s->inlets->run[k];
+    const jd_inlet *def = &s->scene->inlets[k];
+    if (def->stop != JD_INLET_STOP_HEIGHT || s->step < r->next_check) return;
+    r->next_check = s->step + def->every;
+    sim_finish_step(s); /* the speeds at this step */
+    const double v2 = def->below_speed * def->below_speed;
+    double top = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        const double *v = &s->v[3 * i];
+        if (jd_dot(v, v) < v2) top = fmax(top, s->x[3 * i + 2] + s->radius[i]);
+    }
+    if (top >= def->height && r->st.stop_step > s->step) r->st.stop_step = s->step;
+}
+
+int sim_inlets_step(jd_sim *s, char *err, size_t errlen) {
+    jd_sim_inlets *in = s->inlets;
+    for (size_t k = 0; k < in->n_inlets; k++) check_height(s, k);
+    if (s->step != in->next_step) return 0;
+    const double t0 = sim_clock();
+    sim_finish_step(s); /* v at this step, so that the new particles join the state of it */
+    size_t added = 0;
+    in->next_step = JD_INLET_NEVER;
+    for (size_t k = 0; k < in->n_inlets; k++) {
+        inlet_run *r = &in->run[k];
+        size_t got;
+        while (r->st.next_step == s->step &&
+               (got = jd_inlet_pop(&r->spec, &r->st, s->step, in->buf, in->buf_cap)) > 0) {
+            for (size_t q = 0; q < got && s->n < in->cap; q++) append(s, &in->buf[q]);
+            added += got;
+        }
+        in->next_step = r->st.next_step < in->next_step ? r->st.next_step : in->next_step;
+    }
+    int rc = 0;
+    if (added) {
+        sim_particle_kinds(s);
+        rc = sim_neighbour_build(s, err, errlen);
+    }
+    in->seconds += sim_clock() - t0;
+    return rc;
+}
+
+int64_t sim_inlets_inserted(const jd_sim *s) {
+    return s->inlets ? (int64_t)(s->n - s->inlets->n_scene) : 0;
+}
+
+double sim_inlets_seconds(const jd_sim *s) { return s->inlets ? s->inlets->seconds : 0.0; }
+
+double sim_inlets_energy(const jd_sim *s) { return s->inlets ? s->inlets->energy_in : 0.0; }
+
+/* The trajectory's particle set: every row the run can hold. */
+int sim_inlets_particles(const jd_sim *s, int64_t *id, int32_t *species, double *radius,
+                         double *mass) {
+    const jd_sim_inlets *in = s->inlets;
+    for (size_t k = 0; k < in->cap; k++) {
+        id[k] = in->rows[k].id;
+        species[k] = in->rows[k].species;
+        radius[k] = in->rows[k].radius;
+        mass[k] = in->rows[k].mass;
+    }
+    return 0;
+}
+
+size_t sim_inlets_rows(const jd_sim *s) { return s->inlets ? s->inlets->cap : s->n; }
+
+double *sim_inlets_frame_rows(const jd_sim *s, int k, const double *scene_ordered) {
+    const jd_sim_inlets *in = s->inlets;
+    double *out = in->frame + (size_t)k * 3 * in->cap;
+    for (size_t r = 0; r < 3 * in->cap; r++) out[r] = NAN;
+    for (size_t j = 0; j < s->n; j++)
+        memcpy(&out[3 * (size_t)in->slot[j]], &scene_ordered[3 * j], 3 * sizeof *out);
+    return out;
+}
