@@ -22,6 +22,7 @@
 using namespace LAMMPS_NS;
 
 int jdem_dump_close_ok = 0;
+int jdem_dump_close_failed = 0;
 
 #ifndef JDEM_VERSION
 #define JDEM_VERSION "0.1.0"
@@ -63,9 +64,14 @@ DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
 
 DumpH5mdJdem::~DumpH5mdJdem() {
   if (h5) {
-    char err[256] = "";
-    if (jd_h5md_close(h5, jdem_dump_close_ok, err, sizeof err) != 0 && screen)
-      fprintf(screen, "WARNING: dump h5md/jdem: closing %s failed: %s\n", path.c_str(), err);
+    char err[1024] = "";
+    if (jd_h5md_close(h5, jdem_dump_close_ok, err, sizeof err) != 0) {
+      /* no Error::all in a destructor: the message goes to stderr and the log (also under
+       * -screen none), and liggghts-jdem's exit status says the output failed */
+      std::fprintf(stderr, "ERROR: dump h5md/jdem: closing %s failed: %s\n", path.c_str(), err);
+      if (logfile) std::fprintf(logfile, "ERROR: dump h5md/jdem: closing %s failed: %s\n", path.c_str(), err);
+      jdem_dump_close_failed = 1;
+    }
     h5 = NULL;
   }
 }

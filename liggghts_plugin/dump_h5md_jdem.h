@@ -32,6 +32,9 @@ struct jd_h5md;
  * LIGGGHTS' error path (Error::all deletes Output to flush dumps), which keeps PATH.part so that
  * an aborted run never looks complete. */
 extern int jdem_dump_close_ok;
+/* Set when a dump's final close failed (the result is not complete: its message is on stderr
+ * and in the log); liggghts-jdem then exits with status 3, an I/O failure as in build/jdem. */
+extern int jdem_dump_close_failed;
 
 namespace LAMMPS_NS {
 

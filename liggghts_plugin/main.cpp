@@ -194,5 +194,5 @@ int main(int argc, char **argv) {
   delete lmp;
   MPI_Barrier(MPI_COMM_WORLD);
   MPI_Finalize();
-  return 0;
+  return jdem_dump_close_failed ? 3 : 0;
 }
