@@ -8,7 +8,8 @@
  * elastic_energy, damping_dissipation, friction_dissipation, wall_work, contacts,
  * wall_contacts; with fix bond/jiang the bonds formed and broken (/connectivity) and the
  * observables bonds, fragments, bond_elastic_energy, bond_damping_dissipation,
- * bond_breakage_energy (jdem_bond_output.h); also the last step of a run that is not a multiple of N (runs of at least N
+ * bond_breakage_energy (jdem_bond_output.h); with fix jdem/observables the observables on their
+ * own cadence instead (fix_jdem_observables.h); also the last step of a run that is not a multiple of N (runs of at least N
  * steps), like build/jdem.  The file is FILE.h5.part while the run goes on and is renamed to FILE.h5
  * when LIGGGHTS ends normally or at `undump`; after an error it stays FILE.h5.part.  The optional keywords scene, case
  * and scene_yaml only annotate /parameters.  energy no (build/jdem's output.energy: false)
@@ -24,6 +25,7 @@
 #include "dump.h"
 
 #include "jdem_bond_output.h"
+#include "jdem_observables.h"
 
 struct jd_h5md;
 
@@ -51,12 +53,21 @@ class DumpH5mdJdem : public Dump {
   }
   bigint last_frame_step() const { return last_step; } /* -1: no frame yet */
   bool writes_energy() const { return energy; }         /* keyword energy (default yes) */
+  /* fix jdem/observables M: the observables at step 0, every M steps and the last step, as
+   * build/jdem's output.observables_every (0, the default: at every frame). */
+  void set_observables_every(bigint every) { observables_every = every; }
+  bool observables_due(bigint step) const;
+  /* The contact observables of this step, between frames (collective; error->all on failure). */
+  void write_observable_sample();
 
  protected:
   virtual void init_style();
   virtual void write_header(bigint) {}
   virtual void pack(int *) {}
   virtual void write_data(int, double *) {}
+  void reduce_observables(double all_obs[JDO_N]);
+  int write_contact_observables(const double all_obs[JDO_N], bigint step, double time, char *err,
+                                size_t errlen);
 
  private:
   struct jd_h5md *h5;
@@ -64,6 +75,7 @@ class DumpH5mdJdem : public Dump {
   bool energy;
   bigint natoms0;
   bigint last_step; /* of the last frame written; -1: none */
+  bigint observables_every; /* steps between observable samples; 0: at the frames */
   JdemBondOutput bonds;
 };
 
