@@ -32,7 +32,7 @@ enum { COL_ID = 0, COL_TYPE, COL_R, COL_M, COL_X, COL_V = COL_X + 3, COL_W = COL
        COL_F = COL_W + 3, COL_T = COL_F + 3, NCOL = COL_T + 3 };
 
 DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
-    : Dump(lmp, narg, arg), h5(NULL), energy(true), natoms0(-1), last_step(-1), observables_every(0) {
+    : Dump(lmp, narg, arg), h5(NULL), energy(true), natoms0(-1), last_step(-1), observables_every(0), stop_frame(false) {
   if (narg < 5) error->all(FLERR, "Illegal dump h5md/jdem command: dump ID group h5md/jdem N FILE.h5");
   path = arg[4];
   if (path.find('*') != std::string::npos || path.find('%') != std::string::npos)
@@ -117,7 +117,7 @@ void DumpH5mdJdem::write() {
   /* the observables, summed on rank 0 */
   double all_obs[JDO_N];
   reduce_observables(all_obs);
-  const bool sample = observables_due(update->ntimestep);
+  const bool sample = stop_frame || observables_due(update->ntimestep);
 
   /* gather the rows on rank 0 */
   const std::vector<double> all = jdem_gather_rows(world, mine);

@@ -46,10 +46,13 @@ class DumpH5mdJdem : public Dump {
   virtual ~DumpH5mdJdem();
   virtual void write();
   const std::string &file_name() const { return path; } /* FILE.h5 (FILE.h5.part while open) */
-  /* A run stopped early (jdem_stop.h): write the frame of `step` unless it is the last one
-   * written (collective, like write()). */
+  /* A run stopped early (jdem_stop.h): write the frame of `step` and its observables unless it
+   * is the last one written (collective, like write()). */
   void write_stop_frame(bigint step) {
-    if (step != last_step) write();
+    if (step == last_step) return;
+    stop_frame = true; /* with its observables, whatever their cadence */
+    write();
+    stop_frame = false;
   }
   bigint last_frame_step() const { return last_step; } /* -1: no frame yet */
   bool writes_energy() const { return energy; }         /* keyword energy (default yes) */
@@ -76,6 +79,7 @@ class DumpH5mdJdem : public Dump {
   bigint natoms0;
   bigint last_step; /* of the last frame written; -1: none */
   bigint observables_every; /* steps between observable samples; 0: at the frames */
+  bool stop_frame;          /* write() is writing the frame of a run stopped early */
   JdemBondOutput bonds;
 };
 
