@@ -572,6 +572,7 @@ fail:
 
 int jd_h5md_close(jd_h5md *h, int ok, char *err, size_t errlen) {
     if (!h) return 0;
+    if (err && errlen) err[0] = '\0';
     quiet_t q;
     h5md_quiet_on(&q, h->h5detail);
     int rc = 0, clean = !h->broken;
@@ -594,8 +595,8 @@ int jd_h5md_close(jd_h5md *h, int ok, char *err, size_t errlen) {
     if (rc == 0 && ok) rc = xdmf_write(&xi, h->sidecar_part, err, errlen);
     if (rc == 0 && ok)
         rc = h5md_publish(h->part, h->path, h->sidecar_part, h->sidecar, err, errlen);
-    else if (ok || !clean)
-        h5md_part_keep_or_remove(h->part, clean, err, errlen);
+    else if ((ok || !clean) && h5md_part_keep_or_remove(h->part, clean, err, errlen) != 0)
+        rc = -1;
     h5md_quiet_off(&q);
     free_handle(h);
     return rc;

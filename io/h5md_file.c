@@ -136,14 +136,19 @@ int h5md_part_readable(const char *part) {
 }
 
 /* A failed run (clean: every write and the close succeeded): keep PATH.part if it can be read,
- * else remove it and say so in err. */
-void h5md_part_keep_or_remove(const char *part, int clean, char *err, size_t errlen) {
-    if (clean || h5md_part_readable(part)) return;
+ * else remove it, say so in err and return -1. */
+int h5md_part_keep_or_remove(const char *part, int clean, char *err, size_t errlen) {
+    if (clean || h5md_part_readable(part)) return 0;
     char why[512];
     snprintf(why, sizeof why, "%s", err ? err : "");
     unlink(part);
-    h5md_set_err(err, errlen, "%s; '%s' was unreadable after the failure and has been removed: "
-                 "nothing could be kept", why, part);
+    if (why[0])
+        h5md_set_err(err, errlen, "%s; '%s' was unreadable after the failure and has been "
+                     "removed: nothing could be kept", why, part);
+    else
+        h5md_set_err(err, errlen, "'%s' was unreadable after an earlier write error and has "
+                     "been removed: nothing could be kept", part);
+    return -1;
 }
 
 int h5md_publish(const char *part, const char *path, const char *sidecar_part,

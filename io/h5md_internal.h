@@ -65,7 +65,7 @@ int h5md_part_open(const char *path, const char *part, const char *sidecar, int 
                    size_t errlen);
 hid_t h5md_part_create(const char *part, int fd, char *err, size_t errlen, char *detail);
 int h5md_part_readable(const char *part);
-void h5md_part_keep_or_remove(const char *part, int clean, char *err, size_t errlen);
+int h5md_part_keep_or_remove(const char *part, int clean, char *err, size_t errlen);
 int h5md_publish(const char *part, const char *path, const char *sidecar_part,
                  const char *sidecar, char *err, size_t errlen);
 

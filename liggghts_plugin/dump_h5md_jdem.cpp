@@ -22,6 +22,7 @@
 using namespace LAMMPS_NS;
 
 int jdem_dump_close_ok = 0;
+int jdem_dump_close_failed = 0;
 
 #ifndef JDEM_VERSION
 #define JDEM_VERSION "0.1.0"
@@ -31,7 +32,7 @@ enum { COL_ID = 0, COL_TYPE, COL_R, COL_M, COL_X, COL_V = COL_X + 3, COL_W = COL
        COL_F = COL_W + 3, COL_T = COL_F + 3, NCOL = COL_T + 3 };
 
 DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
-    : Dump(lmp, narg, arg), h5(NULL), energy(true), natoms0(-1), last_step(-1) {
+    : Dump(lmp, narg, arg), h5(NULL), energy(true), natoms0(-1), last_step(-1), observables_every(0), stop_frame(false) {
   if (narg < 5) error->all(FLERR, "Illegal dump h5md/jdem command: dump ID group h5md/jdem N FILE.h5");
   path = arg[4];
   if (path.find('*') != std::string::npos || path.find('%') != std::string::npos)
@@ -63,9 +64,14 @@ DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
 
 DumpH5mdJdem::~DumpH5mdJdem() {
   if (h5) {
-    char err[256] = "";
-    if (jd_h5md_close(h5, jdem_dump_close_ok, err, sizeof err) != 0 && screen)
-      fprintf(screen, "WARNING: dump h5md/jdem: closing %s failed: %s\n", path.c_str(), err);
+    char err[1024] = "";
+    if (jd_h5md_close(h5, jdem_dump_close_ok, err, sizeof err) != 0) {
+      /* no Error::all in a destructor: the message goes to stderr and the log (also under
+       * -screen none), and liggghts-jdem's exit status says the output failed */
+      std::fprintf(stderr, "ERROR: dump h5md/jdem: closing %s failed: %s\n", path.c_str(), err);
+      if (logfile) std::fprintf(logfile, "ERROR: dump h5md/jdem: closing %s failed: %s\n", path.c_str(), err);
+      jdem_dump_close_failed = 1;
+    }
     h5 = NULL;
   }
 }
@@ -109,10 +115,9 @@ void DumpH5mdJdem::write() {
   }
 
   /* the observables, summed on rank 0 */
-  PairGranJiang *pair = dynamic_cast<PairGranJiang *>(force->pair);
-  double obs[JDO_N], all_obs[JDO_N];
-  jdem_local_observables(lmp, groupbit, obs);
-  MPI_Reduce(obs, all_obs, JDO_N, MPI_DOUBLE, MPI_SUM, 0, world);
+  double all_obs[JDO_N];
+  reduce_observables(all_obs);
+  const bool sample = stop_frame || observables_due(update->ntimestep);
 
   /* gather the rows on rank 0 */
   const std::vector<double> all = jdem_gather_rows(world, mine);
@@ -185,34 +190,20 @@ void DumpH5mdJdem::write() {
       fr.torque = trq.data();
       if (jd_h5md_write_frame(h5, &fr, err, sizeof err) != 0) failed = 1;
     }
-    struct { const char *name; double value; bool on; } o[] = {
-        {"kinetic_energy", all_obs[JDO_KINETIC], true},
-        {"rotational_energy", all_obs[JDO_ROTATIONAL], true},
-        {"elastic_energy", all_obs[JDO_ELASTIC], pair != NULL && energy},
-        {"gravitational_energy", all_obs[JDO_GRAVITATIONAL], true},
-        {"damping_dissipation", all_obs[JDO_DAMPING], pair != NULL && energy},
-        {"friction_dissipation", all_obs[JDO_FRICTION], pair != NULL && energy},
-        {"wall_work", all_obs[JDO_WALL_WORK], pair != NULL && energy},
-        {"contacts", all_obs[JDO_CONTACTS], pair != NULL},
-        {"wall_contacts", all_obs[JDO_WALL_CONTACTS], pair != NULL},
-    };
-    for (size_t k = 0; !failed && k < sizeof o / sizeof o[0]; k++)
-      if (o[k].on && jd_h5md_write_observable(h5, o[k].name, (int64_t)step, time, o[k].value, err, sizeof err) != 0)
-        failed = 1;
+    if (!failed && sample && write_contact_observables(all_obs, step, time, err, sizeof err) != 0)
+      failed = 1;
   }
   /* bonds (collective); rank 0 holds a file unless the frame failed */
   MPI_Bcast(&failed, 1, MPI_INT, 0, world);
   if (!failed && bonds.write(lmp, h5, err, sizeof err) != 0) failed = 1;
-  if (me == 0 && !failed && bonds.active()) {
-    const struct { const char *name; double value; bool on; } b[] = {
-        {"bonds", bonds.bonds(), true},
-        {"fragments", bonds.fragments(), true},
-        {"bond_elastic_energy", all_obs[JDO_BOND_ELASTIC], energy},
-        {"bond_damping_dissipation", all_obs[JDO_BOND_DAMPING], energy},
-        {"bond_breakage_energy", all_obs[JDO_BOND_BREAKAGE], energy},
-    };
-    for (size_t k = 0; !failed && k < sizeof b / sizeof b[0]; k++)
-      if (b[k].on && jd_h5md_write_observable(h5, b[k].name, (int64_t)step, time, b[k].value, err, sizeof err) != 0)
+  if (me == 0 && !failed && sample && bonds.active()) {
+    const double bv[JD_N_BOND_OBSERVABLES] = {bonds.bonds(), bonds.fragments(),
+                                              all_obs[JDO_BOND_ELASTIC], all_obs[JDO_BOND_DAMPING],
+                                              all_obs[JDO_BOND_BREAKAGE]};
+    for (int k = 0; !failed && k < JD_N_BOND_OBSERVABLES; k++)
+      if ((energy || !jd_bond_observable_is_energy[k]) &&
+          jd_h5md_write_observable(h5, jd_bond_observable_names[k], (int64_t)step, time, bv[k], err,
+                                   sizeof err) != 0)
         failed = 1;
   }
   /* Like the standalone engine, also write the last step of the run when it is not a multiple of
@@ -230,5 +221,49 @@ void DumpH5mdJdem::write() {
     MPI_Bcast(err, sizeof err, MPI_CHAR, 0, world);
     std::string msg = std::string("dump h5md/jdem: ") + err;
     error->all(FLERR, msg.c_str());
+  }
+}
+
+void DumpH5mdJdem::reduce_observables(double all_obs[JDO_N]) {
+  double obs[JDO_N];
+  jdem_local_observables(lmp, groupbit, obs);
+  MPI_Reduce(obs, all_obs, JDO_N, MPI_DOUBLE, MPI_SUM, 0, world);
+}
+
+bool DumpH5mdJdem::observables_due(bigint step) const {
+  return observables_every <= 0 || step == 0 || step == update->laststep ||
+         step % observables_every == 0;
+}
+
+/* Rank 0: the contact observables of this sample; the kinetic, rotational and gravitational
+ * energies always, the others with pair_style gran/jiang (the energies not with energy no). */
+int DumpH5mdJdem::write_contact_observables(const double all_obs[JDO_N], bigint step, double time,
+                                            char *err, size_t errlen) {
+  const bool pair = dynamic_cast<PairGranJiang *>(force->pair) != NULL;
+  for (int k = 0; k < JD_N_OBSERVABLES; k++) {
+    const bool always = k == JDO_KINETIC || k == JDO_ROTATIONAL || k == JDO_GRAVITATIONAL;
+    if ((always || (pair && (energy || !jd_observable_is_energy[k]))) &&
+        jd_h5md_write_observable(h5, jd_observable_names[k], (int64_t)step, time, all_obs[k], err,
+                                 errlen) != 0)
+      return -1;
+  }
+  return 0;
+}
+
+void DumpH5mdJdem::write_observable_sample() {
+  double all_obs[JDO_N];
+  reduce_observables(all_obs);
+  const bigint step = update->ntimestep;
+  const double time = update->atime + (double)(step - update->atimestep) * update->dt;
+  int failed = 0;
+  char err[512] = "";
+  if (me == 0) {
+    if (!h5) std::snprintf(err, sizeof err, "no frame written before the observables of step %ld", (long)step);
+    failed = !h5 || write_contact_observables(all_obs, step, time, err, sizeof err) != 0;
+  }
+  MPI_Bcast(&failed, 1, MPI_INT, 0, world);
+  if (failed) {
+    MPI_Bcast(err, sizeof err, MPI_CHAR, 0, world);
+    error->all(FLERR, (std::string("dump h5md/jdem: ") + err).c_str());
   }
 }

@@ -8,7 +8,8 @@
  * elastic_energy, damping_dissipation, friction_dissipation, wall_work, contacts,
  * wall_contacts; with fix bond/jiang the bonds formed and broken (/connectivity) and the
  * observables bonds, fragments, bond_elastic_energy, bond_damping_dissipation,
- * bond_breakage_energy (jdem_bond_output.h); also the last step of a run that is not a multiple of N (runs of at least N
+ * bond_breakage_energy (jdem_bond_output.h); with fix jdem/observables the observables on their
+ * own cadence instead (fix_jdem_observables.h); also the last step of a run that is not a multiple of N (runs of at least N
  * steps), like build/jdem.  The file is FILE.h5.part while the run goes on and is renamed to FILE.h5
  * when LIGGGHTS ends normally or at `undump`; after an error it stays FILE.h5.part.  The optional keywords scene, case
  * and scene_yaml only annotate /parameters.  energy no (build/jdem's output.energy: false)
@@ -24,6 +25,7 @@
 #include "dump.h"
 
 #include "jdem_bond_output.h"
+#include "jdem_observables.h"
 
 struct jd_h5md;
 
@@ -32,6 +34,9 @@ struct jd_h5md;
  * LIGGGHTS' error path (Error::all deletes Output to flush dumps), which keeps PATH.part so that
  * an aborted run never looks complete. */
 extern int jdem_dump_close_ok;
+/* Set when a dump's final close failed (the result is not complete: its message is on stderr
+ * and in the log); liggghts-jdem then exits with status 3, an I/O failure as in build/jdem. */
+extern int jdem_dump_close_failed;
 
 namespace LAMMPS_NS {
 
@@ -41,19 +46,31 @@ class DumpH5mdJdem : public Dump {
   virtual ~DumpH5mdJdem();
   virtual void write();
   const std::string &file_name() const { return path; } /* FILE.h5 (FILE.h5.part while open) */
-  /* A run stopped early (jdem_stop.h): write the frame of `step` unless it is the last one
-   * written (collective, like write()). */
+  /* A run stopped early (jdem_stop.h): write the frame of `step` and its observables unless it
+   * is the last one written (collective, like write()). */
   void write_stop_frame(bigint step) {
-    if (step != last_step) write();
+    if (step == last_step) return;
+    stop_frame = true; /* with its observables, whatever their cadence */
+    write();
+    stop_frame = false;
   }
   bigint last_frame_step() const { return last_step; } /* -1: no frame yet */
   bool writes_energy() const { return energy; }         /* keyword energy (default yes) */
+  /* fix jdem/observables M: the observables at step 0, every M steps and the last step, as
+   * build/jdem's output.observables_every (0, the default: at every frame). */
+  void set_observables_every(bigint every) { observables_every = every; }
+  bool observables_due(bigint step) const;
+  /* The contact observables of this step, between frames (collective; error->all on failure). */
+  void write_observable_sample();
 
  protected:
   virtual void init_style();
   virtual void write_header(bigint) {}
   virtual void pack(int *) {}
   virtual void write_data(int, double *) {}
+  void reduce_observables(double all_obs[JDO_N]);
+  int write_contact_observables(const double all_obs[JDO_N], bigint step, double time, char *err,
+                                size_t errlen);
 
  private:
   struct jd_h5md *h5;
@@ -61,6 +78,8 @@ class DumpH5mdJdem : public Dump {
   bool energy;
   bigint natoms0;
   bigint last_step; /* of the last frame written; -1: none */
+  bigint observables_every; /* steps between observable samples; 0: at the frames */
+  bool stop_frame;          /* write() is writing the frame of a run stopped early */
   JdemBondOutput bonds;
 };
 

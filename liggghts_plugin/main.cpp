@@ -8,6 +8,7 @@
  *   fix bond/jiang          idem
  *   fix jdem/loads          idem
  *   fix jdem/guard          idem
+ *   fix jdem/observables    idem
  *   dump h5md/jdem          LIGGGHTS 3.8 has no dump map: Output::add_dump() is an if-else chain
  *                           over style_dump.h.  We interpose Output::add_dump (libliggghts.so
  *                           calls it through its PLT, so the executable's definition wins) and
@@ -41,6 +42,7 @@
 #include "fix_bond_jiang.h"
 #include "fix_jdem_loads.h"
 #include "fix_jdem_guard.h"
+#include "fix_jdem_observables.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_wall_jiang.h"
 #include "jdem_error.h"
@@ -84,6 +86,10 @@ static Fix *create_fix_jdem_guard(LAMMPS *lmp, int narg, char **arg) {
   return new FixJdemGuard(lmp, narg, arg);
 }
 
+static Fix *create_fix_jdem_observables(LAMMPS *lmp, int narg, char **arg) {
+  return new FixJdemObservables(lmp, narg, arg);
+}
+
 static void register_jdem_styles(LAMMPS *lmp) {
   (*lmp->force->pair_map)["gran/jiang"] = &create_pair_gran_jiang;
   FixMap *fix_map = lmp->modify->*get(ModifyFixMap());
@@ -92,6 +98,7 @@ static void register_jdem_styles(LAMMPS *lmp) {
   (*fix_map)["bond/jiang"] = &create_fix_bond_jiang;
   (*fix_map)["jdem/loads"] = &create_fix_jdem_loads;
   (*fix_map)["jdem/guard"] = &create_fix_jdem_guard;
+  (*fix_map)["jdem/observables"] = &create_fix_jdem_observables;
 }
 
 /* ---- dump h5md/jdem: interposed Output::add_dump ---- */
@@ -194,5 +201,5 @@ int main(int argc, char **argv) {
   delete lmp;
   MPI_Barrier(MPI_COMM_WORLD);
   MPI_Finalize();
-  return 0;
+  return jdem_dump_close_failed ? 3 : 0;
 }

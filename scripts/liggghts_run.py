@@ -166,6 +166,9 @@ def main():
     a = ap.parse_args()
     child = Child()
 
+    if os.path.isdir(a.output):  # build/jdem's message and exit status (io/h5md_file.c)
+        say("output path '%s' is a directory (give a file name, e.g. '%s/run.h5')" % (a.output, a.output))
+        return EXIT_IO
     out = os.path.abspath(a.output)
     base = out[:-3] if out.endswith(".h5") else out
     deck_dir = base + ".deck"

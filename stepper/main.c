@@ -313,7 +313,8 @@ static int setup_failure(const char *err) {
 
 /* The exit status of a run that did not complete, after its message.  The file was closed
  * with ok = 0: readable, and kept as OUT.part, never under the name of a complete run. */
-static int report_unfinished(int rc, const jd_sim *sim, const char *err, const char *out) {
+static int report_unfinished(int rc, const jd_sim *sim, const char *err, const char *out,
+                             int kept) {
     if (rc == JD_RUN_STOPPED) {
         fprintf(stderr, "jdem: %s at step %lld; the trajectory up to step %lld is kept, closed, "
                 "as %s.part\n", stop_signal_text(), (long long)sim->step,
@@ -325,7 +326,10 @@ static int report_unfinished(int rc, const jd_sim *sim, const char *err, const c
                 "(the run failed)\n", err, (long long)sim->frame_step, out);
         return EXIT_FAILED_RUN;
     }
-    fprintf(stderr, "jdem: %s; the partial trajectory is in %s.part\n", err, out);
+    if (kept)
+        fprintf(stderr, "jdem: %s; the partial trajectory is in %s.part\n", err, out);
+    else
+        fprintf(stderr, "jdem: %s; nothing could be kept\n", err);
     if (rc == JD_RUN_OUTPUT) return EXIT_IO;
     return strstr(err, "out of memory") ? EXIT_NO_MEMORY : EXIT_FAILED_RUN;
 }
@@ -431,10 +435,13 @@ static int run_and_close(const cli *c, jd_sim *sim, jd_h5md *h, const char *out)
     const int run_rc = sim_run(sim, h, !c->quiet, err, sizeof err);
     if (c->timing) print_timing(sim);
     if (run_rc != 0) {
-        char err2[256];
-        if (jd_h5md_close(h, 0, err2, sizeof err2) != 0)
+        char err2[1024];
+        int kept = 1;
+        if (jd_h5md_close(h, 0, err2, sizeof err2) != 0) {
             fprintf(stderr, "jdem: closing %s.part failed: %s\n", out, err2);
-        return report_unfinished(run_rc, sim, err, out);
+            kept = strstr(err2, "nothing could be kept") == NULL; /* the writer removed it */
+        }
+        return report_unfinished(run_rc, sim, err, out, kept);
     }
     if (jd_h5md_close(h, 1, err, sizeof err) != 0) {
         fprintf(stderr, "jdem: %s\n", err);

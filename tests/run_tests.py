@@ -36,6 +36,8 @@ SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines",
 SUITES += [("inlet", [PY, "tests/inlet/test_inlet.py"], "lines", {})]
 # The two engines on the same scenes (bitwise or 1e-10), and LIGGGHTS on 1 vs 2 MPI ranks.
 SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {})]
+# The /observables cadence (output.observables_every below, at and not dividing every) in both engines.
+SUITES += [("observables-cadence", [PY, "tests/liggghts/check_observables_cadence.py"], "lines", {})]
 # The law set (kernel/jdem_laws.h) each engine selects, for every scene of reference_runs/ and
 # tests/, and hand-written decks that leave out `rolling on`.
 SUITES += [("law-sets", [PY, "tests/liggghts/check_law_sets.py"], "lines", {})]

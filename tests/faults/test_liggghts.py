@@ -220,6 +220,17 @@ def paths(c, d):
         c.check("path_%s_exit" % label, r.rc == 0, repr(r)[-1500:])
         c.check("path_%s_written_there" % label, h5_readable(out) is None, "%s: %s; files %s" % (
             out, h5_readable(out), files(os.path.dirname(out))))
+    # a directory as the output: build/jdem's message and exit status, nothing run or written
+    outdir = os.path.join(d, "outdir")
+    os.makedirs(outdir)
+    r = wrapper(scene, outdir, cwd=d)
+    want = "output path '%s' is a directory (give a file name, e.g. '%s/run.h5')" % (outdir, outdir)
+    c.check("path_directory_exit", r.rc == EXIT["io"], repr(r)[-1500:])
+    c.check("path_directory_message", want in r.err and "Traceback" not in r.err, r.err[-1500:])
+    c.check("path_directory_nothing", files(outdir) == [] and not os.path.exists(outdir + ".deck"),
+            "%s; deck %s" % (files(outdir), os.path.exists(outdir + ".deck")))
+    r = run([JDEM, "run", scene, "-o", outdir, "--quiet"])
+    c.check("path_directory_same_as_jdem", r.rc == EXIT["io"] and want in r.err, repr(r)[-1500:])
     star = os.path.join(d, "x", "star*.h5")
     r = wrapper(scene, star, cwd=d)
     c.check("path_star_refused", r.rc == EXIT["input"] and "LIGGGHTS dumps expand '*' and '%'" in r.err, repr(r))

@@ -1,0 +1,160 @@
+#!/usr/bin/python3
+"""Faults at the trajectory writer (io/h5md*.c), in both engines: a disk that fills at creation,
+mid-run and at the final write (a small tmpfs), a read-only output directory, symbolic links at
+OUT.h5.part and OUT.xdmf.part, two runs on one output path, an output path that is a directory,
+and an address-space limit (`ulimit -v`).  Each case asserts the exit code, the message and the
+files left on disk.  jdem runs directly; liggghts-jdem through scripts/liggghts_run.py.
+"""
+import os
+import signal
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from faults_common import (EXIT, JDEM, PY, ROOT, Checks, NotRoot, files, h5_readable,  # noqa: E402
+                           read_only, run, scratch, small_scene, start, finish, tmpfs,
+                           wait_for_file, write_scene)
+
+LIGGGHTS_RUN = os.path.join(ROOT, "scripts", "liggghts_run.py")
+
+
+def jdem(scene, out, **kw):
+    return run([JDEM, "run", "--quiet", scene, "-o", out], **kw)
+
+
+def case_symlinks(c):
+    d = scratch()
+    scene = write_scene(d, "small", small_scene())
+    victim = os.path.join(d, "victim.txt")
+    for link in ("b.h5.part", "b.xdmf.part"):
+        with open(victim, "w") as f:
+            f.write("keep")
+        for name in ("b.h5.part", "b.xdmf.part"):
+            if os.path.lexists(os.path.join(d, name)):
+                os.remove(os.path.join(d, name))
+        os.symlink(victim, os.path.join(d, link))
+        r = jdem(scene, os.path.join(d, "b.h5"))
+        with open(victim) as f:
+            kept = f.read() == "keep"
+        c.check(f"jdem: symlink at {link}: target untouched", kept, repr(r))
+        if link == "b.h5.part":
+            c.check("jdem: symlink at b.h5.part: refused, I/O exit code",
+                    r.rc == EXIT["io"] and "is a symbolic link; a trajectory is never written "
+                    "through one" in r.err, repr(r))
+        else:
+            # the sidecar's .part is replaced (the link removed, never followed) and the run ends
+            c.check("jdem: symlink at b.xdmf.part: replaced, run complete",
+                    r.rc == 0 and not os.path.islink(os.path.join(d, "b.xdmf.part"))
+                    and os.path.exists(os.path.join(d, "b.xdmf")), repr(r))
+
+
+def case_concurrent(c):
+    d = scratch()
+    long_scene = write_scene(d, "long", small_scene(name="long", steps=3000000, every=100000))
+    short = write_scene(d, "short", small_scene())
+    out = os.path.join(d, "c.h5")
+    first = start([JDEM, "run", "--quiet", long_scene, "-o", out])
+    if not wait_for_file(out + ".part", 30):
+        c.check("jdem: two runs on one path: first run started", False, "no c.h5.part")
+        first.kill()
+        return
+    size_before = os.path.getsize(out + ".part")
+    r = jdem(short, out)
+    c.check("jdem: two runs on one path: second refused (locked), I/O exit code",
+            r.rc == EXIT["io"] and "is being written by another run" in r.err, repr(r))
+    # the live file is locked against readers too; not truncated is what can be seen now
+    size_after = os.path.getsize(out + ".part")
+    c.check("jdem: two runs on one path: first run's file not truncated",
+            size_after >= size_before > 0, f"{size_before} -> {size_after} bytes")
+    first.send_signal(signal.SIGINT)
+    r1 = finish(first)
+    c.check("jdem: two runs on one path: first run stops cleanly, its frames kept",
+            r1.rc == 128 + signal.SIGINT and h5_readable(out + ".part") is None, repr(r1))
+
+
+def case_directory(c):
+    d = scratch()
+    scene = write_scene(d, "small", small_scene())
+    target = os.path.join(d, "out")
+    os.mkdir(target)
+    r = jdem(scene, target)
+    c.check("jdem: output path a directory: refused, I/O exit code",
+            r.rc == EXIT["io"] and f"output path '{target}' is a directory" in r.err, repr(r))
+    c.check("jdem: output path a directory: nothing written", files(d) == ["small.yaml"],
+            str(files(d)))
+
+
+def case_disk_full(c, engine):
+    """A tmpfs too small for the run: the run fails with an I/O exit code, no crash; what the
+    message names is on disk and readable, or the message says nothing could be kept."""
+    for size, steps, label in (("64k", 2000, "at creation"), ("160k", 40000, "mid-run")):
+        d = scratch()
+        scene = write_scene(d, "small", small_scene(steps=steps, every=10))
+        try:
+            with tmpfs(size) as mnt:
+                out = os.path.join(mnt, "a.h5")
+                if engine == "jdem":
+                    r = jdem(scene, out)
+                else:
+                    r = run([PY, LIGGGHTS_RUN, scene, "-o", out], timeout=300)
+                left = files(mnt)
+                part_ok = h5_readable(out + ".part") if "a.h5.part" in left else "absent"
+        except NotRoot as e:
+            c.skip(f"{engine}: disk full {label}", str(e))
+            return
+        c.check(f"{engine}: disk full {label}: no crash (exit {r.rc})",
+                r.rc not in (-signal.SIGSEGV, 139, -signal.SIGABRT, 134) and r.rc != 0, repr(r))
+        if engine == "jdem":
+            c.check(f"{engine}: disk full {label}: I/O exit code", r.rc == EXIT["io"], repr(r))
+        # jdem names the .part it keeps; liggghts-jdem's log names the file that failed
+        named = ("the partial trajectory is in" in r.err if engine == "jdem"
+                 else "a.h5.part" in r.err)
+        c.check(f"{engine}: disk full {label}: the named .part is readable, or nothing kept",
+                (named and "a.h5.part" in left and part_ok is None) or
+                ("a.h5.part" not in left and "nothing could be kept" in r.err),
+                f"{r.err.strip()[-300:]!r}; files {left}; .part: {part_ok}")
+        c.check(f"{engine}: disk full {label}: no a.h5 or sidecar under the final names",
+                "a.h5" not in left and "a.xdmf" not in left, str(left))
+
+
+def case_read_only(c):
+    d = scratch()
+    scene = write_scene(d, "small", small_scene())
+    out_dir = scratch()
+    try:
+        with read_only(out_dir) as ro:
+            r = jdem(scene, os.path.join(ro, "a.h5"))
+    except NotRoot as e:
+        c.skip("jdem: read-only output directory", str(e))
+        return
+    c.check("jdem: read-only output directory: I/O exit code and the reason",
+            r.rc == EXIT["io"] and "Read-only file system" in r.err, repr(r))
+    c.check("jdem: read-only output directory: nothing written", files(out_dir) == [],
+            str(files(out_dir)))
+
+
+def case_memory_limit(c):
+    d = scratch()
+    scene = write_scene(d, "small", small_scene(steps=20000, every=10))
+    for mb in (360, 400):
+        r = jdem(scene, os.path.join(d, f"m{mb}.h5"), mem_bytes=mb << 20)
+        c.check(f"jdem: ulimit -v {mb} MB: no crash (exit {r.rc})",
+                r.rc in (0, EXIT["io"], EXIT["memory"]), repr(r))
+        if r.rc == 0:
+            c.check(f"jdem: ulimit -v {mb} MB: complete result readable",
+                    h5_readable(os.path.join(d, f"m{mb}.h5")) is None, "")
+
+
+def main():
+    c = Checks()
+    case_symlinks(c)
+    case_concurrent(c)
+    case_directory(c)
+    case_read_only(c)
+    case_disk_full(c, "jdem")
+    case_disk_full(c, "liggghts-jdem")
+    case_memory_limit(c)
+    return c.exit()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

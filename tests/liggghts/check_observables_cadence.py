@@ -1,0 +1,86 @@
+#!/usr/bin/python3
+"""check_observables_cadence.py — the /observables cadence across engines.
+
+    tests/liggghts/check_observables_cadence.py
+
+Builds nothing (run `make` first).  Runs tests/liggghts/scenes/mpi_pile.yaml, shortened to 2100
+steps with output.every 200, in build/jdem and through scripts/liggghts_run.py, for
+output.observables_every 100 (smaller than every), 200 (equal) and 300 (not a divisor).  Checks,
+for each: every observable has the same step list in both files, and that list is build/jdem's
+rule (docs/scenes.md): 0, the multiples of observables_every, the last step; then the values
+agree by scripts/compare_trajectories.py at the scene's tolerance.  One PASS/FAIL line per check.
+"""
+import os
+import subprocess
+import sys
+import tempfile
+
+import h5py
+import yaml
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+PY = sys.executable
+JDEM = os.path.join(ROOT, "build", "jdem")
+STEPS, EVERY = 2100, 200
+
+
+def run(cmd):
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    return r.returncode, (r.stdout + r.stderr).strip()
+
+
+def observable_steps(path):
+    with h5py.File(path, "r") as f:
+        return {name: f["observables"][name]["step"][()].tolist() for name in f["observables"]}
+
+
+def expected_steps(obs_every):
+    return sorted(set([0, STEPS] + list(range(0, STEPS + 1, obs_every))))
+
+
+def check(tmp, obs_every):
+    label = "observables_every_%d" % obs_every
+    with open(os.path.join(HERE, "scenes", "mpi_pile.yaml")) as f:
+        scene = yaml.safe_load(f)
+    scene["time"]["steps"] = STEPS
+    scene["output"] = {"every": EVERY, "observables_every": obs_every}
+    path = os.path.join(tmp, label + ".yaml")
+    with open(path, "w") as f:
+        yaml.safe_dump(scene, f)
+    a, b = os.path.join(tmp, label + ".jdem.h5"), os.path.join(tmp, label + ".liggghts.h5")
+    for cmd, what in (([JDEM, "run", path, "-o", a, "--quiet"], "build/jdem"),
+                      ([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), path, "-o", b],
+                       "liggghts_run.py")):
+        rc, out = run(cmd)
+        if rc != 0:
+            print("FAIL %s: %s exit %d:\n%s" % (label, what, rc, out[-1500:]))
+            return False
+    sa, sb = observable_steps(a), observable_steps(b)
+    want = expected_steps(obs_every)
+    ok = True
+    if sorted(sa) != sorted(sb):
+        print("FAIL %s_names: jdem %s, liggghts %s" % (label, sorted(sa), sorted(sb)))
+        ok = False
+    bad = [n for n in sorted(set(sa) & set(sb)) if sa[n] != want or sb[n] != want]
+    if bad:
+        n = bad[0]
+        print("FAIL %s_steps: %s: jdem %d samples %s..., liggghts %d samples %s..., want %d %s..."
+              % (label, n, len(sa[n]), sa[n][:6], len(sb[n]), sb[n][:6], len(want), want[:6]))
+        ok = False
+    else:
+        print("PASS %s_steps (%d observables, %d samples each)" % (label, len(sa), len(want)))
+    rc, out = run([PY, os.path.join(ROOT, "scripts", "compare_trajectories.py"), a, b])
+    line = out.splitlines()[-1] if out else ""
+    print("%s %s_values: %s" % ("PASS" if rc == 0 else "FAIL", label, line.split(" ", 1)[-1]))
+    return ok and rc == 0
+
+
+def main():
+    with tempfile.TemporaryDirectory() as tmp:
+        results = [check(tmp, m) for m in (100, 200, 300)]
+    return 0 if all(results) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
