@@ -157,8 +157,8 @@ static int read_inlet(loader *L, const yaml_node_t *m, const char *path, jd_inle
     sd_join(sub, path, "name");
     if (!name) return sd_missing(&L->c, m, path, "name", "a unique name");
     if (sd_name(&L->c, name, sub, in->name, sizeof in->name)) return -1;
-    for (size_t k = 0; k < L->s->n_inlets; k++)
-        if (strcmp(L->s->inlets[k].name, in->name) == 0)
+    for (const jd_inlet *other = L->s->inlets; other < in; other++)
+        if (strcmp(other->name, in->name) == 0)
             return sd_fail(&L->c, name, sub, "duplicate inlet name '%s'; valid: unique names",
                            in->name);
     return read_section(L, m, path, in) || sd_req_vec3(&L->c, m, path, "origin", in->origin) ||
@@ -183,8 +183,8 @@ int scene_read_inlets(loader *L) {
         char path[SD_PATH_MAX];
         sd_join_index(path, "inlets", k);
         L->inode[k] = sd_item(&L->c, list, k);
+        s->n_inlets = k + 1; /* counted before it is read: the scene frees what a failed read took */
         if (read_inlet(L, L->inode[k], path, &s->inlets[k])) return -1;
-        s->n_inlets++;
     }
     return 0;
 }
