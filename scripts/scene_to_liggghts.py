@@ -309,6 +309,10 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
     ntypes = len(names)
     tid = {n: i + 1 for i, n in enumerate(names)}
     walls = scene.get("walls") or []
+    inlets = scene.get("inlets") or []
+    if inlets:
+        fail("the scene has inlets (inlets.0 '%s'), which liggghts-jdem does not run yet; valid: a "
+             "scene without inlets (run this one with build/jdem)" % inlets[0].get("name"))
     if not particles.count:
         fail("the scene has no particles")
     model = scene.get("model") or {}

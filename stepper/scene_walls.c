@@ -10,9 +10,11 @@
 /* Relative tolerance of docs/scenes.md: wall geometry, fraction of the wall's size. */
 #define GEOM_TOL 1e-9
 
-static const char *const PLANE_KEYS[] = {"name", "type", "corners", "material", "velocity", NULL};
-static const char *const CYLINDER_KEYS[] = {"name", "type", "axis", "radius", "side", "material",
-                                            "velocity", NULL};
+static const char *const PLANE_KEYS[] = {"name",     "type",     "corners", "material",
+                                         "velocity", "present",  NULL};
+static const char *const CYLINDER_KEYS[] = {"name",     "type",     "axis",    "radius", "side",
+                                            "material", "velocity", "present", NULL};
+static const char *const BOOLEANS[] = {"false", "true", NULL};
 
 /* Enum spellings, indexed by the kernel's enum values. */
 static const char *const WALL_TYPES[] = {"plane", "cylinder", NULL};
@@ -90,7 +92,11 @@ static int read_cylinder(loader *L, const yaml_node_t *w, const char *path, jd_w
     return 0;
 }
 
-static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t index) {
+/* Reads the wall at PATH into walls[index]; *present = 0 for a wall that the case leaves out
+ * (present: false, so that one swept scene can hold the obstacles of every model): it is checked
+ * like the others but takes no slot and marks no material as in use. */
+static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t index,
+                     int *present) {
     jd_wall *wall = &L->s->walls[index];
     char sub[SD_PATH_MAX];
     if (sd_mapping(&L->c, w, path, "{name, type, material, ...}")) return -1;
@@ -100,6 +106,8 @@ static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t i
     if (sd_enum(&L->c, type, sub, WALL_TYPES, &wall->type)) return -1;
     const int plane = wall->type == JD_WALL_PLANE;
     if (sd_keys(&L->c, w, path, plane ? PLANE_KEYS : CYLINDER_KEYS)) return -1;
+    *present = 1;
+    if (sd_opt_enum(&L->c, w, path, "present", BOOLEANS, present)) return -1;
     sd_join(sub, path, "name");
     if (!name) return sd_missing(&L->c, w, path, "name", "a unique name");
     if (sd_name(&L->c, name, sub, wall->name, sizeof wall->name)) return -1;
@@ -110,7 +118,7 @@ static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t i
     if (scene_req_material(L, w, path, &wall->material) ||
         sd_opt_vec3(&L->c, w, path, "velocity", wall->velocity))
         return -1;
-    L->by_wall[wall->material] = 1;
+    if (*present) L->by_wall[wall->material] = 1;
     if (!plane) return read_cylinder(L, w, path, wall);
     sd_join(sub, path, "corners");
     const yaml_node_t *corners = sd_get(&L->c, w, "corners");
@@ -125,11 +133,13 @@ int scene_read_walls(loader *L) {
     if (sd_sequence(&L->c, list, "walls", "a list of {name, type, material, ...}")) return -1;
     L->s->walls = calloc(sd_len(list) ? sd_len(list) : 1, sizeof *L->s->walls);
     if (!L->s->walls) return sd_no_memory(&L->c, list, "walls");
-    L->s->n_walls = sd_len(list);
     for (size_t i = 0; i < sd_len(list); i++) {
         char path[SD_PATH_MAX];
+        int present;
         sd_join_index(path, "walls", i);
-        if (read_wall(L, sd_item(&L->c, list, i), path, i)) return -1;
+        if (read_wall(L, sd_item(&L->c, list, i), path, L->s->n_walls, &present)) return -1;
+        if (present) L->s->n_walls++;
+        else memset(&L->s->walls[L->s->n_walls], 0, sizeof L->s->walls[0]);
     }
     return 0;
 }

@@ -131,6 +131,27 @@ def main():
               f"{unbooked:g} without")
 
 
+# The seed's obstacle models (Figs 4-3 to 4-8; docs/mixing.md §1): the cylinders' axis heights and
+# positions across the box, none in Model 1.  The Chapter 4 scene switches them per case with
+# `present:`; a wall left out must be absent from the resolved case.
+MODEL_CYLINDERS = {"model1": [], "model2": [(0.3, 1.2)], "model3": [(0.3, 1.5)],
+                   "model4": [(0.4, 1.2)], "model5": [(0.3, 1.5), (0.7, 1.2)],
+                   "model6": [(0.3, 1.5), (0.6, 1.2)]}
+
+
+def chapter4_models():
+    scene = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "models.yaml")
+    for case, want in MODEL_CYLINDERS.items():
+        r = subprocess.run([JDEM, "resolve", scene, "--case", case], capture_output=True, text=True)
+        if not check(f"ch4-{case}-resolves", r.returncode == 0, r.stderr.strip()):
+            continue
+        walls = yaml.safe_load(r.stdout).get("walls") or []
+        got = sorted((w["axis"][0][0], w["axis"][0][2]) for w in walls if w["type"] == "cylinder")
+        check(f"ch4-{case}-cylinders", got == sorted(want) and len(walls) == 5 + len(want),
+              f"cylinders {got}, expected {sorted(want)}; {len(walls)} walls")
+
+
 if __name__ == "__main__":
     main()
+    chapter4_models()
     sys.exit(1 if failures else 0)
