@@ -12,7 +12,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from faults_common import (EXIT, JDEM, PY, ROOT, Checks, NotRoot, files, h5_readable,  # noqa: E402
                            read_only, run, scratch, small_scene, start, finish, tmpfs,
-                           wait_for_file, write_scene)
+                           wait_for, wait_for_file, write_scene)
 
 LIGGGHTS_RUN = os.path.join(ROOT, "scripts", "liggghts_run.py")
 
@@ -55,6 +55,11 @@ def case_concurrent(c):
     first = start([JDEM, "run", "--quiet", long_scene, "-o", out])
     if not wait_for_file(out + ".part", 30):
         c.check("jdem: two runs on one path: first run started", False, "no c.h5.part")
+        first.kill()
+        return
+    # the file exists (locked, empty) before HDF5 writes its header: wait for the header
+    if not wait_for(lambda: os.path.getsize(out + ".part") > 0, 30):
+        c.check("jdem: two runs on one path: first run wrote its header", False, "c.h5.part empty")
         first.kill()
         return
     size_before = os.path.getsize(out + ".part")
