@@ -109,7 +109,10 @@ static void range_text(sd_range r, char *out, size_t size) {
 /* Loading                                                                                   */
 
 static int parser_fail(sd_ctx *c, const yaml_parser_t *p) {
-    if (p->error == YAML_MEMORY_ERROR) return sd_no_memory(c, NULL, NULL);
+    /* libyaml names every input error; some of its allocation failures (e.g. a tag or anchor
+     * copy in the loader) fail without setting the error at all */
+    if (p->error == YAML_MEMORY_ERROR || p->error == YAML_NO_ERROR)
+        return sd_no_memory(c, NULL, NULL);
     if (p->error == YAML_READER_ERROR && ferror(c->in))
         return snprintf(c->err, c->errlen, "%s: cannot read: %s", c->file, strerror(errno)), -1;
     snprintf(c->err, c->errlen, "%s:%zu: invalid YAML: %s%s%s; valid: a YAML document", c->file,
