@@ -17,22 +17,19 @@ named PWNED may appear and the exit status must be 0 or LIGGGHTS' error status 1
 Anything else (a Python exception, a crash) is written to OUT/deck_crash_N.yaml and fails the run.
 Prints one line per check: PASS/FAIL fuzz_deck_<what>.
 """
-import argparse
 import contextlib
 import glob
 import io
 import os
-import random
 import re
 import subprocess
 import sys
-import tempfile
 import time
 
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
+from fuzz_common import ROOT, Findings, start  # noqa: E402
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import scene_to_liggghts  # noqa: E402
 
@@ -166,19 +163,11 @@ def run_deck(deck_dir):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--seconds", type=float, default=60)
-    ap.add_argument("--seed", type=int, default=None)
-    ap.add_argument("--run-every", type=int, default=10)
-    ap.add_argument("--out", default=os.path.join(ROOT, "build", "fuzz"))
-    a = ap.parse_args()
-    seed = a.seed if a.seed is not None else int(time.time())
-    rng = random.Random(seed)
-    os.makedirs(a.out, exist_ok=True)
-    tmp = tempfile.mkdtemp(prefix="jdem_fuzz_deck_")
+    a, rng, tmp = start(__doc__, "jdem_fuzz_deck_",
+                        lambda ap: ap.add_argument("--run-every", type=int, default=10))
     base = seeds(tmp)
     counts = {"inputs": 0, "refused": 0, "decks": 0, "ran": 0}
-    bad = []
+    bad = Findings(a.out, "deck")
     end = time.monotonic() + a.seconds
     while time.monotonic() < end:
         n = counts["inputs"]
@@ -217,17 +206,12 @@ def main():
         else:
             problem = "exit %s: %s" % (rc, err[-500:])
         if problem:
-            crash = os.path.join(a.out, "deck_crash_%d.yaml" % len(bad))
-            with open(crash, "wb") as f:
-                f.write(data)
-            bad.append("%s (input %s)" % (problem, crash))
-            if len(bad) >= 20:
+            bad.add(problem, data, ".yaml")
+            if bad.full():
                 break
     print("fuzz_deck: seed %d, %d inputs in %.0f s: %d refused with a message, %d decks, %d run by liggghts-jdem"
-          % (seed, counts["inputs"], a.seconds, counts["refused"], counts["decks"], counts["ran"]))
-    ok = not bad and counts["inputs"] > 0
-    print("%s fuzz_deck_clean%s" % ("PASS" if ok else "FAIL", "" if ok else ": " + "; ".join(bad[:5])))
-    return 0 if ok else 1
+          % (a.seed, counts["inputs"], a.seconds, counts["refused"], counts["decks"], counts["ran"]))
+    return bad.verdict("fuzz_deck_clean", counts["inputs"])
 
 
 if __name__ == "__main__":

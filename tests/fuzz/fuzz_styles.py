@@ -13,18 +13,15 @@ style's own keywords, lines cut short.  build/liggghts-jdem must end with status
 status or a hang (60 s) is written to OUT/styles_crash_N.in and fails the run.
 Prints one line per check: PASS/FAIL fuzz_styles_<what>.
 """
-import argparse
 import os
-import random
 import re
 import shutil
 import subprocess
 import sys
-import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
+from fuzz_common import ROOT, Findings, start  # noqa: E402
 JDEM = os.path.join(ROOT, "build", "jdem")
 LIGGGHTS_JDEM = os.path.join(ROOT, "build", "liggghts-jdem")
 GEN = os.path.join(ROOT, "scripts", "scene_to_liggghts.py")
@@ -110,20 +107,12 @@ def run_one(work, base_dir, text):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--seconds", type=float, default=60)
-    ap.add_argument("--seed", type=int, default=None)
-    ap.add_argument("--out", default=os.path.join(ROOT, "build", "fuzz"))
-    a = ap.parse_args()
-    seed = a.seed if a.seed is not None else int(time.time())
-    rng = random.Random(seed)
-    os.makedirs(a.out, exist_ok=True)
-    tmp = tempfile.mkdtemp(prefix="jdem_fuzz_styles_")
+    a, rng, tmp = start(__doc__, "jdem_fuzz_styles_")
     decks = base_decks(tmp)
     work = os.path.join(tmp, "work")
     os.makedirs(work)
     counts = {"inputs": 0, "ok": 0, "error": 0}
-    bad = []
+    bad = Findings(a.out, "styles")
     end = time.monotonic() + a.seconds
     while decks and time.monotonic() < end:
         base_dir, text = rng.choice(decks)
@@ -135,18 +124,13 @@ def main():
         elif rc == 1 and "ERROR" in err:
             counts["error"] += 1
         else:
-            crash = os.path.join(a.out, "styles_crash_%d.in" % len(bad))
-            with open(crash, "w") as f:
-                f.write(mutant)
-            bad.append("exit %s (%s): %s" % (rc, crash, err.strip()[-300:]))
-            if len(bad) >= 20:
+            bad.add("exit %s: %s" % (rc, err.strip()[-300:]), mutant, ".in")
+            if bad.full():
                 break
     shutil.rmtree(tmp, ignore_errors=True)
     print("fuzz_styles: seed %d, %d inputs in %.0f s: %d ran, %d stopped with an ERROR message"
-          % (seed, counts["inputs"], a.seconds, counts["ok"], counts["error"]))
-    ok = not bad and counts["inputs"] > 0
-    print("%s fuzz_styles_clean%s" % ("PASS" if ok else "FAIL", "" if ok else ": " + "; ".join(bad[:5])))
-    return 0 if ok else 1
+          % (a.seed, counts["inputs"], a.seconds, counts["ok"], counts["error"]))
+    return bad.verdict("fuzz_styles_clean", counts["inputs"])
 
 
 if __name__ == "__main__":
