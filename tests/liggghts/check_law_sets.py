@@ -29,13 +29,11 @@ DECK = os.path.join(ROOT, "scripts", "scene_to_liggghts.py")
 ROLLING_ERROR = ("pair_style gran/jiang: coefficientRollingFriction is > 0 for a pair of types in use, "
                  "which needs the rolling law and its history: add 'rolling on' to pair_style "
                  "gran/jiang (or set coefficientRollingFriction to 0)")
-failed = 0
+sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
+from engine_common import Checks  # noqa: E402
 
-
-def report(name, ok, detail=""):
-    global failed
-    print(("PASS %s" % name) if ok else ("FAIL %s: %s" % (name, detail)), flush=True)
-    failed += not ok
+checks = Checks()
+report = checks.check
 
 
 def scenes():
@@ -168,7 +166,7 @@ def main():
         seen = every_scene(tmp)
         report("law_set scenes covered", len(seen) >= 20, "only %d distinct rule inputs" % len(seen))
         hand_written(tmp)
-    return 1 if failed else 0
+    return 1 if checks.failed else 0
 
 
 if __name__ == "__main__":

@@ -22,6 +22,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 PY = sys.executable
 JDEM = os.path.join(ROOT, "build", "jdem")
+sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
+from engine_common import Checks  # noqa: E402
 STEPS, EVERY = 2100, 200
 
 
@@ -39,7 +41,7 @@ def expected_steps(obs_every):
     return sorted(set([0, STEPS] + list(range(0, STEPS + 1, obs_every))))
 
 
-def check(tmp, obs_every):
+def check(c, tmp, obs_every):
     label = "observables_every_%d" % obs_every
     with open(os.path.join(HERE, "scenes", "mpi_pile.yaml")) as f:
         scene = yaml.safe_load(f)
@@ -54,32 +56,28 @@ def check(tmp, obs_every):
                        "liggghts_run.py")):
         rc, out = run(cmd)
         if rc != 0:
-            print("FAIL %s: %s exit %d:\n%s" % (label, what, rc, out[-1500:]))
-            return False
+            c.check(label, False, "%s exit %d:\n%s" % (what, rc, out[-1500:]))
+            return
     sa, sb = observable_steps(a), observable_steps(b)
     want = expected_steps(obs_every)
-    ok = True
     if sorted(sa) != sorted(sb):
-        print("FAIL %s_names: jdem %s, liggghts %s" % (label, sorted(sa), sorted(sb)))
-        ok = False
+        c.check(label + "_names", False, "jdem %s, liggghts %s" % (sorted(sa), sorted(sb)))
     bad = [n for n in sorted(set(sa) & set(sb)) if sa[n] != want or sb[n] != want]
-    if bad:
-        n = bad[0]
-        print("FAIL %s_steps: %s: jdem %d samples %s..., liggghts %d samples %s..., want %d %s..."
-              % (label, n, len(sa[n]), sa[n][:6], len(sb[n]), sb[n][:6], len(want), want[:6]))
-        ok = False
-    else:
-        print("PASS %s_steps (%d observables, %d samples each)" % (label, len(sa), len(want)))
+    n = bad[0] if bad else None
+    c.check("%s_steps (%d observables, %d samples each)" % (label, len(sa), len(want)), not bad,
+            n and "%s: jdem %d samples %s..., liggghts %d samples %s..., want %d %s..."
+            % (n, len(sa[n]), sa[n][:6], len(sb[n]), sb[n][:6], len(want), want[:6]))
     rc, out = run([PY, os.path.join(ROOT, "scripts", "compare_trajectories.py"), a, b])
     line = out.splitlines()[-1] if out else ""
-    print("%s %s_values: %s" % ("PASS" if rc == 0 else "FAIL", label, line.split(" ", 1)[-1]))
-    return ok and rc == 0
+    c.check("%s_values: %s" % (label, line.split(" ", 1)[-1]), rc == 0, "the trajectories differ")
 
 
 def main():
+    c = Checks()
     with tempfile.TemporaryDirectory() as tmp:
-        results = [check(tmp, m) for m in (100, 200, 300)]
-    return 0 if all(results) else 1
+        for m in (100, 200, 300):
+            check(c, tmp, m)
+    return 1 if c.failed else 0
 
 
 if __name__ == "__main__":
