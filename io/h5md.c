@@ -592,7 +592,13 @@ int jd_h5md_close(jd_h5md *h, int ok, char *err, size_t errlen) {
         rc = -1;
     }
     /* the sidecar first: PATH and its sidecar replace the previous pair only when both exist */
-    if (rc == 0 && ok) rc = xdmf_write(&xi, h->sidecar_part, err, errlen);
+    if (rc == 0 && ok && xdmf_write(&xi, h->sidecar_part, err, errlen) != 0) {
+        char why[512];
+        snprintf(why, sizeof why, "%s", err ? err : "");
+        h5md_set_err(err, errlen, "%s; the trajectory is complete in '%s' (without its sidecar); "
+                     "the previous result is unchanged", why, h->part);
+        rc = -1;
+    }
     if (rc == 0 && ok)
         rc = h5md_publish(h->part, h->path, h->sidecar_part, h->sidecar, err, errlen);
     else if ((ok || !clean) && h5md_part_keep_or_remove(h->part, clean, err, errlen) != 0)

@@ -196,16 +196,8 @@ void DumpH5mdJdem::write() {
   /* bonds (collective); rank 0 holds a file unless the frame failed */
   MPI_Bcast(&failed, 1, MPI_INT, 0, world);
   if (!failed && bonds.write(lmp, h5, err, sizeof err) != 0) failed = 1;
-  if (me == 0 && !failed && sample && bonds.active()) {
-    const double bv[JD_N_BOND_OBSERVABLES] = {bonds.bonds(), bonds.fragments(),
-                                              all_obs[JDO_BOND_ELASTIC], all_obs[JDO_BOND_DAMPING],
-                                              all_obs[JDO_BOND_BREAKAGE]};
-    for (int k = 0; !failed && k < JD_N_BOND_OBSERVABLES; k++)
-      if ((energy || !jd_bond_observable_is_energy[k]) &&
-          jd_h5md_write_observable(h5, jd_bond_observable_names[k], (int64_t)step, time, bv[k], err,
-                                   sizeof err) != 0)
-        failed = 1;
-  }
+  if (me == 0 && !failed && sample && write_bond_observables(all_obs, step, time, err, sizeof err) != 0)
+    failed = 1;
   /* Like the standalone engine, also write the last step of the run when it is not a multiple of
    * N: Output::write() adds N to next_dump after this call, so aim N steps short of it.  (At
    * set-up Output::setup() overwrites next_dump; a run shorter than N gets no last frame.) */
@@ -250,16 +242,34 @@ int DumpH5mdJdem::write_contact_observables(const double all_obs[JDO_N], bigint 
   return 0;
 }
 
+/* Rank 0: the bond observables of this sample, when some fix bond/jiang exists (the energies
+ * not with energy no). */
+int DumpH5mdJdem::write_bond_observables(const double all_obs[JDO_N], bigint step, double time,
+                                         char *err, size_t errlen) {
+  if (!bonds.active()) return 0;
+  const double bv[JD_N_BOND_OBSERVABLES] = {bonds.bonds(), bonds.fragments(),
+                                            all_obs[JDO_BOND_ELASTIC], all_obs[JDO_BOND_DAMPING],
+                                            all_obs[JDO_BOND_BREAKAGE]};
+  for (int k = 0; k < JD_N_BOND_OBSERVABLES; k++)
+    if ((energy || !jd_bond_observable_is_energy[k]) &&
+        jd_h5md_write_observable(h5, jd_bond_observable_names[k], (int64_t)step, time, bv[k], err,
+                                 errlen) != 0)
+      return -1;
+  return 0;
+}
+
 void DumpH5mdJdem::write_observable_sample() {
   double all_obs[JDO_N];
   reduce_observables(all_obs);
+  bonds.count(lmp);
   const bigint step = update->ntimestep;
   const double time = update->atime + (double)(step - update->atimestep) * update->dt;
   int failed = 0;
   char err[512] = "";
   if (me == 0) {
     if (!h5) std::snprintf(err, sizeof err, "no frame written before the observables of step %ld", (long)step);
-    failed = !h5 || write_contact_observables(all_obs, step, time, err, sizeof err) != 0;
+    failed = !h5 || write_contact_observables(all_obs, step, time, err, sizeof err) != 0 ||
+             write_bond_observables(all_obs, step, time, err, sizeof err) != 0;
   }
   MPI_Bcast(&failed, 1, MPI_INT, 0, world);
   if (failed) {

@@ -60,7 +60,8 @@ class DumpH5mdJdem : public Dump {
    * build/jdem's output.observables_every (0, the default: at every frame). */
   void set_observables_every(bigint every) { observables_every = every; }
   bool observables_due(bigint step) const;
-  /* The contact observables of this step, between frames (collective; error->all on failure). */
+  /* The contact and bond observables of this step, between frames (collective; error->all on
+   * failure). */
   void write_observable_sample();
 
  protected:
@@ -71,6 +72,8 @@ class DumpH5mdJdem : public Dump {
   void reduce_observables(double all_obs[JDO_N]);
   int write_contact_observables(const double all_obs[JDO_N], bigint step, double time, char *err,
                                 size_t errlen);
+  int write_bond_observables(const double all_obs[JDO_N], bigint step, double time, char *err,
+                             size_t errlen);
 
  private:
   struct jd_h5md *h5;

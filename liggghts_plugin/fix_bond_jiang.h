@@ -91,6 +91,9 @@ class FixBondJiang : public Fix {
   /* This rank's records since the last call; dump h5md/jdem collects them. */
   std::vector<Event> take_events();
   std::vector<Formed> take_formed();
+  /* The records take_formed() would return now, left in place (an observable sample between
+   * frames marks their atoms as ever bonded). */
+  const std::vector<Formed> &pending_formed() const { return formed; }
   /* True when local atom i (the lower id) holds an intact bond with the atom of id tag_b. */
   bool bonded(int i, int tag_b) const;
 

@@ -99,11 +99,6 @@ int JdemBondOutput::write(LAMMPS *lmp, jd_h5md *h, char *err, size_t errlen) {
     nb[i].id[1] = (int64_t)r[F_B];
     nb[i].type = (int32_t)r[F_TYPE];
     nb[i].formed_step = (int64_t)r[F_STEP];
-    for (int c = 0; c < 2; c++) {
-      const size_t id = (size_t)nb[i].id[c];
-      if (id >= ever_bonded_.size()) ever_bonded_.resize(id + 1, 0);
-      ever_bonded_[id] = 1;
-    }
   }
   if (jd_h5md_write_bonds(h, nb.size(), nb.data(), err, errlen) != 0) return -1;
 
@@ -126,7 +121,47 @@ int JdemBondOutput::write(LAMMPS *lmp, jd_h5md *h, char *err, size_t errlen) {
   }
   if (jd_h5md_write_bond_breaks(h, br.size(), br.data(), err, errlen) != 0) return -1;
 
-  /* fragments: union-find over the ever-bonded particles along the intact bonds */
+  std::vector<double> formed_pairs;
+  for (const jd_h5md_bond &b : nb) {
+    formed_pairs.push_back((double)b.id[0]);
+    formed_pairs.push_back((double)b.id[1]);
+  }
+  count_intact(formed_pairs, intact);
+  return 0;
+}
+
+void JdemBondOutput::count(LAMMPS *lmp) {
+  std::vector<double> formed_pairs, intact;
+  for (int k = 0; k < lmp->modify->nfix; k++) {
+    FixBondJiang *b = dynamic_cast<FixBondJiang *>(lmp->modify->fix[k]);
+    if (!b) continue;
+    active_ = true;
+    for (const FixBondJiang::Formed &f : b->pending_formed()) {
+      formed_pairs.push_back((double)f.tag_a);
+      formed_pairs.push_back((double)f.tag_b);
+    }
+    std::vector<int> pairs;
+    b->local_bonds(pairs);
+    intact.insert(intact.end(), pairs.begin(), pairs.end());
+  }
+  if (!active_) return;
+  MPI_Comm world = lmp->world;
+  formed_pairs = jdem_gather_rows(world, formed_pairs);
+  intact = jdem_gather_rows(world, intact);
+  int me = 0;
+  MPI_Comm_rank(world, &me);
+  if (me == 0) count_intact(formed_pairs, intact);
+}
+
+/* fragments: union-find over the ever-bonded particles along the intact bonds */
+void JdemBondOutput::count_intact(const std::vector<double> &formed_pairs,
+                                  const std::vector<double> &intact) {
+  for (const std::vector<double> *pairs : {&formed_pairs, &intact})
+    for (double t : *pairs) {
+      const size_t id = (size_t)t;
+      if (id >= ever_bonded_.size()) ever_bonded_.resize(id + 1, 0);
+      ever_bonded_[id] = 1;
+    }
   std::vector<int> parent(ever_bonded_.size());
   for (size_t i = 0; i < parent.size(); i++) parent[i] = (int)i;
   for (size_t p = 0; p + 1 < intact.size(); p += 2) {
@@ -138,7 +173,6 @@ int JdemBondOutput::write(LAMMPS *lmp, jd_h5md *h, char *err, size_t errlen) {
     if (ever_bonded_[i] && find_root(parent, (int)i) == (int)i) nfrag++;
   bonds_ = (double)(intact.size() / 2);
   fragments_ = (double)nfrag;
-  return 0;
 }
 
 }  // namespace LAMMPS_NS

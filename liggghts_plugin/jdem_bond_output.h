@@ -29,11 +29,17 @@ class JdemBondOutput {
    * on rank 0, appends them to h and sets the intact-bond count and the fragments.  Returns 0,
    * or -1 with a reason in err (rank 0). */
   int write(LAMMPS *lmp, jd_h5md *h, char *err, size_t errlen);
+  /* Collective.  Sets the intact-bond count and the fragments (rank 0) for an observable sample
+   * between frames; the records stay with the fixes for the next write(). */
+  void count(LAMMPS *lmp);
   bool active() const { return active_; }
   double bonds() const { return bonds_; }
   double fragments() const { return fragments_; }
 
  private:
+  /* Marks the atoms of both lists of (lower id, higher id) pairs as ever bonded, then counts the intact bonds
+   * and the fragments over the concatenated (lower id, higher id) pairs (rank 0). */
+  void count_intact(const std::vector<double> &formed_pairs, const std::vector<double> &intact);
   bool active_ = false;
   double bonds_ = 0.0, fragments_ = 0.0;
   std::vector<char> ever_bonded_; /* by particle id (rank 0) */

@@ -426,13 +426,10 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
     L.append("\ntimestep        %s\n" % num(dt))
     L.append("thermo          %d\n" % max(1, steps // 10))
     # the observables on their own cadence (output.observables_every), also between frames (the
-    # last fix: after those that change the state at end_of_step).  Not with bond types: the bond
-    # counts are collected at frames only, so a bonded run keeps every observable at its frames
-    # (docs/liggghts.md, "Observables")
+    # last fix: after those that change the state at end_of_step)
     out = scene.get("output") or {}
-    if not scene.get("bond_types"):
-        L.append("fix observables all jdem/observables %d d\n"
-                 % int(out.get("observables_every", out.get("every", 1))))
+    L.append("fix observables all jdem/observables %d d\n"
+             % int(out.get("observables_every", out.get("every", 1))))
     L.append("dump d all h5md/jdem %d %s scene %s case %s scene_yaml %s%s\n" % (
         every, dump_path(traj_path), word(scene.get("name", "scene"), "scene name"),
         word(scene.get("case", scene.get("name", "case")), "case name"),

@@ -121,6 +121,86 @@ def case_disk_full(c, engine):
                 "a.h5" not in left and "a.xdmf" not in left, str(left))
 
 
+def fill_to(directory, free_bytes):
+    """A filler file in DIRECTORY that leaves exactly FREE_BYTES (a multiple of its block size)."""
+    st = os.statvfs(directory)
+    with open(os.path.join(directory, "filler"), "wb") as f:
+        f.write(b"\0" * (st.f_bavail * st.f_frsize - free_bytes))
+
+
+def pages(nbytes, size=4096):
+    return -(-nbytes // size) * size
+
+
+def liggghts_deck(scene, out, deck_dir):
+    """The deck of SCENE writing OUT, in DECK_DIR (outside the tmpfs, so that the log and the
+    deck take none of its space); the command that runs it there."""
+    resolved = os.path.join(deck_dir, "resolved.yaml")
+    r = run([JDEM, "resolve", scene])
+    with open(resolved, "w") as f:
+        f.write(r.out)
+    r = run([PY, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), resolved, "-o",
+             os.path.join(deck_dir, "in.jdem"), "--trajectory", out])
+    if r.rc != 0:
+        raise RuntimeError(repr(r))
+    return [os.path.join(ROOT, "build", "liggghts-jdem"), "-in", "in.jdem", "-log", "log.lammps",
+            "-screen", "none"]
+
+
+def run_engine(engine, scene, out, before_run=lambda: None):
+    """SCENE to OUT in ENGINE; liggghts-jdem runs its deck outside OUT's directory."""
+    if engine == "jdem":
+        before_run()
+        return jdem(scene, out)
+    deck_dir = scratch()
+    cmd = liggghts_deck(scene, out, deck_dir)
+    before_run()
+    return run(cmd, cwd=deck_dir, timeout=300)
+
+
+def case_disk_full_at_final_write(c, engine):
+    """The disk fills at the final write: the new trajectory fits, its sidecar does not.  A tmpfs
+    holding an earlier result (a shorter run) under the final names is filled to exactly the
+    new .h5's size in pages (measured from the same run on a normal disk): the run fails with
+    the I/O reason, the earlier a.h5 and a.xdmf are byte-identical, the new run is complete and
+    readable in a.h5.part (the message says so), and no sidecar .part is left."""
+    d = scratch()
+    scene = write_scene(d, "small", small_scene(steps=2000, every=10))
+    earlier = write_scene(d, "earlier", small_scene(name="earlier", steps=1000, every=10))
+    reference = os.path.join(d, "reference", "a.h5")
+    os.mkdir(os.path.dirname(reference))
+    r = run_engine(engine, scene, reference)
+    if r.rc != 0:
+        c.check(f"{engine}: disk full at the final write: reference run", False, repr(r))
+        return
+    h5_size = os.path.getsize(reference)
+    name = f"{engine}: disk full at the final write"
+    try:
+        with tmpfs("3m") as mnt:
+            out = os.path.join(mnt, "a.h5")
+            r = jdem(earlier, out)
+            before = {f: open(os.path.join(mnt, f), "rb").read() for f in ("a.h5", "a.xdmf")}
+            r = run_engine(engine, scene, out, before_run=lambda: fill_to(mnt, pages(h5_size)))
+            after = {f: open(os.path.join(mnt, f), "rb").read() for f in ("a.h5", "a.xdmf")}
+            left = files(mnt)
+            part_ok = h5_readable(out + ".part") if "a.h5.part" in left else "absent"
+            part_size = os.path.getsize(out + ".part") if "a.h5.part" in left else -1
+    except NotRoot as e:
+        c.skip(name, str(e))
+        return
+    c.check(f"{name}: I/O exit code", r.rc == EXIT["io"], repr(r))
+    c.check(f"{name}: the reason and where the run is",
+            f"cannot write '{out[:-3]}.xdmf.part': No space left on device; the trajectory is "
+            f"complete in '{out}.part' (without its sidecar); the previous result is unchanged"
+            in r.err, repr(r))
+    c.check(f"{name}: the earlier a.h5 and a.xdmf are unchanged", before == after,
+            "the earlier result changed")
+    c.check(f"{name}: the new run complete and readable in a.h5.part",
+            part_ok is None and part_size == h5_size, f".part: {part_ok}, {part_size} bytes "
+            f"(the run on a normal disk: {h5_size})")
+    c.check(f"{name}: no sidecar .part left", "a.xdmf.part" not in left, str(left))
+
+
 def case_read_only(c):
     d = scratch()
     scene = write_scene(d, "small", small_scene())
@@ -157,6 +237,8 @@ def main():
     case_read_only(c)
     case_disk_full(c, "jdem")
     case_disk_full(c, "liggghts-jdem")
+    case_disk_full_at_final_write(c, "jdem")
+    case_disk_full_at_final_write(c, "liggghts-jdem")
     case_memory_limit(c)
     return c.exit()
 
