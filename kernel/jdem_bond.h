@@ -416,6 +416,17 @@ static JD_ALWAYS_INLINE int jd_bond(const unsigned features, const jd_bond_param
     return JD_BOND_INTACT;
 }
 
+/* Moves the energies bond s has dissipated in its dashpots and released by breaking
+ * (JD_B_ENERGY) into *damp and *brk [J] and zeroes them in s: the one harvest of both engines.
+ * fix bond/jiang harvests every bond at every step and a broken one before it removes it; the
+ * stepper harvests a broken bond when it leaves the list, and reads the others from a copy for
+ * its observables (the contact harvest, jdem_kernel.h, says why the times differ). */
+static inline void jd_bond_harvest(jd_bond_state *s, double *damp, double *brk) {
+    *damp += s->e_damp;
+    *brk += s->e_break;
+    s->e_damp = s->e_break = 0.0;
+}
+
 #ifdef __cplusplus
 }
 #endif

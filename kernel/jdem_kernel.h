@@ -625,6 +625,19 @@ static inline double jd_load_work(const double prev[6], const double now[6], con
  * evaluation [J] (JD_F_ENERGY); zero once the contact has ended. */
 static inline double jd_contact_elastic_energy(const jd_contact_state *s) { return s->u_prev; }
 
+/* Moves the energies contact s has dissipated so far (damping, friction; JD_F_ENERGY), weighted
+ * by w [-] (1, or 1/2 for a pair that two ranks evaluate), into *damp and *fric [J] and zeroes
+ * them in s.  The one harvest of both engines; they call it at different times because their
+ * contact lists end differently: LIGGGHTS deletes an ended contact's history without telling the
+ * pair, so its styles harvest every contact at every step; the stepper drops an entry only at a
+ * neighbour rebuild, so it harvests there, and until then the entry's own accumulators are the
+ * record (its observables add them to what was harvested). */
+static inline void jd_contact_harvest(jd_contact_state *s, double w, double *damp, double *fric) {
+    *damp += w * s->e_damp;
+    *fric += w * s->e_fric;
+    s->e_damp = s->e_fric = 0.0;
+}
+
 #ifdef __cplusplus
 }
 #endif

@@ -456,8 +456,7 @@ void FixBondJiang::loop(bool commit) {
         ev.r = out;
         if (record) events.push_back(ev);
         nbroken[mode == JD_BOND_BROKE_TENSION ? 0 : 1] += 1.0;
-        e_damp += st.e_damp;
-        e_broken += st.e_break;
+        jd_bond_harvest(&st, &e_damp, &e_broken);
         /* remove the slot, keeping the others in order (the force summation order) */
         for (int m = k + 1; m < nbond[i]; m++) {
           partner[i][m - 1] = partner[i][m];
@@ -466,8 +465,7 @@ void FixBondJiang::loop(bool commit) {
         nbond[i]--;
         continue;
       }
-      e_damp += st.e_damp; /* harvested every step, as gran/jiang does */
-      st.e_damp = 0.0;
+      jd_bond_harvest(&st, &e_damp, &e_broken); /* every step, as gran/jiang does */
       std::memcpy(state(i, k), &st, sizeof st);
       k++;
       if (mode != JD_BOND_INTACT) continue; /* set-up evaluation of a bond that would fail */

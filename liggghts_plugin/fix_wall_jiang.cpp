@@ -227,9 +227,7 @@ void FixWallJiang::loop(bool commit) {
     if (F & JD_F_ENERGY) {
       /* f_prev is booked only with the energies; the work also over the step a contact ends */
       work += jd_wall_work(f_prev, out.f, vel, dt);
-      e_damp += hs.st->e_damp;
-      e_fric += hs.st->e_fric;
-      hs.st->e_damp = hs.st->e_fric = 0.0;
+      jd_contact_harvest(hs.st, 1.0, &e_damp, &e_fric);
       if (carries) e_el += jd_contact_elastic_energy(hs.st);
     }
     hs.finish();

@@ -284,9 +284,7 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
       /* a pair with a ghost partner is evaluated on both ranks: count it half on each */
       const double w = j < nlocal ? 1.0 : 0.5;
       if (F & JD_F_ENERGY) {
-        e_damp += w * h.st->e_damp;
-        e_fric += w * h.st->e_fric;
-        h.st->e_damp = h.st->e_fric = 0.0;
+        jd_contact_harvest(h.st, w, &e_damp, &e_fric);
         if (carries) e_el += w * jd_contact_elastic_energy(h.st);
       }
       if (carries) ncontacts += w;

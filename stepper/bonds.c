@@ -408,10 +408,9 @@ static size_t bond_breaks(jd_sim *s, int64_t step) {
 static void compact(jd_bonds *b) {
     size_t w = 0;
     for (size_t k = 0; k < b->n; k++) {
-        const jd_bond_state st = state_get(b, b->sw, k);
+        jd_bond_state st = state_get(b, b->sw, k);
         if (!jd_bond_intact(&st)) {
-            b->e_damp_dropped += st.e_damp;
-            b->e_break_dropped += st.e_break;
+            jd_bond_harvest(&st, &b->e_damp_dropped, &b->e_break_dropped);
             continue;
         }
         if (w != k) {
@@ -523,10 +522,9 @@ void sim_bonds_observables(const jd_sim *s, jd_bond_observables *o) {
                                .damping_dissipation = b->e_damp_dropped,
                                .breakage_energy = b->e_break_dropped};
     for (size_t k = 0; (b->features & JD_B_ENERGY) && k < b->n; k++) {
-        const jd_bond_state st = state_get(b, b->sw, k);
+        jd_bond_state st = state_get(b, b->sw, k); /* a copy: the list keeps its accumulators */
         o->elastic_energy += st.u_prev;
-        o->damping_dissipation += st.e_damp;
-        o->breakage_energy += st.e_break;
+        jd_bond_harvest(&st, &o->damping_dissipation, &o->breakage_energy);
     }
     /* fragments: union-find over the intact bonds; components among the particles ever bonded */
     int32_t *parent = malloc((s->n ? s->n : 1) * sizeof *parent);

@@ -105,14 +105,13 @@ static int key_less(const jd_contact_list *a, size_t p, const jd_contact_list *b
     return a->i[p] < b->i[q] || (a->i[p] == b->i[q] && a->j[p] < b->j[q]);
 }
 
-/* The dissipation accumulated by entry c (energy bookkeeping only), added to the run's totals
- * when the entry is dropped. */
+/* The dissipation accumulated by entry c (energy bookkeeping only), harvested into the run's
+ * totals when the entry is dropped (jd_contact_harvest). */
 static void drop_entry(jd_sim *s, const jd_contact_list *l, size_t c) {
     if (l->hw < JD_CONTACT_STATE_LEN) return;
     jd_contact_state st;
     sim_hist_get(l, c, &st, NULL);
-    s->e_damp_dropped += st.e_damp;
-    s->e_fric_dropped += st.e_fric;
+    jd_contact_harvest(&st, 1.0, &s->e_damp_dropped, &s->e_fric_dropped);
 }
 
 /* Give every entry of nw (one sorted run) the history of the same (i, j) in old, or a fresh

@@ -21,8 +21,7 @@ static void list_energies(const jd_contact_list *l, double *damp, double *fric) 
     for (size_t c = 0; c < l->n; c++) {
         jd_contact_state st;
         sim_hist_get(l, c, &st, NULL);
-        *damp += st.e_damp;
-        *fric += st.e_fric;
+        jd_contact_harvest(&st, 1.0, damp, fric); /* from a copy: the entry keeps its own */
     }
 }
 
