@@ -717,7 +717,8 @@ static void test_failed_sidecar_keeps_previous_pair(void **state) {
     if (!h) fail_msg("create: %s", err);
     write_frames(h, 3, 1u);
     assert_int_equal(jd_h5md_close(h, 1, err, sizeof err), -1);
-    snprintf(want, sizeof want, "cannot create '%s': File exists", blocker);
+    snprintf(want, sizeof want, "cannot create '%s': File exists; the trajectory is complete in "
+             "'%s' (without its sidecar); the previous result is unchanged", blocker, t.part);
     assert_string_equal(err, want);
     assert_int_equal(frames_in(t.h5), 2);
     assert_true(exists(t.part)); /* the new, complete run stays under PATH.part */
