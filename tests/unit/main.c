@@ -3,6 +3,7 @@
 
 int run_inlet_tests(void);
 int run_servo_tests(void);
+int run_mesh_tests(void);
 
 int main(void) {
     int failed = 0;
@@ -17,5 +18,6 @@ int main(void) {
     failed += run_hugepages_tests();
     failed += run_inlet_tests();
     failed += run_servo_tests();
+    failed += run_mesh_tests();
     return failed;
 }

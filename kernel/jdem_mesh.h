@@ -1,0 +1,123 @@
+/*
+ * jdem_mesh.h — a sphere against a triangle mesh wall (an STL surface), in the kernel's
+ * conventions (jdem_geometry.h): the mesh's topology, the closest feature of one triangle, and
+ * the rule that turns a sphere's candidate triangles into contacts without double counting.
+ * Both engines call these, so they open the same contacts at the same steps.
+ *
+ * Pure C11.  No I/O, no allocation (the caller supplies every array), no globals.  Units SI (m).
+ *
+ * The contact rule.  A mesh is two-sided (as LIGGGHTS' meshes are).  For a sphere centre p each
+ * triangle reports its closest feature: its open face (p projects strictly inside it), one of its
+ * open edges, or one of its vertices, found with the edge and vertex data of the mesh's tables, so
+ * that every triangle sharing an edge or a vertex computes it from the same numbers in the same
+ * order (the same bits).  A feature is a contact of the sphere when its distance is below R and
+ * every triangle that holds the feature reports it as its closest one: that is, when the
+ * feature's point is a local minimum of the distance from p over the surface.  A face has one
+ * triangle; an edge has its valence (2 inside a manifold, 1 on the boundary); a vertex its
+ * valence.  So a sphere resting on a flat or convex region gets exactly one contact, at its
+ * nearest point, wherever it lies (face, edge, vertex), and a sphere in a concave corner gets one
+ * contact per face it touches, as it should.  The caller's candidate list must hold every
+ * triangle within R of p (a neighbour list with a skin does); an edge or vertex contact then
+ * belongs to the lowest-numbered triangle that holds it.
+ *
+ * Known limit: two faces meeting at a slightly concave crease both count when the sphere touches
+ * both, as they would for two plane walls.
+ */
+#ifndef JDEM_KERNEL_MESH_H
+#define JDEM_KERNEL_MESH_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "jdem_kernel.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The topology of a mesh of ntri triangles: the corners welded into vertices (corners with
+ * bitwise-identical coordinates are one vertex) and the edges between them.  Vertex and edge
+ * ids follow the lexicographic order of the coordinates and of the vertex-id pairs, so they do
+ * not depend on the order in which an engine stores the triangles' corners. */
+typedef struct jd_mesh {
+    size_t ntri, nvert, nedge;
+    double (*vertex)[3];      /* [nvert] vertex coordinates                               [m] */
+    int32_t (*tri_vertex)[3]; /* [ntri] the triangle's corners k = 0, 1, 2 as vertex ids      */
+    int32_t (*tri_edge)[3];   /* [ntri] edge k joins corners k and (k + 1) % 3               */
+    int32_t (*edge_vertex)[2]; /* [nedge] the edge's vertex ids, lower first                  */
+    int32_t *edge_valence;    /* [nedge] triangles that hold the edge                         */
+    int32_t *vertex_valence;  /* [nvert] triangles that hold the vertex                       */
+} jd_mesh;
+
+/* The arrays jd_mesh_build fills, each sized for ntri triangles: vertex[3 ntri],
+ * tri_vertex[ntri], tri_edge[ntri], edge_vertex[3 ntri], edge_valence[3 ntri],
+ * vertex_valence[3 ntri], and scratch[3 ntri] (int64_t, for the sort). */
+typedef struct jd_mesh_storage {
+    double (*vertex)[3];
+    int32_t (*tri_vertex)[3];
+    int32_t (*tri_edge)[3];
+    int32_t (*edge_vertex)[2];
+    int32_t *edge_valence;
+    int32_t *vertex_valence;
+    int64_t *scratch;
+} jd_mesh_storage;
+
+/* Builds m from the corners of ntri triangles (corner[t][k] [m]) into the arrays of st.
+ * Returns JD_MESH_OK, or JD_MESH_DEGENERATE with *bad the first triangle with two welded
+ * corners (zero-length edge) or zero area, or JD_MESH_TOO_LARGE when 3 ntri does not fit in
+ * int32_t. */
+enum { JD_MESH_OK = 0, JD_MESH_DEGENERATE = 1, JD_MESH_TOO_LARGE = 2 };
+int jd_mesh_build(size_t ntri, const double (*corner)[3][3], const jd_mesh_storage *st, jd_mesh *m,
+                  size_t *bad);
+
+/* The closest feature of one triangle to a point. */
+enum { JD_MESH_FACE = 0, JD_MESH_EDGE = 1, JD_MESH_VERTEX = 2 };
+typedef struct jd_mesh_closest {
+    int32_t tri;      /* the triangle                                                        */
+    int kind;         /* JD_MESH_FACE, JD_MESH_EDGE or JD_MESH_VERTEX                         */
+    int32_t feature;  /* the triangle's id, the edge id or the vertex id                     */
+    double point[3];  /* the closest point of the triangle                                [m] */
+    double dist2;     /* squared distance from the point queried                        [m^2] */
+} jd_mesh_closest;
+
+/* The closest feature of triangle t of m to p [m].  Face when p projects strictly inside the
+ * triangle (the three edge tests > 0); otherwise the edges are tried from their tables (the
+ * parameter along edge (lo, hi) from the lower vertex): a vertex is the closest feature only when
+ * both of the triangle's edges through it end there, else the open edge whose point is nearest
+ * (ties to the lower edge id). */
+void jd_mesh_closest_feature(const jd_mesh *m, int32_t t, const double p[3], jd_mesh_closest *c);
+
+/* The contacts among n candidates of one sphere of radius R [m] (c[k] from
+ * jd_mesh_closest_feature for every triangle within R of the centre, in any order):
+ * contact[k] = 1 when c[k]'s feature is a contact by the rule above and c[k].tri is the
+ * lowest-numbered triangle among the candidates reporting it, else 0 (so the result does not
+ * depend on the order of the list).  Returns the number of contacts.  O(n^2); n is small. */
+size_t jd_mesh_contacts(const jd_mesh *m, size_t n, const jd_mesh_closest *c, double R,
+                        unsigned char *contact);
+
+/* The geometric fields of jd_contact_geom (jdem_geometry.h conventions: a the particle, b the
+ * wall) for a contact of a sphere of centre x [m] and radius R [m] with feature c: n from the
+ * centre towards the point, delta = R - |point - x|, ra = (R - delta) n, rb = 0, r_roll = R.
+ * Returns 1, or 0 when the centre lies on the surface (no normal) or there is no overlap. */
+static inline int jd_geom_mesh(const jd_mesh_closest *c, const double x[3], double R,
+                               jd_contact_geom *g) {
+    const double d = sqrt(c->dist2);
+    const double dl = R - d;
+    if (!(d > 0.0) || !(dl > 0.0)) return 0;
+    g->delta = dl;
+    const double la = R - dl;
+    for (int k = 0; k < 3; k++) {
+        g->n[k] = (c->point[k] - x[k]) / d;
+        g->ra[k] = la * g->n[k];
+        g->rb[k] = 0.0;
+    }
+    g->r_roll = R;
+    return 1;
+}
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
