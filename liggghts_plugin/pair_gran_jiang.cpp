@@ -9,6 +9,7 @@
 #include <string>
 
 #include "atom.h"
+#include "compute_pair_gran_local.h"
 #include "comm.h"
 #include "error.h"
 #include "fix.h"
@@ -290,6 +291,7 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
       if (carries) ncontacts += w;
       touch[jj] = 1; /* keep the history across neighbour rebuilds while overlapping */
       h.finish();
+      if (addflag && cpl()) report_pair(i, j, carries, out, hist);
       if (!carries || !apply) continue;
 
       jd_sub3(f[i], out.f);
@@ -310,5 +312,18 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
   }
   e_elastic_now = e_el;
   contacts_now = ncontacts;
-  (void)addflag;
+}
+
+/* compute pair/gran/local: a row for every pair whose spheres overlap (the rows it counts), with
+ * the force and torque on i as LIGGGHTS' own pairs report them (zero once Luding's end of
+ * collision has released the pair) and the stored history. */
+void PairGranJiang::report_pair(int i, int j, bool carries, const jd_contact_result &out,
+                                double *hist) {
+  double fi[3] = {0.0, 0.0, 0.0}, ti[3] = {0.0, 0.0, 0.0};
+  if (carries)
+    for (int d = 0; d < 3; d++) {
+      fi[d] = -out.f[d];
+      ti[d] = out.ta[d];
+    }
+  cpl()->add_pair(i, j, fi[0], fi[1], fi[2], ti[0], ti[1], ti[2], hist, NULL);
 }

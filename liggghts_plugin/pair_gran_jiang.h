@@ -83,6 +83,7 @@ class PairGranJiang : public PairGran {
 
  private:
   void update_law_set(bool report);
+  void report_pair(int i, int j, bool carries, const jd_contact_result &out, double *hist);
   unsigned features_;
   int ntypes_;
   std::vector<double> E_, nu_;
