@@ -17,6 +17,8 @@ scripts/scene_to_liggghts.py writes from it (--inlet-record), on 1 and 2 MPI ran
 * energy: the inflow energy fix jdem/inlet reports equals jdem's inlet_energy observable and the
   sum of 1/2 m v^2 - m g.x over the record (masses 4/3 pi R^3 rho of the resolved scene), and the
   run passes fix jdem/watchdog's energy check while that inflow is far beyond its 5 % limit.
+* stop rules: a time and a deposit-height rule that admit one section where the sections rule
+  admits two give the same records in both engines (the rules are the kernel's).
 * the deck's own trajectory: the unmodified deck writes dump h5md/jdem (FAIL naming the reason
   while that dump refuses a growing or empty particle set).
 * bad input: each malformed fix jdem/inlet argument stops LIGGGHTS with its exact message.
@@ -282,12 +284,47 @@ def bad_input(deck_dir, deck_text):
         f.write(original)
 
 
+def stop_rules(tmp):
+    """The time and deposit-height stop rules: the same records in both engines, one section
+    where the sections rule gives two by 0.2 s (copy 1 starts at step 2700: 0.135 s)."""
+    base = yaml.safe_load(open(SCENE))
+    base["time"]["end_time"] = 0.2
+    for name, stop in (("time", {"time": 0.125}),
+                       ("height", {"deposit_height": {"height": 0.3, "below_speed": 10.0, "every": 500}})):
+        doc = dict(base, inlets=[dict(base["inlets"][0], stop=stop)])
+        scene = os.path.join(tmp, "stop_%s.yaml" % name)
+        with open(scene, "w") as f:
+            yaml.safe_dump(doc, f)
+        rec = os.path.join(tmp, "stop_%s.jdem.csv" % name)
+        r = subprocess.run([JDEM, "run", scene, "-o", os.path.join(tmp, "stop_%s.h5" % name), "--inlet-record", rec,
+                            "--quiet"], capture_output=True, text=True)
+        if not check("stop-%s-jdem" % name, r.returncode == 0, r.stderr.strip()):
+            continue
+        resolved = os.path.join(tmp, "stop_%s.resolved.yaml" % name)
+        with open(resolved, "w") as f:
+            f.write(subprocess.run([JDEM, "resolve", scene], capture_output=True, text=True, check=True).stdout)
+        deck_dir = os.path.join(tmp, "stop_%s.deck" % name)
+        lrec = os.path.join(deck_dir, "lig.csv")
+        subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), resolved, "-o",
+                        os.path.join(deck_dir, "in.jdem"), "--trajectory", os.path.join(tmp, "x.h5"),
+                        "--inlet-record", lrec], check=True)
+        with open(os.path.join(deck_dir, "in.custom"), "w") as f:
+            f.write(custom_dump_deck(open(os.path.join(deck_dir, "in.jdem")).read(), 1000, "d.dump"))
+        rc, log = run_deck(deck_dir, "in.custom", "log.custom")
+        if not check("stop-%s-liggghts" % name, rc == 0, log[-800:]):
+            continue
+        a, b = open(rec).read(), open(lrec).read()
+        check("stop-%s-stream" % name, a == b and a.count("\n") == 10,
+              "jdem %d lines, liggghts-jdem %d (want the header and one section of 9)" % (a.count("\n"), b.count("\n")))
+
+
 def main():
     for exe in (JDEM, LIG):
         if not check("built-" + os.path.basename(exe), os.access(exe, os.X_OK), "run make"):
             return
     tmp = tempfile.mkdtemp(prefix="inlet-cross-")
     got = cross_engine(tmp)
+    stop_rules(tmp)
     if got:
         bad_input(*got)
     if not checks.failed:
