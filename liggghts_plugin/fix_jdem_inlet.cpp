@@ -224,16 +224,20 @@ void FixJdemInlet::read_section(const char *path) {
 }
 
 /* A new record (its header first), or the record an earlier fix jdem/inlet of the deck started:
- * the fixes write their lines at pre_exchange in their order, each step's lines flushed. */
+ * the fixes write their lines at pre_exchange in their order, each step's lines flushed, and
+ * every fix holds the file in append mode, so that each write lands at its end. */
 void FixJdemInlet::open_record(const char *path, bool append) {
   char msg[512] = "";
   if (comm->me == 0) {
-    record = std::fopen(path, append ? "a" : "w");
+    bool started = append;
+    if (!append) {
+      FILE *fresh = std::fopen(path, "w");
+      const bool wrote = fresh && std::fputs(JD_INLET_RECORD_HEADER, fresh) >= 0;
+      started = fresh && std::fclose(fresh) == 0 && wrote;
+    }
+    record = started ? std::fopen(path, "a") : NULL;
     if (!record)
       std::snprintf(msg, sizeof msg, "fix jdem/inlet: record file %s: %s", path, std::strerror(errno));
-    else if (!append)
-      std::fputs(JD_INLET_RECORD_HEADER, record);
-    if (record) std::fflush(record);
   }
   MPI_Bcast(msg, sizeof msg, MPI_CHAR, 0, world);
   if (msg[0]) error->all(FLERR, msg);

@@ -18,7 +18,8 @@ scripts/scene_to_liggghts.py writes from it (--inlet-record), on 1 and 2 MPI ran
   sum of 1/2 m v^2 - m g.x over the record (masses 4/3 pi R^3 rho of the resolved scene), and the
   run passes fix jdem/watchdog's energy check while that inflow is far beyond its 5 % limit.
 * stop rules: a time and a deposit-height rule that admit one section where the sections rule
-  admits two give the same records in both engines (the rules are the kernel's).
+  admits two give the same records in both engines (the rules are the kernel's); so does a
+  scene with a second inlet (one record, the inlets' lines of a step in the scene's order).
 * the deck's own trajectory: the unmodified deck writes dump h5md/jdem (FAIL naming the reason
   while that dump refuses a growing or empty particle set).
 * bad input: each malformed fix jdem/inlet argument stops LIGGGHTS with its exact message.
@@ -289,9 +290,11 @@ def stop_rules(tmp):
     where the sections rule gives two by 0.2 s (copy 1 starts at step 2700: 0.135 s)."""
     base = yaml.safe_load(open(SCENE))
     base["time"]["end_time"] = 0.2
-    for name, stop in (("time", {"time": 0.125}),
-                       ("height", {"deposit_height": {"height": 0.3, "below_speed": 10.0, "every": 500}})):
-        doc = dict(base, inlets=[dict(base["inlets"][0], stop=stop)])
+    second = dict(base["inlets"][0], name="belt2", origin=[0.01, 0.1, 0.35], stop={"sections": 2}, first_id=1000)
+    for name, stop, more in (("time", {"time": 0.125}, []),
+                             ("height", {"deposit_height": {"height": 0.3, "below_speed": 10.0, "every": 500}}, []),
+                             ("two-inlets", {"time": 0.125}, [second])):
+        doc = dict(base, inlets=[dict(base["inlets"][0], stop=stop)] + more)
         scene = os.path.join(tmp, "stop_%s.yaml" % name)
         with open(scene, "w") as f:
             yaml.safe_dump(doc, f)
@@ -314,8 +317,9 @@ def stop_rules(tmp):
         if not check("stop-%s-liggghts" % name, rc == 0, log[-800:]):
             continue
         a, b = open(rec).read(), open(lrec).read()
-        check("stop-%s-stream" % name, a == b and a.count("\n") == 10,
-              "jdem %d lines, liggghts-jdem %d (want the header and one section of 9)" % (a.count("\n"), b.count("\n")))
+        want = 10 + 18 * len(more)  # the header, one section of the first inlet, two of the second
+        check("stop-%s-stream" % name, a == b and a.count("\n") == want,
+              "jdem %d lines, liggghts-jdem %d (want %d)" % (a.count("\n"), b.count("\n"), want))
 
 
 def main():
