@@ -229,13 +229,13 @@ void FixJdemInlet::read_section(const char *path) {
 void FixJdemInlet::open_record(const char *path, bool append) {
   char msg[512] = "";
   if (comm->me == 0) {
-    bool started = append;
+    bool header_ok = append;
     if (!append) {
       FILE *fresh = std::fopen(path, "w");
       const bool wrote = fresh && std::fputs(JD_INLET_RECORD_HEADER, fresh) >= 0;
-      started = fresh && std::fclose(fresh) == 0 && wrote;
+      header_ok = fresh && std::fclose(fresh) == 0 && wrote;
     }
-    record = started ? std::fopen(path, "a") : NULL;
+    record = header_ok ? std::fopen(path, "a") : NULL;
     if (!record)
       std::snprintf(msg, sizeof msg, "fix jdem/inlet: record file %s: %s", path, std::strerror(errno));
   }
