@@ -3,6 +3,7 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cmath>
@@ -249,6 +250,10 @@ double FixJdemInlet::max_rad(int t) {
     if (type0[p] + 1 == t && radius[p] > r) r = radius[p];
   return r;
 }
+
+int FixJdemInlet::min_type() { return *std::min_element(type0.begin(), type0.end()) + 1; }
+
+int FixJdemInlet::max_type() { return *std::max_element(type0.begin(), type0.end()) + 1; }
 
 /* ---- the stream ---- */
 

@@ -65,6 +65,10 @@ class FixJdemInlet : public Fix {
   /* the largest section radius of atom type t [m] (0 for a type the section lacks): LIGGGHTS'
    * granular pair styles size the neighbour and ghost cutoffs of future particles with it */
   double max_rad(int t);
+  /* the smallest and largest atom type of the section (LIGGGHTS' material properties count
+   * the types of future particles with them) */
+  int min_type();
+  int max_type();
 
   /* kinetic + gravitational energy the inserted particles brought [J] (the same on every rank) */
   double inflow_energy() const { return energy_in; }

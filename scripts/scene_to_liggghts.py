@@ -16,7 +16,12 @@ Decks are generated, never edited by hand.
 infinite `fix wall/gran ... primitive` (axis-aligned planes -> x/y/zplane, axis-aligned cylinders
 -> x/y/zcylinder; anything else, and moving walls, are refused).  A finite plane becomes the
 infinite plane through it and a cylinder loses its end caps and its side: equivalent only where
-no particle reaches an edge, a rim or the far side.
+no particle reaches an edge, a rim or the far side.  A material with E < 5e6 Pa gets
+`soft_particles yes` (LIGGGHTS' own models refuse it in SI units otherwise).
+
+Inlets (the resolved scene's `inlets:`) become one `fix jdem/inlet` each, with the section in
+`inlet_NAME.txt` beside the deck; --inlet-record FILE makes them write the insertion record of
+`jdem run --inlet-record`.  A scene of inlets alone starts from an empty box (create_box).
 """
 import argparse
 import math
@@ -435,6 +440,8 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         len(walls), ntypes, ", ".join("%d=%s" % (tid[n], word(n, "material name")) for n in names)))
     L.append("\nunits           si\n")
     L.append("hard_particles  yes\n")
+    if min(prop(n, "youngs_modulus") for n in elastic) < 5e6:  # LIGGGHTS' own SI range (--builtin)
+        L.append("soft_particles  yes\n")
     L.append("atom_style      granular\n")
     L.append("atom_modify     map array sort 0 0.0\n")
     L.append("newton          off\n")

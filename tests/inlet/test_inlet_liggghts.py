@@ -14,6 +14,7 @@ scripts/scene_to_liggghts.py writes from it (--inlet-record), on 1 and 2 MPI ran
   cross-engine tolerance (output.compare_tolerance, default 1e-10, scaled as
   scripts/compare_trajectories.py: by the largest radius, the belt speed, and their ratio); 2
   ranks agree with 1 rank the same way.
+* builtin: the --builtin deck (LIGGGHTS' own hertz/history law) inserts the same stream.
 * energy: the inflow energy fix jdem/inlet reports equals jdem's inlet_energy observable and the
   sum of 1/2 m v^2 - m g.x over the record (masses 4/3 pi R^3 rho of the resolved scene), and the
   run passes fix jdem/watchdog's energy check while that inflow is far beyond its 5 % limit.
@@ -212,6 +213,17 @@ def cross_engine(tmp):
         worst = worst_difference(lig_frames[1], lig_frames[2], scales)
         check("ranks-1-vs-2", not same_particles(lig_frames[1], lig_frames[2]) and worst <= tol,
               "largest scaled difference %.3g" % worst)
+    builtin = os.path.join(tmp, "builtin")
+    brec = os.path.join(builtin, "rec.csv")
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), resolved, "-o",
+                        os.path.join(builtin, "in.jdem"), "--trajectory", os.path.join(tmp, "b.h5"), "--builtin",
+                        "--inlet-record", brec], capture_output=True, text=True)
+    if check("builtin-deck", r.returncode == 0, r.stderr.strip()):
+        with open(os.path.join(builtin, "in.custom"), "w") as f:
+            f.write(custom_dump_deck(open(os.path.join(builtin, "in.jdem")).read(), every, "b.dump"))
+        rc, log = run_deck(builtin, "in.custom", "log.custom")
+        check("builtin-stream-identical", rc == 0 and open(brec).read() == jrec,
+              "exit %d: %s" % (rc, log[-600:]))
     rc, log = run_deck(deck_dir, "in.jdem", "log.h5md", 1)
     refused = re.search(r"h5md/jdem needs a fixed particle set|dump h5md/jdem: h5md: frame at step \d+ has no "
                         r"positions", log)
