@@ -307,3 +307,37 @@ size_t jd_inlet_pop(const jd_inlet_spec *s, jd_inlet_stream *st, int64_t step,
     update_next(s, st);
     return count;
 }
+
+/* ---------------------------------------------------------------------------------------- */
+/* Stop rules and the record                                                                */
+/* ---------------------------------------------------------------------------------------- */
+
+int64_t jd_inlet_stop_step_of_time(double time, double dt) {
+    const double steps = ceil(time / dt);
+    return steps < 9.0e18 ? (int64_t)steps : JD_INLET_NO_STOP;
+}
+
+int jd_inlet_height_due(int64_t step, int64_t every) {
+    return step > 0 && every > 0 && step % every == 0;
+}
+
+double jd_inlet_deposit_top(size_t n, const double *x, const double *v, const double *radius,
+                            double below_speed) {
+    const double v2 = below_speed * below_speed;
+    double top = -INFINITY;
+    for (size_t i = 0; i < n; i++)
+        if (dot3(&v[3 * i], &v[3 * i]) < v2)
+            top = fmax(top, x[3 * i + 2] + radius[i]);
+    return top;
+}
+
+void jd_inlet_height_stop(jd_inlet_stream *st, int64_t step, double top, double height) {
+    if (top >= height && st->stop_step > step + 1)
+        st->stop_step = step + 1;
+}
+
+int jd_inlet_record_line(const jd_inlet_particle *p, char *buf, size_t len) {
+    return snprintf(buf, len, "%lld,%lld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", (long long)p->id,
+                    (long long)p->step, p->position[0], p->position[1], p->position[2],
+                    p->velocity[0], p->velocity[1], p->velocity[2]);
+}

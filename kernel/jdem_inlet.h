@@ -33,8 +33,9 @@
  *
  * Stop rule.  Copies are inserted whole: copy c belongs to the stream if c < max_sections (when
  * max_sections > 0) and its start step (the smallest k* of its particles) is < stop_step.  A
- * deposit-height rule is measured by the engine, which then sets jd_inlet_stream.stop_step to the
- * current step: copies already started are completed, no new copy starts.
+ * deposit-height rule is measured by the engine with jd_inlet_deposit_top at the steps
+ * jd_inlet_height_due names, and jd_inlet_height_stop then lowers jd_inlet_stream.stop_step to
+ * the next step: copies already started are completed, no new copy starts.
  */
 #ifndef JDEM_KERNEL_INLET_H
 #define JDEM_KERNEL_INLET_H
@@ -149,6 +150,37 @@ void jd_inlet_stream_init(const jd_inlet_spec *s, jd_inlet_stream *st, jd_inlet_
  * step).  Updates st->next_step. */
 size_t jd_inlet_pop(const jd_inlet_spec *s, jd_inlet_stream *st, int64_t step,
                     jd_inlet_particle *out, size_t cap);
+
+/* ---- The stop rules both engines apply, and the insertion record ---- */
+
+/* Stop rule `time`: no copy starts at or after step ceil(time/dt); JD_INLET_NO_STOP when that
+ * step is beyond int64 (time > 0 and dt > 0 [s]). */
+int64_t jd_inlet_stop_step_of_time(double time, double dt);
+
+/* Stop rule `deposit_height`: it is checked at the steps every, 2 every, ... (step > 0), on the
+ * state of the step after that step's insertions (so the particles inserted at it count). */
+int jd_inlet_height_due(int64_t step, int64_t every);
+
+/* The deposit's top [m]: the largest x_z + R over the n particles (x, v: [3n] in particle order;
+ * radius: [n]) whose speed is below below_speed [m/s] (|v|^2 < below_speed^2); -INFINITY when
+ * none is.  An engine spread over ranks takes the maximum of the ranks' tops. */
+double jd_inlet_deposit_top(size_t n, const double *x, const double *v, const double *radius,
+                            double below_speed);
+
+/* A top at or above height [m] found at `step` stops the stream from the next step on: no copy
+ * starts after `step` (copies already started are completed). */
+void jd_inlet_height_stop(jd_inlet_stream *st, int64_t step, double top, double height);
+
+/* The insertion record (`jdem run --inlet-record`, fix jdem/inlet `record`): a CSV file with this
+ * header line, then one line per inserted particle in insertion order. */
+#define JD_INLET_RECORD_HEADER "id,step,x,y,z,vx,vy,vz\n"
+
+/* Longest record line, with its newline and terminating NUL [bytes]. */
+#define JD_INLET_RECORD_LINE_MAX 256
+
+/* The record line of one inserted particle ("id,step,x,y,z,vx,vy,vz\n", the numbers to 17
+ * significant digits: they read back bit for bit) into buf of len bytes; returns its length. */
+int jd_inlet_record_line(const jd_inlet_particle *p, char *buf, size_t len);
 
 #ifdef __cplusplus
 }

@@ -16,6 +16,7 @@
 #include "update.h"
 
 #include "fix_bond_jiang.h"
+#include "fix_jdem_inlet.h"
 #include "fix_wall_jiang.h"
 #include "jdem_guard.h"
 #include "jdem_kernel.h"
@@ -72,6 +73,18 @@ void FixJdemGuard::setup(int) {
   for (int t = 0; t < nt; t++) rho[t] = rmin[t] == g_rmin[t] ? rho[t] : 0.0; /* the owner's */
   MPI_Allreduce(rho.data(), g_rho.data(), nt, MPI_DOUBLE, MPI_MAX, world);
 
+  /* the inlets' section particles, once each (as the stepper's guard: they take part once inserted) */
+  for (int k = 0; k < modify->nfix; k++) {
+    const FixJdemInlet *in = dynamic_cast<const FixJdemInlet *>(modify->fix[k]);
+    for (size_t p = 0; in && p < in->section_types().size(); p++) {
+      const int t = in->section_types()[p];
+      g_count[t] += 1.0;
+      if (in->section_radii()[p] < g_rmin[t]) {
+        g_rmin[t] = in->section_radii()[p];
+        g_rho[t] = in->section_densities()[p];
+      }
+    }
+  }
   std::vector<jd_guard_species> sp(nt);
   for (int t = 0; t < nt; t++) {
     sp[t].count = (size_t)g_count[t];

@@ -20,6 +20,7 @@
 #include "update.h"
 
 #include "dump_h5md_jdem.h"
+#include "fix_jdem_inlet.h"
 #include "fix_wall_jiang.h"
 #include "jdem_observables.h"
 #include "jdem_stop.h"
@@ -197,7 +198,12 @@ bool FixJdemWatchdog::energy(std::string &msg) {
   bond[JD_OBS_BOND_ELASTIC] = sum[JDO_BOND_ELASTIC];
   bond[JD_OBS_BOND_DAMPING] = sum[JDO_BOND_DAMPING];
   bond[JD_OBS_BOND_BREAKAGE] = sum[JDO_BOND_BREAKAGE];
-  const jd_energy_terms now = jd_energy_terms_of(sum, bond);
+  jd_energy_terms now = jd_energy_terms_of(sum, bond);
+  /* the energy the inlets brought in is input, as the stepper books it (stepper/watchdog.c) */
+  for (int k = 0; k < modify->nfix; k++) {
+    const FixJdemInlet *in = dynamic_cast<const FixJdemInlet *>(modify->fix[k]);
+    if (in) now.wall_work += in->inflow_energy();
+  }
   const double jump = has_ref ? jd_energy_jump(&ref, &now) : 0.0;
   if (!(jump <= max_energy_jump)) { /* NaN trips too */
     const int id = most_energetic();

@@ -20,7 +20,8 @@
 
 namespace LAMMPS_NS {
 
-static void gravity_vector(Modify *modify, double g[3]) {
+void jdem_gravity(LAMMPS *lmp, double g[3]) {
+  Modify *modify = lmp->modify;
   g[0] = g[1] = g[2] = 0.0;
   for (int k = 0; k < modify->nfix; k++) {
     FixGravity *fg = dynamic_cast<FixGravity *>(modify->fix[k]);
@@ -35,7 +36,7 @@ void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]) {
   Atom *atom = lmp->atom;
   for (int k = 0; k < JDO_N; k++) out[k] = 0.0;
   double g[3];
-  gravity_vector(lmp->modify, g);
+  jdem_gravity(lmp, g);
   const int *mask = atom->mask;
   double **x = atom->x, **v = atom->v, **omega = atom->omega;
   for (int i = 0; i < atom->nlocal; i++) {

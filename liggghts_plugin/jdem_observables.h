@@ -26,6 +26,9 @@ enum { JDO_KINETIC = JD_OBS_KINETIC, JDO_ROTATIONAL = JD_OBS_ROTATIONAL,
  * terms stay 0 without pair_style gran/jiang, the bond terms without fix bond/jiang. */
 void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]);
 
+/* The acceleration of every fix gravity, summed [m/s^2] (the weight m g of an atom of mass m). */
+void jdem_gravity(LAMMPS *lmp, double g[3]);
+
 /* True when some consumer of the bond energies is defined (a dump h5md/jdem without `energy
  * no`, which writes them,
  * or a fix jdem/watchdog that checks the energy balance): fix bond/jiang then books them. */

@@ -9,6 +9,7 @@
  *   fix jdem/loads          idem
  *   fix jdem/guard          idem
  *   fix jdem/observables    idem
+ *   fix jdem/inlet          idem
  *   dump h5md/jdem          LIGGGHTS 3.8 has no dump map: Output::add_dump() is an if-else chain
  *                           over style_dump.h.  We interpose Output::add_dump (libliggghts.so
  *                           calls it through its PLT, so the executable's definition wins) and
@@ -42,6 +43,7 @@
 #include "fix_bond_jiang.h"
 #include "fix_jdem_loads.h"
 #include "fix_jdem_guard.h"
+#include "fix_jdem_inlet.h"
 #include "fix_jdem_observables.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_wall_jiang.h"
@@ -90,6 +92,10 @@ static Fix *create_fix_jdem_observables(LAMMPS *lmp, int narg, char **arg) {
   return new FixJdemObservables(lmp, narg, arg);
 }
 
+static Fix *create_fix_jdem_inlet(LAMMPS *lmp, int narg, char **arg) {
+  return new FixJdemInlet(lmp, narg, arg);
+}
+
 static void register_jdem_styles(LAMMPS *lmp) {
   (*lmp->force->pair_map)["gran/jiang"] = &create_pair_gran_jiang;
   FixMap *fix_map = lmp->modify->*get(ModifyFixMap());
@@ -99,6 +105,7 @@ static void register_jdem_styles(LAMMPS *lmp) {
   (*fix_map)["jdem/loads"] = &create_fix_jdem_loads;
   (*fix_map)["jdem/guard"] = &create_fix_jdem_guard;
   (*fix_map)["jdem/observables"] = &create_fix_jdem_observables;
+  (*fix_map)["jdem/inlet"] = &create_fix_jdem_inlet;
 }
 
 /* ---- dump h5md/jdem: interposed Output::add_dump ---- */
@@ -172,6 +179,9 @@ static const char *jdem_help =
     "                                 [velocity vx vy vz]\n"
     "                jdem/watchdog N [overlap F] [energy J|off]   (stop a run that goes wrong)\n"
     "                jdem/guard vmax V [coordination C] [force]   (refuse an unsafe timestep)\n"
+    "                jdem/inlet file SECTION origin X Y Z velocity VX VY VZ plane PX PY PZ NX NY NZ\n"
+    "                           period L [offset D] first_id ID stop sections N|time T|height H\n"
+    "                           [below_speed V] [every N] [record FILE]   (conveyor inlet)\n"
     "* Dump styles:  h5md/jdem    N FILE.h5 [scene NAME] [case NAME] [scene_yaml PATH]\n"
     "                             [energy yes|no]\n"
     "(gran/jiang presents itself as \"gran\" to LIGGGHTS; do not use `clear` or restart files.)\n\n";

@@ -20,6 +20,7 @@
 #include "neighbor.h"
 #include "update.h"
 
+#include "fix_jdem_inlet.h"
 #include "fix_wall_jiang.h"
 #include "jdem_dispatch.h"
 #include "jdem_laws.h"
@@ -154,13 +155,18 @@ void PairGranJiang::init_granular() {
 }
 
 /* The law set of the interactions that can occur (jd_law_set_select, the stepper's rule): the
- * types of the atoms present on any rank against those types and the walls' (fix wall/jiang).
+ * types of the atoms present on any rank and of the inlets' sections (fix jdem/inlet) against
+ * those types and the walls' (fix wall/jiang).
  * At set-up, and again after every neighbour build, when atoms of another type may have been
  * inserted: the set then widens (collective: every rank builds its lists at the same step). */
 void PairGranJiang::update_law_set(bool report) {
   const int nt = ntypes_;
   std::vector<int> mine(nt, 0), all(nt, 0);
   for (int i = 0; i < atom->nlocal; i++) mine[atom->type[i] - 1] = 1;
+  for (int k = 0; k < modify->nfix; k++) { /* the inlets' particles, as the stepper counts them */
+    const FixJdemInlet *in = dynamic_cast<const FixJdemInlet *>(modify->fix[k]);
+    for (size_t p = 0; in && p < in->section_types().size(); p++) mine[in->section_types()[p]] = 1;
+  }
   MPI_Allreduce(&mine[0], &all[0], nt, MPI_INT, MPI_MAX, world);
   bool grew = report;
   for (int t = 0; t < nt; t++)

@@ -16,7 +16,12 @@ Decks are generated, never edited by hand.
 infinite `fix wall/gran ... primitive` (axis-aligned planes -> x/y/zplane, axis-aligned cylinders
 -> x/y/zcylinder; anything else, and moving walls, are refused).  A finite plane becomes the
 infinite plane through it and a cylinder loses its end caps and its side: equivalent only where
-no particle reaches an edge, a rim or the far side.
+no particle reaches an edge, a rim or the far side.  A material with E < 5e6 Pa gets
+`soft_particles yes` (LIGGGHTS' own models refuse it in SI units otherwise).
+
+Inlets (the resolved scene's `inlets:`) become one `fix jdem/inlet` each, with the section in
+`inlet_NAME.txt` beside the deck; --inlet-record FILE makes them write the insertion record of
+`jdem run --inlet-record`.  A scene of inlets alone starts from an empty box (create_box).
 """
 import argparse
 import math
@@ -284,7 +289,86 @@ def guard_lines(scene, builtin, force):
         " force" if force else "")]
 
 
-def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=False, particles=None):
+def dot3(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def inlet_crossings(inlet):
+    """(position, radius) of each section particle of copy 0 where it crosses the inlet plane,
+    for the box only (the crossing step itself is the kernel's: fix jdem/inlet)."""
+    v = [float(c) for c in inlet["velocity"]]
+    N = [float(c) for c in inlet["plane"]["normal"]]
+    P = [float(c) for c in inlet["plane"]["point"]]
+    speed = math.sqrt(dot3(v, v))
+    back = float(inlet.get("offset", 0.0))
+    out = []
+    for p in inlet["section"]["particles"]:
+        q = [float(inlet["origin"][d]) + float(p["position"][d]) - back * v[d] / speed for d in range(3)]
+        t = max(0.0, -dot3(N, [q[d] - P[d] for d in range(3)]) / dot3(N, v))
+        out.append(([q[d] + v[d] * t for d in range(3)], float(p["radius"])))
+    return out
+
+
+def add_inlets_to_extent(scene, particles):
+    """Grow the particles' extent, largest radius, speed and materials by the inlets' sections
+    at their crossing points (the particles exist in LIGGGHTS from there on), one step of belt
+    motion wider."""
+    dt = float(scene["time"]["dt"])
+    for inlet in scene.get("inlets") or []:
+        v = [float(c) for c in inlet["velocity"]]
+        speed = math.sqrt(dot3(v, v))
+        for (x, r), p in zip(inlet_crossings(inlet), inlet["section"]["particles"]):
+            for d in range(3):
+                particles.lo[d] = min(particles.lo[d], x[d] - r - speed * dt)
+                particles.hi[d] = max(particles.hi[d], x[d] + r + speed * dt)
+            particles.rmax = r if particles.rmax is None else max(particles.rmax, r)
+            particles.used.add(p["material"])
+        particles.vmax = max(particles.vmax, speed)
+
+
+def inlet_stop_words(stop):
+    """The stop rule of a resolved inlet as fix jdem/inlet's words."""
+    if "sections" in stop:
+        return "stop sections %d" % int(stop["sections"])
+    if "time" in stop:
+        return "stop time %s" % num(stop["time"])
+    h = stop["deposit_height"]
+    return "stop height %s below_speed %s every %d" % (num(h["height"]), num(h["below_speed"]), int(h["every"]))
+
+
+def inlet_lines(scene, tid, deck_dir, record):
+    """One `fix jdem/inlet` per inlet, in the scene's order (the stepper inserts the inlets'
+    particles of one step in that order), its section in a file beside the deck ("TYPE RADIUS
+    DENSITY X Y Z"); RECORD: the insertion record of all inlets (the first fix starts it, the
+    others append), as `jdem run --inlet-record`."""
+    inlets = scene.get("inlets") or []
+    if not inlets:
+        return []
+    mats = scene["materials"]
+    L = ["\n# conveyor inlets (fix jdem/inlet: the stream of kernel/jdem_inlet.h; docs/mixing.md 2.1)\n"]
+    taken = set()
+    for k, inlet in enumerate(inlets):
+        ident = identifier(inlet["name"], "in_", taken)
+        fname = "inlet_%s.txt" % ident[3:]
+        with open(os.path.join(deck_dir, fname), "w") as f:
+            f.write("# section of inlet %s: type radius density x y z (relative to the origin), generated "
+                    "by scripts/scene_to_liggghts.py\n" % word(inlet["name"], "inlet name"))
+            for p in inlet["section"]["particles"]:
+                f.write("%d %s %s %s\n" % (tid[p["material"]], num(p["radius"]),
+                                           num(mats[p["material"]]["density"]), vec(p["position"])))
+        plane = inlet["plane"]
+        words = "file %s origin %s velocity %s plane %s %s period %s offset %s first_id %d %s" % (
+            fname, vec(inlet["origin"]), vec(inlet["velocity"]), vec(plane["point"]), vec(plane["normal"]),
+            num(inlet["period"]), num(inlet.get("offset", 0.0)), int(inlet["first_id"]),
+            inlet_stop_words(inlet["stop"]))
+        if record:
+            words += " %s %s" % ("record" if k == 0 else "append_record", word(os.path.abspath(record), "record path"))
+        L.append("fix %s all jdem/inlet %s\n" % (ident, words))
+    return L
+
+
+def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=False, particles=None,
+               inlet_record=None):
     """The deck of SCENE.  PARTICLES: its particles, gathered by a ParticleStream while
     resolved_stream.read_resolved read the scene; None: SCENE["particles"] is their list."""
     deck_dir = os.path.dirname(os.path.abspath(deck_path))
@@ -298,23 +382,25 @@ def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=
             particles.remove()
             raise
     try:
-        write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force)
+        write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
+                         inlet_record)
     finally:
         particles.remove()
 
 
-def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force):
+def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
+                     inlet_record):
     mats = scene["materials"]
     names = list(mats.keys())
     ntypes = len(names)
     tid = {n: i + 1 for i, n in enumerate(names)}
     walls = scene.get("walls") or []
     inlets = scene.get("inlets") or []
-    if inlets:
-        fail("the scene has inlets (inlets.0 '%s'), which liggghts-jdem does not run yet; valid: a "
-             "scene without inlets (run this one with build/jdem)" % inlets[0].get("name"))
-    if not particles.count:
+    if inlet_record and not inlets:
+        fail("--inlet-record: the scene has no inlets")
+    if not particles.count and not inlets:
         fail("the scene has no particles")
+    add_inlets_to_extent(scene, particles)
     model = scene.get("model") or {}
     table = interaction_table(scene, names)
 
@@ -342,7 +428,8 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
     # the run is at least `every` steps long), as build/jdem writes them
     every = min(int((scene.get("output") or {}).get("every", 1)), steps)
 
-    particles.write_data(os.path.join(deck_dir, "particles.data"), ntypes, lo, hi)
+    if particles.count:
+        particles.write_data(os.path.join(deck_dir, "particles.data"), ntypes, lo, hi)
 
     def pairs_line(k):
         return " ".join(num(table[(a, b)][k]) for a in names for b in names)
@@ -353,6 +440,8 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         len(walls), ntypes, ", ".join("%d=%s" % (tid[n], word(n, "material name")) for n in names)))
     L.append("\nunits           si\n")
     L.append("hard_particles  yes\n")
+    if min(prop(n, "youngs_modulus") for n in elastic) < 5e6:  # LIGGGHTS' own SI range (--builtin)
+        L.append("soft_particles  yes\n")
     L.append("atom_style      granular\n")
     L.append("atom_modify     map array sort 0 0.0\n")
     L.append("newton          off\n")
@@ -362,7 +451,12 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         fail("--builtin: LIGGGHTS has no parallel bonds")
     L.append("communicate     single vel yes%s\n" % (" cutoff %s" % num(ghost_cut) if ghost_cut else ""))
     L.append("boundary        f f f\n")
-    L.append("read_data       particles.data\n")
+    if particles.count:
+        L.append("read_data       particles.data\n")
+    else:  # read_data of no atoms turns the atom ids off (LIGGGHTS: no id > 0), which the inlets need
+        L.append("region          domain block %s %s %s %s %s %s units box\n" % tuple(
+            num(c) for d in range(3) for c in (lo[d], hi[d])))
+        L.append("create_box      %d domain\n" % ntypes)
     L.append("\n# materials (LIGGGHTS conventions; one atom type per material)\n")
     L.append("fix m1 all property/global youngsModulus peratomtype %s\n"
              % " ".join(num(prop(n, "youngs_modulus")) for n in names))
@@ -420,6 +514,7 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
             fail("--builtin: held particles and external forces need fix jdem/loads")
         particles.write_loads(os.path.join(deck_dir, "loads.txt"))
         L.append("fix loads all jdem/loads file loads.txt   # last of the forces, as build/jdem\n")
+    L.extend(inlet_lines(scene, tid, deck_dir, inlet_record))
     L.append("fix integr all nve/sphere\n")
     L.extend(watchdog_lines(scene, builtin))
     L.extend(guard_lines(scene, builtin, force))
@@ -448,6 +543,8 @@ def main():
                     help="LIGGGHTS' own hertz/history/epsd2 law and primitive walls instead of jdem's styles")
     ap.add_argument("--force", action="store_true",
                     help="run even if the time step is unsafe (fix jdem/guard ... force)")
+    ap.add_argument("--inlet-record", metavar="FILE",
+                    help="the inlets write every insertion to FILE as `jdem run --inlet-record` (CSV)")
     a = ap.parse_args()
     source = "stdin" if a.resolved == "-" else a.resolved
     deck_dir = os.path.dirname(os.path.abspath(a.output))
@@ -467,7 +564,7 @@ def main():
             scene = read_resolved(f, particles)
         if not isinstance(scene, dict):
             raise TypeError("the resolved scene is not a mapping")
-        write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin, a.force, particles)
+        write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin, a.force, particles, a.inlet_record)
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
         fail("%s: cannot read the resolved scene: %s" % (source, e))
     except (KeyError, TypeError, ValueError, AttributeError, IndexError, RecursionError, OverflowError) as e:

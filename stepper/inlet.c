@@ -30,7 +30,6 @@ typedef struct inlet_run {
     jd_inlet_stream st;
     jd_inlet_cursor *cursor;
     int64_t copies;        /* copies that start by the last step (capacity) */
-    int64_t next_check;    /* deposit-height rule: the next step it is checked */
 } inlet_run;
 
 /* A trajectory row: id first, so that bsearch on an id finds it. */
@@ -142,7 +141,6 @@ int sim_inlets_init(jd_sim *s, char *err, size_t errlen) {
         r->cursor = malloc(r->spec.n * sizeof *r->cursor);
         if (!r->cursor) goto oom;
         jd_inlet_stream_init(&r->spec, &r->st, r->cursor);
-        r->next_check = sc->inlets[k].every;
         in->next_step = r->st.next_step < in->next_step ? r->st.next_step : in->next_step;
         if (r->spec.n > in->buf_cap) in->buf_cap = r->spec.n;
     }
@@ -195,31 +193,26 @@ static void append(jd_sim *s, const jd_inlet_particle *p) {
     }
     in->energy_in += 0.5 * s->mass[i] * jd_dot(p->velocity, p->velocity) -
                      s->mass[i] * jd_dot(s->g, p->position);
-    if (in->log)
-        fprintf(in->log, "%lld,%lld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", (long long)p->id,
-                (long long)p->step, p->position[0], p->position[1], p->position[2],
-                p->velocity[0], p->velocity[1], p->velocity[2]);
+    if (in->log) {
+        char line[JD_INLET_RECORD_LINE_MAX];
+        jd_inlet_record_line(p, line, sizeof line);
+        fputs(line, in->log);
+    }
 }
 
-/* The deposit-height rule: the top z + R of the particles slower than below_speed. */
+/* The deposit-height rule (kernel/jdem_inlet.h) at its steps, on the state after this step's
+ * insertions. */
 static void check_height(jd_sim *s, size_t k) {
     inlet_run *r = &s->inlets->run[k];
     const jd_inlet *def = &s->scene->inlets[k];
-    if (def->stop != JD_INLET_STOP_HEIGHT || s->step < r->next_check) return;
-    r->next_check = s->step + def->every;
+    if (def->stop != JD_INLET_STOP_HEIGHT || !jd_inlet_height_due(s->step, def->every)) return;
     sim_finish_step(s); /* the speeds at this step */
-    const double v2 = def->below_speed * def->below_speed;
-    double top = -INFINITY;
-    for (size_t i = 0; i < s->n; i++) {
-        const double *v = &s->v[3 * i];
-        if (jd_dot(v, v) < v2) top = fmax(top, s->x[3 * i + 2] + s->radius[i]);
-    }
-    if (top >= def->height && r->st.stop_step > s->step) r->st.stop_step = s->step;
+    const double top = jd_inlet_deposit_top(s->n, s->x, s->v, s->radius, def->below_speed);
+    jd_inlet_height_stop(&r->st, s->step, top, def->height);
 }
 
-int sim_inlets_step(jd_sim *s, char *err, size_t errlen) {
+static int insert_due(jd_sim *s, char *err, size_t errlen) {
     jd_sim_inlets *in = s->inlets;
-    for (size_t k = 0; k < in->n_inlets; k++) check_height(s, k);
     if (s->step != in->next_step) return 0;
     const double t0 = sim_clock();
     sim_finish_step(s); /* v at this step, so that the new particles join the state of it */
@@ -241,6 +234,12 @@ int sim_inlets_step(jd_sim *s, char *err, size_t errlen) {
         rc = sim_neighbour_build(s, err, errlen);
     }
     in->seconds += sim_clock() - t0;
+    return rc;
+}
+
+int sim_inlets_step(jd_sim *s, char *err, size_t errlen) {
+    const int rc = insert_due(s, err, errlen);
+    for (size_t k = 0; rc == 0 && k < s->inlets->n_inlets; k++) check_height(s, k);
     return rc;
 }
 

@@ -200,10 +200,7 @@ void scene_inlet_spec(const jd_scene *sc, size_t k, jd_inlet_spec *out) {
     memcpy(out->velocity, in->velocity, sizeof out->velocity);
     memcpy(out->plane_point, in->plane_point, sizeof out->plane_point);
     memcpy(out->plane_normal, in->plane_normal, sizeof out->plane_normal);
-    if (in->stop == JD_INLET_STOP_TIME) {
-        const double steps = ceil(in->stop_time / sc->dt);
-        out->stop_step = steps < 9.0e18 ? (int64_t)steps : JD_INLET_NO_STOP;
-    }
+    if (in->stop == JD_INLET_STOP_TIME) out->stop_step = jd_inlet_stop_step_of_time(in->stop_time, sc->dt);
 }
 
 /* The key of inlet K a kernel check failure is about. */

@@ -34,6 +34,9 @@ SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines",
            for t in ENGINE_TESTS]
 # The conveyor inlet: the stream against its closed form, the growing trajectory, the energy.
 SUITES += [("inlet", [PY, "tests/inlet/test_inlet.py"], "lines", {})]
+# The inlet in both engines: the same insertion stream bit for bit on 1 and 2 ranks, the same
+# particles and states at every frame, the inflow energy, fix jdem/inlet's bad arguments.
+SUITES += [("inlet-cross-engine", [PY, "tests/inlet/test_inlet_liggghts.py"], "lines", {})]
 # The two engines on the same scenes (bitwise or 1e-10), and LIGGGHTS on 1 vs 2 MPI ranks.
 SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {})]
 # The /observables cadence (output.observables_every below, at and not dividing every) in both engines.

@@ -4,9 +4,9 @@
     tests/fuzz/fuzz_styles.py [--seconds N] [--seed S] [--out DIR]
 
 Base decks: generated (scripts/scene_to_liggghts.py) from tests/liggghts/scenes/walls_and_options.yaml,
-tests/liggghts/scenes/mpi_pile.yaml and tests/liggghts/bond_scenes/block_drop.yaml, cut to a few
-steps.  Each input mutates one to three lines of our styles (one or two edits each) (pair_style gran/jiang, fix wall/jiang,
-bond/jiang, jdem/watchdog, jdem/guard, jdem/loads, dump h5md/jdem): words deleted, repeated,
+tests/liggghts/scenes/mpi_pile.yaml, tests/liggghts/bond_scenes/block_drop.yaml and
+tests/inlet/fill_small.yaml, cut to a few steps.  Each input mutates one to three lines of our styles (one or two edits each) (pair_style gran/jiang, fix wall/jiang,
+bond/jiang, jdem/watchdog, jdem/guard, jdem/loads, jdem/inlet, dump h5md/jdem): words deleted, repeated,
 swapped, replaced by hostile numbers (0, -1, nan, inf, 1e308, 1e-320, 2^63, junk) or by the
 style's own keywords, lines cut short.  build/liggghts-jdem must end with status 0, or 1 with an
 "ERROR" line on stderr (LIGGGHTS' clean error path); a signal (a crash, an abort), another
@@ -26,16 +26,18 @@ JDEM = os.path.join(ROOT, "build", "jdem")
 LIGGGHTS_JDEM = os.path.join(ROOT, "build", "liggghts-jdem")
 GEN = os.path.join(ROOT, "scripts", "scene_to_liggghts.py")
 SCENES = ["tests/liggghts/scenes/walls_and_options.yaml", "tests/liggghts/scenes/mpi_pile.yaml",
-          "tests/liggghts/bond_scenes/block_drop.yaml"]
+          "tests/liggghts/bond_scenes/block_drop.yaml", "tests/inlet/fill_small.yaml"]
 OURS = re.compile(r"^(pair_style\s+gran/jiang|fix\s+\S+\s+\S+\s+(wall/jiang|bond/jiang|jdem/watchdog|jdem/guard|"
-                  r"jdem/loads)|dump\s+\S+\s+\S+\s+h5md/jdem)\b")
+                  r"jdem/loads|jdem/inlet)|dump\s+\S+\s+\S+\s+h5md/jdem)\b")
 JUNK = ["0", "-1", "1", "2", "nan", "inf", "-inf", "1e308", "-1e308", "1e-320", "9223372036854775808",
         "99999999999", "0x10", "abc", "''", "1.5", "-0", "1e", "1,2", "plane", "cylinder", "type", "file",
         "/dev/zero", "/", "nonexistent.txt", "rule", "group", "all", "corners", "axis", "radius", "side",
         "velocity", "energy", "yes", "no", "off", "on", "kn", "kt", "sigma_c", "tau_c", "lambda", "damping",
         "bending", "max_bonds", "step", "max_gap", "overlap", "vmax", "coordination", "force", "scene",
         "case", "scene_yaml", "wall_rule", "tangential_limit", "mu_r", "rolling", "hertz", "jiang2021",
-        "exact_restitution", "coulomb", "unconstrained", "inside", "outside", "I", "J_literal"]
+        "exact_restitution", "coulomb", "unconstrained", "inside", "outside", "I", "J_literal", "origin",
+        "period", "offset", "first_id", "stop", "sections", "time", "height", "below_speed", "every",
+        "record", "append_record"]
 
 
 def base_decks(tmp):

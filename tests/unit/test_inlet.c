@@ -301,6 +301,74 @@ static void check_messages(void **state) {
     assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_EMPTY);
 }
 
+/* ceil(time/dt): 0.5 s at 1e-3 s is step 500 (0.5/1e-3 rounds to 500 exactly); 0.5005 s is step
+ * 501 (a step boundary is not a copy's start: the next step is the first refused). */
+static void time_stop_is_the_ceiling(void **state) {
+    (void)state;
+    assert_int_equal(jd_inlet_stop_step_of_time(0.5, 1e-3), 500);
+    assert_int_equal(jd_inlet_stop_step_of_time(0.5005, 1e-3), 501);
+    assert_true(jd_inlet_stop_step_of_time(1e300, 1e-3) == JD_INLET_NO_STOP);
+}
+
+/* The height rule: checked at every, 2 every, ... only; the top of the slow particles; a top
+ * at the height stops copies that start after the step, not one that starts at it. */
+static void height_rule(void **state) {
+    (void)state;
+    assert_false(jd_inlet_height_due(0, 10));
+    assert_false(jd_inlet_height_due(5, 10));
+    assert_true(jd_inlet_height_due(10, 10));
+    assert_true(jd_inlet_height_due(30, 10));
+    const double x[9] = {0, 0, 1.0, 0, 0, 2.0, 0, 0, 0.5};
+    const double v[9] = {0.05, 0, 0, 0, 0.2, 0, 0, 0, -0.0999};
+    const double r[3] = {0.01, 0.02, 0.03};
+    /* particle 1 is too fast: the top is max(1.0 + 0.01, 0.5 + 0.03) */
+    assert_true(jd_inlet_deposit_top(3, x, v, r, 0.1) == 1.0 + 0.01);
+    assert_true(jd_inlet_deposit_top(3, x, v, r, 0.01) == -INFINITY);
+    const double rel[3] = {0, 0, 0};
+    const int32_t sp[1] = {0};
+    jd_inlet_spec s = one_sphere(rel, R1, sp);
+    jd_inlet_cursor cur[1];
+    jd_inlet_stream st;
+    jd_inlet_stream_init(&s, &st, cur);
+    jd_inlet_height_stop(&st, 300, 1.0, 1.01); /* below: nothing */
+    assert_true(st.stop_step == JD_INLET_NO_STOP);
+    jd_inlet_height_stop(&st, 251, 1.01, 1.01); /* copy 1 starts at 251 (51 + 200): admitted */
+    assert_int_equal(st.stop_step, 252);
+    jd_inlet_height_stop(&st, 400, 2.0, 1.01); /* a later check never raises it */
+    assert_int_equal(st.stop_step, 252);
+    jd_inlet_particle p[1];
+    int64_t last = -1;
+    for (int64_t k = 0; k < 1000; k++)
+        if (jd_inlet_pop(&s, &st, k, p, 1)) last = p[0].copy;
+    assert_int_equal(last, 1);
+}
+
+/* A record line reads back bit for bit (strtod of %.17g) with the header's columns. */
+static void record_line_round_trip(void **state) {
+    (void)state;
+    const jd_inlet_particle p = {.id = 123456789012LL, .step = 42, .position = {0.1, -1.0 / 3.0, 1e-300},
+                                 .velocity = {1.0, 0.0, -2.5e-17}};
+    char line[JD_INLET_RECORD_LINE_MAX];
+    const int len = jd_inlet_record_line(&p, line, sizeof line);
+    assert_int_equal(len, (int)strlen(line));
+    assert_true(line[len - 1] == '\n');
+    char *at = line;
+    assert_true(strtoll(at, &at, 10) == p.id && *at++ == ',');
+    assert_true(strtoll(at, &at, 10) == p.step && *at++ == ',');
+    for (int k = 0; k < 6; k++) {
+        const double want = k < 3 ? p.position[k] : p.velocity[k - 3];
+        assert_true(strtod(at, &at) == want);
+        assert_true(*at++ == (k < 5 ? ',' : '\n'));
+    }
+    /* the longest line fits: 19-digit numbers and 6 negative subnormal-exponent values */
+    const jd_inlet_particle big = {.id = INT64_MAX, .step = INT64_MAX,
+                                   .position = {-1.2345678901234567e-300, -1.2345678901234567e-300,
+                                                -1.2345678901234567e-300},
+                                   .velocity = {-1.2345678901234567e-300, -1.2345678901234567e-300,
+                                                -1.2345678901234567e-300}};
+    assert_true(jd_inlet_record_line(&big, line, sizeof line) < JD_INLET_RECORD_LINE_MAX);
+}
+
 int run_inlet_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(crossing_step_of_each_copy),
@@ -312,6 +380,9 @@ int run_inlet_tests(void) {
         cmocka_unit_test(cap_leaves_the_rest_due),
         cmocka_unit_test(jiang_section_period),
         cmocka_unit_test(check_messages),
+        cmocka_unit_test(time_stop_is_the_ceiling),
+        cmocka_unit_test(height_rule),
+        cmocka_unit_test(record_line_round_trip),
     };
     return cmocka_run_group_tests_name("inlet", tests, NULL, NULL);
 }
