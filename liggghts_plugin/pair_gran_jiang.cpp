@@ -26,6 +26,7 @@
 #include "jdem_laws.h"
 #include "jdem_history.h"
 #include "jdem_observables.h"
+#include "jdem_script_checks.h"
 #include "jdem_geometry.h"
 #include "jdem_watchdog.h"
 
@@ -35,7 +36,7 @@ PairGranJiang::PairGranJiang(LAMMPS *lmp)
     : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
       xi_limit(JD_XI_COULOMB), mu_r(1.0), rolling(false), energy_accounts(true), energy(false),
       e_damp_cum(0.0), e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
-      features_(0), ntypes_(0), kp_ncalls_(-1), kp_nall_(-1) {}
+      features_(0), ntypes_(0), kp_ncalls_(-1), kp_nall_(-1), script_checked_(false) {}
 
 /* ---------------------------------------------------------------------------------------- */
 
@@ -117,8 +118,8 @@ void PairGranJiang::init_granular() {
   for (int i = 1; i <= nt; i++) {
     E_[i] = fE->compute_vector(i - 1);
     nu_[i] = fnu->compute_vector(i - 1);
-    if (!(E_[i] > 0.0) || !(nu_[i] > -1.0 && nu_[i] < 0.5))
-      error->all(FLERR, "gran/jiang: youngsModulus must be > 0 and poissonsRatio in (-1, 0.5)");
+    if (!(E_[i] > 0.0) || !(nu_[i] > -1.0 && nu_[i] <= 0.5))
+      error->all(FLERR, "gran/jiang: youngsModulus must be > 0 and poissonsRatio in (-1, 0.5]");
   }
   /* the type-pair tables, 0-based and row-major as the kernel's rulebook reads them */
   restitution_.assign(nt * nt, 0.0);
@@ -152,6 +153,8 @@ void PairGranJiang::init_granular() {
 
   types_in_use_.assign(nt, 0);
   update_law_set(true);
+  if (!script_checked_) jdem_warn_script(lmp); /* at the first run's set-up only */
+  script_checked_ = true;
 }
 
 /* The law set of the interactions that can occur (jd_law_set_select, the stepper's rule): the

@@ -95,6 +95,7 @@ class PairGranJiang : public PairGran {
   std::vector<double> kp_, kw_;
   bigint kp_ncalls_;
   int kp_nall_;
+  bool script_checked_; /* jdem_warn_script has run (at the first set-up) */
 };
 
 }  // namespace LAMMPS_NS

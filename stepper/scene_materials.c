@@ -19,7 +19,7 @@ static const char *const INTERACTION_KEYS[] = {"materials", "restitution", "fric
                                                "rolling_friction", NULL};
 
 static const sd_range RESTITUTION = {0.0, 1.0, 1, 0};
-static const sd_range POISSON = {-1.0, 0.5, 1, 1};
+static const sd_range POISSON = {-1.0, 0.5, 1, 0}; /* 0.5: incompressible (rubber) */
 
 /* ---------------------------------------------------------------------------------------- */
 /* References by name                                                                        */
@@ -74,7 +74,7 @@ static int read_elastic(loader *L, const yaml_node_t *m, const char *path, jd_ma
     for (int k = 0; k < 3; k++)
         if (!sd_get(&L->c, m, keys[k])) {
             char valid[128];
-            snprintf(valid, sizeof valid, "%s (%s)", k == 1 ? "a number in (-1, 0.5)"
+            snprintf(valid, sizeof valid, "%s (%s)", k == 1 ? "a number in (-1, 0.5]"
                                                             : "a number > 0", together);
             return sd_missing(&L->c, m, path, keys[k], valid);
         }

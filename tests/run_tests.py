@@ -46,6 +46,8 @@ SUITES += [("observables-cadence", [PY, "tests/liggghts/check_observables_cadenc
 SUITES += [("law-sets", [PY, "tests/liggghts/check_law_sets.py"], "lines", {})]
 # compute pair/gran/local with gran/jiang: our contacts' forces, against build/jdem's.
 SUITES += [("liggghts-pair-local", [PY, "tests/liggghts/check_pair_local.py"], "lines", {})]
+# A hand-written script: warnings for a stock wall/gran and foreign material properties.
+SUITES += [("liggghts-script-warnings", [PY, "tests/liggghts/check_script_warnings.py"], "lines", {})]
 # The watchdog in LIGGGHTS (fix jdem/watchdog): the same trips as the stepper's.
 SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "lines", {})]
 # SIGINT/SIGTERM stop liggghts-jdem cleanly (exit 130/143, OUT.part kept), on 1 and 2 ranks.
