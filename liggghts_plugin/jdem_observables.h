@@ -6,6 +6,7 @@
 #define JDEM_OBSERVABLES_H
 
 #include <string>
+#include <vector>
 
 #include "jdem_observable_names.h"
 
@@ -25,6 +26,14 @@ enum { JDO_KINETIC = JD_OBS_KINETIC, JDO_ROTATIONAL = JD_OBS_ROTATIONAL,
  * 1/2, see PairGranJiang) and bonds (each stored on one rank, see FixBondJiang).  The contact
  * terms stay 0 without pair_style gran/jiang, the bond terms without fix bond/jiang. */
 void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]);
+
+/* The wall observables of docs/scenes.md "Servo walls" (names of jdem_observable_names.h): for
+ * every fix wall/jiang with a name, in fix order, its force and, for a servo wall, its stress
+ * and position; then, if any wall has a name, the stress tensor of their contacts
+ * (jd_stress_tensor per rank, summed over the ranks) in the box of every plane wall's current
+ * corners (jd_servo_box).  Collective; the values are complete on rank 0. */
+void jdem_wall_observables(LAMMPS *lmp, std::vector<std::string> &names,
+                           std::vector<double> &values);
 
 /* True when some consumer of the bond energies is defined (a dump h5md/jdem without `energy
  * no`, which writes them,
