@@ -22,7 +22,10 @@
  *
  * For a linear bed of stiffness k [N/m] under a wall of area A, one step changes the error by the
  * factor 1 - alpha k dt / A: the error decays without overshoot for alpha <= A / (k dt)
- * (jd_servo_gain_limit), oscillates beyond it and diverges beyond twice it.
+ * (jd_servo_gain_limit), oscillates beyond it and diverges beyond twice it.  The measured force
+ * also holds the damping of the wall's contacts, which sees the wall's own speed: with C [N s/m]
+ * their summed damping coefficient, a speed error is multiplied by -alpha C / A each step, so
+ * alpha must also stay below A / C, or the wall chatters between +-v_max (docs/model.md sec. 10).
  */
 #ifndef JDEM_KERNEL_SERVO_H
 #define JDEM_KERNEL_SERVO_H
