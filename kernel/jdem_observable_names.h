@@ -44,6 +44,19 @@ static const char *const jd_bond_observable_names[JD_N_BOND_OBSERVABLES] = {
     "bond_breakage_energy"};
 static const int jd_bond_observable_is_energy[JD_N_BOND_OBSERVABLES] = {0, 0, 1, 1, 1};
 
+/* The wall observables of a scene with a servo wall (docs/scenes.md "Servo walls"), each a
+ * scalar series: for every wall WALL_FORCE/NAME/{x,y,z} [N], the particles' total force on it;
+ * for every servo wall SERVO_STRESS/NAME [Pa] (its measured stress, jd_servo_stress) and
+ * SERVO_POSITION/NAME [m] (its displacement along its normal since the start); and
+ * STRESS_TENSOR/{xx,xy,...,zz} [Pa], the boundary stress of jd_stress_tensor, row-major. */
+static const char *const jd_obs_wall_force = "wall_force";
+static const char *const jd_obs_servo_stress = "servo_stress";
+static const char *const jd_obs_servo_position = "servo_position";
+static const char *const jd_obs_stress_tensor = "stress_tensor";
+static const char *const jd_obs_axes[3] = {"x", "y", "z"};
+static const char *const jd_obs_tensor_components[9] = {"xx", "xy", "xz", "yx", "yy",
+                                                         "yz", "zx", "zy", "zz"};
+
 #ifdef __cplusplus
 }
 #endif

@@ -22,7 +22,10 @@
  *
  * For a linear bed of stiffness k [N/m] under a wall of area A, one step changes the error by the
  * factor 1 - alpha k dt / A: the error decays without overshoot for alpha <= A / (k dt)
- * (jd_servo_gain_limit), oscillates beyond it and diverges beyond twice it.
+ * (jd_servo_gain_limit), oscillates beyond it and diverges beyond twice it.  The measured force
+ * also holds the damping of the wall's contacts, which sees the wall's own speed: with C [N s/m]
+ * their summed damping coefficient, a speed error is multiplied by -alpha C / A each step, so
+ * alpha must also stay below A / C, or the wall chatters between +-v_max (docs/model.md sec. 10).
  */
 #ifndef JDEM_KERNEL_SERVO_H
 #define JDEM_KERNEL_SERVO_H
@@ -52,13 +55,25 @@ typedef struct jd_servo_state {
 /* Result codes of jd_servo_check. */
 typedef enum {
     JD_SERVO_OK = 0,
-    JD_SERVO_BAD_TARGET, /* target <= 0 (the wrong sign: a servo wall only pushes) or not finite */
-    JD_SERVO_BAD_VALUE   /* gain, tolerance, max_speed or hold_steps out of range                */
+    JD_SERVO_BAD_TARGET,    /* target <= 0 (the wrong sign: a servo wall only pushes) or not finite */
+    JD_SERVO_BAD_GAIN,      /* gain <= 0 or not finite                                   */
+    JD_SERVO_BAD_TOLERANCE, /* tolerance < 0 or not finite                               */
+    JD_SERVO_BAD_MAX_SPEED, /* max_speed <= 0 (or NaN)                                   */
+    JD_SERVO_BAD_HOLD       /* hold_steps < 1                                            */
 } jd_servo_status;
 
-/* Check a description.  Returns JD_SERVO_OK, or a code with a one-line message in msg naming the
- * value and what would be valid (the engines prefix the scene file and key). */
+/* Check a description.  Returns JD_SERVO_OK, or the code of the first bad value (in the order
+ * above, so that the engines can name its key) with a one-line message in msg naming the value
+ * and what would be valid (the engines prefix the scene file and key). */
 jd_servo_status jd_servo_check(const jd_servo_spec *s, char *msg, size_t msglen);
+
+/* The hold of a test in steps: a duration hold > 0 [s] at time step dt > 0 [s] is
+ * ceil(hold / dt) steps, at least 1. */
+int64_t jd_servo_hold_steps(double hold, double dt);
+
+/* Area [m^2] of a planar convex quadrilateral with corners p in order around its edge: half
+ * the norm of the cross product of its diagonals. */
+double jd_servo_area(const double p[4][3]);
 
 /* Measured stress of a wall [Pa], > 0 in compression: -(F . n) / area, with F [N] the particles'
  * total force on the wall, n its unit normal into the sample, area > 0 [m^2]. */
@@ -77,6 +92,14 @@ double jd_servo_gain_limit(double stiffness, double area, double dt);
  * [N] (so the tensor is positive in compression), c the sample centre [m] (the sum is independent
  * of c only when the forces balance) and V > 0 the current sample volume [m^3].  sigma is [9],
  * row-major (sigma[3 i + j]) [Pa]. */
+/* The sample box of the stress tensor, bounded by n >= 1 plane walls with corners p [12 n] (4
+ * per wall, at their current positions) [m] and unit normals nrm [3 n] into the sample: along
+ * each axis d the box runs from the highest wall facing +d (n_d >= 1 - 1e-9) to the lowest
+ * facing -d, and on a side without such a wall to the extreme corner.  Returns its centre [m]
+ * and volume [m^3] (0 when the walls leave no room). */
+void jd_servo_box(size_t n, const double *p, const double *nrm, double centre[3],
+                  double *volume);
+
 void jd_stress_tensor(size_t n, const double *x, const double *f, const double centre[3],
                       double volume, double sigma[9]);
 

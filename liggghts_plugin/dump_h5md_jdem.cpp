@@ -220,6 +220,7 @@ void DumpH5mdJdem::reduce_observables(double all_obs[JDO_N]) {
   double obs[JDO_N];
   jdem_local_observables(lmp, groupbit, obs);
   MPI_Reduce(obs, all_obs, JDO_N, MPI_DOUBLE, MPI_SUM, 0, world);
+  jdem_wall_observables(lmp, wall_names, wall_values);
 }
 
 bool DumpH5mdJdem::observables_due(bigint step) const {
@@ -239,6 +240,10 @@ int DumpH5mdJdem::write_contact_observables(const double all_obs[JDO_N], bigint 
                                  errlen) != 0)
       return -1;
   }
+  for (size_t k = 0; k < wall_names.size(); k++)
+    if (jd_h5md_write_observable(h5, wall_names[k].c_str(), (int64_t)step, time, wall_values[k],
+                                 err, errlen) != 0)
+      return -1;
   return 0;
 }
 

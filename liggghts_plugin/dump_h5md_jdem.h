@@ -82,6 +82,9 @@ class DumpH5mdJdem : public Dump {
   bigint natoms0;
   bigint last_step; /* of the last frame written; -1: none */
   bigint observables_every; /* steps between observable samples; 0: at the frames */
+  /* this sample's wall observables (jdem_wall_observables), set by reduce_observables */
+  std::vector<std::string> wall_names;
+  std::vector<double> wall_values;
   bool stop_frame;          /* write() is writing the frame of a run stopped early */
   JdemBondOutput bonds;
 };

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <mpi.h>
 #include <string>
 
 #include "atom.h"
@@ -25,10 +26,15 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), e_damp_cum(0.0), e_fric_cum(0.0), work_cum(0.0),
       e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY), shape(-1), wtype(0), slen(0), hist(NULL),
       nmax_hist(0), pair(NULL), use_candidates(false), cand_ncalls(-1), cand_nlocal(0) {
+  servo = false;
+  servo_state = jd_servo_state();
+  servo_hold = servo_area = servo_stress = servo_speed = servo_position = 0.0;
+  force_all[0] = force_all[1] = force_all[2] = 0.0;
   const char *usage =
       "Illegal fix wall/jiang command: fix ID group wall/jiang plane corners x1 y1 z1 x2 y2 z2 "
-      "x3 y3 z3 x4 y4 z4 type T [velocity vx vy vz] | cylinder axis x1 y1 z1 x2 y2 z2 radius R "
-      "side outside|inside type T [velocity vx vy vz]";
+      "x3 y3 z3 x4 y4 z4 type T [velocity vx vy vz] [name NAME] [servo target S gain G tolerance "
+      "E max_speed V hold H] | cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T "
+      "[velocity vx vy vz] [name NAME]";
   std::memset(&plane, 0, sizeof plane);
   std::memset(&cyl, 0, sizeof cyl);
   vel[0] = vel[1] = vel[2] = 0.0;
@@ -64,6 +70,11 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
     } else if (k == "velocity" && iarg + 3 < narg) {
       for (int d = 0; d < 3; d++) vel[d] = force->numeric(FLERR, arg[iarg + 1 + d]);
       iarg += 4;
+    } else if (k == "name" && iarg + 1 < narg) {
+      name = arg[iarg + 1];
+      iarg += 2;
+    } else if (shape == 0 && k == "servo") {
+      parse_servo(narg, arg, ++iarg);
     } else if (shape == 1 && k == "radius" && iarg + 1 < narg) {
       cyl.rc = force->numeric(FLERR, arg[iarg + 1]);
       iarg += 2;
@@ -86,6 +97,12 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
     if (!(jd_dot(ab, ab) > 0.0)) error->all(FLERR, "fix wall/jiang: the cylinder axis has zero length");
   }
 
+  if (servo && name.empty()) error->all(FLERR, "fix wall/jiang: a servo wall needs 'name NAME' (its observables)");
+  if (servo && (vel[0] != 0.0 || vel[1] != 0.0 || vel[2] != 0.0))
+    error->all(FLERR, "fix wall/jiang: a servo wall moves by its servo law; no velocity with servo");
+  if (servo) servo_area = jd_servo_area(plane.p);
+  shift[0] = shift[1] = shift[2] = 0.0;
+
   pair = dynamic_cast<PairGranJiang *>(force->pair);
   if (!pair) error->all(FLERR, "fix wall/jiang requires pair_style gran/jiang (defined before the fix)");
   slen = pair->state_len();
@@ -93,6 +110,27 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
   create_attribute = 1;
   grow_arrays(atom->nmax);
   atom->add_callback(0);
+}
+
+/* servo target S gain G tolerance E max_speed V hold H, all five, in this order (the deck
+ * generator writes them from the resolved scene); checked by the kernel once dt is known. */
+void FixWallJiang::parse_servo(int narg, char **arg, int &iarg) {
+  static const char *const keys[5] = {"target", "gain", "tolerance", "max_speed", "hold"};
+  double value[5];
+  for (int k = 0; k < 5; k++) {
+    if (iarg + 1 >= narg || std::strcmp(arg[iarg], keys[k]) != 0)
+      error->all(FLERR, "fix wall/jiang: servo needs target S gain G tolerance E max_speed V hold H");
+    const std::string v = arg[iarg + 1];
+    value[k] = (k == 3 && v == "inf") ? INFINITY : force->numeric(FLERR, arg[iarg + 1]);
+    iarg += 2;
+  }
+  servo = true;
+  servo_spec.target = value[0];
+  servo_spec.gain = value[1];
+  servo_spec.tolerance = value[2];
+  servo_spec.max_speed = value[3];
+  servo_hold = value[4];
+  servo_spec.hold_steps = 1;
 }
 
 FixWallJiang::~FixWallJiang() {
@@ -115,6 +153,13 @@ void FixWallJiang::init() {
    * delay 0.  Otherwise every particle is tested every step. */
   use_candidates = neighbor->every == 1 && neighbor->delay == 0 && neighbor->skin > 0.0;
   cand_ncalls = -1;
+  if (servo) {
+    if (!(servo_hold > 0.0)) error->all(FLERR, "fix wall/jiang: servo hold must be > 0 [s]");
+    servo_spec.hold_steps = jd_servo_hold_steps(servo_hold, update->dt);
+    char msg[256];
+    if (jd_servo_check(&servo_spec, msg, sizeof msg) != JD_SERVO_OK)
+      error->all(FLERR, (std::string("fix wall/jiang: ") + msg).c_str());
+  }
 }
 
 /* The set-up force evaluation does not advance the history (as LIGGGHTS' pair set-up).  It
@@ -122,6 +167,7 @@ void FixWallJiang::init() {
 void FixWallJiang::setup(int vflag) {
   cand_ncalls = -1;
   compute(false);
+  sum_force_and_servo();
 }
 
 void FixWallJiang::post_force(int vflag) {
@@ -135,6 +181,7 @@ void FixWallJiang::post_force(int vflag) {
       cyl.a1[d] += dx;
       shift[d] += dx;
     }
+    if (servo) servo_position += servo_speed * dt;
   }
   if (use_candidates) {
     const double halfskin = 0.5 * neighbor->skin;
@@ -143,6 +190,27 @@ void FixWallJiang::post_force(int vflag) {
       refresh_candidates();
   }
   compute(true);
+  sum_force_and_servo();
+}
+
+/* With a name: the wall's force over all ranks, each rank's sum added in rank order (the same
+ * bits on every rank); then the servo's speed for the next step, as build/jdem's walls.c. */
+void FixWallJiang::sum_force_and_servo() {
+  if (name.empty()) return;
+  double local[3] = {0.0, 0.0, 0.0};
+  for (size_t c = 0; c < contact_f.size(); c += 3)
+    for (int d = 0; d < 3; d++) local[d] += contact_f[c + d];
+  int nprocs = 1;
+  MPI_Comm_size(world, &nprocs);
+  std::vector<double> all(3 * (size_t)nprocs);
+  MPI_Allgather(local, 3, MPI_DOUBLE, all.data(), 3, MPI_DOUBLE, world);
+  force_all[0] = force_all[1] = force_all[2] = 0.0;
+  for (int r = 0; r < nprocs; r++)
+    for (int d = 0; d < 3; d++) force_all[d] += all[3 * (size_t)r + d];
+  if (!servo) return;
+  servo_stress = jd_servo_stress(force_all, plane.n, servo_area);
+  servo_speed = jd_servo_speed(&servo_spec, &servo_state, servo_stress);
+  for (int d = 0; d < 3; d++) vel[d] = servo_speed * plane.n[d];
 }
 
 /* The particles of the group that can touch the wall before the next neighbour build: each
@@ -156,7 +224,8 @@ void FixWallJiang::refresh_candidates() {
   const double *radius = atom->radius;
   const int *mask = atom->mask;
   const int nlocal = atom->nlocal;
-  const bool moving = vel[0] != 0.0 || vel[1] != 0.0 || vel[2] != 0.0;
+  /* a servo wall can start moving at any step: its margin is always a moving wall's */
+  const bool moving = servo || vel[0] != 0.0 || vel[1] != 0.0 || vel[2] != 0.0;
   const double margin = 0.5 * neighbor->skin * (moving ? 2.0 : 1.0);
   candidates.clear();
   for (int i = 0; i < nlocal; i++) {
@@ -193,6 +262,8 @@ void FixWallJiang::loop(bool commit) {
   double e_damp = 0.0, e_fric = 0.0, e_el = 0.0, ncontacts = 0.0, work = 0.0;
   const int *tag = atom->tag;
   overlap_trip = JdOverlapTrip();
+  contact_x.clear();
+  contact_f.clear();
   /* the candidates (refresh_candidates), or every particle of the group */
   const bool listed = commit && use_candidates;
   const int n = listed ? (int)candidates.size() : nlocal;
@@ -235,6 +306,11 @@ void FixWallJiang::loop(bool commit) {
     ncontacts += 1.0;
     jd_sub3(f[i], out.f);
     jd_add3(torque[i], out.ta);
+    if (name.empty()) continue;
+    for (int d = 0; d < 3; d++) {
+      contact_x.push_back(x[i][d] + g.ra[d]);
+      contact_f.push_back(out.f[d]);
+    }
   }
   if (commit) {
     e_damp_cum += e_damp;

@@ -1,7 +1,8 @@
 /* fix_wall_jiang.h — `fix wall/jiang`: a particle–wall contact through jdem's C kernel.
  *
  *   fix ID group wall/jiang plane corners x1 y1 z1 x2 y2 z2 x3 y3 z3 x4 y4 z4 type T
- *                           [velocity vx vy vz]
+ *                           [velocity vx vy vz] [name NAME]
+ *                           [servo target S gain G tolerance E max_speed V hold H]
  *   fix ID group wall/jiang cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T
  *                           [velocity vx vy vz]
  *
@@ -17,11 +18,19 @@
  * + jd_rolling_state with rolling on, or only their law fields with energy no), migrating with
  * the atom; reset when the particle leaves the wall.
  *
+ * name NAME: the wall's total force (summed over the ranks, in rank order) becomes the
+ * observables wall_force/NAME/{x,y,z}, and its contacts count in the boundary stress tensor
+ * (jdem_observables.h).  servo (plane walls, with name): the wall moves along its normal by the
+ * kernel's servo law (kernel/jdem_servo.h) instead of a velocity: S [Pa], G [m/(s Pa)], E [Pa],
+ * V [m/s] (inf: no cap), H [s]; after every force evaluation the speed for the next step is set
+ * from the measured stress; observables servo_stress/NAME and servo_position/NAME.
+ *
  * Cost: each step only the particles found near the wall at the last neighbour build are
  * evaluated (with neigh_modify every 1 delay 0; see refresh_candidates). */
 #ifndef JDEM_FIX_WALL_JIANG_H
 #define JDEM_FIX_WALL_JIANG_H
 
+#include <string>
 #include <vector>
 
 #include "fix.h"
@@ -29,6 +38,7 @@
 #include "jdem_dispatch.h"
 #include "jdem_geometry.h"
 #include "jdem_overlap.h"
+#include "jdem_servo.h"
 
 namespace LAMMPS_NS {
 
@@ -53,6 +63,20 @@ class FixWallJiang : public Fix {
    * evaluation the elastic energy [J] and the number of wall contacts carrying force. */
   double e_damp_cum, e_fric_cum, work_cum, e_elastic_now, contacts_now;
 
+  /* name NAME (empty: none).  At the last force evaluation: the wall's total force over all
+   * ranks [N], and this rank's contacts that carry force as contact points and forces on the
+   * wall (3 per contact) for the stress tensor. */
+  std::string name;
+  double force_all[3];
+  std::vector<double> contact_x, contact_f;
+  /* servo: the law's state, measured stress [Pa], displacement along n [m] */
+  bool servo;
+  jd_servo_spec servo_spec;
+  jd_servo_state servo_state;
+  double servo_hold, servo_area, servo_stress, servo_speed, servo_position;
+  /* the plane where it is now, for the stress tensor's box; NULL for a cylinder */
+  const jd_plane *plane_wall() const { return shape == 0 ? &plane : NULL; }
+
   /* As PairGranJiang's: set by fix jdem/watchdog; INFINITY (the default): never. */
   double overlap_limit;
   JdOverlapTrip overlap_trip;
@@ -61,6 +85,8 @@ class FixWallJiang : public Fix {
   template <unsigned F> JD_SPECIALISED void loop(bool commit);
   void compute(bool commit);
   void refresh_candidates();
+  void sum_force_and_servo();
+  void parse_servo(int narg, char **arg, int &iarg);
 
   int shape; /* 0 plane, 1 cylinder */
   jd_plane plane;

@@ -10,12 +10,15 @@
 #include "dump.h"
 #include "fix.h"
 
+#include <mpi.h>
+
 #include "dump_h5md_jdem.h"
 #include "fix_bond_jiang.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_jdem_loads.h"
 #include "fix_wall_jiang.h"
 #include "jdem_kernel.h"
+#include "jdem_servo.h"
 #include "pair_gran_jiang.h"
 
 namespace LAMMPS_NS {
@@ -71,6 +74,56 @@ void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]) {
     out[JDO_FRICTION] += w->e_fric_cum;
     out[JDO_WALL_WORK] += w->work_cum;
     out[JDO_WALL_CONTACTS] += w->contacts_now;
+  }
+}
+
+/* The stress tensor of the named walls' contacts on this rank, in the box of all plane walls. */
+static void local_stress_tensor(Modify *modify, double sigma[9]) {
+  std::vector<double> corners, normals;
+  for (int k = 0; k < modify->nfix; k++) {
+    FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
+    if (!w || !w->plane_wall()) continue;
+    const jd_plane *p = w->plane_wall();
+    for (int c = 0; c < 4; c++) corners.insert(corners.end(), p->p[c], p->p[c] + 3);
+    normals.insert(normals.end(), p->n, p->n + 3);
+  }
+  double centre[3] = {0.0, 0.0, 0.0}, volume = 0.0, part[9];
+  if (!normals.empty()) jd_servo_box(normals.size() / 3, corners.data(), normals.data(), centre, &volume);
+  for (int k = 0; k < 9; k++) sigma[k] = 0.0;
+  for (int k = 0; k < modify->nfix; k++) {
+    FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
+    if (!w || w->name.empty()) continue;
+    jd_stress_tensor(w->contact_f.size() / 3, w->contact_x.data(), w->contact_f.data(), centre,
+                     volume, part);
+    for (int c = 0; c < 9; c++) sigma[c] += part[c];
+  }
+}
+
+void jdem_wall_observables(LAMMPS *lmp, std::vector<std::string> &names,
+                           std::vector<double> &values) {
+  names.clear();
+  values.clear();
+  Modify *modify = lmp->modify;
+  for (int k = 0; k < modify->nfix; k++) {
+    FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
+    if (!w || w->name.empty()) continue;
+    for (int d = 0; d < 3; d++) {
+      names.push_back(std::string(jd_obs_wall_force) + "/" + w->name + "/" + jd_obs_axes[d]);
+      values.push_back(w->force_all[d]);
+    }
+    if (!w->servo) continue;
+    names.push_back(std::string(jd_obs_servo_stress) + "/" + w->name);
+    values.push_back(w->servo_stress);
+    names.push_back(std::string(jd_obs_servo_position) + "/" + w->name);
+    values.push_back(w->servo_position);
+  }
+  if (names.empty()) return;
+  double sigma[9], all[9];
+  local_stress_tensor(modify, sigma);
+  MPI_Reduce(sigma, all, 9, MPI_DOUBLE, MPI_SUM, 0, lmp->world);
+  for (int c = 0; c < 9; c++) {
+    names.push_back(std::string(jd_obs_stress_tensor) + "/" + jd_obs_tensor_components[c]);
+    values.push_back(all[c]);
   }
 }
 

@@ -6,6 +6,7 @@
 #define JDEM_OBSERVABLES_H
 
 #include <string>
+#include <vector>
 
 #include "jdem_observable_names.h"
 
@@ -28,6 +29,14 @@ void jdem_local_observables(LAMMPS *lmp, int groupbit, double out[JDO_N]);
 
 /* The acceleration of every fix gravity, summed [m/s^2] (the weight m g of an atom of mass m). */
 void jdem_gravity(LAMMPS *lmp, double g[3]);
+
+/* The wall observables of docs/scenes.md "Servo walls" (names of jdem_observable_names.h): for
+ * every fix wall/jiang with a name, in fix order, its force and, for a servo wall, its stress
+ * and position; then, if any wall has a name, the stress tensor of their contacts
+ * (jd_stress_tensor per rank, summed over the ranks) in the box of every plane wall's current
+ * corners (jd_servo_box).  Collective; the values are complete on rank 0. */
+void jdem_wall_observables(LAMMPS *lmp, std::vector<std::string> &names,
+                           std::vector<double> &values);
 
 /* True when some consumer of the bond energies is defined (a dump h5md/jdem without `energy
  * no`, which writes them,

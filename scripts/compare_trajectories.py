@@ -18,8 +18,11 @@ of each field is scaled by the scene's scale of that field:
     torque            largest |torque| over both runs, else force scale x R
 
 The observables present in both files are compared too (energies relative to the largest
-kinetic + rotational + elastic energy of A, counts of contacts, bonds and fragments absolutely;
---no-observables skips them).  --until STEP compares the frames up to STEP only (e.g. up to the
+kinetic + rotational + elastic energy of A, counts of contacts, bonds and fragments absolutely,
+the wall observables of a servo scene -- series in groups such as wall_force/NAME/x -- relative
+to the largest magnitude of A's series of the same group (wall_force, servo_stress,
+stress_tensor), servo_position/NAME relative to the position scale; --no-observables skips
+them).  --until STEP compares the frames up to STEP only (e.g. up to the
 first broken bond).  Prints a compact table (a sample of frames and the worst frame) and exits 1
 when any scaled difference exceeds the tolerance (2 on unusable input).
 """
@@ -114,7 +117,7 @@ def field_differences(A, B, fields, common, scale):
     return table
 
 
-def observable_differences(A, B, until=None):
+def observable_differences(A, B, until=None, position_scale=1.0):
     """{name: largest difference} of the observables present in both files at common steps:
     energies relative to the largest kinetic + rotational + elastic energy of A, counts
     absolute; and that energy scale."""
@@ -129,7 +132,7 @@ def observable_differences(A, B, until=None):
     escale = float(np.max(np.abs(tot))) if tot is not None and len(tot) else 0.0
     escale = escale if escale > 0 else 1.0
     diffs = {}
-    for k in sorted(set(oa.keys()) & set(ob.keys())):
+    for k in sorted(set(series_names(oa)) & set(series_names(ob))):
         cs, ka, kb = np.intersect1d(oa[k]["step"][()], ob[k]["step"][()], return_indices=True)
         if until is not None:
             keep = cs <= until
@@ -137,8 +140,28 @@ def observable_differences(A, B, until=None):
         if not len(cs):
             continue
         d = np.abs(oa[k]["value"][()][ka] - ob[k]["value"][()][kb])
-        diffs[k] = float(d.max()) / (1.0 if k in COUNTS else escale)
+        diffs[k] = float(d.max()) / (1.0 if k in COUNTS else group_scale(oa, k, position_scale)
+                                     if "/" in k else escale)
     return diffs, escale
+
+
+def series_names(group):
+    """The observable series (groups holding step and value) under GROUP, as relative paths."""
+    names = []
+    group.visititems(lambda name, obj: names.append(name) if isinstance(obj, h5py.Group)
+                     and "value" in obj and "step" in obj else None)
+    return names
+
+
+def group_scale(obs, name, position_scale):
+    """Scale of a wall observable series NAME: servo_position the position scale, the others
+    the largest magnitude over A's series of the same top-level group (else 1)."""
+    top = name.split("/")[0]
+    if top == "servo_position":
+        return position_scale
+    peak = max((float(np.max(np.abs(obs[top][k]["value"][()])))
+                for k in series_names(obs[top]) if len(obs[top][k]["value"])), default=0.0)
+    return peak if peak > 0 else 1.0
 
 
 def compare(path_a, path_b, observables=True, until=None):
@@ -161,7 +184,8 @@ def compare(path_a, path_b, observables=True, until=None):
         raise Unusable("no common steps")
     scale = scales(A, B, fields, common)
     table = field_differences(A, B, fields, common, scale)
-    obs, escale = observable_differences(A, B, until) if observables else ({}, 1.0)
+    obs, escale = (observable_differences(A, B, until, scale["position"]) if observables
+                   else ({}, 1.0))
     worst = max([float(table.max())] + list(obs.values()))
     return {"A": A, "B": B, "fields": fields, "common": common, "scale": scale, "table": table,
             "observables": obs, "energy_scale": escale, "worst": worst}

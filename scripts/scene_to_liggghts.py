@@ -147,6 +147,17 @@ def axis_of(vector):
     return nonzero[0] if len(nonzero) == 1 else None
 
 
+def servo_words(w):
+    """fix wall/jiang's servo keywords for the resolved scene's `servo:` of wall w (or none)."""
+    sv = w.get("servo")
+    if not sv:
+        return ""
+    cap = float(sv["max_speed"])
+    return " servo target %s gain %s tolerance %s max_speed %s hold %s" % (
+        num(sv["target"]), num(sv["gain"]), num(sv["tolerance"]),
+        "inf" if math.isinf(cap) else num(cap), num(sv["hold"]))
+
+
 def primitive_wall(w):
     """The `primitive` arguments of LIGGGHTS' wall/gran for an axis-aligned plane or cylinder."""
     if w["type"] == "plane":
@@ -485,13 +496,17 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
     if walls:
         L.append("\n# walls (before bonds and gravity: the standalone engine's order of forces)\n")
     taken = set()
+    # with a servo wall every wall's force is an observable, under its scene name
+    observed = any(w.get("servo") for w in walls)
     for w in walls:
         v = w.get("velocity", [0, 0, 0])
         vel = "" if all(float(c) == 0.0 for c in v) else " velocity %s" % vec(v)
+        if observed:
+            vel += " name %s" % word(w["name"], "wall name") + servo_words(w)
         fid = identifier(w["name"], "w_", taken)
         if builtin:
             if vel:
-                fail("wall %s: --builtin supports fixed walls only" % w["name"])
+                fail("wall %s: --builtin supports fixed walls only (no velocity, no servo)" % w["name"])
             L.append("fix %s all wall/gran %s primitive type %d %s\n" % (
                 fid, builtin_model, tid[w["material"]], primitive_wall(w)))
         elif w["type"] == "plane":

@@ -520,6 +520,16 @@ static JD_ALWAYS_INLINE void wall_batch_evaluate(const jd_sim *s, const unsigned
     }
 }
 
+/* Wall-list entry c (particle i) carries force f [N] on the wall at x_i + ra [m] (sim.h,
+ * wall_forces). */
+static JD_ALWAYS_INLINE void record_wall_force(jd_sim *s, size_t c, int32_t i, const double f[3],
+                                               const double ra[3]) {
+    for (int d = 0; d < 3; d++) {
+        s->wall_f[3 * c + d] = f[d];
+        s->wall_x[3 * c + d] = s->x[3 * (size_t)i + d] + ra[d];
+    }
+}
+
 /* Lanes [0, nb) of a wall batch back: history, watchdog, the walls' work (energy bookkeeping:
  * also over the step a contact ends; added to *work one contact at a time, the plain loop's
  * order) and the forces on the particles, in list order. */
@@ -544,6 +554,11 @@ static JD_ALWAYS_INLINE void wall_batch_scatter(jd_sim *s, const unsigned F, con
         for (int d = 0; d < 3; d++) {
             fa[d] -= B->f[d][b];
             ta[d] += B->ta[d][b];
+        }
+        if (s->wall_forces) {
+            const double f[3] = {B->f[0][b], B->f[1][b], B->f[2][b]};
+            const double ra[3] = {B->ra[0][b], B->ra[1][b], B->ra[2][b]};
+            record_wall_force(s, c, i, f, ra);
         }
     }
 }
@@ -668,6 +683,7 @@ static double plain_wall_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1,
             a.f[3 * (size_t)i + d] -= out.f[d];
             a.t[3 * (size_t)i + d] += out.ta[d];
         }
+        if (s->wall_forces) record_wall_force(s, c, i, out.f, g.ra);
     }
     return work;
 }
@@ -797,6 +813,7 @@ void sim_compute_forces(jd_sim *s) {
      * post-force loads (loads.c); without loads, the weight is added by the half kick that
      * follows (integrate.c), which reads f anyway: the same sums, one pass less (sim.h,
      * weight_in_kick) */
+    if (s->wall_forces) sim_walls_sum(s);
     if (s->bonds) sim_bonds_forces(s);
     if (s->in_setup || !s->weight_in_kick) sim_gravity(s);
     if (s->loads) sim_loads_apply(s);

@@ -392,6 +392,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
         snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads);
         return -1;
     }
+    if (sim_walls_reserve(s, err, errlen) != 0) return -1;
     memcpy(s->x_build, s->x, 3 * s->n * sizeof *s->x);
     s->drift_bound = 0.0;
     for (size_t w = 0; w < s->n_walls; w++) memset(s->walls[w].disp, 0, sizeof s->walls[w].disp);

@@ -12,6 +12,7 @@
 #include <stdio.h>
 
 #include "jdem_bond.h"
+#include "jdem_servo.h"
 
 #define JD_NAME_MAX 64
 
@@ -45,6 +46,11 @@ typedef struct jd_wall {
     double axis[2][3];        /* [m] end points of the axis segment */
     double radius;            /* [m] */
     int inside;               /* 0: obstacle (contact on the outer surface), 1: container */
+    /* servo (plane walls only, docs/scenes.md "Servo walls") */
+    int has_servo;            /* 1: the wall moves along its normal by the servo law */
+    jd_servo_spec servo;      /* target, gain, tolerance, max_speed; hold_steps is set by the
+                                 engine from servo_hold once dt is known (jd_servo_hold_steps) */
+    double servo_hold;        /* [s] within tolerance this long completes the test */
 } jd_wall;
 
 /* Run-time watchdog (docs/scenes.md "Watchdog"): limits that stop a run that goes wrong. */

@@ -190,6 +190,11 @@ static int emit_points(yaml_emitter_t *e, const char *key, const double (*p)[3],
     return seq_end(e);
 }
 
+/* A strength or a speed cap: INFINITY as YAML's .inf. */
+static int num_or_inf(yaml_emitter_t *e, double v) {
+    return isinf(v) ? scalar(e, ".inf", YAML_PLAIN_SCALAR_STYLE) : num(e, v);
+}
+
 static int emit_wall(yaml_emitter_t *e, const jd_scene *s, const jd_wall *w) {
     const int plane = w->type == JD_WALL_PLANE;
     if (map_start(e, 0) || key_str(e, "name", w->name) ||
@@ -199,13 +204,13 @@ static int emit_wall(yaml_emitter_t *e, const jd_scene *s, const jd_wall *w) {
               : emit_points(e, "axis", w->axis, 2) || key_num(e, "radius", w->radius) ||
                     key_str(e, "side", w->inside ? "inside" : "outside"))
         return 1;
-    return key_str(e, "material", s->materials[w->material].name) ||
-           key_vec(e, "velocity", w->velocity) || map_end(e);
-}
-
-/* A strength: INFINITY as YAML's .inf. */
-static int num_or_inf(yaml_emitter_t *e, double v) {
-    return isinf(v) ? scalar(e, ".inf", YAML_PLAIN_SCALAR_STYLE) : num(e, v);
+    if (key_str(e, "material", s->materials[w->material].name)) return 1;
+    if (!w->has_servo) return key_vec(e, "velocity", w->velocity) || map_end(e);
+    const jd_servo_spec *sp = &w->servo;
+    return str(e, "servo") || map_start(e, 1) || key_num(e, "target", sp->target) ||
+           key_num(e, "gain", sp->gain) || key_num(e, "tolerance", sp->tolerance) ||
+           str(e, "max_speed") || num_or_inf(e, sp->max_speed) ||
+           key_num(e, "hold", w->servo_hold) || map_end(e) || map_end(e);
 }
 
 static const char *const BENDINGS[] = {"potyondy_cundall", "jiang2021_literal"};

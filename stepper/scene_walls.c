@@ -4,14 +4,16 @@
  */
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "scene_internal.h"
 
 /* Relative tolerance of docs/scenes.md: wall geometry, fraction of the wall's size. */
 #define GEOM_TOL 1e-9
 
-static const char *const PLANE_KEYS[] = {"name",     "type",     "corners", "material",
-                                         "velocity", "present",  NULL};
+static const char *const PLANE_KEYS[] = {"name",     "type",    "corners", "material",
+                                         "velocity", "present", "servo",   NULL};
+static const char *const SERVO_KEYS[] = {"target", "gain", "tolerance", "max_speed", "hold", NULL};
 static const char *const CYLINDER_KEYS[] = {"name",     "type",     "axis",    "radius", "side",
                                             "material", "velocity", "present", NULL};
 static const char *const BOOLEANS[] = {"false", "true", NULL};
@@ -92,6 +94,66 @@ static int read_cylinder(loader *L, const yaml_node_t *w, const char *path, jd_w
     return 0;
 }
 
+/* The Ch. 4 campaign's values (docs/mixing.md section 1) as the defaults of the optional keys. */
+#define SERVO_GAIN 1e-4      /* [m/(s Pa)] */
+#define SERVO_TOLERANCE 10.0 /* [Pa] */
+#define SERVO_MAX_SPEED 0.02 /* [m/s] */
+#define SERVO_HOLD 0.05      /* [s] */
+
+/* max_speed: a number (the kernel checks its sign), or .inf (no cap). */
+static int read_max_speed(loader *L, const yaml_node_t *m, const char *path, double *out) {
+    const yaml_node_t *n = sd_get(&L->c, m, "max_speed");
+    const char *text = n ? sd_scalar(n) : NULL;
+    if (text && (strcasecmp(text, ".inf") == 0 || strcasecmp(text, "+.inf") == 0)) {
+        *out = INFINITY;
+        return 0;
+    }
+    *out = SERVO_MAX_SPEED;
+    return sd_opt_num(&L->c, m, path, "max_speed", SD_ANY, out);
+}
+
+/* The kernel's check (jd_servo_check) names the first bad value; its key, in the kernel's order. */
+static const char *servo_key(jd_servo_status st) {
+    static const char *const keys[] = {"", "target", "gain", "tolerance", "max_speed", "hold"};
+    return keys[st];
+}
+
+/* walls.K.servo: the values, then the kernel's check (hold_steps is dt's business: 1 here). */
+static int read_servo(loader *L, const yaml_node_t *w, const char *path, jd_wall *wall) {
+    const yaml_node_t *m = sd_get(&L->c, w, "servo");
+    if (!m) return 0;
+    char sub[SD_PATH_MAX];
+    sd_join(sub, path, "servo");
+    if (sd_mapping(&L->c, m, sub, "{target, gain, tolerance, max_speed, hold}") ||
+        sd_keys(&L->c, m, sub, SERVO_KEYS))
+        return -1;
+    if (sd_get(&L->c, w, "velocity")) {
+        char vpath[SD_PATH_MAX];
+        sd_join(vpath, path, "velocity");
+        return sd_fail(&L->c, sd_get(&L->c, w, "velocity"), vpath, "a servo wall moves by its "
+                       "servo law; valid: no velocity on a wall with a servo");
+    }
+    jd_servo_spec *sp = &wall->servo;
+    sp->gain = SERVO_GAIN;
+    sp->tolerance = SERVO_TOLERANCE;
+    sp->hold_steps = 1;
+    wall->servo_hold = SERVO_HOLD;
+    if (sd_req_num(&L->c, m, sub, "target", SD_ANY, &sp->target) ||
+        sd_opt_num(&L->c, m, sub, "gain", SD_ANY, &sp->gain) ||
+        sd_opt_num(&L->c, m, sub, "tolerance", SD_ANY, &sp->tolerance) ||
+        read_max_speed(L, m, sub, &sp->max_speed) ||
+        sd_opt_num(&L->c, m, sub, "hold", SD_POSITIVE, &wall->servo_hold))
+        return -1;
+    char msg[256], key[SD_PATH_MAX];
+    const jd_servo_status st = jd_servo_check(sp, msg, sizeof msg);
+    if (st == JD_SERVO_OK) {
+        wall->has_servo = 1;
+        return 0;
+    }
+    sd_join(key, sub, servo_key(st));
+    return sd_fail(&L->c, sd_get(&L->c, m, servo_key(st)), key, "%s", msg);
+}
+
 /* Reads the wall at PATH into walls[index]; *present = 0 for a wall that the case leaves out
  * (present: false, so that one swept scene can hold the obstacles of every model): it is checked
  * like the others but takes no slot and marks no material as in use. */
@@ -105,6 +167,10 @@ static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t i
     if (!type) return sd_missing(&L->c, w, path, "type", "plane, cylinder");
     if (sd_enum(&L->c, type, sub, WALL_TYPES, &wall->type)) return -1;
     const int plane = wall->type == JD_WALL_PLANE;
+    sd_join(sub, path, "servo");
+    if (!plane && sd_get(&L->c, w, "servo"))
+        return sd_fail(&L->c, sd_get(&L->c, w, "servo"), sub, "a servo moves a plane wall along "
+                       "its normal; valid: servo on a wall of type plane");
     if (sd_keys(&L->c, w, path, plane ? PLANE_KEYS : CYLINDER_KEYS)) return -1;
     *present = 1;
     if (sd_opt_enum(&L->c, w, path, "present", BOOLEANS, present)) return -1;
@@ -124,7 +190,7 @@ static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t i
     const yaml_node_t *corners = sd_get(&L->c, w, "corners");
     if (!corners) return sd_missing(&L->c, w, path, "corners", "four points [[x, y, z], ...]");
     if (sd_points(&L->c, corners, sub, 4, &wall->corners[0][0])) return -1;
-    return check_plane(L, w, path, wall);
+    return check_plane(L, w, path, wall) || read_servo(L, w, path, wall);
 }
 
 int scene_read_walls(loader *L) {

@@ -272,7 +272,7 @@ void sim_free(jd_sim *s) {
     jd_huge_free(s->particle_block, s->particle_block_bytes);
     sim_forces_free(s);
     free(s->coeffs);
-    free(s->walls);
+    sim_walls_free(s);
     free(s->cell_start);
     sim_contact_list_free(&s->pairs);
     sim_contact_list_free(&s->wall_pairs);
@@ -344,6 +344,8 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     if (h && s->inlets && jd_h5md_write_observable(h, "inlet_energy", s->step,
                                                    (double)s->step * s->dt,
                                                    sim_inlets_energy(s), err, errlen) != 0)
+        return JD_RUN_OUTPUT;
+    if (h && s->wall_forces && sim_walls_write_observables(s, h, err, errlen) != 0)
         return JD_RUN_OUTPUT;
     if (s->bonds) {
         double bv[JD_N_BOND_OBSERVABLES];

@@ -150,6 +150,16 @@ typedef struct jd_sim_wall {
     jd_plane plane;
     jd_cylinder cyl;
     double disp[3];    /* translation since the last neighbour build [m] */
+    double force[3];   /* the particles' total force on the wall at the last evaluation [N]
+                          (scenes with a servo wall: wall_forces) */
+    /* servo (the scene's has_servo): v = speed n, set from the stress after every evaluation */
+    int servo;
+    jd_servo_spec spec;     /* hold_steps from the scene's hold and dt */
+    jd_servo_state state;
+    double area;            /* [m^2] */
+    double stress;          /* measured at the last evaluation [Pa] */
+    double speed;           /* along n, for the next step [m/s] */
+    double position;        /* displacement along n since the start [m] */
 } jd_sim_wall;
 
 /* A thread's share of the force loops (see "Threads" above; forces.c). */
@@ -210,6 +220,14 @@ typedef struct jd_sim {
 
     size_t n_walls;
     jd_sim_wall *walls;
+    /* Wall forces, for a scene with a servo wall (walls.c): per wall-list entry the force on the
+     * wall [N] and the contact point [m] (3 each, zero unless it carries force), written by the
+     * wall loops and summed in list order after them, so the sums are the same bits whatever
+     * the threads; the boundary stress of those contacts [Pa] (jd_stress_tensor). */
+    int wall_forces;
+    double *wall_f, *wall_x;
+    size_t wall_cap;
+    double stress_tensor[9];
 
     jd_sim_options opt;
     int threads;       /* threads actually used (opt.threads clamped to >= 1) */
@@ -348,6 +366,16 @@ static inline long long sim_particle_id(const jd_sim *s, size_t i) {
 /* walls.c */
 int sim_walls_init(jd_sim *s, char *err, size_t errlen);
 void sim_walls_move(jd_sim *s);
+void sim_walls_free(jd_sim *s);
+/* With wall_forces: room for an entry record per wall-list entry (after every list build). */
+int sim_walls_reserve(jd_sim *s, char *err, size_t errlen);
+/* With wall_forces, after the wall loops: each wall's force, the boundary stress, and each
+ * servo wall's measured stress and speed for the next step (kernel/jdem_servo.h); the records
+ * are zeroed for the next evaluation. */
+void sim_walls_sum(jd_sim *s);
+/* With wall_forces: the wall observables of jdem_observable_names.h at this step (sim.c). */
+struct jd_h5md;
+int sim_walls_write_observables(const jd_sim *s, struct jd_h5md *h, char *err, size_t errlen);
 
 /* forces.c: zero f and torque, then pair forces, wall forces, bonds, gravity (unless
  * s->weight_in_kick), loads. */

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "h5md.h"
+#include "jdem_servo.h"
 #include "sim.h"
 
 int sim_walls_init(jd_sim *s, char *err, size_t errlen) {
@@ -22,6 +24,13 @@ int sim_walls_init(jd_sim *s, char *err, size_t errlen) {
         w->type = in->type;
         w->material = in->material;
         memcpy(w->v, in->velocity, sizeof w->v);
+        if (in->has_servo) {
+            w->servo = 1;
+            w->spec = in->servo;
+            w->spec.hold_steps = jd_servo_hold_steps(in->servo_hold, s->dt);
+            w->area = jd_servo_area(in->corners);
+            s->wall_forces = 1;
+        }
         if (in->type == JD_WALL_PLANE) {
             /* the scene reader has checked planarity; only a degenerate quad can fail here */
             if (jd_plane_init(&w->plane, in->corners, 1e-6) != JD_GEOM_OK) {
@@ -44,6 +53,84 @@ int sim_walls_init(jd_sim *s, char *err, size_t errlen) {
     return 0;
 }
 
+void sim_walls_free(jd_sim *s) {
+    free(s->walls);
+    free(s->wall_f);
+    free(s->wall_x);
+}
+
+int sim_walls_reserve(jd_sim *s, char *err, size_t errlen) {
+    const size_t n = s->wall_pairs.n;
+    if (!s->wall_forces || n <= s->wall_cap) return 0;
+    free(s->wall_f);
+    free(s->wall_x);
+    s->wall_f = calloc(3 * n, sizeof *s->wall_f);
+    s->wall_x = calloc(3 * n, sizeof *s->wall_x);
+    s->wall_cap = s->wall_f && s->wall_x ? n : 0;
+    if (s->wall_cap) return 0;
+    snprintf(err, errlen, "out of memory for the wall forces of %zu wall contacts", n);
+    return -1;
+}
+
+/* The sample box of the stress tensor: the plane walls where they are now. */
+static void sample_box(const jd_sim *s, double centre[3], double *volume) {
+    double p[12 * s->n_walls], nrm[3 * s->n_walls];
+    size_t n = 0;
+    for (size_t k = 0; k < s->n_walls; k++)
+        if (s->walls[k].type == JD_WALL_PLANE) {
+            memcpy(p + 12 * n, s->walls[k].plane.p, sizeof(double[12]));
+            memcpy(nrm + 3 * n, s->walls[k].plane.n, sizeof(double[3]));
+            n++;
+        }
+    jd_servo_box(n, p, nrm, centre, volume);
+}
+
+void sim_walls_sum(jd_sim *s) {
+    const jd_contact_list *L = &s->wall_pairs;
+    for (size_t k = 0; k < s->n_walls; k++) memset(s->walls[k].force, 0, sizeof s->walls[k].force);
+    for (size_t c = 0; c < L->n; c++)
+        for (int d = 0; d < 3; d++) s->walls[L->j[c]].force[d] += s->wall_f[3 * c + d];
+    double centre[3], volume;
+    sample_box(s, centre, &volume);
+    jd_stress_tensor(L->n, s->wall_x, s->wall_f, centre, volume, s->stress_tensor);
+    memset(s->wall_f, 0, 3 * L->n * sizeof *s->wall_f);
+    memset(s->wall_x, 0, 3 * L->n * sizeof *s->wall_x);
+    for (size_t k = 0; k < s->n_walls; k++) {
+        jd_sim_wall *w = &s->walls[k];
+        if (!w->servo) continue;
+        w->stress = jd_servo_stress(w->force, w->plane.n, w->area);
+        w->speed = jd_servo_speed(&w->spec, &w->state, w->stress);
+        for (int d = 0; d < 3; d++) w->v[d] = w->speed * w->plane.n[d];
+    }
+}
+
+static int write_scalar(jd_h5md *h, const jd_sim *s, const char *group, const char *item,
+                        double value, char *err, size_t errlen) {
+    char name[2 * JD_NAME_MAX + 32];
+    snprintf(name, sizeof name, "%s/%s", group, item);
+    return jd_h5md_write_observable(h, name, s->step, (double)s->step * s->dt, value, err, errlen);
+}
+
+int sim_walls_write_observables(const jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
+    for (size_t k = 0; k < s->n_walls; k++) {
+        const jd_sim_wall *w = &s->walls[k];
+        const char *name = s->scene->walls[k].name;
+        char group[JD_NAME_MAX + 32];
+        snprintf(group, sizeof group, "%s/%s", jd_obs_wall_force, name);
+        for (int d = 0; d < 3; d++)
+            if (write_scalar(h, s, group, jd_obs_axes[d], w->force[d], err, errlen)) return -1;
+        if (w->servo &&
+            (write_scalar(h, s, jd_obs_servo_stress, name, w->stress, err, errlen) ||
+             write_scalar(h, s, jd_obs_servo_position, name, w->position, err, errlen)))
+            return -1;
+    }
+    for (int k = 0; k < 9; k++)
+        if (write_scalar(h, s, jd_obs_stress_tensor, jd_obs_tensor_components[k],
+                         s->stress_tensor[k], err, errlen))
+            return -1;
+    return 0;
+}
+
 /* x_wall += v dt for every point that defines the wall. */
 void sim_walls_move(jd_sim *s) {
     const double dt = s->dt;
@@ -57,5 +144,6 @@ void sim_walls_move(jd_sim *s) {
             w->cyl.a1[d] += dx;
             w->disp[d] += dx;
         }
+        if (w->servo) w->position += w->speed * dt;
     }
 }

@@ -19,7 +19,7 @@ PY = "/usr/bin/python3"
 
 ENGINE_TESTS = ["neighbour", "fastpaths", "free_flight", "hertz_impact", "energy_balance", "guard",
                 "guard_coordination", "dt_auto", "watchdog",
-                "signals", "bench_tiling", "deposit"]
+                "signals", "bench_tiling", "deposit", "servo"]
 SANITIZED = {"JDEM": "build/san/jdem"}
 
 # name, command, output style, extra environment.  Sanitizer builds run the same checks.

@@ -127,16 +127,58 @@ static void check_messages(void **state) {
                              "stress > 0 (the wall pushes on the sample)");
     s = CH4;
     s.gain = 0.0;
-    assert_int_equal(jd_servo_check(&s, msg, sizeof msg), JD_SERVO_BAD_VALUE);
+    assert_int_equal(jd_servo_check(&s, msg, sizeof msg), JD_SERVO_BAD_GAIN);
     assert_string_equal(msg, "servo gain 0 is not valid; valid: a number > 0 [m/(s Pa)]");
     s = CH4;
     s.tolerance = -1.0;
-    assert_int_equal(jd_servo_check(&s, msg, sizeof msg), JD_SERVO_BAD_VALUE);
+    assert_int_equal(jd_servo_check(&s, msg, sizeof msg), JD_SERVO_BAD_TOLERANCE);
     assert_string_equal(msg, "servo tolerance -1 is not valid; valid: a number >= 0 [Pa]");
     s = CH4;
     s.hold_steps = 0;
-    assert_int_equal(jd_servo_check(&s, msg, sizeof msg), JD_SERVO_BAD_VALUE);
+    assert_int_equal(jd_servo_check(&s, msg, sizeof msg), JD_SERVO_BAD_HOLD);
     assert_string_equal(msg, "servo hold 0 steps is not valid; valid: at least 1 step");
+    s = CH4;
+    s.max_speed = 0.0;
+    assert_int_equal(jd_servo_check(&s, msg, sizeof msg), JD_SERVO_BAD_MAX_SPEED);
+    assert_string_equal(msg, "servo max_speed 0 is not valid; valid: a number > 0 [m/s], or .inf");
+}
+
+/* ceil(hold / dt), at least one step: 0.05 s at 1e-4 s is 500 steps, 0.6 s at 0.25 s is 3, a
+ * hold shorter than a step is one step. */
+static void hold_in_steps(void **state) {
+    (void)state;
+    assert_int_equal(jd_servo_hold_steps(0.05, 1e-4), 500);
+    assert_int_equal(jd_servo_hold_steps(0.5, 0.25), 2);
+    assert_int_equal(jd_servo_hold_steps(0.6, 0.25), 3);
+    assert_int_equal(jd_servo_hold_steps(1e-9, 0.25), 1);
+}
+
+/* A 0.2 m cube's bottom, its x_lo side wall (0.3 m high) and its top at 0.28 m: the box runs
+ * from the bottom to the top along z (not to the side wall's top), from x_lo to the extreme
+ * corner along x (no wall faces -x), from corner to corner along y. */
+static void box_of_the_walls(void **state) {
+    (void)state;
+    const double p[36] = {0.15, 0.4, 0.1, 0.35, 0.4, 0.1, 0.35, 0.6, 0.1, 0.15, 0.6, 0.1,
+                          0.15, 0.4, 0.1, 0.15, 0.6, 0.1, 0.15, 0.6, 0.4, 0.15, 0.4, 0.4,
+                          0.15, 0.4, 0.28, 0.15, 0.6, 0.28, 0.35, 0.6, 0.28, 0.35, 0.4, 0.28};
+    const double n[9] = {0, 0, 1, 1, 0, 0, 0, 0, -1};
+    double c[3], v;
+    jd_servo_box(3, p, n, c, &v);
+    assert_rel(c[0], 0.25, 1e-15);
+    assert_rel(c[1], 0.5, 1e-15);
+    assert_rel(c[2], 0.19, 1e-15);
+    assert_rel(v, 0.2 * 0.2 * 0.18, 1e-14);
+}
+
+/* A 0.2 x 0.3 m rectangle tilted about x by 30 degrees, and a unit trapezoid of parallel sides
+ * 1 and 2: the areas by hand. */
+static void quad_areas(void **state) {
+    (void)state;
+    const double c = sqrt(3.0) / 2.0, s = 0.5; /* 30 degrees */
+    const double rect[4][3] = {{0, 0, 0}, {0.2, 0, 0}, {0.2, 0.3 * c, 0.3 * s}, {0, 0.3 * c, 0.3 * s}};
+    assert_rel(jd_servo_area(rect), 0.06, 1e-14);
+    const double trap[4][3] = {{0, 0, 1}, {2, 0, 1}, {1.5, 1, 1}, {0.5, 1, 1}};
+    assert_rel(jd_servo_area(trap), 1.5, 1e-15);
 }
 
 int run_servo_tests(void) {
@@ -147,6 +189,9 @@ int run_servo_tests(void) {
         cmocka_unit_test(wall_stress_sign),
         cmocka_unit_test(stress_tensor_of_a_loaded_cube),
         cmocka_unit_test(check_messages),
+        cmocka_unit_test(hold_in_steps),
+        cmocka_unit_test(box_of_the_walls),
+        cmocka_unit_test(quad_areas),
     };
     return cmocka_run_group_tests_name("servo", tests, NULL, NULL);
 }
