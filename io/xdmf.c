@@ -99,26 +99,58 @@ static void range(const xdmf_out *o, const char *dset, hsize_t rows, hsize_t sta
     xdmf_hdf_item(o->fp, o->file, dset, dims, ntype, prec, sel);
 }
 
-static void particles_grid(const xdmf_out *o, hsize_t f, const xdmf_run *run) {
+/* XInclude of element k of frame 0's particle grid (element(): child numbers from the root:
+ * Xdmf, Domain, the temporal grid, frame 0, its grid 2 — the first after Time). */
+static void include_particles_item(FILE *fp, int k) {
+    fprintf(fp, "<xi:include xpointer=\"element(/1/1/1/1/2/%d)\"/>", k);
+}
+
+/* Frame f's grid of the live rows `run`.  same_as_first: the run is frame 0's first run, so its
+ * cells and time-independent arrays are frame 0's, included instead of written again. */
+static void particles_grid(const xdmf_out *o, hsize_t f, const xdmf_run *run, int same_as_first) {
     static const char *const vec[] = {"velocity", "angular_velocity", "force", "torque"};
     static const int veck[] = {TD_VELOCITY, TD_ANGVEL, TD_FORCE, TD_TORQUE};
     const xdmf_info *h = o->h;
     const hsize_t n = h->n, c = run->count;
-    fprintf(o->fp, "<Grid Name=\"particles\"><Topology TopologyType=\"Polyvertex\" "
-                   "NumberOfElements=\"%llu\" NodesPerElement=\"1\">", (unsigned long long)c);
-    range(o, "/jdem/vertex_index", n, 0, c, "Int", 8);
-    fprintf(o->fp, "</Topology>\n<Geometry GeometryType=\"XYZ\">");
+    const int share = same_as_first && f > 0; /* children: Topology 1, Geometry 2, radius 3, id 4,
+                                                 species 5 */
+    fprintf(o->fp, "<Grid Name=\"particles\">");
+    if (share) {
+        include_particles_item(o->fp, 1);
+    } else {
+        fprintf(o->fp, "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%llu\" "
+                       "NodesPerElement=\"1\">", (unsigned long long)c);
+        range(o, "/jdem/vertex_index", n, 0, c, "Int", 8);
+        fprintf(o->fp, "</Topology>");
+    }
+    fprintf(o->fp, "\n<Geometry GeometryType=\"XYZ\">");
     frame_rows(o, "/particles/all/position/value", f, n, run->start, c, 3, "Float", 8);
-    fprintf(o->fp, "</Geometry>\n<Attribute Name=\"radius\" Center=\"Node\">");
-    range(o, "/particles/all/radius", n, run->start, c, "Float", 8);
-    fprintf(o->fp, "</Attribute>\n<Attribute Name=\"id\" Center=\"Node\">");
-    if (h->growing)
-        frame_rows(o, "/particles/all/id/value", f, n, run->start, c, 0, "Int", 8);
-    else
-        range(o, "/particles/all/id", n, run->start, c, "Int", 8);
-    fprintf(o->fp, "</Attribute>\n<Attribute Name=\"species\" Center=\"Node\">");
-    range(o, "/particles/all/species", n, run->start, c, "Int", 4);
-    fprintf(o->fp, "</Attribute>\n");
+    fprintf(o->fp, "</Geometry>\n");
+    if (share) {
+        include_particles_item(o->fp, 3);
+    } else {
+        fprintf(o->fp, "<Attribute Name=\"radius\" Center=\"Node\">");
+        range(o, "/particles/all/radius", n, run->start, c, "Float", 8);
+        fprintf(o->fp, "</Attribute>");
+    }
+    if (share && !h->growing) {
+        include_particles_item(o->fp, 4);
+    } else {
+        fprintf(o->fp, "<Attribute Name=\"id\" Center=\"Node\">");
+        if (h->growing)
+            frame_rows(o, "/particles/all/id/value", f, n, run->start, c, 0, "Int", 8);
+        else
+            range(o, "/particles/all/id", n, run->start, c, "Int", 8);
+        fprintf(o->fp, "</Attribute>");
+    }
+    if (share) {
+        include_particles_item(o->fp, 5);
+    } else {
+        fprintf(o->fp, "<Attribute Name=\"species\" Center=\"Node\">");
+        range(o, "/particles/all/species", n, run->start, c, "Int", 4);
+        fprintf(o->fp, "</Attribute>");
+    }
+    fprintf(o->fp, "\n");
     for (int v = 0; v < 4; ++v) {
         if (!h->present[veck[v]]) continue;
         char dset[64];
@@ -147,9 +179,15 @@ static void bonds_grid(const xdmf_out *o, hsize_t f) {
     fprintf(o->fp, "</Attribute></Grid>\n");
 }
 
-static void walls_grid(const xdmf_out *o, hsize_t f) {
+/* Frame f's walls; walls that stand still are frame 0's grid (child `first` of frame 0),
+ * included. */
+static void walls_grid(const xdmf_out *o, hsize_t f, int first) {
     const h5md_wall_mesh *m = o->h->walls;
     char dims[64];
+    if (!m->moving && f > 0) {
+        fprintf(o->fp, "<xi:include xpointer=\"element(/1/1/1/1/%d)\"/>\n", first);
+        return;
+    }
     fprintf(o->fp, "<Grid Name=\"walls\"><Topology TopologyType=\"Quadrilateral\" "
                    "NumberOfElements=\"%zu\">", m->nq);
     snprintf(dims, sizeof dims, "%zu 4", m->nq);
@@ -180,17 +218,23 @@ int xdmf_write(const xdmf_info *h, const char *tmp, char *err, size_t errlen) {
     }
     const xdmf_out o = {fp, h, file};
     fprintf(fp, "<?xml version=\"1.0\" ?>\n"
-                "<Xdmf Version=\"3.0\">\n"
+                "<Xdmf xmlns:xi=\"http://www.w3.org/2001/XInclude\" Version=\"3.0\">\n"
                 "  <Domain>\n"
                 "    <Grid Name=\"run\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
     for (hsize_t i = 0; i < h->nframes; ++i) {
         fprintf(fp, "<Grid Name=\"frame_%llu\" GridType=\"Collection\" "
                     "CollectionType=\"Spatial\"><Time Value=\"%.17g\"/>\n",
                 (unsigned long long)i, h->times[i]);
-        for (size_t r = h->frame_runs[i]; r < h->frame_runs[i + 1]; ++r)
-            particles_grid(&o, i, &h->runs[r]);
+        for (size_t r = h->frame_runs[i]; r < h->frame_runs[i + 1]; ++r) {
+            const xdmf_run *run = &h->runs[r];
+            const int same = h->frame_runs[1] > 0 && run->start == h->runs[0].start &&
+                             run->count == h->runs[0].count;
+            particles_grid(&o, i, run, same);
+        }
         if (h->bonds && h->bond_count[i] > 0) bonds_grid(&o, i);
-        if (h->walls->present && h->walls->nq > 0) walls_grid(&o, i);
+        /* frame 0's walls grid: after Time, its particle grids and its bond grid */
+        const int walls_at = 2 + (int)h->frame_runs[1] + (h->bonds && h->bond_count[0] > 0);
+        if (h->walls->present && h->walls->nq > 0) walls_grid(&o, i, walls_at);
         fprintf(fp, "</Grid>\n");
     }
     fprintf(fp, "    </Grid>\n  </Domain>\n</Xdmf>\n");
