@@ -183,6 +183,22 @@ def one(case, scene, engine, tmp, pngs):
         shutil.copy(png, os.path.join(pngs, f"{engine[0]}_{case}.png"))
 
 
+def refuses_without_grow(tmp):
+    """dump h5md/jdem grow no: a changing atom count stops the run with the message that names
+    the keyword, and no trajectory is published."""
+    out = os.path.join(tmp, "grow_no", "g.h5")
+    os.makedirs(os.path.dirname(out))
+    r = subprocess.run([os.path.join(ROOT, "build", "liggghts-jdem"), "-in",
+                        os.path.join(ROOT, "tests", "paraview", "insert_pack.in"), "-var", "out",
+                        out, "-var", "dumpkw", "grow no", "-log", "none"], capture_output=True, text=True,
+                       cwd=os.path.dirname(out))
+    want = ("ERROR: dump h5md/jdem: the number of atoms changed (0 -> 12); give the dump "
+            "'grow yes' for a particle set that changes")
+    check("liggghts-jdem grow no: a growing set is refused by name",
+          r.returncode != 0 and want in r.stdout + r.stderr and not os.path.exists(out),
+          (r.stdout + r.stderr)[-300:])
+
+
 def main(argv):
     pngs = os.path.abspath(argv[argv.index("--pngs") + 1]) if "--pngs" in argv else None
     if not shutil.which("pvbatch") or not shutil.which("xvfb-run"):
@@ -195,6 +211,7 @@ def main(argv):
             path = short_pour(tmp)
         for engine in engines:
             one(case, path, engine, tmp, pngs)
+    refuses_without_grow(tmp)
     if not failed:
         shutil.rmtree(tmp, ignore_errors=True)
     else:
