@@ -11,11 +11,16 @@
  *   /parameters                 attrs engine, scene_name, case_name, dt [s]; dataset "scene"
  *                               (variable-length string: the resolved scene, YAML) when given
  *   /particles/all/box          attrs dimension = 3, boundary = ["none","none","none"]
- *   /particles/all/{id,species,radius,mass}        [N] time-independent (int64, int32, f64, f64)
+ *   /particles/all/{id,species,radius,mass}        [N] time-independent (int64, int32, f64, f64);
+ *                               a growing set: id/{step,time,value} [F][N], -1 in empty rows
+ *                               (fill value -1; vectors NaN there), the particle axis extendible
  *   /particles/all/{position,velocity,angular_velocity,force,torque}/{step,time,value}
  *                               step [F] int64, time [F] f64, value [F][N][3] f64
  *   /observables/NAME/{step,time,value}            value [F] f64 (counts stored as f64 too)
- *   /jdem/vertex_index          [N] int64 0..N-1: the sidecar's vertex connectivity
+ *   /jdem/vertex_index          [N] int64 0..N-1: the sidecar's vertex connectivity (at close)
+ *   /jdem/walls/...             the walls and their quadrilateral mesh (jd_h5md_set_walls)
+ *   /jdem/bond_lines/{rows,frame_start,frame_count}  the bonds intact at each frame as row
+ *                               pairs (at close, from the bond tables)
  *   /jdem/bonds/{ids,type,formed_step}             every bond formed, in formation order
  *                               (jd_h5md_write_bonds); ids [B][2] int64 is also the H5MD tuple
  *                               list /connectivity/bonds (particles_group: object reference)
