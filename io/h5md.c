@@ -63,7 +63,8 @@ struct jd_h5md {
     int fd;     /* PATH.part, open while the writer lives: it holds the lock (h5md_file.c) */
     hid_t file;
     hid_t all; /* /particles/all */
-    size_t n;
+    h5md_rows rows;          /* the particle rows (h5md_rows.c) */
+    h5md_wall_mesh walls;    /* the walls (h5md_walls.c) */
     int decided;             /* groups fixed at the first frame */
     int present[TD_COUNT];   /* which time-dependent groups this run writes */
     hid_t grp[TD_COUNT];     /* group ids (H5I_INVALID_HID when absent) */
@@ -71,6 +72,7 @@ struct jd_h5md {
     hid_t step_ds, time_ds;  /* shared step/time (position/), hard-linked elsewhere */
     hsize_t nframes;
     double *times; /* per frame, for the XDMF sidecar */
+    int64_t *steps; /* per frame, for the bond lines */
     size_t cap;
     obs *obs;
     size_t nobs, obs_cap;
@@ -102,6 +104,8 @@ static void free_objects(jd_h5md *h) {
     h5md_close_id(&h->step_ds);
     h5md_close_id(&h->time_ds);
     h5md_close_id(&h->all);
+    h5md_rows_close(&h->rows);
+    h5md_close_id(&h->walls.position);
     free(h->obs);
     h->obs = NULL;
     h->nobs = 0;
@@ -111,6 +115,9 @@ static void free_handle(jd_h5md *h) {
     free_objects(h);
     h5md_close_id(&h->file);
     free(h->times);
+    free(h->steps);
+    h5md_rows_free(&h->rows);
+    h5md_walls_free(&h->walls);
     free(h->path);
     free(h->part);
     free(h->sidecar);
@@ -131,12 +138,13 @@ static const char *author_name(const jd_h5md_meta *meta) {
 }
 
 /* /jdem/vertex_index [N] = 0..N-1: the sidecar's Polyvertex connectivity (Xdmf3 makes no cells
- * of its own), 8 bytes a particle. */
+ * of its own), 8 bytes a row; written at close, when the rows are known. */
 static int write_vertex_index(hid_t file, size_t n) {
     int64_t *idx = malloc((n ? n : 1) * sizeof *idx);
     if (!idx) return -1;
     for (size_t i = 0; i < n; ++i) idx[i] = (int64_t)i;
-    hid_t g = h5md_group_create(file, "jdem");
+    hid_t g = H5Lexists(file, "jdem", H5P_DEFAULT) > 0 ? H5Gopen2(file, "jdem", H5P_DEFAULT)
+                                                      : h5md_group_create(file, "jdem");
     int rc = g >= 0 ? h5md_dset_fixed(g, "vertex_index", H5T_STD_I64LE, H5T_NATIVE_INT64, n, idx,
                                       NULL)
                     : -1;
@@ -230,22 +238,8 @@ static int write_header(jd_h5md *h, const jd_h5md_meta *meta, const jd_h5md_part
     h5md_close_id(&g);
 
     /* time-independent per-particle data */
-    where = "/particles/all/id";
-    if (h5md_dset_fixed(h->all, "id", H5T_STD_I64LE, H5T_NATIVE_INT64, p->n, p->id, NULL) < 0)
-        goto fail;
-    where = "/particles/all/species";
-    if (h5md_dset_fixed(h->all, "species", H5T_STD_I32LE, H5T_NATIVE_INT32, p->n, p->species,
-                        NULL) < 0)
-        goto fail;
-    where = "/particles/all/radius";
-    if (h5md_dset_fixed(h->all, "radius", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, p->n, p->radius, "m") <
-        0)
-        goto fail;
-    where = "/particles/all/mass";
-    if (h5md_dset_fixed(h->all, "mass", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, p->n, p->mass, "kg") < 0)
-        goto fail;
-    where = "/jdem/vertex_index";
-    if (write_vertex_index(h->file, p->n) < 0) goto fail;
+    where = "/particles/all/{id, species, radius, mass}";
+    if (h5md_rows_create(&h->rows, h->all, p) < 0) goto fail;
     return 0;
 
 fail:
@@ -271,7 +265,7 @@ jd_h5md *jd_h5md_create(const char *path, const jd_h5md_meta *meta,
         h5md_set_err(err, errlen, "h5md: particle arrays id/species/radius/mass must all be given");
         return NULL;
     }
-    for (size_t i = 1; i < particles->n; ++i)
+    for (size_t i = 1; !particles->growing && i < particles->n; ++i)
         if (particles->id[i] <= particles->id[i - 1]) {
             h5md_set_err(err, errlen,
                          "h5md: particle ids must be sorted ascending and unique (id %lld at index "
@@ -287,7 +281,9 @@ jd_h5md *jd_h5md_create(const char *path, const jd_h5md_meta *meta,
     h->fd = -1;
     h->file = h->all = h->step_ds = h->time_ds = H5I_INVALID_HID;
     for (int k = 0; k < TD_COUNT; ++k) h->grp[k] = h->value[k] = H5I_INVALID_HID;
-    h->n = particles->n;
+    h->rows.species = h->rows.radius = h->rows.mass = H5I_INVALID_HID;
+    h->rows.id_grp = h->rows.id_value = H5I_INVALID_HID;
+    h->walls.position = H5I_INVALID_HID;
     size_t len = strlen(path);
     h->path = malloc(len + 1);
     h->part = malloc(len + 6);
@@ -342,8 +338,10 @@ static void value_chunk(size_t n, hsize_t chunk[3]) {
 static int setup_groups(jd_h5md *h, const jd_h5md_frame *f, char *err, size_t errlen) {
     const double *arr[TD_COUNT] = {f->position, f->velocity, f->angular_velocity, f->force,
                                    f->torque};
-    hsize_t rest[2] = {(hsize_t)h->n, 3}, vchunk[3], schunk[1] = {512};
-    value_chunk(h->n, vchunk);
+    hsize_t vchunk[3], schunk[1] = {512};
+    const int wide = h->rows.growing && h->rows.n < GROWING_CHUNK_ROWS;
+    value_chunk(wide ? GROWING_CHUNK_ROWS : h->rows.n, vchunk);
+    if (h->rows.growing && vchunk[0] > GROWING_CHUNK_FRAMES) vchunk[0] = GROWING_CHUNK_FRAMES;
     for (int k = 0; k < TD_COUNT; ++k) {
         h->present[k] = arr[k] != NULL;
         if (!h->present[k]) continue;
@@ -351,7 +349,7 @@ static int setup_groups(jd_h5md *h, const jd_h5md_frame *f, char *err, size_t er
         h->grp[k] = H5Gcreate2(h->all, td_name[k], H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
         if (h->grp[k] < 0) goto fail;
         what = "value";
-        h->value[k] = h5md_dset_extendible(h->grp[k], "value", H5T_IEEE_F64LE, 3, rest, vchunk);
+        h->value[k] = h5md_rows_value(&h->rows, h->grp[k], vchunk);
         if (h->value[k] < 0 || h5md_attr_str(h->value[k], "unit", td_unit[k]) < 0) goto fail;
         if (k == TD_POSITION) {
             what = "step";
@@ -372,6 +370,11 @@ static int setup_groups(jd_h5md *h, const jd_h5md_frame *f, char *err, size_t er
     fail:
         h5md_err(h->h5detail, err, errlen, "cannot create %s of /particles/all/%s in '%s'", what,
                  td_name[k], h->part);
+        h->broken = 1;
+        return -1;
+    }
+    if (h5md_rows_setup(&h->rows, h->all, h->grp[TD_POSITION]) < 0) {
+        h5md_err(h->h5detail, err, errlen, "cannot create /particles/all/id in '%s'", h->part);
         h->broken = 1;
         return -1;
     }
@@ -408,8 +411,10 @@ int jd_h5md_write_frame(jd_h5md *h, const jd_h5md_frame *frame, char *err, size_
     if (h->nframes == h->cap) { /* grow the in-memory time list (XDMF needs it) */
         size_t cap = h->cap ? 2 * h->cap : 64;
         double *t = realloc(h->times, cap * sizeof *t);
-        if (!t) goto oom;
-        h->times = t;
+        if (t) h->times = t;
+        int64_t *st = realloc(h->steps, cap * sizeof *st);
+        if (st) h->steps = st;
+        if (!t || !st) goto oom;
         h->cap = cap;
     }
 
@@ -419,11 +424,21 @@ int jd_h5md_write_frame(jd_h5md *h, const jd_h5md_frame *frame, char *err, size_
         h5md_quiet_off(&q);
         return -1;
     }
-    hsize_t rest[2] = {(hsize_t)h->n, 3};
-    const char *what = "value";
+    char why[256];
+    if (h5md_rows_frame(&h->rows, frame, h->nframes, why, sizeof why) < 0) {
+        h5md_err(h->h5detail, err, errlen, "h5md: %s in '%s'", why, h->part);
+        h->broken = 1;
+        h5md_quiet_off(&q);
+        return -1;
+    }
+    hsize_t rest[2] = {(hsize_t)h->rows.n, 3};
+    const char *what = "wall vertices";
+    if (h5md_walls_frame(&h->walls, h->nframes, frame->time) < 0) goto fail;
+    what = "value";
     for (int k = 0; k < TD_COUNT; ++k) {
         if (!h->present[k]) continue;
-        if (h5md_append_row(h->value[k], h->nframes, 3, rest, H5T_NATIVE_DOUBLE, arr[k]) < 0) {
+        if (h5md_append_row(h->value[k], h->nframes, 3, rest, H5T_NATIVE_DOUBLE,
+                            h5md_rows_vector(&h->rows, arr[k])) < 0) {
             what = td_name[k];
             goto fail;
         }
@@ -443,6 +458,7 @@ int jd_h5md_write_frame(jd_h5md *h, const jd_h5md_frame *frame, char *err, size_
         return -1;
     }
     h->times[h->nframes] = frame->time;
+    h->steps[h->nframes] = frame->step;
     h->nframes++;
     h->obs_dirty = 0; /* the flush covered pending observable samples too */
     h5md_quiet_off(&q);
@@ -570,6 +586,48 @@ fail:
     return -1;
 }
 
+/* What the sidecar needs that is known only at the end: /jdem/vertex_index over the final rows
+ * and the bond lines of every frame.  *range (malloc'd) holds the bond lines' start and count
+ * per frame. */
+static int close_extras(jd_h5md *h, hid_t file, xdmf_info *xi, hsize_t **range, char *err,
+                        size_t errlen) {
+    if (write_vertex_index(file, h->rows.n) < 0) {
+        h5md_err(h->h5detail, err, errlen, "cannot write /jdem/vertex_index in '%s'", h->part);
+        return -1;
+    }
+    if (H5Lexists(file, "jdem/bonds", H5P_DEFAULT) <= 0) return 0;
+    *range = malloc(2 * (h->nframes ? h->nframes : 1) * sizeof **range);
+    if (!*range) {
+        h5md_set_err(err, errlen, "h5md: out of memory");
+        return -1;
+    }
+    if (h5md_bond_lines(file, h->rows.row_id, h->rows.n, h->steps, h->nframes, *range,
+                        *range + h->nframes, &xi->bond_rows) != 0) {
+        h5md_err(h->h5detail, err, errlen, "cannot write /jdem/bond_lines in '%s'", h->part);
+        return -1;
+    }
+    xi->bonds = 1;
+    xi->bond_start = *range;
+    xi->bond_count = *range + h->nframes;
+    return 0;
+}
+
+int jd_h5md_set_walls(jd_h5md *h, size_t n, const jd_h5md_wall *walls, char *err, size_t errlen) {
+    if (!h || h->walls.present || h->nframes > 0) {
+        h5md_set_err(err, errlen, "h5md: walls are set once, before the first frame");
+        return -1;
+    }
+    quiet_t q;
+    h5md_quiet_on(&q, h->h5detail);
+    const int rc = h5md_walls_write(h->file, n, walls, &h->walls);
+    if (rc != 0) {
+        h5md_err(h->h5detail, err, errlen, "cannot write /jdem/walls in '%s'", h->part);
+        h->broken = 1;
+    }
+    h5md_quiet_off(&q);
+    return rc;
+}
+
 int jd_h5md_close(jd_h5md *h, int ok, char *err, size_t errlen) {
     if (!h) return 0;
     if (err && errlen) err[0] = '\0';
@@ -580,8 +638,16 @@ int jd_h5md_close(jd_h5md *h, int ok, char *err, size_t errlen) {
      * failure). */
     hid_t file = h->file;
     h->file = H5I_INVALID_HID;
-    xdmf_info xi = {h->path, h->n, h->nframes, h->times, h->present};
     free_objects(h);
+    hsize_t *bond_range = NULL;
+    xdmf_info xi = {.path = h->path, .n = h->rows.n, .growing = h->rows.growing,
+                    .nframes = h->nframes, .times = h->times, .present = h->present,
+                    .runs = h->rows.runs, .frame_runs = h->rows.frame_runs, .walls = &h->walls};
+    if (file >= 0 && ok && !h->broken &&
+        close_extras(h, file, &xi, &bond_range, err, errlen) != 0) {
+        rc = -1;
+        clean = 0;
+    }
     if (file >= 0 && H5Fclose(file) < 0) {
         h5md_err(h->h5detail, err, errlen, "cannot close '%s'", h->part);
         rc = -1;
@@ -604,6 +670,7 @@ int jd_h5md_close(jd_h5md *h, int ok, char *err, size_t errlen) {
     else if ((ok || !clean) && h5md_part_keep_or_remove(h->part, clean, err, errlen) != 0)
         rc = -1;
     h5md_quiet_off(&q);
+    free(bond_range);
     free_handle(h);
     return rc;
 }

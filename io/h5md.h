@@ -11,11 +11,16 @@
  *   /parameters                 attrs engine, scene_name, case_name, dt [s]; dataset "scene"
  *                               (variable-length string: the resolved scene, YAML) when given
  *   /particles/all/box          attrs dimension = 3, boundary = ["none","none","none"]
- *   /particles/all/{id,species,radius,mass}        [N] time-independent (int64, int32, f64, f64)
+ *   /particles/all/{id,species,radius,mass}        [N] time-independent (int64, int32, f64, f64);
+ *                               a growing set: id/{step,time,value} [F][N], -1 in empty rows
+ *                               (fill value -1; vectors NaN there), the particle axis extendible
  *   /particles/all/{position,velocity,angular_velocity,force,torque}/{step,time,value}
  *                               step [F] int64, time [F] f64, value [F][N][3] f64
  *   /observables/NAME/{step,time,value}            value [F] f64 (counts stored as f64 too)
- *   /jdem/vertex_index          [N] int64 0..N-1: the sidecar's vertex connectivity
+ *   /jdem/vertex_index          [N] int64 0..N-1: the sidecar's vertex connectivity (at close)
+ *   /jdem/walls/...             the walls and their quadrilateral mesh (jd_h5md_set_walls)
+ *   /jdem/bond_lines/{rows,frame_start,frame_count}  the bonds intact at each frame as row
+ *                               pairs (at close, from the bond tables)
  *   /jdem/bonds/{ids,type,formed_step}             every bond formed, in formation order
  *                               (jd_h5md_write_bonds); ids [B][2] int64 is also the H5MD tuple
  *                               list /connectivity/bonds (particles_group: object reference)
@@ -46,13 +51,18 @@ extern "C" {
 
 typedef struct jd_h5md jd_h5md;
 
-/* Static description of the particle set (arrays of n entries, sorted by id). */
+/* The particle set: n rows, each the row of one particle for the whole run.  For a fixed set
+ * (growing = 0) the rows are the particles sorted by id.  For a set that changes (growing = 1,
+ * H5MD 1.1's time-dependent particle count) id is written per frame, -1 for an empty row, and
+ * each frame gives its rows (jd_h5md_frame.rows): a row keeps its particle (the caller assigns
+ * rows, e.g. in order of arrival), rows are only added, never removed. */
 typedef struct jd_h5md_particles {
     size_t n;
-    const int64_t *id;
+    const int64_t *id;      /* the particle of each row; in a frame's rows, -1: empty */
     const int32_t *species; /* index into the scene's material list (0-based) */
     const double *radius;   /* [m]  */
     const double *mass;     /* [kg] */
+    int growing;            /* create only: 1 = the set changes during the run */
 } jd_h5md_particles;
 
 /* Run metadata written under /parameters.  Any pointer may be NULL. */
@@ -77,6 +87,10 @@ typedef struct jd_h5md_frame {
     const double *angular_velocity;
     const double *force;
     const double *torque;
+    /* growing sets only: this frame's rows (n >= the previous frame's n; rows beyond it are new
+     * and bring their species, radius and mass); the vectors above have 3 rows->n entries, and
+     * those of an empty row are not read (the file holds NaN there). */
+    const jd_h5md_particles *rows;
 } jd_h5md_frame;
 
 /* Create PATH.part.  Returns NULL and writes a one-line reason into err on failure. */
@@ -90,6 +104,24 @@ int jd_h5md_write_frame(jd_h5md *h, const jd_h5md_frame *frame, char *err, size_
  * sampled on their own schedule.  Returns 0 or -1 with a reason in err. */
 int jd_h5md_write_observable(jd_h5md *h, const char *name, int64_t step, double time,
                              double value, char *err, size_t errlen);
+
+/* A wall as drawn in the output (/jdem/walls): its geometry at time 0 and its motion, a rigid
+ * translation x(t) = x(0) + velocity t (both engines move walls so). */
+typedef struct jd_h5md_wall {
+    const char *name;
+    int type;               /* 0 plane (the quadrilateral corners), 1 cylinder (axis, radius) */
+    double corners[4][3];   /* [m] plane */
+    double axis[2][3];      /* [m] cylinder: end points of the axis segment */
+    double radius;          /* [m] cylinder */
+    int inside;             /* cylinder: 1 container, 0 obstacle */
+    double velocity[3];     /* [m/s] */
+} jd_h5md_wall;
+
+/* Record the run's walls (once, before the first frame; n may be 0).  Each frame then carries
+ * their surfaces for the sidecar: planes as their quadrilateral, cylinders as
+ * JD_H5MD_CYLINDER_FACETS quadrilaterals around the axis.  Returns 0 or -1 with err. */
+int jd_h5md_set_walls(jd_h5md *h, size_t n, const jd_h5md_wall *walls, char *err, size_t errlen);
+#define JD_H5MD_CYLINDER_FACETS 32
 
 /* A bond as recorded in /connectivity. */
 typedef struct jd_h5md_bond {

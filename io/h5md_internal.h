@@ -69,13 +69,83 @@ int h5md_part_keep_or_remove(const char *part, int clean, char *err, size_t errl
 int h5md_publish(const char *part, const char *path, const char *sidecar_part,
                  const char *sidecar, char *err, size_t errlen);
 
+/* h5md_walls.c: the walls' surface mesh (quadrilaterals) */
+typedef struct h5md_wall_mesh {
+    int present;     /* jd_h5md_set_walls was called */
+    int moving;      /* some wall moves: vertex_position holds the vertices per frame */
+    size_t nv, nq;   /* vertices, quadrilaterals */
+    double *vert0;   /* [nv][3] vertices at time 0 [m] */
+    double *vel;     /* [nv][3] their velocity [m/s] */
+    hid_t position;  /* /jdem/walls/mesh/vertex_position [F][nv][3] when moving */
+} h5md_wall_mesh;
+
+/* Write /jdem/walls (description and mesh); fills m.  0 / -1. */
+int h5md_walls_write(hid_t file, size_t n, const jd_h5md_wall *walls, h5md_wall_mesh *m);
+/* Append the vertices of frame `frame` at `time` [s] (moving walls only).  0 / -1. */
+int h5md_walls_frame(h5md_wall_mesh *m, hsize_t frame, double time);
+void h5md_walls_free(h5md_wall_mesh *m);
+
+/* A run of consecutive live rows [start, start + count) in one frame. */
+typedef struct xdmf_run {
+    hsize_t start, count;
+} xdmf_run;
+
+/* h5md_rows.c: the particle rows (time-independent data; the growing set's id per frame) */
+typedef struct h5md_rows {
+    int growing;          /* jd_h5md_particles.growing */
+    size_t n;             /* rows so far */
+    int64_t *row_id;      /* [n] the particle of each row */
+    hid_t species, radius, mass; /* growing: extendible datasets [n] */
+    hid_t id_grp, id_value;      /* growing: /particles/all/id and its value [F][n] */
+    const int64_t *frame_id;     /* growing: the ids of the frame being written */
+    double *scratch;             /* growing: one vector of the frame with NaN in empty rows */
+    xdmf_run *runs;              /* live runs of every frame */
+    size_t nruns, runs_cap;
+    size_t *frame_runs;          /* [nframes + 1] */
+    size_t nframes, frame_cap;
+} h5md_rows;
+
+/* Write id (fixed set), species, radius, mass under `all`.  0 / -1. */
+int h5md_rows_create(h5md_rows *r, hid_t all, const jd_h5md_particles *p);
+/* Least rows per chunk along the particle axis of a growing set (its final size is unknown,
+ * so a chunk holds the initial rows or this many, whichever is more), and most frames: a small
+ * set's file stays small whatever it grows to. */
+#define GROWING_CHUNK_ROWS 64
+#define GROWING_CHUNK_FRAMES 16
+/* A per-particle value dataset [0][n][3] in grp (extendible along the particles too when
+ * growing, fill NaN). */
+hid_t h5md_rows_value(const h5md_rows *r, hid_t grp, const hsize_t chunk[3]);
+/* At the first frame: the growing set's id element, step/time linked from position/. */
+int h5md_rows_setup(h5md_rows *r, hid_t all, hid_t position);
+/* Before a frame's vectors: add its new rows, append its ids, record its live runs.  0, or -1
+ * with a reason in why. */
+int h5md_rows_frame(h5md_rows *r, const jd_h5md_frame *f, hsize_t frame, char *why,
+                    size_t whylen);
+/* v, or (growing) a copy of it with NaN in the frame's empty rows; valid until the next call. */
+const double *h5md_rows_vector(h5md_rows *r, const double *v);
+void h5md_rows_close(h5md_rows *r); /* the HDF5 objects */
+void h5md_rows_free(h5md_rows *r);  /* and the memory */
+
+/* h5md_bond_lines.c: /jdem/bond_lines, the intact bonds of each frame as row pairs.  Reads the
+ * bond tables back from the file; row_id [n] is the particle of each row.  Fills start/count
+ * [nframes] (the frames' ranges of /jdem/bond_lines/rows); *total = its rows.  0 / -1. */
+int h5md_bond_lines(hid_t file, const int64_t *row_id, size_t n, const int64_t *steps,
+                    hsize_t nframes, hsize_t *start, hsize_t *count, hsize_t *total);
+
 /* xdmf.c: what the sidecar needs of a closed writer */
 typedef struct xdmf_info {
     const char *path; /* final .h5 path */
-    size_t n;
+    size_t n;         /* rows (the particle axis of every per-particle dataset) */
+    int growing;      /* id is /particles/all/id/value [F][n] */
     hsize_t nframes;
     const double *times;
     const int *present;
+    const xdmf_run *runs;      /* the live runs of every frame, frame after frame */
+    const size_t *frame_runs;  /* [nframes + 1]: frame f's runs are [frame_runs[f], frame_runs[f+1]) */
+    const h5md_wall_mesh *walls;
+    int bonds;                 /* /jdem/bond_lines exists */
+    const hsize_t *bond_start, *bond_count; /* [nframes] */
+    hsize_t bond_rows;         /* rows of /jdem/bond_lines/rows */
 } xdmf_info;
 
 /* PATH with its extension replaced by .xdmf (malloc'd; NULL when out of memory). */

@@ -15,6 +15,7 @@
 #include "output.h"
 #include "update.h"
 
+#include "fix_wall_jiang.h"
 #include "h5md.h"
 #include "jdem_observables.h"
 #include "pair_gran_jiang.h"
@@ -32,7 +33,7 @@ enum { COL_ID = 0, COL_TYPE, COL_R, COL_M, COL_X, COL_V = COL_X + 3, COL_W = COL
        COL_F = COL_W + 3, COL_T = COL_F + 3, NCOL = COL_T + 3 };
 
 DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
-    : Dump(lmp, narg, arg), h5(NULL), energy(true), natoms0(-1), last_step(-1), observables_every(0), stop_frame(false) {
+    : Dump(lmp, narg, arg), h5(NULL), energy(true), grow(-1), natoms0(-1), last_step(-1), observables_every(0), stop_frame(false) {
   if (narg < 5) error->all(FLERR, "Illegal dump h5md/jdem command: dump ID group h5md/jdem N FILE.h5");
   path = arg[4];
   if (path.find('*') != std::string::npos || path.find('%') != std::string::npos)
@@ -54,8 +55,12 @@ DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
       if (std::strcmp(arg[i + 1], "yes") == 0) energy = true;
       else if (std::strcmp(arg[i + 1], "no") == 0) energy = false;
       else error->all(FLERR, "dump h5md/jdem: energy must be yes or no");
+    } else if (k == "grow") {
+      if (std::strcmp(arg[i + 1], "yes") == 0) grow = 1;
+      else if (std::strcmp(arg[i + 1], "no") == 0) grow = 0;
+      else error->all(FLERR, "dump h5md/jdem: grow must be yes or no");
     } else {
-      error->all(FLERR, "dump h5md/jdem: unknown keyword (valid: scene, case, scene_yaml, energy)");
+      error->all(FLERR, "dump h5md/jdem: unknown keyword (valid: scene, case, scene_yaml, energy, grow)");
     }
   }
   size_one = NCOL;
@@ -134,7 +139,9 @@ void DumpH5mdJdem::write() {
     RowById cmp = {all.data()};
     std::sort(order.begin(), order.end(), cmp);
 
-    std::vector<double> pos(3 * nat), vel(3 * nat), angv(3 * nat), frc(3 * nat), trq(3 * nat);
+    /* one spare row: a frame without atoms (before an insertion) still hands the writer arrays */
+    std::vector<double> pos(3 * nat + 3), vel(3 * nat + 3), angv(3 * nat + 3), frc(3 * nat + 3),
+        trq(3 * nat + 3);
     for (size_t i = 0; i < nat; i++) {
       const double *row = &all[(size_t)order[i] * NCOL];
       for (int d = 0; d < 3; d++) {
@@ -147,37 +154,23 @@ void DumpH5mdJdem::write() {
     }
 
     if (!h5) {
-      std::vector<int64_t> ids(nat);
-      std::vector<int32_t> species(nat);
-      std::vector<double> rad(nat), mass(nat);
-      for (size_t i = 0; i < nat; i++) {
-        const double *row = &all[(size_t)order[i] * NCOL];
-        ids[i] = (int64_t)row[COL_ID];
-        species[i] = (int32_t)row[COL_TYPE] - 1;
-        rad[i] = row[COL_R];
-        mass[i] = row[COL_M];
-      }
-      jd_h5md_particles parts;
-      parts.n = nat;
-      parts.id = ids.data();
-      parts.species = species.data();
-      parts.radius = rad.data();
-      parts.mass = mass.data();
-      jd_h5md_meta meta;
-      std::memset(&meta, 0, sizeof meta);
-      meta.creator = "liggghts-jdem";
-      meta.creator_version = JDEM_VERSION;
-      meta.scene_name = scene_name.empty() ? NULL : scene_name.c_str();
-      meta.case_name = case_name.empty() ? NULL : case_name.c_str();
-      meta.scene_yaml = scene_yaml.empty() ? NULL : scene_yaml.c_str();
-      meta.dt = dt;
-      h5 = jd_h5md_create(path.c_str(), &meta, &parts, err, sizeof err);
-      if (!h5) failed = 1;
+      if (grow < 0) grow = insertion_fix() ? 1 : 0;
+      failed = create_file(all, order, dt, err, sizeof err);
       natoms0 = (bigint)nat;
-    } else if ((bigint)nat != natoms0) {
-      std::snprintf(err, sizeof err, "the number of atoms changed (%ld -> %ld); h5md/jdem needs a fixed particle set",
-                    (long)natoms0, (long)nat);
+    } else if (!grow && (bigint)nat != natoms0) {
+      std::snprintf(err, sizeof err, "the number of atoms changed (%ld -> %ld); give the dump "
+                    "'grow yes' for a particle set that changes", (long)natoms0, (long)nat);
       failed = 1;
+    }
+    jd_h5md_particles frame_rows;
+    if (!failed && grow) {
+      place_rows(all, order, pos, vel, angv, frc, trq);
+      frame_rows.n = row_id.size();
+      frame_rows.id = frame_id.data();
+      frame_rows.species = row_species.data();
+      frame_rows.radius = row_radius.data();
+      frame_rows.mass = row_mass.data();
+      frame_rows.growing = 1;
     }
     if (!failed) {
       jd_h5md_frame fr;
@@ -188,6 +181,7 @@ void DumpH5mdJdem::write() {
       fr.angular_velocity = angv.data();
       fr.force = frc.data();
       fr.torque = trq.data();
+      fr.rows = grow ? &frame_rows : NULL;
       if (jd_h5md_write_frame(h5, &fr, err, sizeof err) != 0) failed = 1;
     }
     if (!failed && sample && write_contact_observables(all_obs, step, time, err, sizeof err) != 0)
@@ -214,6 +208,99 @@ void DumpH5mdJdem::write() {
     std::string msg = std::string("dump h5md/jdem: ") + err;
     error->all(FLERR, msg.c_str());
   }
+}
+
+/* A fix that adds atoms during the run: LIGGGHTS' insertion fixes (insert/pack, insert/stream,
+ * insert/rate/region, ...) and jdem's inlet.  With one, the dump writes a growing set. */
+bool DumpH5mdJdem::insertion_fix() const {
+  for (int k = 0; k < modify->nfix; k++) {
+    const char *style = modify->fix[k]->style;
+    if (std::strncmp(style, "insert/", 7) == 0 || std::strcmp(style, "jdem/inlet") == 0)
+      return true;
+  }
+  return false;
+}
+
+/* Rank 0, first frame: the file, its particle set (the atoms now, sorted by id) and walls. */
+int DumpH5mdJdem::create_file(const std::vector<double> &all, const std::vector<int> &order,
+                              double dt, char *err, size_t errlen) {
+  const size_t nat = order.size();
+  std::vector<int64_t> ids(nat);
+  std::vector<int32_t> species(nat);
+  std::vector<double> rad(nat), mass(nat);
+  for (size_t i = 0; i < nat; i++) {
+    const double *row = &all[(size_t)order[i] * NCOL];
+    ids[i] = (int64_t)row[COL_ID];
+    species[i] = (int32_t)row[COL_TYPE] - 1;
+    rad[i] = row[COL_R];
+    mass[i] = row[COL_M];
+  }
+  jd_h5md_particles parts;
+  parts.n = nat;
+  parts.id = ids.data();
+  parts.species = species.data();
+  parts.radius = rad.data();
+  parts.mass = mass.data();
+  parts.growing = grow;
+  if (grow) {
+    row_id = ids;
+    row_species = species;
+    row_radius = rad;
+    row_mass = mass;
+    for (size_t i = 0; i < nat; i++) row_of[ids[i]] = i;
+  }
+  jd_h5md_meta meta;
+  std::memset(&meta, 0, sizeof meta);
+  meta.creator = "liggghts-jdem";
+  meta.creator_version = JDEM_VERSION;
+  meta.scene_name = scene_name.empty() ? NULL : scene_name.c_str();
+  meta.case_name = case_name.empty() ? NULL : case_name.c_str();
+  meta.scene_yaml = scene_yaml.empty() ? NULL : scene_yaml.c_str();
+  meta.dt = dt;
+  h5 = jd_h5md_create(path.c_str(), &meta, &parts, err, errlen);
+  if (!h5) return 1;
+  std::vector<jd_h5md_wall> walls;
+  const double now = update->atime + (double)(update->ntimestep - update->atimestep) * dt;
+  for (int k = 0; k < modify->nfix; k++) {
+    const FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
+    if (!w) continue;
+    walls.push_back(jd_h5md_wall());
+    w->output_geometry(&walls.back(), now);
+  }
+  return jd_h5md_set_walls(h5, walls.size(), walls.empty() ? NULL : walls.data(), err, errlen) != 0;
+}
+
+/* Rank 0, growing set: the rows of this frame.  An atom keeps the row it got when it first
+ * appeared; atoms new since the last frame get new rows in id order (order is by id); the row
+ * of an atom that is gone is empty (id -1).  The vectors, sorted by id on entry, come back in
+ * row order. */
+void DumpH5mdJdem::place_rows(const std::vector<double> &all, const std::vector<int> &order,
+                              std::vector<double> &pos, std::vector<double> &vel,
+                              std::vector<double> &angv, std::vector<double> &frc,
+                              std::vector<double> &trq) {
+  for (size_t i = 0; i < order.size(); i++) {
+    const double *row = &all[(size_t)order[i] * NCOL];
+    const int64_t id = (int64_t)row[COL_ID];
+    if (row_of.count(id)) continue;
+    row_of[id] = row_id.size();
+    row_id.push_back(id);
+    row_species.push_back((int32_t)row[COL_TYPE] - 1);
+    row_radius.push_back(row[COL_R]);
+    row_mass.push_back(row[COL_M]);
+  }
+  const size_t nrows = row_id.size();
+  frame_id.assign(nrows, -1);
+  std::vector<double> *vecs[5] = {&pos, &vel, &angv, &frc, &trq};
+  std::vector<double> by_row[5];
+  for (int k = 0; k < 5; k++) by_row[k].assign(3 * nrows + 3, 0.0); /* + the spare row */
+  for (size_t i = 0; i < order.size(); i++) {
+    const int64_t id = (int64_t)all[(size_t)order[i] * NCOL + COL_ID];
+    const size_t r = row_of[id];
+    frame_id[r] = id;
+    for (int k = 0; k < 5; k++)
+      for (int d = 0; d < 3; d++) by_row[k][3 * r + d] = (*vecs[k])[3 * i + d];
+  }
+  for (int k = 0; k < 5; k++) vecs[k]->swap(by_row[k]);
 }
 
 void DumpH5mdJdem::reduce_observables(double all_obs[JDO_N]) {

@@ -1,5 +1,5 @@
 /* dump_h5md_jdem.h — `dump ID group h5md/jdem N FILE.h5 [scene NAME] [case NAME]
- *                    [scene_yaml PATH] [energy yes|no]`: jdem's H5MD trajectory (io/h5md.h),
+ *                    [scene_yaml PATH] [energy yes|no] [grow yes|no]`: jdem's H5MD trajectory (io/h5md.h),
  * written on rank 0 through the shared C writer.
  *
  * Every N steps: position, velocity, angular velocity, force, torque of the group's atoms,
@@ -14,11 +14,15 @@
  * when LIGGGHTS ends normally or at `undump`; after an error it stays FILE.h5.part.  The optional keywords scene, case
  * and scene_yaml only annotate /parameters.  energy no (build/jdem's output.energy: false)
  * leaves out elastic_energy, damping_dissipation, friction_dissipation and wall_work, so that
- * pair_style gran/jiang can run without energy accounts (energy no).  The particle set must not
- * change during the run. */
+ * pair_style gran/jiang can run without energy accounts (energy no).  grow yes writes a particle
+ * set that changes (H5MD 1.1's time-dependent id, -1 in empty rows; an atom keeps its row, new
+ * atoms get new rows in id order); the default is yes when the input has an insertion fix
+ * (style insert/... or jdem/inlet) at the first frame, else the set must not change.  The
+ * walls of every fix wall/jiang go to /jdem/walls. */
 #ifndef JDEM_DUMP_H5MD_JDEM_H
 #define JDEM_DUMP_H5MD_JDEM_H
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -74,12 +78,24 @@ class DumpH5mdJdem : public Dump {
                                 size_t errlen);
   int write_bond_observables(const double all_obs[JDO_N], bigint step, double time, char *err,
                              size_t errlen);
+  bool insertion_fix() const;
+  int create_file(const std::vector<double> &all, const std::vector<int> &order, double dt,
+                  char *err, size_t errlen);
+  void place_rows(const std::vector<double> &all, const std::vector<int> &order,
+                  std::vector<double> &pos, std::vector<double> &vel, std::vector<double> &angv,
+                  std::vector<double> &frc, std::vector<double> &trq);
 
  private:
   struct jd_h5md *h5;
   std::string path, scene_name, case_name, scene_yaml;
   bool energy;
+  int grow;       /* keyword grow: 1 yes, 0 no, -1 (default) yes when an insertion fix exists */
   bigint natoms0;
+  /* growing set (rank 0): the particle of each row, its constants, and this frame's ids */
+  std::map<int64_t, size_t> row_of;
+  std::vector<int64_t> row_id, frame_id;
+  std::vector<int32_t> row_species;
+  std::vector<double> row_radius, row_mass;
   bigint last_step; /* of the last frame written; -1: none */
   bigint observables_every; /* steps between observable samples; 0: at the frames */
   /* this sample's wall observables (jdem_wall_observables), set by reduce_observables */

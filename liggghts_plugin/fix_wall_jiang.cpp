@@ -14,6 +14,7 @@
 #include "neighbor.h"
 #include "update.h"
 
+#include "h5md.h"
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
 #include "jdem_watchdog.h"
@@ -350,3 +351,18 @@ int FixWallJiang::unpack_exchange(int nlocal, double *buf) {
 }
 
 double FixWallJiang::memory_usage() { return (double)nmax_hist * slen * sizeof(double); }
+
+void FixWallJiang::output_geometry(jd_h5md_wall *w, double time) const {
+  std::memset(w, 0, sizeof *w);
+  w->name = id;
+  w->type = shape;
+  for (int d = 0; d < 3; d++) {
+    const double back = vel[d] * time;
+    for (int c = 0; c < 4; c++) w->corners[c][d] = plane.p[c][d] - back;
+    w->axis[0][d] = cyl.a0[d] - back;
+    w->axis[1][d] = cyl.a1[d] - back;
+    w->velocity[d] = vel[d];
+  }
+  w->radius = cyl.rc;
+  w->inside = cyl.inside;
+}

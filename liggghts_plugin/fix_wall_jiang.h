@@ -40,11 +40,16 @@
 #include "jdem_overlap.h"
 #include "jdem_servo.h"
 
+struct jd_h5md_wall;
+
 namespace LAMMPS_NS {
 
 class FixWallJiang : public Fix {
  public:
   int wall_type() const { return wtype; } /* the wall's atom type (material) */
+  /* The wall for the trajectory (io/h5md.h): its geometry at time 0, i.e. now (`time` [s])
+   * less velocity x time, its velocity, and the fix ID as its name. */
+  void output_geometry(jd_h5md_wall *w, double time) const;
   FixWallJiang(class LAMMPS *, int, char **);
   ~FixWallJiang();
   int setmask();

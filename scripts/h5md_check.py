@@ -16,6 +16,10 @@ if any rule failed.  The rules, from the specification's text:
                  [dimension] or [dimension][dimension] floats, required when any is periodic);
                  position, velocity, force, ...: H5MD elements (below), position's last axis =
                  dimension; id and species of integer type.
+  particle count a time-dependent id (a particle set that changes) is integer [var][N] with
+                 HDF5 fill value -1, holds -1 for each empty slot and no id twice in a frame,
+                 and every time-dependent element of the group has N slots on the same
+                 frames.
   elements       a time-dependent element is a group with step (integer, [var] or scalar),
                  value ([var][...]) and, when given, time (float, the shape of step); a [var]
                  step has one entry per row of value and increases strictly.
@@ -223,7 +227,46 @@ def check_connectivity(f):
     return p
 
 
+def check_particle_count(f):
+    """H5MD 1.1, particles group: with a varying number of particles, id is time-dependent and
+    -1 (its fill value) marks the slots that hold no particle."""
+    p = []
+    for gname, grp in (f.get("particles") or {}).items():
+        ids = grp.get("id")
+        if not isinstance(ids, h5py.Group) or "value" not in ids:
+            continue
+        w = f"/particles/{gname}/id"
+        val = ids["value"]
+        if len(val.shape) != 2 or not int_kind(val):
+            p.append(f"{w}/value must be integer [var][N], is {val.dtype}{val.shape}")
+            continue
+        buf = np.zeros(1, dtype=val.dtype)
+        val.id.get_create_plist().get_fill_value(buf)
+        fill = int(buf[0])
+        if fill != -1:
+            p.append(f"{w}/value has fill value {fill}, not -1")
+        a = val[()]
+        if np.any(a < -1):
+            p.append(f"{w}/value holds ids below -1 ({int(a.min())})")
+        for k, row in enumerate(a):
+            live = row[row >= 0]
+            if len(np.unique(live)) != len(live):
+                p.append(f"{w}/value frame {k} holds an id twice")
+                break
+        steps = ids["step"][()] if "step" in ids else None
+        for name, obj in grp.items():
+            if name in TD_SKIP or name == "id" or not isinstance(obj, h5py.Group):
+                continue
+            v = obj["value"]
+            if len(v.shape) < 2 or v.shape[1] != val.shape[1]:
+                p.append(f"/particles/{gname}/{name}/value has {v.shape[1:2]} slots, id {val.shape[1]}")
+            if steps is not None and "step" in obj and not np.array_equal(obj["step"][()], steps):
+                p.append(f"/particles/{gname}/{name}: frames other than id's")
+    return p
+
+
 RULES = [("h5md group", check_h5md), ("modules", check_modules), ("particles", check_particles),
+         ("particle count", check_particle_count),
          ("observables", check_observables), ("connectivity", check_connectivity)]
 
 

@@ -10,9 +10,10 @@
  * is a rigid motion.
  *
  * Order.  Scene index (orig) n_scene + k is the k-th inserted particle.  The trajectory holds
- * the whole capacity set, sorted by id, with a NaN position (and velocities) for each particle
- * not yet inserted: slot[] maps a scene index to its row.  A deposit-height rule may end the
- * stream before the capacity is reached; the rows of the particles never inserted stay NaN.
+ * the whole capacity set, sorted by id, as a growing set (io/h5md.h): a row's id is -1 until
+ * its particle is inserted (and its vectors NaN): slot[] maps a scene index to its row.  A
+ * deposit-height rule may end the stream before the capacity is reached; the rows of the
+ * particles never inserted stay empty.
  *
  * Cost.  Before each step the run loop compares the step with next_step (the smallest cursor
  * step over the inlets); only at a step where particles are due does it pop them, append them
@@ -47,6 +48,7 @@ struct jd_sim_inlets {
     int32_t *slot;         /* [cap] row of each scene index in the trajectory (sorted by id) */
     jd_row *rows;          /* [cap] the trajectory's rows, sorted by id */
     double *frame;         /* [5 x 3 cap] the vectors of a frame in row order */
+    int64_t *frame_id;     /* [cap] the ids of a frame in row order, -1: not inserted */
     jd_inlet_particle *buf;
     size_t buf_cap;
     int64_t next_step;     /* the smallest next_step of the streams */
@@ -132,7 +134,8 @@ int sim_inlets_init(jd_sim *s, char *err, size_t errlen) {
     in->slot = malloc((in->cap ? in->cap : 1) * sizeof *in->slot);
     in->rows = malloc((in->cap ? in->cap : 1) * sizeof *in->rows);
     in->frame = malloc(JD_INLET_FRAME_VECTORS * 3 * (in->cap ? in->cap : 1) * sizeof *in->frame);
-    if (!in->run || !in->id || !in->slot || !in->rows || !in->frame) goto oom;
+    in->frame_id = malloc((in->cap ? in->cap : 1) * sizeof *in->frame_id);
+    if (!in->run || !in->id || !in->slot || !in->rows || !in->frame || !in->frame_id) goto oom;
     in->next_step = JD_INLET_NEVER;
     for (size_t k = 0; k < sc->n_inlets; k++) {
         inlet_run *r = &in->run[k];
@@ -163,6 +166,7 @@ void sim_inlets_free(jd_sim *s) {
     free(in->slot);
     free(in->rows);
     free(in->frame);
+    free(in->frame_id);
     free(in->buf);
     free(in);
     s->inlets = NULL;
@@ -273,4 +277,11 @@ double *sim_inlets_frame_rows(const jd_sim *s, int k, const double *scene_ordere
     for (size_t j = 0; j < s->n; j++)
         memcpy(&out[3 * (size_t)in->slot[j]], &scene_ordered[3 * j], 3 * sizeof *out);
     return out;
+}
+
+const int64_t *sim_inlets_frame_ids(const jd_sim *s) {
+    const jd_sim_inlets *in = s->inlets;
+    for (size_t r = 0; r < in->cap; r++) in->frame_id[r] = -1;
+    for (size_t j = 0; j < s->n; j++) in->frame_id[in->slot[j]] = in->id[j];
+    return in->frame_id;
 }

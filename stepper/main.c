@@ -388,7 +388,7 @@ static int output_particles(const jd_scene *sc, const jd_sim *sim, jd_h5md_parti
     int32_t *species = malloc(n1 * sizeof *species);
     double *radius = malloc(2 * n1 * sizeof *radius);
     *p = (jd_h5md_particles){.n = n, .id = id, .species = species, .radius = radius,
-                             .mass = radius ? radius + n1 : NULL};
+                             .mass = radius ? radius + n1 : NULL, .growing = sim->inlets != NULL};
     if (!id || !species || !radius) return -1;
     if (sim->inlets) return sim_inlets_particles(sim, id, species, radius, radius + n1);
     memcpy(id, sc->id, n * sizeof *id);
@@ -402,6 +402,26 @@ static void free_output_particles(jd_h5md_particles *p) {
     free((void *)p->id);
     free((void *)p->species);
     free((void *)p->radius);
+}
+
+/* The scene's walls into the trajectory (/jdem/walls), as they stand at time 0. */
+static int output_walls(const jd_scene *sc, jd_h5md *h, char *err, size_t errlen) {
+    jd_h5md_wall *w = calloc(sc->n_walls ? sc->n_walls : 1, sizeof *w);
+    if (!w) {
+        snprintf(err, errlen, "out of memory for the walls' output");
+        return -1;
+    }
+    for (size_t k = 0; k < sc->n_walls; k++) {
+        const jd_wall *s = &sc->walls[k];
+        w[k] = (jd_h5md_wall){.name = s->name, .type = s->type, .radius = s->radius,
+                              .inside = s->inside};
+        memcpy(w[k].corners, s->corners, sizeof w[k].corners);
+        memcpy(w[k].axis, s->axis, sizeof w[k].axis);
+        memcpy(w[k].velocity, s->velocity, sizeof w[k].velocity);
+    }
+    const int rc = jd_h5md_set_walls(h, sc->n_walls, w, err, errlen);
+    free(w);
+    return rc;
 }
 
 /* Open the trajectory of a set-up run; NULL after reporting, with the exit status in *rc. */
@@ -418,9 +438,12 @@ static jd_h5md *create_output(const jd_scene *sc, const jd_sim *sim, const char 
         const jd_h5md_meta meta = {.creator = "jdem", .creator_version = JDEM_VERSION,
                                    .scene_name = sc->name, .case_name = sc->case_name,
                                    .scene_yaml = yaml, .dt = sc->dt};
-        if (!(h = jd_h5md_create(out, &meta, &parts, err, sizeof err))) {
+        if (!(h = jd_h5md_create(out, &meta, &parts, err, sizeof err)) ||
+            output_walls(sc, h, err, sizeof err) != 0) {
             fprintf(stderr, "jdem: %s\n", err);
             *rc = EXIT_IO;
+            if (h) jd_h5md_close(h, 0, err, sizeof err);
+            h = NULL;
         }
     }
     free(yaml);

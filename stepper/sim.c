@@ -319,11 +319,14 @@ static int write_frame(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     jd_h5md_frame fr = {.step = s->step, .time = (double)s->step * s->dt, .position = s->x,
                         .velocity = s->v, .angular_velocity = s->omega, .force = s->f,
                         .torque = s->torque};
-    if (s->inlets) { /* the rows of every particle the run can hold, NaN until inserted */
+    jd_h5md_particles rows = {0};
+    if (s->inlets) { /* the rows of every particle the run can hold, id -1 until inserted */
         const double *const vec[JD_INLET_FRAME_VECTORS] = {s->x, s->v, s->omega, s->f, s->torque};
         const double **dst[JD_INLET_FRAME_VECTORS] = {&fr.position, &fr.velocity,
                                                       &fr.angular_velocity, &fr.force, &fr.torque};
         for (int k = 0; k < JD_INLET_FRAME_VECTORS; k++) *dst[k] = sim_inlets_frame_rows(s, k, vec[k]);
+        rows = (jd_h5md_particles){.n = sim_inlets_rows(s), .id = sim_inlets_frame_ids(s)};
+        fr.rows = &rows;
     }
     const int rc = jd_h5md_write_frame(h, &fr, err, errlen);
     sim_vectors_to_sim_order(s);

@@ -336,6 +336,8 @@ int sim_inlets_particles(const jd_sim *s, int64_t *id, int32_t *species, double 
 /* Vector k of a frame (3 per active particle, scene order) spread onto the rows, NaN for the
  * particles not inserted (yet). */
 double *sim_inlets_frame_rows(const jd_sim *s, int k, const double *scene_ordered);
+/* The id of each row at this frame: -1 for the particles not inserted (yet). */
+const int64_t *sim_inlets_frame_ids(const jd_sim *s);
 
 /* neighbour.c */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);

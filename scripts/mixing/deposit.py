@@ -55,7 +55,14 @@ def read_frame(path, frame=-1):
         if not -frames <= frame < frames:
             raise DepositError(f"{path}: frame {frame} does not exist; valid: {-frames} to "
                                f"{frames - 1} ({frames} frames)")
-        return Deposit(p["id"][()], p["species"][()], p["radius"][()], p["mass"][()],
+        ids = p["id"]
+        if isinstance(ids, h5py.Group):  # a growing set: the frame's live rows (id >= 0)
+            frame_ids = ids["value"][frame]
+            live = frame_ids >= 0
+            return Deposit(frame_ids[live], p["species"][()][live], p["radius"][()][live],
+                           p["mass"][()][live], p["position/value"][frame][live],
+                           int(p["position/step"][frame]), float(p["position/time"][frame]))
+        return Deposit(ids[()], p["species"][()], p["radius"][()], p["mass"][()],
                        p["position/value"][frame], int(p["position/step"][frame]),
                        float(p["position/time"][frame]))
 

@@ -6,7 +6,8 @@ One line per check, `PASS name` or `FAIL name: detail`.
 * stream: every insertion jdem records (--inlet-record) equals the stream computed here from the
   resolved scene by the closed form of kernel/jdem_inlet.h, in Python: ids, crossing steps,
   positions and velocities bit for bit, in insertion order (step, then id).
-* trajectory: the rows are every id the run can hold, sorted; a row is finite exactly from its
+* trajectory: the rows are every id the run can hold, sorted; a row's id is -1 before its
+  insertion and its id after (H5MD 1.1's time-dependent particle set); a row is finite exactly from its
   insertion step on (NaN before).
 * free flight: a particle seen in a frame before anything touched it is at the closed-form
   x_k + v t + g t^2 / 2 (velocity Verlet is exact for constant gravity up to round-off).
@@ -92,7 +93,8 @@ def main():
         inserted = {g[0]: g for g in got}
 
         with h5py.File(traj, "r") as h:
-            ids = h["/particles/all/id"][:]
+            frame_ids = h["/particles/all/id/value"][:]  # a growing set: -1 in an empty row
+            ids = frame_ids.max(axis=0)  # each row's particle, whenever it is there
             mass = dict(zip(ids, h["/particles/all/mass"][:]))
             pos = h["/particles/all/position/value"][:]
             fsteps = h["/particles/all/position/step"][:]
@@ -102,6 +104,9 @@ def main():
         have = np.all(np.isfinite(pos), axis=2)
         check("rows-nan-until-inserted", np.array_equal(want, have),
               f"{int(np.sum(want != have))} rows differ")
+        check("rows-id-minus-one-until-inserted",
+              np.array_equal(frame_ids, np.where(want, ids[None, :], -1)),
+              f"{int(np.sum(frame_ids != np.where(want, ids[None, :], -1)))} entries differ")
 
         g, dt = np.array(sc["gravity"]), sc["time"]["dt"]
         worst, seen = 0.0, 0

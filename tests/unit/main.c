@@ -15,6 +15,7 @@ int main(void) {
     failed += run_guard_tests();
     failed += run_bond_tests();
     failed += run_h5md_bonds_tests();
+    failed += run_h5md_output_tests();
     failed += run_hugepages_tests();
     failed += run_inlet_tests();
     failed += run_servo_tests();

@@ -66,7 +66,7 @@ static int exists(const char *p) {
 
 static jd_h5md *open_writer(const char *path, char *err, size_t errlen) {
     jd_h5md_meta meta = {"jdem", "0.1.0", "glass", "chung_ooi_1", t_scene, 1e-6, "A. Tester"};
-    jd_h5md_particles p = {NP, t_id, t_species, t_radius, t_mass};
+    jd_h5md_particles p = {NP, t_id, t_species, t_radius, t_mass, 0};
     return jd_h5md_create(path, &meta, &p, err, errlen);
 }
 
@@ -80,7 +80,7 @@ static void write_frames(jd_h5md *h, int nf, unsigned mask) {
                 for (int c = 0; c < 3; ++c) buf[a][3 * i + c] = val(a, f, i, c);
         jd_h5md_frame fr = {100 * f, 1e-4 * f, buf[0], (mask & 2) ? buf[1] : NULL,
                             (mask & 4) ? buf[2] : NULL, (mask & 8) ? buf[3] : NULL,
-                            (mask & 16) ? buf[4] : NULL};
+                            (mask & 16) ? buf[4] : NULL, NULL};
         err[0] = 0;
         int rc = jd_h5md_write_frame(h, &fr, err, sizeof err);
         if (rc != 0) fail_msg("write_frame: %s", err);
@@ -427,7 +427,10 @@ static void test_xdmf_sidecar(void **state) {
              NP);
     assert_non_null(strstr(text, slab));
     assert_null(strstr(text, "HyperSlab"));
-    assert_non_null(strstr(text, ">glass.jdem.h5:/jdem/vertex_index</DataItem></Topology>"));
+    char vertices[96];
+    snprintf(vertices, sizeof vertices, ">glass.jdem.h5:/jdem/vertex_index|0:1:%d:%d</DataItem></Topology>",
+             NP, NP);
+    assert_non_null(strstr(text, vertices));
     tdir_remove(&t);
 }
 
@@ -481,7 +484,7 @@ static void test_killed_run_readable(void **state) {
         if (!h) _exit(2);
         double pos[3 * NP] = {0};
         for (int f = 0; f < 3; ++f) {
-            jd_h5md_frame fr = {f, 0.5 * f, pos, NULL, NULL, NULL, NULL};
+            jd_h5md_frame fr = {f, 0.5 * f, pos, NULL, NULL, NULL, NULL, NULL};
             if (jd_h5md_write_frame(h, &fr, err, sizeof err) != 0) _exit(3);
         }
         /* batch at step 2 (two samples), then a new batch at step 3 flushes it */
@@ -564,21 +567,21 @@ static void test_errors(void **state) {
     tdir_make(&t);
     {
         const int64_t unsorted[NP] = {1, 5, 2};
-        jd_h5md_particles p = {NP, unsorted, t_species, t_radius, t_mass};
+        jd_h5md_particles p = {NP, unsorted, t_species, t_radius, t_mass, 0};
         assert_null(jd_h5md_create(t.h5, NULL, &p, err, sizeof err));
         assert_non_null(strstr(err, "sorted"));
         assert_false(exists(t.part));
     }
     h = open_writer(t.h5, err, sizeof err);
     if (!h) fail_msg("create: %s", err);
-    jd_h5md_frame nopos = {0, 0.0, NULL, NULL, NULL, NULL, NULL};
+    jd_h5md_frame nopos = {0, 0.0, NULL, NULL, NULL, NULL, NULL, NULL};
     err[0] = 0;
     assert_int_equal(jd_h5md_write_frame(h, &nopos, err, sizeof err), -1);
     assert_true(err[0] != 0);
     write_frames(h, 1, 3u);
     /* changing the set of arrays after the first frame is refused */
     double pos[3 * NP] = {0};
-    jd_h5md_frame fr = {1, 1.0, pos, NULL, NULL, NULL, NULL};
+    jd_h5md_frame fr = {1, 1.0, pos, NULL, NULL, NULL, NULL, NULL};
     err[0] = 0;
     assert_int_equal(jd_h5md_write_frame(h, &fr, err, sizeof err), -1);
     assert_non_null(strstr(err, "velocity"));

@@ -40,7 +40,7 @@ static void connectivity_roundtrip(void **state) {
     const int64_t id[3] = {1, 2, 3};
     const int32_t sp[3] = {0, 0, 0};
     const double r[3] = {1e-3, 1e-3, 1e-3}, m[3] = {1e-6, 1e-6, 1e-6};
-    const jd_h5md_particles p = {3, id, sp, r, m};
+    const jd_h5md_particles p = {3, id, sp, r, m, 0};
     const jd_h5md_meta meta = {.creator = "test", .dt = 1e-6};
     jd_h5md *h = jd_h5md_create(path, &meta, &p, err, sizeof err);
     if (!h) fail_msg("create: %s", err);

@@ -29,6 +29,7 @@ int run_guard_tests(void);
 int run_bond_tests(void);
 int run_laws_tests(void);
 int run_h5md_bonds_tests(void);
+int run_h5md_output_tests(void); /* test_h5md_output.c */
 int run_hugepages_tests(void);
 
 #endif
