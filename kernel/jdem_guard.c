@@ -6,14 +6,15 @@
  * per sphere).  By the block Gershgorin theorem (Feingold & Varga 1962) that eigenvalue is at most
  * max_i sum_{contacts c of i} (||D_ci|| + ||O_c||), D_ci the block a contact adds on particle i's
  * diagonal and O_c the block coupling it to its partner.  With the secant stiffness K = k_n
- * sqrt(delta) of Jiang's law, the normal tangent stiffness is 3/2 K, the tangential spring K
- * (K_t = K_n, Sec. 2.3.2) acting at the lever arm R, and the rolling spring K r_roll^2:
- *   ||D_ai|| <= max(3/2 K/m_a, K (1/m_a + R_a^2/I_a)) + K r_roll^2/I_a
- *   ||O||    <= max(3/2 K/sqrt(m_a m_b), K sqrt((1/m_a + R_a^2/I_a)(1/m_b + R_b^2/I_b)))
+ * sqrt(delta) of Jiang's law, the normal tangent stiffness is 3/2 K, the tangential spring K_t
+ * (K_t = K, Sec. 2.3.2, or Mindlin's 8 G* sqrt(R* delta), which exceeds K: 3(1-nu)/(2-nu) K for
+ * like materials) acting at the lever arm R, and the rolling spring K r_roll^2:
+ *   ||D_ai|| <= max(3/2 K/m_a, K_t (1/m_a + R_a^2/I_a)) + K r_roll^2/I_a
+ *   ||O||    <= max(3/2 K/sqrt(m_a m_b), K_t sqrt((1/m_a + R_a^2/I_a)(1/m_b + R_b^2/I_b)))
  *               + K r_roll^2/sqrt(I_a I_b)
  * (the normal and the two tangential directions are orthogonal in the mass-scaled coordinates,
  * so their parts combine by max; the rolling part is added).  For two equal spheres without
- * rolling this is exact: omega^2 = 7 K/m, the coupled sliding-rolling mode.  K is taken at the
+ * rolling this is exact: omega^2 = 7 K_t/m, the coupled sliding-rolling mode.  K is taken at the
  * peak overlap of an impact at max_impact_speed, and a particle is assumed to carry
  * `coordination` contacts of the stiffest kind its species has.  Viscous damping of ratio zeta
  * lowers the limit of the central-difference scheme to (2/omega)(sqrt(1 + zeta^2) - zeta).
@@ -46,12 +47,20 @@ static side side_of(double R, double rho) {
 }
 
 /* Gershgorin row sum ||D_a|| + ||O|| of one contact of a (b NULL: a wall) with secant
- * stiffness K and rolling arm r [1/s^2]. */
-static double row_sum(const side *a, const side *b, double K, double r) {
+ * stiffness K, tangential stiffness Kt and rolling arm r [1/s^2]. */
+static double row_sum(const side *a, const side *b, double K, double Kt, double r) {
     const double Kr = K * r * r;
-    double s = fmax(1.5 * K / a->m, K * a->mob) + Kr / a->I;
-    if (b) s += fmax(1.5 * K / sqrt(a->m * b->m), K * sqrt(a->mob * b->mob)) + Kr / sqrt(a->I * b->I);
+    double s = fmax(1.5 * K / a->m, Kt * a->mob) + Kr / a->I;
+    if (b) s += fmax(1.5 * K / sqrt(a->m * b->m), Kt * sqrt(a->mob * b->mob)) + Kr / sqrt(a->I * b->I);
     return s;
+}
+
+/* The tangential stiffness at overlap delta of a contact with secant stiffness K, effective
+ * radius r_star and Mindlin's share of 1/G* of each side (jd_shear_compliance; a wall's is 0). */
+static double tangential_k(int rule, double K, double share_a, double share_b, double r_star,
+                           double delta) {
+    if (rule != JD_KT_MINDLIN) return K;
+    return 8.0 / (share_a + share_b) * sqrt(r_star * delta);
 }
 
 static void tighten(jd_guard_result *r, double dt, double bound, int which) {
@@ -81,6 +90,7 @@ void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
         if (!(v > 0.0)) continue; /* nothing moves: no impact to resolve */
         const side pa = side_of(sa->rmin, sa->density);
         const double kp_a = jd_hertz_prefactor(sa->E, sa->nu, sa->rmin);
+        const double share_a = jd_shear_compliance(sa->E, sa->nu);
         for (size_t b = 0; b < in->n_species; b++) {
             const jd_guard_species *sb = &in->species[b];
             if (!sb->count || (b == a && sa->count < 2)) continue;
@@ -88,14 +98,18 @@ void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
             const double m_eff = pa.m * pb.m / (pa.m + pb.m);
             const double kn = jd_kn_pair(kp_a, jd_hertz_prefactor(sb->E, sb->nu, sb->rmin));
             out->contact_time = fmin(out->contact_time, jd_hertz_contact_time(m_eff, kn, v));
-            const double K = kn * sqrt(jd_hertz_peak_overlap(m_eff, kn, v));
-            omega2 = fmax(omega2, row_sum(&pa, &pb, K, sa->rmin * sb->rmin / (sa->rmin + sb->rmin)));
+            const double d = jd_hertz_peak_overlap(m_eff, kn, v), K = kn * sqrt(d);
+            const double r = sa->rmin * sb->rmin / (sa->rmin + sb->rmin);
+            const double Kt = tangential_k(in->tangential_rule, K, share_a,
+                                           jd_shear_compliance(sb->E, sb->nu), r, d);
+            omega2 = fmax(omega2, row_sum(&pa, &pb, K, Kt, r));
         }
         if (in->has_walls) {
             const double kw = jd_kn_wall(in->wall_rule, sa->E, sa->nu, sa->rmin);
             out->contact_time = fmin(out->contact_time, jd_hertz_contact_time(pa.m, kw, v));
-            const double K = kw * sqrt(jd_hertz_peak_overlap(pa.m, kw, v));
-            omega2 = fmax(omega2, row_sum(&pa, NULL, K, sa->rmin));
+            const double d = jd_hertz_peak_overlap(pa.m, kw, v), K = kw * sqrt(d);
+            const double Kt = tangential_k(in->tangential_rule, K, share_a, 0.0, sa->rmin, d);
+            omega2 = fmax(omega2, row_sum(&pa, NULL, K, Kt, sa->rmin));
         }
     }
     out->contact_bound = out->contact_time / JD_GUARD_STEPS_PER_CONTACT;

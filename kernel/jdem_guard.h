@@ -46,6 +46,8 @@ typedef struct jd_guard_input {
     size_t n_species;
     int has_walls;           /* any wall the particles may touch */
     int wall_rule;           /* jd_wall_rule (jdem_kernel.h) */
+    int tangential_rule;     /* jd_tangential_rule (jdem_kernel.h): which K_t the tangential
+                                spring has */
     double max_impact_speed; /* fastest relative impact to resolve [m/s]; 0: nothing moves */
     double coordination;     /* expected maximum contacts of one particle [-], >= 1 */
     double damping_ratio;    /* largest viscous damping ratio gamma of any pair [-], >= 0 */

@@ -55,8 +55,20 @@ enum {
     JD_F_FRICTION = 1u << 1, /* cumulative tangential spring with Coulomb cap (mu > 0)           */
     JD_F_ROLLING = 1u << 2,  /* rolling resistance spring with cap (eta > 0)                     */
     JD_F_MU_R = 1u << 3,     /* mu_R != 1: reduced rotational slip while sliding (eq. 76)        */
-    JD_F_ENERGY = 1u << 4    /* accumulate the dissipated energies in the contact state          */
+    JD_F_ENERGY = 1u << 4,   /* accumulate the dissipated energies in the contact state          */
+    JD_F_MINDLIN = 1u << 5   /* Mindlin's K_t = 8 G* sqrt(R* delta) instead of K_t = K_n (§4.5)   */
 };
+
+/* The laws that read jd_contact_geom.r_roll (the rolling radius, which is also R* of Mindlin's
+ * K_t): an engine fills it when the law set has one of these bits. */
+#define JD_F_READS_R_STAR (JD_F_ROLLING | JD_F_MINDLIN)
+
+/* Tangential stiffness rule (§4.5). */
+typedef enum {
+    JD_KT_JIANG2021 = 0, /* K_t = K_n, the seed's Sec. 2.3.2 (default)                         */
+    JD_KT_MINDLIN = 1    /* K_t = 8 G* sqrt(R* delta), G* from both materials as LIGGGHTS'
+                            hertz model computes it (jd_shear_compliance)                     */
+} jd_tangential_rule;
 
 /* How the stored tangential displacement xi behaves while sliding (§4.4). */
 typedef enum {
@@ -86,7 +98,20 @@ typedef struct jd_pair_coeffs {
     double eta;    /* rolling friction coefficient, dimensionless (cap = eta * r_roll * F_n)      */
     double mu_r;   /* rotational-slip reduction factor while sliding, in [0, 1] (eq. 76)          */
     int xi_limit;  /* jd_xi_limit                                                                  */
+    double g_star; /* effective shear modulus G* of Mindlin's K_t (JD_F_MINDLIN) [Pa]: of the pair
+                      of materials, or, in the copy jd_wall_coeffs makes, of the particle's
+                      material against a rigid wall                                              */
+    double g_wall; /* G* of the first material against a rigid wall [Pa]                         */
 } jd_pair_coeffs;
+
+/* The coefficients of a sphere–wall contact from its entry (particle material, wall material):
+ * walls are rigid in both wall rules (jd_kn_wall takes the particle's E and nu only), so
+ * Mindlin's G* is the particle's against a rigid body. */
+static inline jd_pair_coeffs jd_wall_coeffs(const jd_pair_coeffs *c) {
+    jd_pair_coeffs w = *c;
+    w.g_star = c->g_wall;
+    return w;
+}
 
 /* ------------------------------------------------------------------------------------------ */
 /* Geometry and kinematics of one contact at the current step (filled by the engine).          */
@@ -99,7 +124,8 @@ typedef struct jd_contact_geom {
     double k_n;    /* Hertz prefactor: K_n = k_n sqrt(delta), F_el = k_n delta^1.5        [N/m^1.5] */
     double m_eff;  /* effective mass m_a m_b/(m_a+m_b); wall: m_a                          [kg]   */
     double i_eff;  /* effective moment of inertia I_a I_b/(I_a+I_b); wall: I_a             [kg m^2] */
-    double r_roll; /* rolling radius R_a R_b/(R_a+R_b); wall: R_a                          [m]    */
+    double r_roll; /* rolling radius R_a R_b/(R_a+R_b); wall: R_a; also R* of Mindlin's K_t
+                      (read only with JD_F_READS_R_STAR)                                   [m]    */
 } jd_contact_geom;
 
 typedef struct jd_kinematics {
@@ -181,6 +207,12 @@ static inline double jd_kn_pair(double kp_a, double kp_b) {
 static inline double jd_kn_wall(int wall_rule, double E, double nu, double R) {
     if (wall_rule == JD_WALL_JIANG2021) return 2.0 * jd_hertz_prefactor(E, nu, R);
     return 4.0 / 3.0 * E / (1.0 - nu * nu) * sqrt(R);
+}
+
+/* One material's share of Mindlin's 1/G*: 2 (2 - nu)(1 + nu)/E [1/Pa], as LIGGGHTS' Geff
+ * (1/G* = the sum over both materials; a rigid body's share is 0). */
+static inline double jd_shear_compliance(double E, double nu) {
+    return 2.0 * (2.0 - nu) * (1.0 + nu) / E;
 }
 
 /* Mass and moment of inertia of a solid sphere, written exactly as LIGGGHTS computes them
@@ -389,10 +421,25 @@ static JD_ALWAYS_INLINE void jd_law_normal(const unsigned features, const jd_pai
     nl->carries = !still_ended & !nl->ends;
 }
 
-/* Tangential stiffness K_t from the normal law: K_t = K_n (Sec. 2.3.2), hence C_t = C_n
- * (eq. 29). */
-static JD_ALWAYS_INLINE double jd_tangential_stiffness(const jd_normal *nl) { return nl->Kn; }
-static JD_ALWAYS_INLINE double jd_tangential_damping(const jd_normal *nl) { return nl->Cn; }
+/* Tangential stiffness K_t [N/m] (§4.5): the seed's K_t = K_n (Sec. 2.3.2), or with
+ * JD_F_MINDLIN Mindlin's K_t = 8 G* sqrt(R* delta) (c->g_star, R* = g->r_roll). */
+static JD_ALWAYS_INLINE double jd_tangential_stiffness(const unsigned features,
+                                                       const jd_pair_coeffs *c,
+                                                       const jd_contact_geom *g,
+                                                       const jd_normal *nl) {
+    if (features & JD_F_MINDLIN) return 8.0 * c->g_star * sqrt(g->r_roll * g->delta);
+    return nl->Kn;
+}
+
+/* Tangential dashpot C_t = 2 gamma sqrt(m_eff K_t) (eq. 29) [N s/m]: C_n itself when K_t = K_n
+ * (the same expression), zero without JD_F_DAMPING. */
+static JD_ALWAYS_INLINE double jd_tangential_damping(const unsigned features,
+                                                     const jd_pair_coeffs *c,
+                                                     const jd_contact_geom *g,
+                                                     const jd_normal *nl, double Kt) {
+    if (!(features & JD_F_MINDLIN)) return nl->Cn;
+    return (features & JD_F_DAMPING) ? 2.0 * c->gamma * sqrt(g->m_eff * Kt) : 0.0;
+}
 
 /* Tangential law (§4): the cumulative spring on h->xi, turned into the tangent plane, with its
  * dashpot and Coulomb cap mu F_n; with JD_F_MU_R only mu_R of the rotational slip acts on the
@@ -415,7 +462,8 @@ static JD_ALWAYS_INLINE void jd_law_tangential(const unsigned features, const jd
             vt_law[d] = was_sliding ? vt_law[d] - red * (wr[d] - wrn * g->n[d]) : vt_law[d];
     }
     jd_rotate_into_plane(h->xi, g->n);
-    const double Kt = jd_tangential_stiffness(nl), Ct = jd_tangential_damping(nl);
+    const double Kt = jd_tangential_stiffness(features, c, g, nl);
+    const double Ct = jd_tangential_damping(features, c, g, nl, Kt);
     double ft[3];
     const int sliding = jd_capped_spring(h->xi, vt_law, Kt, Ct, c->mu * nl->fn, dt, c->xi_limit, ft);
     h->flags = sliding ? (double)JD_S_SLIDING : 0.0;
@@ -437,7 +485,8 @@ static JD_ALWAYS_INLINE void jd_law_rolling(const unsigned features, const jd_pa
                                      const jd_contact_geom *g, const jd_contact_motion *m,
                                      const jd_normal *nl, double dt, jd_contact_step *h,
                                      double m_roll[3], double *u, double *dash) {
-    const double Kr = nl->Kn * g->r_roll * g->r_roll; /* K_r = K_t r^2 */
+    /* K_r = K_t r^2 with the seed's K_t = K_n, whatever the tangential rule (§4.5) */
+    const double Kr = nl->Kn * g->r_roll * g->r_roll;
     const double Cr = (features & JD_F_DAMPING) ? 2.0 * c->gamma * sqrt(g->i_eff * Kr) : 0.0;
     const int rsl = jd_capped_spring(h->theta, m->wrel, Kr, Cr, c->eta * g->r_roll * nl->fn, dt,
                                      c->xi_limit, m_roll);

@@ -20,7 +20,9 @@ _Static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double) &&
                    JD_AT(jd_bond_state, e_break) == JD_BOND_STATE_LEN - 1,
                "the kernel's bond state is a plain array of doubles, the law's fields first");
 
-const char *const jd_law_names[JD_N_LAWS] = {"damping", "friction", "rolling", "mu_r", "energy"};
+const char *const jd_law_names[JD_N_LAWS] = {"damping", "friction", "rolling",
+                                             "mu_r",    "energy",   "mindlin"};
+_Static_assert(JD_F_MINDLIN == 1u << (JD_N_LAWS - 1), "one name per JD_F_* bit, in bit order");
 
 #define JD_LAW_SET_CASE(bits) \
     case (bits):              \
@@ -54,7 +56,8 @@ char *jd_law_set_describe(unsigned bits, char *buf, size_t len) {
 
 unsigned jd_law_set_select(size_t nm, const double *restitution, const double *friction,
                            const double *rolling_friction, const unsigned char *in_particles,
-                           const unsigned char *in_walls, double mu_r, int energy) {
+                           const unsigned char *in_walls, double mu_r, int tangential_rule,
+                           int energy) {
     unsigned laws = 0u;
     for (size_t a = 0; a < nm; a++) {
         if (!in_particles[a]) continue;
@@ -65,19 +68,33 @@ unsigned jd_law_set_select(size_t nm, const double *restitution, const double *f
         }
     }
     if ((laws & JD_F_FRICTION) && mu_r != 1.0) laws |= JD_F_MU_R;
+    if ((laws & JD_F_FRICTION) && tangential_rule == JD_KT_MINDLIN) laws |= JD_F_MINDLIN;
     if (energy) laws |= JD_F_ENERGY;
     return laws;
 }
 
+/* A material's share of 1/G* (jd_shear_compliance), 0 for a rigid one (E <= 0). */
+static double shear_share(double E, double nu) { return E > 0.0 ? jd_shear_compliance(E, nu) : 0.0; }
+
+/* 1/(sum of the shares), 0 when both are rigid. */
+static double g_star_of(double share_a, double share_b) {
+    const double s = share_a + share_b;
+    return s > 0.0 ? 1.0 / s : 0.0;
+}
+
 void jd_pair_coeffs_table(size_t nm, const double *restitution, const double *friction,
-                          const double *rolling_friction, int damping_map, double mu_r,
-                          int xi_limit, jd_pair_coeffs *out) {
+                          const double *rolling_friction, const double *E, const double *nu,
+                          int damping_map, double mu_r, int xi_limit, jd_pair_coeffs *out) {
     const size_t nn = nm * nm;
     for (size_t k = 0; k < nn; k++) {
         size_t q = 0;
         while (q < k && restitution[q] != restitution[k]) q++;
         const double gamma = q < k ? out[q].gamma : jd_gamma_for(damping_map, restitution[k]);
+        const double share_a = shear_share(E[k / nm], nu[k / nm]);
+        const double share_b = shear_share(E[k % nm], nu[k % nm]);
         out[k] = (jd_pair_coeffs){.gamma = gamma, .mu = friction[k], .eta = rolling_friction[k],
-                                  .mu_r = mu_r, .xi_limit = xi_limit};
+                                  .mu_r = mu_r, .xi_limit = xi_limit,
+                                  .g_star = g_star_of(share_a, share_b),
+                                  .g_wall = g_star_of(share_a, 0.0)};
     }
 }

@@ -24,26 +24,30 @@ extern "C" {
 /* dispatcher expands JD_LAW_SETS(X) into its cases (a switch, template instantiations), so    */
 /* that each set has one specialised copy of the force loops and no other copy is compiled.   */
 /* A new law set is one line of JD_LAW_SETS_WITH.  mu_R modifies the tangential law only, so   */
-/* JD_F_MU_R comes with JD_F_FRICTION; every set exists with and without the energy            */
+/* JD_F_MU_R comes with JD_F_FRICTION; so does JD_F_MINDLIN, which changes the tangential      */
+/* spring only (JD_LAW_SETS_TANGENTIAL); every set exists with and without the energy          */
 /* bookkeeping.                                                                                */
 /* ------------------------------------------------------------------------------------------ */
-#define JD_LAW_SETS_WITH(X, E)                                                 \
-    X((E) | 0u)                                                                \
-    X((E) | JD_F_DAMPING)                                                      \
+#define JD_LAW_SETS_TANGENTIAL(X, E)                                           \
     X((E) | JD_F_FRICTION)                                                     \
     X((E) | JD_F_DAMPING | JD_F_FRICTION)                                      \
-    X((E) | JD_F_ROLLING)                                                      \
-    X((E) | JD_F_DAMPING | JD_F_ROLLING)                                       \
     X((E) | JD_F_FRICTION | JD_F_ROLLING)                                      \
     X((E) | JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING)                       \
     X((E) | JD_F_FRICTION | JD_F_MU_R)                                         \
     X((E) | JD_F_DAMPING | JD_F_FRICTION | JD_F_MU_R)                          \
     X((E) | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R)                          \
     X((E) | JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R)
+#define JD_LAW_SETS_WITH(X, E)                                                 \
+    X((E) | 0u)                                                                \
+    X((E) | JD_F_DAMPING)                                                      \
+    X((E) | JD_F_ROLLING)                                                      \
+    X((E) | JD_F_DAMPING | JD_F_ROLLING)                                       \
+    JD_LAW_SETS_TANGENTIAL(X, E)                                               \
+    JD_LAW_SETS_TANGENTIAL(X, (E) | JD_F_MINDLIN)
 #define JD_LAW_SETS(X) JD_LAW_SETS_WITH(X, 0u) JD_LAW_SETS_WITH(X, JD_F_ENERGY)
 
 /* Every JD_F_* bit, for masking a law set. */
-#define JD_F_ALL (JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY)
+#define JD_F_ALL (JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY | JD_F_MINDLIN)
 
 /* The bond law's sets (kernel/jdem_bond.h, JD_B_*), expanded the same way by the bond loops. */
 #define JD_BOND_LAW_SETS(X) X(0u) X(JD_B_DAMPING) X(JD_B_ENERGY) X(JD_B_DAMPING | JD_B_ENERGY)
@@ -52,8 +56,8 @@ extern "C" {
 int jd_law_set_valid(unsigned bits);
 
 /* The names of the JD_F_* bits, in bit order, as the engines report a law set ("damping",
- * "friction", "rolling", "mu_r", "energy"). */
-#define JD_N_LAWS 5
+ * "friction", "rolling", "mu_r", "energy", "mindlin"). */
+#define JD_N_LAWS 6
 extern const char *const jd_law_names[JD_N_LAWS];
 
 /* The law set as text: the names of its bits joined by '+', or "elastic" for none; into buf
@@ -77,20 +81,25 @@ static inline unsigned jd_interaction_laws(double restitution, double friction,
 /* The law set of a run over nm materials: the union of the laws of every interaction that can
  * occur, that is of a material a that some particle has (in_particles[a] != 0) against a
  * material b that some particle or wall has (in_particles[b] or in_walls[b]; in_walls may be
- * NULL: no walls); restitution, friction and rolling_friction are nm x nm, row-major.  Then
- * JD_F_MU_R when the run has friction and mu_r != 1, and JD_F_ENERGY when energy is set.  The
- * result is always one of JD_LAW_SETS. */
+ * NULL: no walls); restitution, friction and rolling_friction are nm x nm, row-major.  Then,
+ * when the run has friction, JD_F_MU_R if mu_r != 1 and JD_F_MINDLIN if tangential_rule is
+ * JD_KT_MINDLIN (jd_tangential_rule); JD_F_ENERGY when energy is set.  The result is always one
+ * of JD_LAW_SETS. */
 unsigned jd_law_set_select(size_t nm, const double *restitution, const double *friction,
                            const double *rolling_friction, const unsigned char *in_particles,
-                           const unsigned char *in_walls, double mu_r, int energy);
+                           const unsigned char *in_walls, double mu_r, int tangential_rule,
+                           int energy);
 
 /* The coefficients of every ordered pair of nm materials into out (nm x nm, row-major, like the
  * three input tables): gamma from the restitution by the damping map (jd_gamma_for, mapped once
- * per distinct value: the exact mapping costs up to ~50 ms), mu, eta, and the run's mu_r and
- * xi_limit. */
+ * per distinct value: the exact mapping costs up to ~50 ms), mu, eta, the run's mu_r and
+ * xi_limit, and Mindlin's G* from the materials' Young's moduli E [Pa] and Poisson's ratios nu
+ * (nm each): g_star of the pair, g_wall of the first material against a rigid wall.  A material
+ * with E <= 0 (no elastic properties: a wall-only material) counts as rigid; G* of two rigid
+ * materials is 0 (no such contact exists). */
 void jd_pair_coeffs_table(size_t nm, const double *restitution, const double *friction,
-                          const double *rolling_friction, int damping_map, double mu_r,
-                          int xi_limit, jd_pair_coeffs *out);
+                          const double *rolling_friction, const double *E, const double *nu,
+                          int damping_map, double mu_r, int xi_limit, jd_pair_coeffs *out);
 
 /* ------------------------------------------------------------------------------------------ */
 /* The history record a law set keeps per contact.                                             */

@@ -101,6 +101,7 @@ void FixJdemGuard::setup(int) {
   in.n_species = (size_t)nt;
   in.has_walls = walls;
   in.wall_rule = pair->wall_rule;
+  in.tangential_rule = pair->tangential_rule;
   in.max_impact_speed = vmax;
   in.coordination = coordination;
   in.damping_ratio = jd_guard_damping_ratio(sp.data(), (size_t)nt, pair->restitution_table(),

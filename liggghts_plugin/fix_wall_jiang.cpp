@@ -295,7 +295,8 @@ void FixWallJiang::loop(bool commit) {
     jd_contact_result out;
     double f_prev[3] = {0.0, 0.0, 0.0};
     if (F & JD_F_ENERGY) jd_copy3(f_prev, hs.st->f_prev);
-    const int carries = jd_contact(F, &pair->coeffs(type[i], wtype), &g, &k, dt, hs.st, hs.rs, &out);
+    const jd_pair_coeffs co = jd_wall_coeffs(&pair->coeffs(type[i], wtype));
+    const int carries = jd_contact(F, &co, &g, &k, dt, hs.st, hs.rs, &out);
     if (F & JD_F_ENERGY) {
       /* f_prev is booked only with the energies; the work also over the step a contact ends */
       work += jd_wall_work(f_prev, out.f, vel, dt);

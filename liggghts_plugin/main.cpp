@@ -174,6 +174,7 @@ static const char *jdem_help =
     "* Pair styles:  gran/jiang   [wall_rule hertz|jiang2021] [damping jiang2021|exact_restitution]\n"
     "                             [tangential_limit coulomb|unconstrained] [mu_r X] [rolling on|off]\n"
     "                             [energy yes|no]   (no: no energy accounts, a shorter history)\n"
+    "                             [tangential_stiffness jiang2021|mindlin]\n"
     "* Fix styles:   wall/jiang   plane corners x1 y1 z1 ... x4 y4 z4 type T [velocity vx vy vz]\n"
     "                             cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T\n"
     "                                 [velocity vx vy vz]\n"

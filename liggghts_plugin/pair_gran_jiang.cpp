@@ -34,7 +34,7 @@ using namespace LAMMPS_NS;
 
 PairGranJiang::PairGranJiang(LAMMPS *lmp)
     : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
-      xi_limit(JD_XI_COULOMB), mu_r(1.0), rolling(false), energy_accounts(true), energy(false),
+      xi_limit(JD_XI_COULOMB), tangential_rule(JD_KT_JIANG2021), mu_r(1.0), rolling(false), energy_accounts(true), energy(false),
       e_damp_cum(0.0), e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
       features_(0), ntypes_(0), kp_ncalls_(-1), kp_nall_(-1), script_checked_(false) {}
 
@@ -56,6 +56,11 @@ void PairGranJiang::settings(int narg, char **arg) {
       if (val == "coulomb") xi_limit = JD_XI_COULOMB;
       else if (val == "unconstrained") xi_limit = JD_XI_UNCONSTRAINED;
       else error->all(FLERR, "pair_style gran/jiang: tangential_limit must be coulomb or unconstrained");
+    } else if (k == "tangential_stiffness") {
+      if (val == "jiang2021") tangential_rule = JD_KT_JIANG2021;
+      else if (val == "mindlin") tangential_rule = JD_KT_MINDLIN;
+      else error->all(FLERR, ("pair_style gran/jiang: tangential_stiffness must be jiang2021 or mindlin, not '" +
+                              val + "'").c_str());
     } else if (k == "mu_r") {
       mu_r = force->numeric(FLERR, arg[i + 1]);
       if (!(mu_r >= 0.0 && mu_r <= 1.0)) error->all(FLERR, "pair_style gran/jiang: mu_r must be in [0, 1]");
@@ -69,7 +74,8 @@ void PairGranJiang::settings(int narg, char **arg) {
       else error->all(FLERR, "pair_style gran/jiang: energy must be yes or no");
     } else {
       error->all(FLERR, ("pair_style gran/jiang: unknown option '" + k +
-                         "' (valid: wall_rule, damping, tangential_limit, mu_r, rolling, energy)").c_str());
+                         "' (valid: wall_rule, damping, tangential_limit, mu_r, rolling, energy, "
+                         "tangential_stiffness)").c_str());
     }
   }
 
@@ -137,8 +143,8 @@ void PairGranJiang::init_granular() {
         error->all(FLERR, "gran/jiang: friction coefficients must be >= 0");
     }
   std::vector<jd_pair_coeffs> table(nt * nt);
-  jd_pair_coeffs_table(nt, &restitution_[0], &friction_[0], &rolling_friction_[0], damping_map,
-                       mu_r, xi_limit, &table[0]);
+  jd_pair_coeffs_table(nt, &restitution_[0], &friction_[0], &rolling_friction_[0], &E_[1],
+                       &nu_[1], damping_map, mu_r, xi_limit, &table[0]);
   coeffs_.assign((nt + 1) * (nt + 1), jd_pair_coeffs());
   for (int i = 1; i <= nt; i++)
     for (int j = 1; j <= nt; j++) coeffs_[i * (nt + 1) + j] = table[(i - 1) * nt + (j - 1)];
@@ -181,7 +187,7 @@ void PairGranJiang::update_law_set(bool report) {
     if (w && w->wall_type() >= 1 && w->wall_type() <= nt) walls[w->wall_type() - 1] = 1;
   }
   features_ = jd_law_set_select(nt, &restitution_[0], &friction_[0], &rolling_friction_[0],
-                                &types_in_use_[0], &walls[0], mu_r, energy);
+                                &types_in_use_[0], &walls[0], mu_r, tangential_rule, energy);
   if ((features_ & JD_F_ROLLING) && !rolling)
     error->all(FLERR, "pair_style gran/jiang: coefficientRollingFriction is > 0 for a pair of types "
                       "in use, which needs the rolling law and its history: add 'rolling on' to "

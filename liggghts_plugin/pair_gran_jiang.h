@@ -3,7 +3,7 @@
  *
  *   pair_style gran/jiang [wall_rule hertz|jiang2021] [damping jiang2021|exact_restitution]
  *                         [tangential_limit coulomb|unconstrained] [mu_r X] [rolling on|off]
- *                         [energy yes|no]
+ *                         [energy yes|no] [tangential_stiffness jiang2021|mindlin]
  *   pair_coeff * *
  *
  * energy no: the contact history keeps no energy accounts (4 doubles per contact instead of 11,
@@ -42,7 +42,7 @@ class PairGranJiang : public PairGran {
   virtual double stressStrainExponent() { return 1.5; }
 
   /* Model options (kernel enums) and the feature bits of the force loop. */
-  int wall_rule, damping_map, xi_limit;
+  int wall_rule, damping_map, xi_limit, tangential_rule;
   double mu_r;
   bool rolling;
   bool energy_accounts; /* keyword energy: the history has room for the energy bookkeeping */

@@ -6,6 +6,9 @@
     chung_ooi.py analyse --out out/chung_ooi [--tests ...] [--engines ...] [--quick]
     chung_ooi.py check   --out out/chung_ooi
 
+`--model OPTION=VALUE` (run, analyse; repeatable) runs every test with that `model:` option set
+(the scenes are written to OUT/scenes/), e.g. `--model tangential_stiffness=mindlin`.
+
 `run` runs every case of reference_runs/chung_ooi/testN/scene.yaml (`build/jdem cases SCENE`)
 into OUT/testN/CASE.ENGINE.h5, then does what `analyse` does: it reads the trajectories, writes
 OUT/summary.json (one record per metric, with its reference and error), one figure per test
@@ -34,6 +37,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from benchmark.analysis import analyse_all  # noqa: E402
+from benchmark import cases  # noqa: E402
 from benchmark.cases import ENGINE_LABEL, LIGGGHTS, LIGGGHTS_RUN, ROOT, TESTS  # noqa: E402
 from benchmark.figures import write_figure  # noqa: E402
 from benchmark.report import write_report  # noqa: E402
@@ -98,6 +102,13 @@ def cmd_check(args):
     return 1 if failures else 0
 
 
+def model_option(text):
+    option, sep, value = text.partition("=")
+    if not sep or not option or not value:
+        raise argparse.ArgumentTypeError(f"'{text}': expected OPTION=VALUE")
+    return option, value
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -108,6 +119,8 @@ def main(argv):
                        type=lambda s: [int(t) for t in s.split(",")])
         p.add_argument("--engines", default="jdem", type=parse_engines)
         p.add_argument("--quick", action="store_true", help="the representative subset QUICK_CASES")
+        p.add_argument("--model", action="append", default=[], type=model_option,
+                       help="OPTION=VALUE: a model option set in every scene")
         if name == "run":
             p.add_argument("--jobs", type=int, default=2)
     p = sub.add_parser("check")
@@ -119,6 +132,8 @@ def main(argv):
         if bad:
             parser.error(f"unknown test(s) {sorted(bad)}; valid: 1..8")
         os.makedirs(args.out, exist_ok=True)
+        if args.model:
+            cases.use_model_options(dict(args.model), args.out)
     return {"run": cmd_run, "analyse": cmd_analyse, "check": cmd_check}[args.command](args)
 
 

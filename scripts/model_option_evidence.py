@@ -14,29 +14,11 @@ import os
 import sys
 
 import numpy as np
-import yaml
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import chung_ooi  # noqa: E402  (the benchmark's runner and analysis, reused as they are)
 from benchmark import cases  # noqa: E402  (its scene_path is replaced per option value)
 
 SKIPPED_METRICS = {"run_wall_time_s", "force_at_end"}
-
-
-def scenes_with(option, value, work):
-    """A benchmark.cases.scene_path replacement returning each test's scene with model.OPTION set."""
-    def scene_path(test):
-        path = os.path.join(work, "scenes", f"test{test}.yaml")
-        if not os.path.exists(path):
-            os.makedirs(os.path.dirname(path), exist_ok=True)
-            with open(os.path.join(chung_ooi.ROOT, "reference_runs", "chung_ooi", f"test{test}",
-                                   "scene.yaml")) as f:
-                scene = yaml.safe_load(f)
-            scene.setdefault("model", {})[option] = value
-            with open(path, "w") as f:
-                yaml.safe_dump(scene, f)
-        return path
-    return scene_path
 
 
 def deviations(records):
@@ -59,7 +41,7 @@ def main():
     results = {}
     for value in args.values:
         work = os.path.join(chung_ooi.ROOT, "out", "evidence", args.option, value)
-        cases.scene_path = scenes_with(args.option, value, work)
+        cases.use_model_options({args.option: value}, work)
         chung_ooi.run_all(os.path.join(work, "out"), tests, ["jdem"], 2, False)
         records, _ = chung_ooi.analyse_all(os.path.join(work, "out"), tests, ["jdem"], False, [])
         results[value] = deviations(records)

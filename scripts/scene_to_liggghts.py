@@ -202,7 +202,8 @@ def watchdog_lines(scene, builtin):
 BENDING = {"potyondy_cundall": "I", "jiang2021_literal": "J_literal"}
 # the keywords of pair_style gran/jiang (docs/liggghts.md), as the resolved scene names them
 MODEL_CHOICES = {"wall_rule": ("hertz", "jiang2021"), "damping": ("jiang2021", "exact_restitution"),
-                 "tangential_limit": ("coulomb", "unconstrained")}
+                 "tangential_limit": ("coulomb", "unconstrained"),
+                 "tangential_stiffness": ("jiang2021", "mindlin")}
 
 
 def dump_path(path):
@@ -483,12 +484,15 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         L.append("\n# LIGGGHTS' built-in contact law (--builtin), not jdem's\n")
         L.append("pair_style      gran %s\n" % builtin_model)
     else:
-        L.append("\npair_style      gran/jiang wall_rule %s damping %s tangential_limit %s mu_r %s rolling %s%s\n" % (
+        L.append("\npair_style      gran/jiang wall_rule %s damping %s tangential_limit %s mu_r %s "
+                 "rolling %s tangential_stiffness %s%s\n" % (
             choice(model.get("wall_rule", "hertz"), MODEL_CHOICES["wall_rule"], "model.wall_rule"),
             choice(model.get("damping", "jiang2021"), MODEL_CHOICES["damping"], "model.damping"),
             choice(model.get("tangential_limit", "coulomb"), MODEL_CHOICES["tangential_limit"],
                    "model.tangential_limit"),
             num(model.get("mu_r", 1.0)), "on" if rolling else "off",
+            choice(model.get("tangential_stiffness", "jiang2021"), MODEL_CHOICES["tangential_stiffness"],
+                   "model.tangential_stiffness"),
             "" if energy_bookkeeping(scene) else " energy no"))
     L.append("pair_coeff      * *\n")
     L.append("neighbor        %s bin\n" % num(skin))

@@ -229,6 +229,23 @@ def friction_scene(jdem):
                             "45 deg; e = 0.8; friction 0 to 10.", R, (3.5355, 0.0, -3.5355), GLASS, e=0.8)
     base["particles"][0]["angular_velocity"] = [0.0, -500.0, 0.0]
     cases = {("mu%g" % mu).replace(".", "p"): {"interactions.0.friction": mu} for mu in (0.0, 0.1, 1.0, 10.0)}
+    return base, (finish(jdem, base, cases, wall_impact_duration) if jdem else None)
+
+
+def mindlin(base, name, description):
+    """The same scene with Mindlin's tangential stiffness, which the guard bounds (stiffer than
+    K_n: docs/model.md §4.5)."""
+    base = copy.deepcopy(base)
+    base["name"] = name
+    base["description"] = description
+    base["model"] = {"tangential_stiffness": "mindlin"}
+    return base
+
+
+def mindlin_friction_scene(jdem):
+    base, _ = friction_scene(None)
+    base = mindlin(base, "friction_mindlin", base["description"] + "  Mindlin's K_t = 8 G* sqrt(R* delta).")
+    cases = {("mu%g" % mu).replace(".", "p"): {"interactions.0.friction": mu} for mu in (0.1, 1.0, 10.0)}
     return base, finish(jdem, base, cases, wall_impact_duration)
 
 
@@ -280,7 +297,7 @@ def column_scene(jdem):
     return base, finish(jdem, base, {"n100": {}}, lambda doc: 2.0)
 
 
-def bed_scene(jdem):
+def bed_scene(jdem, tangential="jiang2021"):
     R, n, E, nu, rho = 0.001, 5, 7.0e10, 0.25, 2500.0
     L = 2 * R * n
     sigma = 10e6
@@ -310,6 +327,10 @@ def bed_scene(jdem):
                     walls=walls,
                     interactions=[{"materials": ["sphere", "wall"], "restitution": 0.5, "friction": 0.3}],
                     time={"max_impact_speed": float("%.3g" % v_eq)}, coordination=6)
+    if tangential == "mindlin":
+        base = mindlin(base, "dense_bed_mindlin", base["description"] + "  Mindlin's K_t = 8 G* "
+                       "sqrt(R* delta) (3(1 - nu)/(2 - nu) = 1.29 K_n): the guard bounds the stiffer "
+                       "tangential spring.")
     return base, finish(jdem, base, {"sc125": {}}, lambda doc: T)
 
 
@@ -350,7 +371,8 @@ def beam_scene(jdem):
 
 
 SCENES = [scale_scene, impact_speed_scene, grazing_scene, restitution_scene, friction_scene,
-          rolling_scene, pile_scene, column_scene, bed_scene, beam_scene]
+          rolling_scene, pile_scene, column_scene, bed_scene, beam_scene, mindlin_friction_scene,
+          lambda jdem: bed_scene(jdem, "mindlin")]
 
 
 def main():

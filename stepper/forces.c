@@ -323,14 +323,13 @@ static JD_ALWAYS_INLINE int batch_evaluate(jd_sim *s, const unsigned F, const in
             g.k_n = pc1.k_n;
             g.m_eff = pc1.m_eff;
             g.i_eff = (F & JD_F_ROLLING) ? pcr1.i_eff : 0.0;
-            g.r_roll = (F & JD_F_ROLLING) ? pcr1.r_roll : 0.0;
+            g.r_roll = (F & JD_F_READS_R_STAR) ? pcr1.r_roll : 0.0;
         } else { /* the pair's constants from the particles' (sim_pair_constants) */
             jd_geom_pair_material(F, &g, kp[i], kp[j], mass[i], mass[j], inertia[i], inertia[j]);
-            g.r_roll = (F & JD_F_ROLLING) ? jd_rolling_radius(ri, rj) : 0.0;
+            g.r_roll = (F & JD_F_READS_R_STAR) ? jd_rolling_radius(ri, rj) : 0.0;
         }
         const int32_t k_co = one_row ? s->pair_row : species[i] * (int32_t)nm + species[j];
-        const jd_pair_coeffs co = {coeffs[k_co].gamma, coeffs[k_co].mu, coeffs[k_co].eta,
-                                   coeffs[k_co].mu_r, coeffs[k_co].xi_limit};
+        const jd_pair_coeffs co = coeffs[k_co];
         jd_kinematics k;
         for (int d = 0; d < 3; d++) {
             k.va[d] = v[3 * i + d];
@@ -507,8 +506,7 @@ static JD_ALWAYS_INLINE void wall_batch_evaluate(const jd_sim *s, const unsigned
         g.r_roll = rad[i];
         jd_geom_wall_material(F, &g, kw[i], mass[i], inertia[i]);
         const int32_t k_co = B->k_co[b];
-        const jd_pair_coeffs co = {coeffs[k_co].gamma, coeffs[k_co].mu, coeffs[k_co].eta,
-                                   coeffs[k_co].mu_r, coeffs[k_co].xi_limit};
+        const jd_pair_coeffs co = jd_wall_coeffs(&coeffs[k_co]);
         jd_kinematics k;
         for (int d = 0; d < 3; d++) {
             k.va[d] = v[3 * i + d];
@@ -669,13 +667,14 @@ static double plain_wall_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1,
             k.vb[d] = w->v[d];
             k.wb[d] = 0.0;
         }
-        const jd_pair_coeffs *co = &s->coeffs[(size_t)s->species[i] * nm + (size_t)w->material];
+        const jd_pair_coeffs co =
+            jd_wall_coeffs(&s->coeffs[(size_t)s->species[i] * nm + (size_t)w->material]);
         jd_contact_state st;
         jd_rolling_state rs;
         hist_load(L, F, c, &st, &rs);
         jd_contact_result out;
         const double f_prev[3] = {st.f_prev[0], st.f_prev[1], st.f_prev[2]};
-        const int carries = jd_contact(F, co, &g, &k, s->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
+        const int carries = jd_contact(F, &co, &g, &k, s->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
         hist_store(L, F, c, &st, &rs);
         if (F & JD_F_ENERGY) work += jd_wall_work(f_prev, out.f, w->v, s->dt);
         if (!carries) continue;

@@ -36,9 +36,9 @@ static inline int sim_pair_touching(const jd_sim *s, int32_t i, int32_t j) {
 
 /* Sphere–sphere for particles i and j: returns 1 and fills g when the spheres overlap
  * (rsq < radsum^2).  The material fields are the pair's constants (sim_pair_constants), or the
- * scene's single set when the particles are all alike; i_eff and r_roll are only read by the
- * rolling law, so they are filled only with JD_F_ROLLING in features (a compile-time constant
- * at the call sites). */
+ * scene's single set when the particles are all alike; i_eff is only read by the rolling law
+ * and r_roll by it and Mindlin's K_t, so they are filled only with JD_F_ROLLING and
+ * JD_F_READS_R_STAR in features (a compile-time constant at the call sites). */
 static inline int sim_pair_geom(const jd_sim *s, const unsigned features, int32_t i,
                                 int32_t j, jd_contact_geom *g) {
     if (!jd_geom_spheres_contact(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
@@ -49,12 +49,8 @@ static inline int sim_pair_geom(const jd_sim *s, const unsigned features, int32_
     if (!s->alike) sim_pair_constants(s, i, j, &pc, &pcr);
     g->k_n = pc.k_n;
     g->m_eff = pc.m_eff;
-    if (features & JD_F_ROLLING) {
-        g->i_eff = pcr.i_eff;
-        g->r_roll = pcr.r_roll;
-    } else {
-        g->i_eff = g->r_roll = 0.0;
-    }
+    g->i_eff = (features & JD_F_ROLLING) ? pcr.i_eff : 0.0;
+    g->r_roll = (features & JD_F_READS_R_STAR) ? pcr.r_roll : 0.0;
     return 1;
 }
 

@@ -41,6 +41,7 @@ int sim_guard(const jd_scene *sc, jd_guard_input *in, jd_guard_species **species
             add_particle(&sp[sc->inlets[k].material[p]], sc->inlets[k].radius[p]);
     *in = (jd_guard_input){.species = sp, .n_species = sc->n_materials,
                            .has_walls = sc->n_walls > 0, .wall_rule = sc->wall_rule,
+                           .tangential_rule = sc->tangential_rule,
                            .max_impact_speed = sc->max_impact_speed,
                            .coordination = sc->coordination_number,
                            .damping_ratio = damping_ratio(sc, sp),

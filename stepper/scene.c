@@ -26,7 +26,8 @@ static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_s
                                          "coordination_number", NULL};
 static const char *const OUTPUT_KEYS[] = {"every", "observables_every", "compare_tolerance",
                                           "energy", NULL};
-static const char *const MODEL_KEYS[] = {"wall_rule", "damping", "tangential_limit", "mu_r", NULL};
+static const char *const MODEL_KEYS[] = {"wall_rule", "damping", "tangential_limit", "mu_r",
+                                         "tangential_stiffness", NULL};
 static const char *const WATCHDOG_KEYS[] = {"enabled", "max_overlap_fraction", "max_energy_jump",
                                             NULL};
 
@@ -34,10 +35,12 @@ static const char *const WATCHDOG_KEYS[] = {"enabled", "max_overlap_fraction", "
 static const char *const WALL_RULES[] = {"hertz", "jiang2021", NULL};
 static const char *const DAMPING_MAPS[] = {"jiang2021", "exact_restitution", NULL};
 static const char *const XI_LIMITS[] = {"coulomb", "unconstrained", NULL};
+static const char *const TANGENTIAL_RULES[] = {"jiang2021", "mindlin", NULL};
 static const char *const BOOLEANS[] = {"false", "true", NULL};
 _Static_assert(JD_WALL_HERTZ == 0 && JD_WALL_JIANG2021 == 1, "WALL_RULES order");
 _Static_assert(JD_DAMP_JIANG2021 == 0 && JD_DAMP_EXACT == 1, "DAMPING_MAPS order");
 _Static_assert(JD_XI_COULOMB == 0 && JD_XI_UNCONSTRAINED == 1, "XI_LIMITS order");
+_Static_assert(JD_KT_JIANG2021 == 0 && JD_KT_MINDLIN == 1, "TANGENTIAL_RULES order");
 
 /* ---------------------------------------------------------------------------------------- */
 /* Small helpers                                                                             */
@@ -202,9 +205,12 @@ static int read_model(loader *L) {
     s->damping_map = JD_DAMP_JIANG2021;
     s->xi_limit = JD_XI_COULOMB;
     s->mu_r = 1.0;
+    s->tangential_rule = JD_KT_JIANG2021;
     if (rc || sd_opt_enum(&L->c, m, "model", "wall_rule", WALL_RULES, &s->wall_rule) ||
         sd_opt_enum(&L->c, m, "model", "damping", DAMPING_MAPS, &s->damping_map) ||
-        sd_opt_enum(&L->c, m, "model", "tangential_limit", XI_LIMITS, &s->xi_limit))
+        sd_opt_enum(&L->c, m, "model", "tangential_limit", XI_LIMITS, &s->xi_limit) ||
+        sd_opt_enum(&L->c, m, "model", "tangential_stiffness", TANGENTIAL_RULES,
+                    &s->tangential_rule))
         return -1;
     return sd_opt_num(&L->c, m, "model", "mu_r", UNIT, &s->mu_r);
 }

@@ -138,6 +138,7 @@ typedef struct jd_scene {
     int damping_map;          /* jd_damping_map */
     int xi_limit;             /* jd_xi_limit */
     double mu_r;
+    int tangential_rule;      /* jd_tangential_rule (model.tangential_stiffness) */
 
     size_t n_materials;
     jd_material *materials;

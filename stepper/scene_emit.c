@@ -114,6 +114,7 @@ static int key_vec(yaml_emitter_t *e, const char *key, const double *v) {
 static const char *const WALL_RULES[] = {"hertz", "jiang2021"};
 static const char *const DAMPING_MAPS[] = {"jiang2021", "exact_restitution"};
 static const char *const XI_LIMITS[] = {"coulomb", "unconstrained"};
+static const char *const TANGENTIAL_RULES[] = {"jiang2021", "mindlin"};
 
 static int emit_watchdog(yaml_emitter_t *e, const jd_watchdog_limits *w) {
     return str(e, "watchdog") || map_start(e, 0) || str(e, "enabled") ||
@@ -137,6 +138,7 @@ static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
            key_str(e, "wall_rule", WALL_RULES[s->wall_rule]) ||
            key_str(e, "damping", DAMPING_MAPS[s->damping_map]) ||
            key_str(e, "tangential_limit", XI_LIMITS[s->xi_limit]) || key_num(e, "mu_r", s->mu_r) ||
+           key_str(e, "tangential_stiffness", TANGENTIAL_RULES[s->tangential_rule]) ||
            map_end(e) || emit_watchdog(e, &s->watchdog);
 }
 

@@ -21,13 +21,21 @@
 #endif
 
 /* The scene's interaction tables, as the kernel's rulebook reads them (jdem_laws.h): nm x nm
- * restitution, friction and rolling friction, row-major, in one block (free the first). */
-static double *interaction_tables(const jd_scene *sc, double **friction, double **rolling) {
-    const size_t nn = sc->n_materials * sc->n_materials;
-    double *e = malloc(3 * (nn ? nn : 1) * sizeof *e);
+ * restitution, friction and rolling friction, row-major, then the materials' Young's moduli and
+ * Poisson's ratios (nm each; a wall-only material's are 0), in one block (free the first). */
+static double *interaction_tables(const jd_scene *sc, double **friction, double **rolling,
+                                  double **youngs, double **poisson) {
+    const size_t nm = sc->n_materials, nn = nm * nm;
+    double *e = malloc((3 * nn + 2 * nm + 1) * sizeof *e);
     if (!e) return NULL;
     *friction = e + nn;
     *rolling = e + 2 * nn;
+    *youngs = e + 3 * nn;
+    *poisson = e + 3 * nn + nm;
+    for (size_t a = 0; a < nm; a++) {
+        (*youngs)[a] = sc->materials[a].youngs_modulus;
+        (*poisson)[a] = sc->materials[a].poisson_ratio;
+    }
     for (size_t k = 0; k < nn; k++) {
         e[k] = sc->interactions[k].restitution;
         (*friction)[k] = sc->interactions[k].friction;
@@ -42,21 +50,25 @@ static double *interaction_tables(const jd_scene *sc, double **friction, double 
 static int init_laws(jd_sim *s) {
     const jd_scene *sc = s->scene;
     const size_t nm = sc->n_materials, nn = nm * nm;
-    double *mu = NULL, *eta = NULL, *e = interaction_tables(sc, &mu, &eta);
+    double *mu = NULL, *eta = NULL, *E = NULL, *nu = NULL;
+    double *e = interaction_tables(sc, &mu, &eta, &E, &nu);
     unsigned char *used = calloc(2 * (nm ? nm : 1), 1), *wall_used = used + nm;
     s->n_materials = nm;
     s->coeffs = calloc(nn ? nn : 1, sizeof *s->coeffs);
     const int rc = (e && used && s->coeffs) ? 0 : -1;
     if (rc == 0) {
-        jd_pair_coeffs_table(nm, e, mu, eta, sc->damping_map, sc->mu_r, sc->xi_limit, s->coeffs);
+        jd_pair_coeffs_table(nm, e, mu, eta, E, nu, sc->damping_map, sc->mu_r, sc->xi_limit,
+                             s->coeffs);
         for (size_t i = 0; i < sc->n_particles; i++) used[sc->material[i]] = 1;
         for (size_t k = 0; k < sc->n_inlets; k++)
             for (size_t p = 0; p < sc->inlets[k].n; p++) used[sc->inlets[k].material[p]] = 1;
         for (size_t w = 0; w < sc->n_walls; w++) wall_used[sc->walls[w].material] = 1;
+        const unsigned mindlin = sc->tangential_rule == JD_KT_MINDLIN ? JD_F_MINDLIN : 0u;
         s->features = s->opt.all_laws
-                          ? JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R |
+                          ? JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | mindlin |
                                 (sc->energy ? JD_F_ENERGY : 0u)
-                          : jd_law_set_select(nm, e, mu, eta, used, wall_used, sc->mu_r, sc->energy);
+                          : jd_law_set_select(nm, e, mu, eta, used, wall_used, sc->mu_r,
+                                              sc->tangential_rule, sc->energy);
     }
     free(e);
     free(used);

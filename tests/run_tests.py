@@ -60,7 +60,8 @@ SUITES += [("pour", [PY, "tests/liggghts/check_pour.py"], "lines", {})]
 # tip-loaded stiff bonded beam at their own dt and at 10x the guard's dt, in both engines and in
 # the sanitized stepper.
 STABILITY_CASES = ("restitution/e0p01,grazing/a89p9,friction/mu10,impact_speed/v100,"
-                   "scale/E1e12_R10um,scale/co5_polyethylene,rolling/eta1,bonded_beam/tip_load")
+                   "scale/E1e12_R10um,scale/co5_polyethylene,rolling/eta1,bonded_beam/tip_load,"
+                   "friction_mindlin/mu10")
 SUITES += [
     ("stability", [PY, "scripts/stability.py", "--out", "out/test/stability", "--cases",
                    STABILITY_CASES, "--factors", "10"], "lines", {}),
@@ -87,6 +88,15 @@ SUITES += [
     ("chung-ooi", ["sh", "-c", f"{PY} scripts/chung_ooi.py run --quick --engines jdem,liggghts "
                    f"--out {CHUNG_OOI} && {PY} scripts/chung_ooi.py check --out {CHUNG_OOI}"],
      "lines", {}),
+]
+# Tests 5 and 8 with Mindlin's tangential stiffness: the same checks, the engines against each
+# other (engine_difference, 1e-10) among them.
+CHUNG_OOI_MINDLIN = "out/test/chung_ooi_mindlin"
+SUITES += [
+    ("chung-ooi-mindlin", ["sh", "-c", f"{PY} scripts/chung_ooi.py run --quick --tests 5,8 "
+                           f"--engines jdem,liggghts --model tangential_stiffness=mindlin "
+                           f"--out {CHUNG_OOI_MINDLIN} && {PY} scripts/chung_ooi.py check "
+                           f"--out {CHUNG_OOI_MINDLIN}"], "lines", {}),
 ]
 
 # The work-precision study reduced to Test 1 in the two engines of the Jiang kernel (`make

@@ -1,10 +1,13 @@
 """The eight Chung & Ooi tests: where their scenes, tools and trajectories live, their cases.
 
 `scene_path` is looked up through this module at call time (cases.scene_path), so a caller may
-replace it, as scripts/model_option_evidence.py does, and the runner and the case lists follow.
+replace it (use_model_options: chung_ooi.py --model, scripts/model_option_evidence.py), and the
+runner and the case lists follow.
 """
 import os
 import subprocess
+
+import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PY = "/usr/bin/python3"
@@ -34,6 +37,28 @@ QUICK_CASES = {
 
 def scene_path(test):
     return os.path.join(ROOT, "reference_runs", "chung_ooi", f"test{test}", "scene.yaml")
+
+
+reference_scene_path = scene_path
+
+
+def use_model_options(options, work):
+    """Replace scene_path by one returning each test's scene with the `model:` options set
+    (options: {OPTION: VALUE}), written once under WORK/scenes/."""
+    global scene_path
+    reference = reference_scene_path
+
+    def with_options(test):
+        path = os.path.join(work, "scenes", f"test{test}.yaml")
+        if not os.path.exists(path):
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            with open(reference(test)) as f:
+                scene = yaml.safe_load(f)
+            scene.setdefault("model", {}).update(options)
+            with open(path, "w") as f:
+                yaml.safe_dump(scene, f)
+        return path
+    scene_path = with_options
 
 
 def trajectory_path(out, test, case, engine):

@@ -182,6 +182,7 @@ static const char *diff_scenes(const jd_scene *a, const jd_scene *b) {
     SAME(damping_map);
     SAME(xi_limit);
     SAME(mu_r);
+    SAME(tangential_rule);
     SAME(watchdog.enabled);
     SAME(watchdog.max_overlap_fraction);
     SAME(watchdog.max_energy_jump);

@@ -5,7 +5,7 @@ Every case of every scene in reference_runs/ and tests/ (the malformed scenes of
 and the fuzz corpus excepted) is resolved, shortened to one step and run by build/jdem (`--timing`
 prints "jdem:   law set X") and, through its generated deck, by build/liggghts-jdem (pair_style
 gran/jiang prints "gran/jiang: law set X").  Cases whose inputs to the rule are the same (the
-interaction table, mu_r, the materials of the particles and of the walls, output.energy) are run
+interaction table, mu_r, tangential_stiffness, the materials of the particles and of the walls, output.energy) are run
 once.  Then hand-written LIGGGHTS scripts: rolling friction given without the `rolling on`
 keyword must stop with the exact error; `rolling on` where no pair has rolling friction runs the
 stepper's law set (no rolling law).
@@ -26,6 +26,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 JDEM = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
 LIGGGHTS = os.environ.get("LIGGGHTS_JDEM", os.path.join(ROOT, "build", "liggghts-jdem"))
 DECK = os.path.join(ROOT, "scripts", "scene_to_liggghts.py")
+TANGENTIAL_ERROR = ("pair_style gran/jiang: tangential_stiffness must be jiang2021 or mindlin, "
+                    "not 'hooke'")
 ROLLING_ERROR = ("pair_style gran/jiang: coefficientRollingFriction is > 0 for a pair of types in use, "
                  "which needs the rolling law and its history: add 'rolling on' to pair_style "
                  "gran/jiang (or set coefficientRollingFriction to 0)")
@@ -49,7 +51,8 @@ def scenes():
 
 def signature(doc):
     """What jd_law_set_select reads from a resolved scene."""
-    return json.dumps([doc.get("interactions"), (doc.get("model") or {}).get("mu_r"),
+    model = doc.get("model") or {}
+    return json.dumps([doc.get("interactions"), model.get("mu_r"), model.get("tangential_stiffness"),
                        sorted({p["material"] for p in doc.get("particles") or []}),
                        sorted({w["material"] for w in doc.get("walls") or []}),
                        (doc.get("output") or {}).get("energy")], sort_keys=True)
@@ -155,6 +158,26 @@ def hand_written(tmp):
     report("hand_written rolling on without rolling friction: the stepper's law set",
            ok and mine == theirs and "rolling" not in mine,
            "jdem selects %s, liggghts-jdem %s" % (mine, theirs))
+    # Mindlin's stiffness asked for where nothing has friction: neither engine selects it
+    doc["model"] = dict(doc.get("model") or {}, tangential_stiffness="mindlin")
+    doc["interactions"] = [dict(i, friction=0) for i in doc["interactions"]]
+    for m in doc["materials"].values():
+        m["friction"] = 0
+    mindlin = os.path.join(tmp, "mindlin_frictionless.yaml")
+    with open(mindlin, "w") as f:
+        yaml.safe_dump(doc, f)
+    mine = jdem_law_set(mindlin, tmp)
+    bare = os.path.join(tmp, "mindlin_frictionless")
+    ok, err = write_deck(mindlin, bare)
+    theirs = liggghts_law_set(bare) if ok else "deck generation failed: " + err
+    report("hand_written tangential_stiffness mindlin without friction: no mindlin law",
+           mine == theirs and "mindlin" not in mine and not mine.startswith("none"),
+           "jdem selects %s, liggghts-jdem %s" % (mine, theirs))
+    # a bad tangential_stiffness value stops with the exact error
+    open(path, "w").write(text.replace(" tangential_stiffness jiang2021", " tangential_stiffness hooke"))
+    rc, out = liggghts_run(deck)
+    report("hand_written tangential_stiffness hooke: exact error",
+           rc != 0 and ("ERROR: " + TANGENTIAL_ERROR) in out, "exit %d, log tail: %s" % (rc, out[-400:]))
 
 
 def main():

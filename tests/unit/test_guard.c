@@ -65,6 +65,34 @@ static void coordination_and_damping_scale_the_verlet_limit(void **state) {
     assert_rel(damped.coordination_bound, four.coordination_bound * 0.5, 1e-12);
 }
 
+/* With Mindlin's K_t = rho K, rho = 3(1-nu)/(2-nu) for like materials (the secant Hertz K against
+ * 8 G* sqrt(R* delta), G* = G/(2(2-nu)), R* = R/2), the sliding-rolling term of the row sum,
+ * K_t (1/m + R^2/I) = 3.5 K_t/m per side, grows by rho and the rolling spring K r^2/I does not:
+ * two like spheres, m omega^2 = 7 rho K + 2 K (R/2)^2/(0.4 R^2) = (7 rho + 1.25) K instead of
+ * 8.25 K; a sphere on a rigid wall (G* of the sphere alone, R* = R, the same rho against the
+ * exact rigid-plane Hertz), (3.5 rho + 2.5) K instead of 6 K. */
+static void mindlin_stiffer_spring_tightens_the_verlet_limit(void **state) {
+    (void)state;
+    jd_guard_species sp;
+    jd_guard_input in = glass_pair(&sp, 1e-9);
+    jd_guard_result seed, mindlin;
+    jd_guard_assess(&in, &seed);
+    in.tangential_rule = JD_KT_MINDLIN;
+    jd_guard_assess(&in, &mindlin);
+    const double nu = 0.2, rho = 3.0 * (1.0 - nu) / (2.0 - nu);
+    assert_rel(mindlin.coordination_bound, seed.coordination_bound * sqrt(8.25 / (7.0 * rho + 1.25)),
+               1e-12);
+    assert_rel(mindlin.contact_bound, seed.contact_bound, 0.0); /* the normal law is unchanged */
+    sp.count = 1; /* alone, on a wall */
+    in.has_walls = 1;
+    in.tangential_rule = JD_KT_JIANG2021;
+    jd_guard_assess(&in, &seed);
+    in.tangential_rule = JD_KT_MINDLIN;
+    jd_guard_assess(&in, &mindlin);
+    assert_rel(mindlin.coordination_bound, seed.coordination_bound * sqrt(6.0 / (3.5 * rho + 2.5)),
+               1e-12);
+}
+
 /* Two glass spheres (as above) joined by a bond whose fastest mode is 1 MHz: the bond bound is
  * 1/20 of its period, 5e-8 s, tighter than the contact bound (8.07e-7 s), and it is named. */
 static void a_stiff_bond_binds(void **state) {
@@ -89,6 +117,7 @@ int run_guard_tests(void) {
         cmocka_unit_test(bounds_match_published_values),
         cmocka_unit_test(the_tightest_broken_bound_is_named),
         cmocka_unit_test(coordination_and_damping_scale_the_verlet_limit),
+        cmocka_unit_test(mindlin_stiffer_spring_tightens_the_verlet_limit),
         cmocka_unit_test(a_stiff_bond_binds),
     };
     return cmocka_run_group_tests_name("guard", tests, NULL, NULL);

@@ -13,7 +13,7 @@
 #include "jdem_kernel.h"
 #include "jdem_laws.h"
 
-enum { ALL = JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY };
+enum { ALL = JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY | JD_F_MINDLIN };
 
 /* Two spheres along z, a at the origin, overlapping by delta. */
 static jd_contact_geom geom_z(double delta, double R, double k_n, double m_eff) {
@@ -108,6 +108,56 @@ static void tangential_law_sticks_then_slides(void **state) {
     assert_true(h.flags == (double)JD_S_SLIDING);
 }
 
+/* Mindlin's K_t = 8 G* sqrt(R* delta), 1/G* = 2(2-nu1)(1+nu1)/E1 + 2(2-nu2)(1+nu2)/E2 (LIGGGHTS'
+ * Geff and hertz model), with C_t = 2 gamma sqrt(m K_t) (eq. 29); the seed's K_t = K_n without
+ * the bit. */
+static void mindlin_tangential_stiffness_is_8_g_sqrt_r_delta(void **state) {
+    (void)state;
+    const double E1 = 2.08e11, nu1 = 0.3, E2 = 7.0e10, nu2 = 0.33, R = 0.01, d = 1e-5, m = 1e-3;
+    const double g_star = 1.0 / (2.0 * (2.0 - nu1) * (1.0 + nu1) / E1 + 2.0 * (2.0 - nu2) * (1.0 + nu2) / E2);
+    const jd_contact_geom g = geom_z(d, R, 1e9, m); /* r_roll = R/2 = R* of two spheres of R */
+    const jd_pair_coeffs c = {.gamma = 0.2, .mu = 0.3, .mu_r = 1.0, .g_star = g_star};
+    jd_normal nl;
+    jd_law_normal(JD_F_DAMPING, &c, &g, 0.0, 0, &nl);
+    const double Kt = jd_tangential_stiffness(JD_F_FRICTION | JD_F_MINDLIN, &c, &g, &nl);
+    assert_rel(Kt, 8.0 * g_star * sqrt(0.5 * R * d), 1e-15);
+    assert_rel(jd_tangential_damping(JD_F_DAMPING | JD_F_FRICTION | JD_F_MINDLIN, &c, &g, &nl, Kt),
+               2.0 * 0.2 * sqrt(m * Kt), 1e-15);
+    assert_true(jd_tangential_damping(JD_F_FRICTION | JD_F_MINDLIN, &c, &g, &nl, Kt) == 0.0);
+    assert_true(jd_tangential_stiffness(JD_F_FRICTION, &c, &g, &nl) == nl.Kn);
+    assert_true(jd_tangential_damping(JD_F_DAMPING | JD_F_FRICTION, &c, &g, &nl, nl.Kn) == nl.Cn);
+    /* the law sticks on K_t: F_t = -K_t xi */
+    jd_contact_motion mo = {.vrel = {0.01, 0, 0}};
+    jd_contact_step h = {0};
+    double f[3] = {0, 0, nl.fn}, u = 0.0, dash = 0.0;
+    jd_law_tangential(JD_F_FRICTION | JD_F_MINDLIN, &c, &g, &mo, &nl, 1e-6, &h, f, &u, &dash);
+    assert_rel(f[0], -Kt * 0.01 * 1e-6, 1e-14);
+}
+
+/* For like spheres Mindlin's K_t against the tangent normal stiffness dF_n/d(delta) = 3/2 K_n of
+ * the Hertz law (k_n of eqs. 4-5) is 2(1-nu)/(2-nu) (Mindlin 1949; Johnson 1985 §7.2). */
+static void mindlin_over_hertz_tangent_is_2_1mnu_over_2mnu(void **state) {
+    (void)state;
+    const double E = 7.0e10, nu = 0.33, R = 0.1, d = 2e-6;
+    jd_pair_coeffs t[1];
+    const double e = 1.0, mu = 0.4, eta = 0.0;
+    jd_pair_coeffs_table(1, &e, &mu, &eta, &E, &nu, JD_DAMP_JIANG2021, 1.0, JD_XI_COULOMB, t);
+    const double kp = jd_hertz_prefactor(E, nu, R);
+    jd_contact_geom g = geom_z(d, R, jd_kn_pair(kp, kp), 1.0);
+    jd_normal nl;
+    jd_law_normal(0u, &t[0], &g, 0.0, 0, &nl);
+    const double Kt = jd_tangential_stiffness(JD_F_FRICTION | JD_F_MINDLIN, &t[0], &g, &nl);
+    assert_rel(Kt / (1.5 * nl.Kn), 2.0 * (1.0 - nu) / (2.0 - nu), 1e-14);
+    /* against a rigid wall (r_roll = R, G* of the particle alone): the same ratio to the exact
+     * rigid-plane Hertz stiffness, whose prefactor is jd_kn_wall's */
+    const jd_pair_coeffs w = jd_wall_coeffs(&t[0]);
+    g.r_roll = R;
+    g.k_n = jd_kn_wall(JD_WALL_HERTZ, E, nu, R);
+    jd_law_normal(0u, &w, &g, 0.0, 0, &nl);
+    assert_rel(jd_tangential_stiffness(JD_F_FRICTION | JD_F_MINDLIN, &w, &g, &nl) / (1.5 * nl.Kn),
+               2.0 * (1.0 - nu) / (2.0 - nu), 1e-14);
+}
+
 static void rolling_law_spring_and_cap(void **state) {
     (void)state;
     const double k = 1e9, d = 1e-4, dt = 1e-6, R = 0.01;
@@ -155,15 +205,15 @@ static void energy_law_books_work_and_luding_end(void **state) {
     assert_rel(e.e_fric, 0.125 + ((-W - (u_new - 1e-3)) - dash), 1e-13);
 }
 
-static void law_sets_are_the_combinations_with_mu_r_only_with_friction(void **state) {
+static void law_sets_are_the_combinations_with_mu_r_and_mindlin_only_with_friction(void **state) {
     (void)state;
     int n = 0;
     for (unsigned b = 0; b <= ALL; b++) {
-        const int expected = !((b & JD_F_MU_R) && !(b & JD_F_FRICTION));
+        const int expected = !((b & (JD_F_MU_R | JD_F_MINDLIN)) && !(b & JD_F_FRICTION));
         assert_int_equal(jd_law_set_valid(b), expected);
         n += jd_law_set_valid(b);
     }
-    assert_int_equal(n, 24);
+    assert_int_equal(n, 40); /* 2 (energy) x (4 without friction + 2 (mindlin) x 8 with it) */
     assert_int_equal(jd_law_set_valid(ALL + 1), 0);
 }
 
@@ -177,18 +227,22 @@ static void law_set_select_counts_only_interactions_that_occur(void **state) {
     mu[3 * NM + 3] = 0.5;  /* unused against unused */
     e[2 * NM + 2] = 0.5;   /* wall against wall: never occurs */
     eta[3 * NM + 0] = 0.1; /* unused against a particle material */
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, 0), 0u);
+    const int KT = JD_KT_JIANG2021, MINDLIN = JD_KT_MINDLIN;
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, MINDLIN, 0), 0u);
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, KT, 0), 0u);
     e[1 * NM + 2] = 0.9; /* particle against wall */
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, 0), JD_F_DAMPING);
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, NULL, 1.0, 0), 0u);
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, KT, 0), JD_F_DAMPING);
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, NULL, 1.0, KT, 0), 0u);
     eta[0 * NM + 1] = 0.1; /* particle against particle */
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 0.5, 1),
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 0.5, KT, 1),
                      JD_F_DAMPING | JD_F_ROLLING | JD_F_ENERGY); /* mu_R needs friction */
     mu[1 * NM + 0] = 0.3;
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 0.5, 0),
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 0.5, KT, 0),
                      JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R);
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, 0),
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, KT, 0),
                      JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING);
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, MINDLIN, 0),
+                     JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MINDLIN);
 }
 
 static void law_set_names(void **state) {
@@ -198,15 +252,16 @@ static void law_set_names(void **state) {
     assert_string_equal(jd_law_set_describe(JD_F_DAMPING | JD_F_FRICTION | JD_F_ENERGY, buf, sizeof buf),
                         "damping+friction+energy");
     assert_string_equal(jd_law_set_describe(ALL, buf, sizeof buf),
-                        "damping+friction+rolling+mu_r+energy");
+                        "damping+friction+rolling+mu_r+energy+mindlin");
     assert_string_equal(jd_law_set_describe(ALL, buf, 8), "damping"); /* truncated, terminated */
 }
 
 static void pair_coeffs_table_maps_each_restitution(void **state) {
     (void)state;
     const double e[4] = {0.5, 0.9, 0.9, 1.0}, mu[4] = {0.1, 0.2, 0.3, 0.4}, eta[4] = {0, 0.01, 0.02, 0};
+    const double E[2] = {2.08e11, 0.0}, nu[2] = {0.3, 0.0}; /* material 1: wall-only, rigid */
     jd_pair_coeffs t[4];
-    jd_pair_coeffs_table(2, e, mu, eta, JD_DAMP_JIANG2021, 0.7, JD_XI_UNCONSTRAINED, t);
+    jd_pair_coeffs_table(2, e, mu, eta, E, nu, JD_DAMP_JIANG2021, 0.7, JD_XI_UNCONSTRAINED, t);
     for (int k = 0; k < 4; k++) {
         /* eq. (30) */
         const double le = log(e[k]), gamma = -le / sqrt(3.14159265358979323846 * 3.14159265358979323846 + le * le);
@@ -215,6 +270,14 @@ static void pair_coeffs_table_maps_each_restitution(void **state) {
         assert_int_equal(t[k].xi_limit, JD_XI_UNCONSTRAINED);
     }
     assert_true(t[3].gamma == 0.0);
+    /* LIGGGHTS' Geff: 1/G* = 2(2-nu)(1+nu)/E per elastic material, a rigid one adds nothing */
+    const double g_self = 2.08e11 / (2.0 * 1.7 * 1.3);
+    assert_rel(t[0].g_star, 0.5 * g_self, 1e-15);
+    assert_rel(t[1].g_star, g_self, 1e-15);
+    assert_rel(t[0].g_wall, g_self, 1e-15);
+    assert_rel(t[2].g_star, g_self, 1e-15);
+    assert_true(t[3].g_star == 0.0); /* two rigid materials never touch */
+    assert_rel(jd_wall_coeffs(&t[0]).g_star, g_self, 1e-15);
 }
 
 static void records_keep_the_law_fields_or_everything(void **state) {
@@ -347,9 +410,11 @@ int run_laws_tests(void) {
         cmocka_unit_test(normal_law_with_damping_and_luding_end),
         cmocka_unit_test(contact_begin_restarts_an_ended_contact),
         cmocka_unit_test(tangential_law_sticks_then_slides),
+        cmocka_unit_test(mindlin_tangential_stiffness_is_8_g_sqrt_r_delta),
+        cmocka_unit_test(mindlin_over_hertz_tangent_is_2_1mnu_over_2mnu),
         cmocka_unit_test(rolling_law_spring_and_cap),
         cmocka_unit_test(energy_law_books_work_and_luding_end),
-        cmocka_unit_test(law_sets_are_the_combinations_with_mu_r_only_with_friction),
+        cmocka_unit_test(law_sets_are_the_combinations_with_mu_r_and_mindlin_only_with_friction),
         cmocka_unit_test(law_set_select_counts_only_interactions_that_occur),
         cmocka_unit_test(law_set_names),
         cmocka_unit_test(pair_coeffs_table_maps_each_restitution),
