@@ -192,6 +192,18 @@ bonds: all
 accuracy: all
 	$(PY) scripts/accuracy.py run $(if $(ACCURACY_REPEATS),--repeats $(ACCURACY_REPEATS))
 
+# Jiang's Chapter 4 mixing campaign (docs/mixing.md §4): the resumable units of
+# scripts/mixing/plan_ch4.py, with progress and an ETA; finished units are skipped.
+#   make mixing [MODEL=model2] [ENGINE=jdem|liggghts-jdem] [UNIT=jdem/model2/fill1]
+#               [DT=seed|guard|half] [LIST=1]        outputs: out/mixing/ch4*/ENGINE/MODEL/
+# The engine's binary only when the selection names one engine (ENGINE=, or UNIT=ENGINE/...).
+MIXING_ENGINE = $(or $(ENGINE),$(firstword $(subst /, ,$(UNIT))))
+.PHONY: mixing
+mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),build/liggghts-jdem build/jdem,all))
+	$(PY) scripts/campaign.py scripts/mixing/plan_ch4.py $(if $(MODEL),--model $(MODEL)) \
+	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
+	    $(if $(DT),-- --dt $(DT))
+
 clean:
 	rm -rf build out
 
