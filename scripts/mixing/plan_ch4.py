@@ -7,7 +7,7 @@ Per engine (jdem, liggghts-jdem) and model 1-6: the first fill, the second-pass 
 it, the second fill, and per pass the 9 cube scenes and their 9 compressions.  --dt picks the
 time-step variant of the error-against-run-time study: `seed` (default) the seed's dt = 1e-4 s
 under out/mixing/ch4/, run with --force because the guard refuses it (docs/mixing.md §6);
-`guard` the guard's dt (time.dt: auto) under out/mixing/ch4_dt_guard/; `half` half of it under
+`guard` the guard's dt (what `time.dt: auto` resolves to) under out/mixing/ch4_dt_guard/; `half` half of it under
 out/mixing/ch4_dt_half/.  A unit's cost for the ETA is its particle-steps.
 
 A unit whose engine lacks a feature it needs is "not yet runnable": the plan asks the engine
@@ -143,8 +143,8 @@ def variant_dt(variant, model):
     """(the --dt argument of generate.py, the dt in s for the cost) of a variant."""
     if variant == "seed":
         return repr(SEED_DT), SEED_DT
-    if variant == "guard":
-        return "auto", guard_dt(model)
+    if variant == "guard":   # the number, not auto: generate.py then rescales the output cadence
+        return repr(guard_dt(model)), guard_dt(model)
     return repr(0.5 * guard_dt(model)), 0.5 * guard_dt(model)
 
 
