@@ -19,6 +19,7 @@ conveyor itself is tested on a small scene by tests/inlet; here the campaign's o
   the deposit, the solid fraction 1 - n and phi_v against a Monte Carlo integration over the
   particles (no lens formula), and the coordination number's contact count against an all-pairs
   count.
+* the front view (scripts/mixing_views.py) of the last frame draws every sphere, in both colours.
 """
 import math
 import os
@@ -182,6 +183,23 @@ def run_fill(tmp, sections, end_time):
     return sc, read_record(rec), traj
 
 
+def check_views(traj, tmp):
+    """scripts/mixing_views.py on the fill: one front view of the last frame with every live
+    sphere drawn, in the cohort colours."""
+    import matplotlib.image as mpimg
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "mixing_views.py"), traj,
+                        "-o", tmp, "--times", "final", "--views", "front"],
+                       capture_output=True, text=True)
+    png = os.path.join(tmp, f"front_t{END_TIME:g}.png")
+    check("views-front-written", r.returncode == 0 and r.stdout.strip() == f"{png}: "
+          f"{SECTIONS * 516} spheres", f"{r.stdout}{r.stderr}")
+    if os.path.exists(png):
+        img = mpimg.imread(png)[:, :, :3]
+        red = np.mean(np.all(np.abs(img - [0.839, 0.153, 0.157]) < 0.08, axis=2))
+        blue = np.mean(np.all(np.abs(img - [0.122, 0.310, 0.706]) < 0.08, axis=2))
+        check("views-front-cohort-colours", red > 0 and blue > red, f"red {red:.4f}, blue {blue:.4f}")
+
+
 def main():
     with tempfile.TemporaryDirectory() as tmp:
         lone = run_fill(tmp, 1, 0.6)
@@ -195,6 +213,7 @@ def main():
             with h5py.File(traj, "r") as h:
                 check_energy(h)
             check_analysis(traj)
+            check_views(traj, tmp)
 
 
 main()
