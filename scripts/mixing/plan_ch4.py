@@ -16,6 +16,7 @@ deck generator), so the gate lifts by itself once the feature lands.
 """
 import functools
 import os
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -160,8 +161,9 @@ def run_command(engine, scene, out, force):
 def fill1_command(engine, model, dt_arg, force):
     """Write the case's scene with the variant's dt into the unit's directory, then run it."""
     run = run_command(engine, '"$1"', '"$2"', force)
-    return ["sh", "-c", f'"{PY}" "{GENERATE}" fill --case {model} --dt {dt_arg} -o "$1" && '
-            + " ".join(run), "fill1", "{dir}/fill1.yaml", "{out0}"]
+    words = [a if a in ('"$1"', '"$2"') else shlex.quote(a) for a in run]
+    return ["sh", "-c", f'{shlex.quote(PY)} {shlex.quote(GENERATE)} fill --case {model} '
+            f'--dt {dt_arg} -o "$1" && ' + " ".join(words), "fill1", "{dir}/fill1.yaml", "{out0}"]
 
 
 def pass_units(engine, model, p, deposit, base, dt_arg, dt, force):
