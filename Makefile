@@ -4,8 +4,9 @@
 #   make            build/jdem and build/liggghts-jdem
 #   make deps       install the Debian packages the project needs (as root), else print the command
 #   make test       unit tests (also under ASan+UBSan), engine tests, Chung–Ooi checks, cross-engine
-#   make demo       build and run the eight Chung–Ooi tests and the stability suite; reports in
-#                   out/chung_ooi/report.md and out/stability/report.md
+#   make demo       build and run the eight Chung–Ooi tests, the stability suite and a short
+#                   Chapter 4 mixing fill; reports in out/chung_ooi/report.md and
+#                   out/stability/report.md, pictures in out/mixing/demo/
 #   make chung-ooi  the Chung–Ooi runs and report only (no dependency check)
 #   make accuracy   error against run time, three engines; report in out/accuracy/report.md
 #   make stability  the stability suite (reference_runs/stability/, both engines, 1x and 2x/5x/10x
@@ -164,7 +165,21 @@ demo: deps
 	$(MAKE) all
 	$(MAKE) chung-ooi
 	$(MAKE) stability
-	@echo "reports: out/chung_ooi/report.md out/stability/report.md"
+	$(MAKE) mixing-demo
+	@echo "reports: out/chung_ooi/report.md out/stability/report.md; picture: out/mixing/demo/front_t$(MIXING_DEMO_TIME).png"
+
+# A short Model 2 fill of the Chapter 4 campaign in jdem (the sections that start within
+# MIXING_DEMO_TIME seconds, at the seed's dt, forced as the campaign runs it) and its front view.
+MIXING_DEMO_TIME ?= 2
+MIXING_DEMO_SECTIONS ?= 8
+.PHONY: mixing-demo
+mixing-demo: build/jdem
+	@mkdir -p out/mixing/demo
+	$(PY) reference_runs/mixing/ch4/generate.py fill --case model2 --sections $(MIXING_DEMO_SECTIONS) \
+	    --end-time $(MIXING_DEMO_TIME) -o out/mixing/demo/model2_fill.yaml
+	build/jdem run out/mixing/demo/model2_fill.yaml -o out/mixing/demo/model2_fill.h5 --force
+	$(PY) scripts/mixing_views.py out/mixing/demo/model2_fill.h5 -o out/mixing/demo \
+	    --times 1,2,final --views front
 
 # Performance benchmark (reference_runs/bench/README.md): settled beds, 3 engines, medians of 3.
 #   make bench [BENCH_SIZES=5k,20k,80k,320k,1M] [BENCH_VARIANTS=soft_mono,soft_mono_bonded]
@@ -191,6 +206,18 @@ bonds: all
 .PHONY: accuracy
 accuracy: all
 	$(PY) scripts/accuracy.py run $(if $(ACCURACY_REPEATS),--repeats $(ACCURACY_REPEATS))
+
+# Jiang's Chapter 4 mixing campaign (docs/mixing.md §4): the resumable units of
+# scripts/mixing/plan_ch4.py, with progress and an ETA; finished units are skipped.
+#   make mixing [MODEL=model2] [ENGINE=jdem|liggghts-jdem] [UNIT=jdem/model2/fill1]
+#               [DT=seed|guard|half] [LIST=1]        outputs: out/mixing/ch4*/ENGINE/MODEL/
+# The engine's binary only when the selection names one engine (ENGINE=, or UNIT=ENGINE/...).
+MIXING_ENGINE = $(or $(ENGINE),$(firstword $(subst /, ,$(UNIT))))
+.PHONY: mixing
+mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),build/liggghts-jdem build/jdem,all))
+	$(PY) scripts/campaign.py scripts/mixing/plan_ch4.py $(if $(MODEL),--model $(MODEL)) \
+	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
+	    $(if $(DT),-- --dt $(DT))
 
 clean:
 	rm -rf build out

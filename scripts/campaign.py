@@ -10,7 +10,9 @@ first output (DIR/.partial/UNIT/, the same file names), and they are moved to th
 (os.replace, atomic per file) only once all of them validate: a killed run never leaves a
 partial file under a final name, and its partial directory is cleared when the unit runs again.
 --model, --engine and --unit run part of the campaign (a unit whose needs are neither done nor
-selected is an error).  Progress and the ETA go to stderr: the ETA is the remaining units'
+selected is an error).  A unit the engines cannot run yet (its `blocked` says why, e.g. a scene
+key not implemented) is reported as "not yet runnable: WHY" and skipped with the units that need
+it; it does not count as a failure, and the closing line counts it.  Progress and the ETA go to stderr: the ETA is the remaining units'
 estimated cost times the measured seconds per unit of cost of the units finished so far (in this
 run and earlier ones: DIR/.campaign_times.json beside the first unit's output).
 """
@@ -36,6 +38,8 @@ class Unit:
     needs: list = field(default_factory=list)  # names of the units whose outputs it reads
     validate: object = None     # f(path) -> None if valid, else the reason; default: non-empty
     cost: float = 1.0           # relative cost, for the ETA (e.g. particle-steps)
+    blocked: object = None      # f() -> None if the engines can run the unit, else why not
+                                # (a feature still missing); such a unit is reported, not run
 
 
 def non_empty(path):
@@ -51,6 +55,17 @@ def invalid_reason(unit, path):
 
 def is_done(unit):
     return all(invalid_reason(unit, p) is None for p in unit.outputs)
+
+
+def blocked_reason(unit, by_name, memo):
+    """None when the unit and every unit it needs can run, else why not (evaluated once)."""
+    if unit.name not in memo:
+        memo[unit.name] = unit.blocked() if unit.blocked else None
+        for n in unit.needs:
+            if memo[unit.name] is None and n in by_name and not is_done(by_name[n]):
+                if blocked_reason(by_name[n], by_name, memo):
+                    memo[unit.name] = f"needs {n}, which is not yet runnable"
+    return memo[unit.name]
 
 
 def partial_dir(unit):
@@ -128,12 +143,20 @@ def fmt_seconds(s):
     return f"{s:.1f} s" if s < 120 else f"{s / 60:.1f} min" if s < 7200 else f"{s / 3600:.1f} h"
 
 
-def run(units, times, log=sys.stderr):
-    """Run the units in order, skipping the done ones; returns the number that failed."""
+def run(units, times, everything=None, log=sys.stderr):
+    """Run the units in order, skipping the done ones and reporting those not yet runnable;
+    returns (number failed, number not yet runnable).  everything: the whole plan (for the
+    needs of a selection; default `units`)."""
+    by_name = {u.name: u for u in (everything or units)}
+    memo = {}
     todo = [u for u in units if not is_done(u)]
     for u in units:
         if u not in todo:
             print(f"campaign: skip {u.name} (done)", file=log, flush=True)
+    blocked = [u for u in todo if blocked_reason(u, by_name, memo)]
+    todo = [u for u in todo if u not in blocked]
+    for u in blocked:
+        print(f"campaign: skip {u.name}: not yet runnable: {memo[u.name]}", file=log, flush=True)
     failed = 0
     for i, u in enumerate(todo):
         eta = times.eta(todo[i:])
@@ -151,7 +174,9 @@ def run(units, times, log=sys.stderr):
         eta = times.eta(todo[i + 1:])
         print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: done in {fmt_seconds(took)}; "
               f"{len(todo) - i - 1} left, ETA {fmt_seconds(eta)}", file=log, flush=True)
-    return failed
+    print(f"campaign: {len(todo) - failed} run, {failed} failed, {len(blocked)} not yet runnable, "
+          f"{len(units) - len(todo) - len(blocked)} already done", file=log, flush=True)
+    return failed, len(blocked)
 
 
 def load_plan(path, argv):
@@ -182,8 +207,11 @@ def main(argv):
               f"{sorted({str(u.engine) for u in units})}", file=sys.stderr)
         return 2
     if a.list:
+        by_name, memo = {u.name: u for u in units}, {}
         for u in chosen:
-            print(f"{'done' if is_done(u) else 'todo'} {u.name}")
+            why = None if is_done(u) else blocked_reason(u, by_name, memo)
+            print(f"{'done' if is_done(u) else 'todo'} {u.name}"
+                  + (f" (not yet runnable: {why})" if why else ""))
         return 0
     problem = check_needs(units, chosen)
     if problem:
@@ -191,7 +219,8 @@ def main(argv):
         return 2
     times = Times(os.path.join(os.path.dirname(os.path.abspath(units[0].outputs[0])),
                                ".campaign_times.json"))
-    return 1 if run(chosen, times) else 0
+    failed, _ = run(chosen, times, units)
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

@@ -116,6 +116,9 @@ SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py
             "lines", {})]
 # The campaign driver (scripts/campaign.py) with dummy units, a killed run resumed.
 SUITES += [("campaign", [PY, "tests/mixing/test_campaign.py"], "lines", {})]
+# A reduced Chapter 4 fill in jdem (3 sections, 0.8 s): stream, free fall, energy, and the
+# analysis on its deposit against Monte Carlo and all-pairs counts.
+SUITES += [("mixing-fill", [PY, "tests/mixing/test_fill.py"], "lines", {})]
 
 CMOCKA_OK = re.compile(r"^\[\s+OK\s+\] (\S+)")
 CMOCKA_FAIL = re.compile(r"^\[\s+FAILED\s+\] (\S+)$")

@@ -1,8 +1,10 @@
 """A deposit: one frame of the particle set of an H5MD trajectory, and the regions cut from it.
 
 read_frame() is the only function that knows the layout of the engines' files
-(io/h5md.h: /particles/all/{id,species,radius,mass} and /particles/all/position/value [F][N][3]);
-a growing particle set is to be added there.
+(io/h5md.h: /particles/all/{id,species,radius,mass} and /particles/all/position/value [F][N][3]).
+A run with an inlet holds more rows than particles in a frame: a slot not yet filled has a
+non-finite position or, where the id is a time series (/particles/all/id/value [F][N]), id -1;
+read_frame keeps the live particles only.
 """
 import math
 import os
@@ -55,15 +57,11 @@ def read_frame(path, frame=-1):
         if not -frames <= frame < frames:
             raise DepositError(f"{path}: frame {frame} does not exist; valid: {-frames} to "
                                f"{frames - 1} ({frames} frames)")
-        ids = p["id"]
-        if isinstance(ids, h5py.Group):  # a growing set: the frame's live rows (id >= 0)
-            frame_ids = ids["value"][frame]
-            live = frame_ids >= 0
-            return Deposit(frame_ids[live], p["species"][()][live], p["radius"][()][live],
-                           p["mass"][()][live], p["position/value"][frame][live],
-                           int(p["position/step"][frame]), float(p["position/time"][frame]))
-        return Deposit(ids[()], p["species"][()], p["radius"][()], p["mass"][()],
-                       p["position/value"][frame], int(p["position/step"][frame]),
+        ids = p["id/value"][frame] if isinstance(p["id"], h5py.Group) else p["id"][()]
+        position = p["position/value"][frame]
+        live = np.all(np.isfinite(position), axis=1) & (ids >= 0)
+        return Deposit(ids[live], p["species"][()][live], p["radius"][()][live],
+                       p["mass"][()][live], position[live], int(p["position/step"][frame]),
                        float(p["position/time"][frame]))
 
 

@@ -1,14 +1,27 @@
 """plan_ch4.py — the units of `make mixing` for scripts/campaign.py (docs/mixing.md §4).
 
     scripts/campaign.py scripts/mixing/plan_ch4.py [--model modelM] [--engine ENGINE] [--list]
+                        [-- --dt seed|guard|half]
 
 Per engine (jdem, liggghts-jdem) and model 1-6: the first fill, the second-pass scene cut from
-it, the second fill, and per pass the 9 cube scenes and their 9 compressions, under
-out/mixing/ch4/ENGINE/modelM/.  The scenes use the target schema (docs/mixing.md §2): the units
-run once the engines implement it.  A unit's cost for the ETA is its particle-steps.
+it, the second fill, and per pass the 9 cube scenes and their 9 compressions.  --dt picks the
+time-step variant of the error-against-run-time study: `seed` (default) the seed's dt = 1e-4 s
+under out/mixing/ch4/, run with --force because the guard refuses it (docs/mixing.md §6);
+`guard` the guard's dt (what `time.dt: auto` resolves to) under out/mixing/ch4_dt_guard/; `half` half of it under
+out/mixing/ch4_dt_half/.  A unit's cost for the ETA is its particle-steps.
+
+A unit whose engine lacks a feature it needs is "not yet runnable": the plan asks the engine
+itself, by reading a probe scene that uses the feature (jdem resolve; for liggghts-jdem also the
+deck generator), so the gate lifts by itself once the feature lands.
 """
+import functools
 import os
+import shlex
+import subprocess
 import sys
+import tempfile
+
+import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -18,12 +31,19 @@ from campaign import Unit  # noqa: E402
 PY = "/usr/bin/python3"
 SCENE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "models.yaml")
 GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "generate.py")
-OUT = os.path.join(ROOT, "out", "mixing", "ch4")
+OUT = {"seed": os.path.join(ROOT, "out", "mixing", "ch4"),
+       "guard": os.path.join(ROOT, "out", "mixing", "ch4_dt_guard"),
+       "half": os.path.join(ROOT, "out", "mixing", "ch4_dt_half")}
 MODELS = [f"model{m}" for m in range(1, 7)]
 ENGINES = ("jdem", "liggghts-jdem")
-FILL_COST = 41280 * 250_000   # 80 sections of 516 spheres over 25 s at dt = 1e-4 s
-CUBE_COST = 400 * 100_000     # about 400 spheres in a 0.2 m cube, up to 10 s
-SCENE_COST = 1e6              # cutting: a read of the deposit
+SEED_DT = 1.0e-4
+FILL_PARTICLES, FILL_TIME = 41280, 25.0   # 80 sections of 516 spheres over 25 s
+CUBE_PARTICLES, CUBE_TIME = 400, 10.0     # about 400 spheres in a 0.2 m cube, up to 10 s
+SCENE_COST = 1e6                          # cutting: a read of the deposit
+
+
+def jdem():
+    return os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
 
 
 def valid_trajectory(path):
@@ -37,7 +57,6 @@ def valid_trajectory(path):
 
 
 def valid_scene(path):
-    import yaml
     try:
         with open(path) as f:
             doc = yaml.safe_load(f)
@@ -46,46 +65,151 @@ def valid_scene(path):
     return None if isinstance(doc, dict) and doc.get("jdem_scene") == 1 else "no jdem_scene: 1"
 
 
-def run_command(engine, scene, out, case=None):
-    sel = ["--case", case] if case else []
+# ---- what the engines can run: probe scenes, each using one feature -------------------------
+PROBE_MATERIALS = ("materials: {m: {youngs_modulus: 1.0e7, poisson_ratio: 0.3, density: 1000,"
+                   " restitution: 0.5, friction: 0.3}, wall: {restitution: 0.5, friction: 0.3}}\n")
+PROBE_FLOOR = ("  - {name: floor, type: plane, corners: [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]],"
+               " material: wall}\n")
+PROBES = {
+    "servo wall": "jdem_scene: 1\nname: probe_servo\ntime: {dt: 1.0e-5, steps: 1}\n"
+                  + PROBE_MATERIALS
+                  + "particles: [{material: m, radius: 0.01, position: [0.5, 0.5, 0.5]}]\n"
+                    "walls:\n" + PROBE_FLOOR
+                  + "  - {name: top, type: plane, material: wall, corners: [[0, 0, 1], [0, 1, 1],"
+                    " [1, 1, 1], [1, 0, 1]], servo: {target: 1000.0, gain: 1.0e-4,"
+                    " tolerance: 10.0, max_speed: 0.02, hold: 0.05}}\n",
+    "conveyor inlet": "jdem_scene: 1\nname: probe_inlet\ntime: {dt: 1.0e-5, steps: 1}\n"
+                      + PROBE_MATERIALS
+                      + "inlets:\n  - {name: belt, section: {particles: [{material: m, radius: 0.01,"
+                        " position: [0, 0, 0]}]}, origin: [0.0, 0.5, 0.5], velocity: [1, 0, 0],"
+                        " plane: {point: [0.05, 0, 0], normal: [1, 0, 0]}, period: 0.1,"
+                        " stop: {sections: 1}}\nwalls:\n" + PROBE_FLOOR,
+    "inlet section from a deposit": "jdem_scene: 1\nname: probe_from_deposit\n"
+                                    "time: {dt: 1.0e-5, steps: 1}\n" + PROBE_MATERIALS
+                                    + "inlets:\n  - {name: belt, section: {from_deposit: [{file:"
+                                      " probe_missing_deposit.h5}]}, origin: [0, 0.5, 0.5],"
+                                      " velocity: [1, 0, 0], plane: {point: [0.05, 0, 0],"
+                                      " normal: [1, 0, 0]}, stop: {sections: 1}}\n"
+                                      "walls:\n" + PROBE_FLOOR,
+}
+
+
+def last_line(text):
+    """The engine's last message, from the key it names on (not the probe's temporary path)."""
+    lines = [line for line in text.strip().splitlines() if line.strip()]
+    line = lines[-1] if lines else "(no message)"
+    return line[line.find("key '"):] if "key '" in line else line
+
+
+@functools.lru_cache(maxsize=None)
+def missing(engine, feature):
+    """None when `engine` reads the probe scene of `feature`, else why not (its own words).
+    jdem: an "unknown key" from `jdem resolve`; liggghts-jdem: any refusal of the deck generator
+    for the resolved probe."""
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = os.path.join(tmp, "probe.yaml")
+        with open(scene, "w") as f:
+            f.write(PROBES[feature])
+        r = subprocess.run([jdem(), "resolve", scene], capture_output=True, text=True, cwd=tmp)
+        if r.returncode != 0:
+            return (f"jdem has no {feature}: {last_line(r.stderr)}" if "unknown key" in r.stderr
+                    else None)
+        if engine == "jdem":
+            return None
+        d = subprocess.run([PY, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), "-",
+                            "-o", os.path.join(tmp, "deck", "in.jdem"), "--trajectory",
+                            os.path.join(tmp, "probe.h5")], input=r.stdout, capture_output=True,
+                           text=True, cwd=tmp)
+        return None if d.returncode == 0 else \
+            f"liggghts-jdem has no {feature}: {last_line(d.stderr)}"
+
+
+def gate(engine, *features):
+    return lambda: next((m for m in (missing(engine, f) for f in features) if m), None)
+
+
+# ---- time steps -----------------------------------------------------------------------------
+@functools.lru_cache(maxsize=None)
+def guard_dt(model):
+    """The guard's largest safe dt [s] for a case (jdem resolve of `time.dt: auto`)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = os.path.join(tmp, "fill.yaml")
+        subprocess.run([PY, GENERATE, "fill", "--case", model, "--dt", "auto", "-o", scene],
+                       check=True)
+        r = subprocess.run([jdem(), "resolve", scene], capture_output=True, text=True, check=True)
+        return float(yaml.safe_load(r.stdout)["time"]["dt"])
+
+
+def variant_dt(variant, model):
+    """(the --dt argument of generate.py, the dt in s for the cost) of a variant."""
+    if variant == "seed":
+        return repr(SEED_DT), SEED_DT
+    if variant == "guard":   # the number, not auto: generate.py then rescales the output cadence
+        return repr(guard_dt(model)), guard_dt(model)
+    return repr(0.5 * guard_dt(model)), 0.5 * guard_dt(model)
+
+
+# ---- units ----------------------------------------------------------------------------------
+def run_command(engine, scene, out, force):
+    """argv running `scene` (a path or a "{...}" placeholder) into `out`."""
+    extra = ["--force"] if force else []
     if engine == "jdem":
-        return [os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem")), "run", scene, *sel,
-                "-o", out, "--quiet"]
-    return [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, *sel, "-o", out]
+        return [jdem(), "run", scene, "-o", out, "--quiet", *extra]
+    return [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out, *extra]
 
 
-def pass_units(engine, model, p, deposit, base):
+def fill1_command(engine, model, dt_arg, force):
+    """Write the case's scene with the variant's dt into the unit's directory, then run it."""
+    run = run_command(engine, '"$1"', '"$2"', force)
+    words = [a if a in ('"$1"', '"$2"') else shlex.quote(a) for a in run]
+    return ["sh", "-c", f'{shlex.quote(PY)} {shlex.quote(GENERATE)} fill --case {model} '
+            f'--dt {dt_arg} -o "$1" && ' + " ".join(words), "fill1", "{dir}/fill1.yaml", "{out0}"]
+
+
+def pass_units(engine, model, p, deposit, base, dt_arg, dt, force):
     """The 9 cube scenes of one deposit and their compressions."""
     name = f"{engine}/{model}/pass{p}"
     cube_dir = os.path.join(base, f"pass{p}_cubes")
     scenes = [os.path.join(cube_dir, f"cube{k}.yaml") for k in range(1, 10)]
     units = [Unit(f"{name}_cubes", scenes, [PY, GENERATE, "cubes", deposit, "--case", model,
-                                            "-o", "{dir}"],
+                                            "--dt", dt_arg, "-o", "{dir}"],
                   model, engine, needs=[f"{engine}/{model}/fill{p}"], validate=valid_scene,
                   cost=SCENE_COST)]
     for k, scene in enumerate(scenes, start=1):
         units.append(Unit(f"{name}_cube{k}", [os.path.join(base, f"pass{p}_cube{k}.h5")],
-                          run_command(engine, scene, "{out0}"), model, engine,
-                          needs=[f"{name}_cubes"], validate=valid_trajectory, cost=CUBE_COST))
+                          run_command(engine, scene, "{out0}", force), model, engine,
+                          needs=[f"{name}_cubes"], validate=valid_trajectory,
+                          cost=CUBE_PARTICLES * CUBE_TIME / dt,
+                          blocked=gate(engine, "servo wall")))
     return units
 
 
-def model_units(engine, model):
-    base = os.path.join(OUT, engine, model)
+def model_units(engine, model, variant):
+    base = os.path.join(OUT[variant], engine, model)
     fill1, fill2 = os.path.join(base, "fill1.h5"), os.path.join(base, "fill2.h5")
     pass2 = os.path.join(base, "pass2.yaml")
     pre = f"{engine}/{model}"
+    dt_arg, dt = variant_dt(variant, model)
+    force = variant == "seed"   # the guard refuses the seed's dt (docs/mixing.md §6)
+    fill_cost = FILL_PARTICLES * FILL_TIME / dt
     units = [
-        Unit(f"{pre}/fill1", [fill1], run_command(engine, SCENE, "{out0}", model), model, engine,
-             validate=valid_trajectory, cost=FILL_COST),
+        Unit(f"{pre}/fill1", [fill1], fill1_command(engine, model, dt_arg, force), model, engine,
+             validate=valid_trajectory, cost=fill_cost, blocked=gate(engine, "conveyor inlet")),
         Unit(f"{pre}/pass2_scene", [pass2], [PY, GENERATE, "second-pass", fill1, "--case", model,
-                                             "-o", "{out0}"],
+                                             "--dt", dt_arg, "-o", "{out0}"],
              model, engine, needs=[f"{pre}/fill1"], validate=valid_scene, cost=SCENE_COST),
-        Unit(f"{pre}/fill2", [fill2], run_command(engine, pass2, "{out0}"), model, engine,
-             needs=[f"{pre}/pass2_scene"], validate=valid_trajectory, cost=FILL_COST),
+        Unit(f"{pre}/fill2", [fill2], run_command(engine, pass2, "{out0}", force), model, engine,
+             needs=[f"{pre}/pass2_scene"], validate=valid_trajectory, cost=fill_cost,
+             blocked=gate(engine, "conveyor inlet", "inlet section from a deposit")),
     ]
-    return units + pass_units(engine, model, 1, fill1, base) + pass_units(engine, model, 2, fill2, base)
+    return units + pass_units(engine, model, 1, fill1, base, dt_arg, dt, force) \
+        + pass_units(engine, model, 2, fill2, base, dt_arg, dt, force)
 
 
 def units(argv):
-    return [u for engine in ENGINES for model in MODELS for u in model_units(engine, model)]
+    import argparse
+    ap = argparse.ArgumentParser(prog="plan_ch4.py")
+    ap.add_argument("--dt", choices=sorted(OUT), default="seed",
+                    help="time-step variant: the seed's 1e-4 s, the guard's dt, half of it")
+    a = ap.parse_args(argv)
+    return [u for engine in ENGINES for model in MODELS for u in model_units(engine, model, a.dt)]

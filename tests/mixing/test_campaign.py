@@ -37,12 +37,20 @@ def valid(path):
 
 def units(argv):
     out = lambda n: os.path.join(HERE, "out", n + ".txt")
-    return [
+    plan = [
         Unit("a", [out("a")], WORKER + ["a", "{{out0}}"], model="m1", engine="e1", validate=valid),
         Unit("b", [out("b")], WORKER + ["b", "{{out0}}"], model="m1", engine="e2", validate=valid,
              needs=["a"]),
         Unit("c", [out("c")], WORKER + ["c", "{{out0}}"], model="m2", engine="e1", validate=valid,
              cost=2.0),
+    ]
+    if not os.environ.get("WITH_D"):  # d and e: the not-yet-runnable test's only
+        return plan
+    return plan + [
+        Unit("d", [out("d")], WORKER + ["d", "{{out0}}"], model="m3", engine="e3", validate=valid,
+             blocked=lambda: os.environ.get("BLOCKED_d")),
+        Unit("e", [out("e")], WORKER + ["e", "{{out0}}"], model="m3", engine="e3", validate=valid,
+             needs=["d"]),
     ]
 '''
 
@@ -127,6 +135,25 @@ def test_validation_and_selection():
     check("list", r.stdout.split("\n")[:3] == ["done a", "done b", "done c"], r.stdout)
 
 
+def test_not_yet_runnable():
+    """A unit whose engine lacks a feature is reported with the reason and skipped, with the
+    units that need it; that is no failure; once the feature exists both run."""
+    here = setup()
+    r = campaign(here, "--model", "m3", env={"WITH_D": "1",
+                                                  "BLOCKED_d": "the engine has no frobnicator"})
+    check("blocked_not_run", r.returncode == 0 and runs(here) == [], f"ran {runs(here)}; {r.stderr}")
+    check("blocked_says_why", "campaign: skip d: not yet runnable: the engine has no frobnicator"
+          in r.stderr and "campaign: skip e: not yet runnable: needs d, which is not yet runnable"
+          in r.stderr, r.stderr)
+    check("blocked_counted", "campaign: 0 run, 0 failed, 2 not yet runnable, 0 already done"
+          in r.stderr, r.stderr)
+    r = campaign(here, "--model", "m3", "--list", env={"WITH_D": "1", "BLOCKED_d": "no frobnicator"})
+    check("blocked_listed", r.stdout.split("\n")[:2] == ["todo d (not yet runnable: no frobnicator)",
+          "todo e (not yet runnable: needs d, which is not yet runnable)"], r.stdout)
+    r = campaign(here, "--model", "m3", env={"WITH_D": "1"})
+    check("unblocked_runs", r.returncode == 0 and runs(here) == ["d", "e"], f"ran {runs(here)}")
+
+
 def test_ch4_plan():
     """The plan of make mixing (docs/mixing.md §4): 2 engines x 6 models x (2 fills, 1 second-
     pass scene, 2 x (1 cube-scene unit + 9 compressions)) = 276 units, unique names, and every
@@ -146,6 +173,29 @@ def test_ch4_plan():
 
 
 test_killed_run_resumes()
+def test_ch4_dt_variants():
+    """The plan's time-step variants: the seed's 1e-4 s forced, the guard's dt as jdem states it
+    when it refuses the seed's, and half of it, each in its own output tree."""
+    import re
+    from mixing import plan_ch4
+    refused = subprocess.run([plan_ch4.jdem(), "run", plan_ch4.SCENE, "--case", "model1", "-o",
+                              os.path.join(tempfile.mkdtemp(), "x.h5")], capture_output=True,
+                             text=True)
+    m = re.search(r"unsafe: .*largest safe dt = ([0-9.e+-]+) s", refused.stderr)
+    check("ch4_seed_dt_refused", refused.returncode == 2 and m is not None, refused.stderr)
+    safe = float(m.group(1)) if m else float("nan")
+    for variant, dt, forced in (("seed", 1e-4, True), ("guard", safe, False),
+                                ("half", safe / 2, False)):
+        fill = plan_ch4.units(["--dt", variant])[0]
+        cmd = fill.command[2]
+        got = float(re.search(r"--dt (\S+)", cmd).group(1))
+        check(f"ch4_dt_{variant}", abs(got - dt) <= 1e-5 * dt and ("--force" in cmd) == forced
+              and fill.outputs[0].startswith(plan_ch4.OUT[variant] + os.sep),
+              f"dt {got} (expected {dt:.6g}), command {cmd}, output {fill.outputs[0]}")
+
+
 test_validation_and_selection()
+test_not_yet_runnable()
+test_ch4_dt_variants()
 test_ch4_plan()
 finish()

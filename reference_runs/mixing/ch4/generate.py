@@ -1,10 +1,18 @@
 #!/usr/bin/python3
 """generate.py — the scenes of the second mixing pass and of the compression cubes, cut from a
-first- or second-pass deposit (docs/mixing.md §1, §2).  TARGET SCHEMA: the scenes it writes use
-`inlets:`, `particles_from:` and `servo:`, which the engines are to implement.
+first- or second-pass deposit, and the first-pass cases as scenes of their own (docs/mixing.md
+§1, §2, §4).  The first-pass scenes run in build/jdem; the second pass's `from_deposit` cells
+and the cubes' `servo:` wall are the target schema, which the engines are to implement.
 
-    generate.py second-pass DEPOSIT.h5 --case modelM -o PASS2.yaml [--gap 0.06]
-    generate.py cubes DEPOSIT.h5 --case modelM -o DIR     (writes DIR/cubeK.yaml, K = 1..9)
+    generate.py fill --case modelM -o FILL1.yaml [--dt DT] [--sections N] [--end-time T]
+    generate.py second-pass DEPOSIT.h5 --case modelM -o PASS2.yaml [--gap 0.06] [--dt DT]
+    generate.py cubes DEPOSIT.h5 --case modelM -o DIR [--dt DT]  (writes DIR/cubeK.yaml, K = 1..9)
+
+fill: the first-pass case of models.yaml as a scene of its own, optionally with another time
+step (a number in s, or auto: the guard's) or a reduced stream (the first N sections, T s).
+--dt sets the time step of every scene written (default: the seed's, models.yaml's time.dt); a
+number rescales the output cadence so that the frames stay at the same times (auto keeps the
+cadence in steps).
 
 second-pass: the bottom 1 m of the deposit's last frame (centres with 0 <= z < 1) is cut into
 1 x 2 x 4 cells of 1 (x) x 0.5 (y) x 0.25 (z) m; cell q = 2 layer + half (bottom to top, y < 0.5
@@ -30,11 +38,13 @@ MODELS = os.path.join(HERE, "models.yaml")
 CELL = (1.0, 0.5, 0.25)   # [RECON] orientation, spec §1.7
 DEPTH = 1.0               # [TEXT] L1539
 CUBE = 0.2                # [TEXT] spec §2.4
+SEED_DT = 1.0e-4          # [TEXT] Table 4-1
 SERVO = {"target": 1000.0, "gain": 1.0e-4, "tolerance": 10.0, "max_speed": 0.02, "hold": 0.05}
 
 
-def case_scene(case):
-    """models.yaml with the overrides of one case applied and the sweep removed."""
+def case_scene(case, dt=None):
+    """models.yaml with the overrides of one case applied and the sweep removed; dt (a number
+    or "auto") replaces the time step."""
     with open(MODELS) as f:
         doc = yaml.safe_load(f)
     values = doc.pop("sweep")[0]["values"]
@@ -43,7 +53,31 @@ def case_scene(case):
     for path, value in values[case].items():
         set_path(doc, path, value)
     doc["case"] = case
+    if dt is not None:
+        set_dt(doc, dt)
     return doc
+
+
+def set_dt(doc, dt):
+    """Replace the time step; with a number, the output cadence (in steps) is rescaled so that
+    the frames stay at the same times (the seed's snapshots at whole seconds)."""
+    old = doc["time"]["dt"]
+    doc["time"]["dt"] = dt
+    if dt != "auto":
+        for key in ("every", "observables_every"):
+            if key in doc["output"]:
+                doc["output"][key] = max(1, round(doc["output"][key] * old / dt))
+
+
+def fill(args):
+    doc = case_scene(args.case, args.dt)
+    if args.sections is not None:
+        doc["inlets"][0]["stop"] = {"sections": args.sections}
+    if args.end_time is not None:
+        doc["time"]["end_time"] = args.end_time
+    write(args.out, doc, f"first pass, {args.case}, dt {doc['time']['dt']}, "
+                         f"{doc['inlets'][0]['stop']['sections']} sections, "
+                         f"{doc['time']['end_time']} s", note="")
 
 
 def cells(dep, deposit_path, gap):
@@ -68,7 +102,7 @@ def second_pass(args):
     if deposit.deposit_height(dep) < DEPTH:
         sys.exit(f"generate.py: {args.deposit}: the deposit is {deposit.deposit_height(dep):.3f} m "
                  f"deep; valid: at least {DEPTH} m for the second pass")
-    doc = case_scene(args.case)
+    doc = case_scene(args.case, args.dt)
     doc["name"] = "mixing_ch4_pass2"
     doc["description"] = f"Jiang (2021) Ch. 4 second mixing pass, {args.case} (Fig. 4-9)"
     inlet = doc["inlets"][0]
@@ -101,43 +135,65 @@ def cubes(args):
     for k, c in enumerate(params.POINTS_TABLE_4_2, start=1):
         lo, hi = (c - CUBE / 2).round(12).tolist(), (c + CUBE / 2).round(12).tolist()
         deposit.keep_box(dep, lo, hi, source=args.deposit)
-        doc = case_scene(args.case)
+        doc = case_scene(args.case, args.dt)
         doc["name"] = f"mixing_ch4_cube{k}"
         doc["description"] = f"Jiang (2021) Ch. 4 compression test, cube {k} (Table 4-2)"
         doc.pop("inlets")
         doc["walls"] = cube_walls(lo, hi)
         doc["particles_from"] = [{"file": os.path.abspath(args.deposit), "frame": -1,
                                   "region": {"lo": lo, "hi": hi}}]
-        doc["time"] = {"dt": doc["time"]["dt"], "end_time": 10.0,
+        dt = doc["time"]["dt"]
+        doc["time"] = {"dt": SEED_DT, "end_time": 10.0,
                        "max_impact_speed": doc["time"]["max_impact_speed"]}
-        doc["output"] = {"every": 1000, "observables_every": 100}
+        doc["output"] = {"every": 1000, "observables_every": 100}   # 0.1 s, 0.01 s
+        set_dt(doc, dt)
         write(os.path.join(args.out, f"cube{k}.yaml"), doc,
               f"compression cube {k} at {c.tolist()} of {args.deposit} ({args.case})")
 
 
-def write(path, doc, what):
+TARGET = "# TARGET SCHEMA (docs/mixing.md §2): does not run until the engines implement it.\n"
+
+
+def write(path, doc, what, note=TARGET):
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
-        f.write(f"# Generated by reference_runs/mixing/ch4/generate.py: {what}.\n"
-                f"# TARGET SCHEMA (docs/mixing.md §2): does not run until the engines implement it.\n")
+        f.write(f"# Generated by reference_runs/mixing/ch4/generate.py: {what}.\n{note}")
         yaml.safe_dump(doc, f, sort_keys=False, default_flow_style=None)
     os.replace(tmp, path)
+
+
+def time_step(text):
+    """--dt: a number > 0 [s] or auto."""
+    if text == "auto":
+        return text
+    try:
+        dt = float(text)
+    except ValueError:
+        dt = -1.0
+    if not dt > 0:
+        raise argparse.ArgumentTypeError(f"'{text}' is not valid; valid: a number > 0 [s], or auto")
+    return dt
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="what", required=True)
-    for name in ("second-pass", "cubes"):
+    for name in ("fill", "second-pass", "cubes"):
         p = sub.add_parser(name)
-        p.add_argument("deposit")
+        if name != "fill":
+            p.add_argument("deposit")
         p.add_argument("--case", required=True)
         p.add_argument("-o", "--out", required=True)
+        p.add_argument("--dt", type=time_step, help="time step [s] or auto (default: the seed's)")
+        if name == "fill":
+            p.add_argument("--sections", type=int, help="sections of the stream (default 80)")
+            p.add_argument("--end-time", type=float, help="simulated time [s] (default 25)")
         if name == "second-pass":
             p.add_argument("--gap", type=float, default=0.06,
                            help="[RECON] gap between queued cells [m], default 2 R_big")
     args = ap.parse_args()
     try:
-        (second_pass if args.what == "second-pass" else cubes)(args)
+        {"fill": fill, "second-pass": second_pass, "cubes": cubes}[args.what](args)
     except deposit.DepositError as e:
         sys.exit(f"generate.py: {e}")
 
