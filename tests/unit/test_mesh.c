@@ -34,6 +34,18 @@ static void set3(double p[3], double x, double y, double z) {
     p[2] = z;
 }
 
+/* The closed unit cube [0, 1]^3, two triangles per face (corner c at (c & 1, c >> 1 & 1, c >> 2)). */
+static void unit_cube(double tri[12][3][3]) {
+    static const int q[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                                {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+    for (int f = 0; f < 6; f++)
+        for (int h = 0; h < 2; h++) {
+            const int idx[3] = {q[f][0], q[f][1 + h], q[f][2 + h]};
+            for (int k = 0; k < 3; k++)
+                set3(tri[2 * f + h][k], idx[k] & 1, (idx[k] >> 1) & 1, (idx[k] >> 2) & 1);
+        }
+}
+
 /* An n x n grid of unit squares in the plane z = 0, two triangles each, alternating diagonals. */
 static size_t grid(int n, double (*tri)[3][3]) {
     size_t t = 0;
@@ -67,15 +79,8 @@ static double urand(unsigned *s) {
 /* A closed cube: V - E + F = 2, every edge shared by two triangles, 36 corners in all. */
 static void cube_topology_obeys_euler(void **state) {
     (void)state;
-    static const int q[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
-                                {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
     double tri[12][3][3];
-    for (int f = 0; f < 6; f++)
-        for (int h = 0; h < 2; h++) {
-            const int idx[3] = {q[f][0], q[f][1 + h], q[f][2 + h]};
-            for (int k = 0; k < 3; k++)
-                set3(tri[2 * f + h][k], idx[k] & 1, (idx[k] >> 1) & 1, (idx[k] >> 2) & 1);
-        }
+    unit_cube(tri);
     built *b = build(12, (const double(*)[3][3])tri);
     assert_int_equal(b->m.nvert, 8);
     assert_int_equal(b->m.nedge, 18);
@@ -202,15 +207,8 @@ static void concave_corner_gives_one_contact_per_face(void **state) {
 /* Outside a closed cube, beyond a corner along its diagonal: one vertex contact at the corner. */
 static void convex_corner_gives_one_vertex_contact(void **state) {
     (void)state;
-    static const int q[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
-                                {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
     double tri[12][3][3];
-    for (int f = 0; f < 6; f++)
-        for (int h = 0; h < 2; h++) {
-            const int idx[3] = {q[f][0], q[f][1 + h], q[f][2 + h]};
-            for (int k = 0; k < 3; k++)
-                set3(tri[2 * f + h][k], idx[k] & 1, (idx[k] >> 1) & 1, (idx[k] >> 2) & 1);
-        }
+    unit_cube(tri);
     built *b = build(12, (const double(*)[3][3])tri);
     jd_mesh_closest c[12];
     unsigned char contact[12];
