@@ -9,7 +9,7 @@ scripts/scene_to_liggghts.py writes from it (--inlet-record), on 1 and 2 MPI ran
   velocities bit for bit, in insertion order), on 1 and on 2 ranks; jdem's is checked against
   the closed form by tests/inlet/test_inlet.py.
 * frames: at each of jdem's frames the particles present in LIGGGHTS (a `dump custom` of the
-  same deck: dump h5md/jdem needs a fixed particle set until the growing set is merged) are
+  same deck, on 1 and 2 ranks) are
   exactly those jdem has inserted, and their positions, velocities and spins agree within the
   cross-engine tolerance (output.compare_tolerance, default 1e-10, scaled as
   scripts/compare_trajectories.py: by the largest radius, the belt speed, and their ratio); 2
@@ -21,8 +21,9 @@ scripts/scene_to_liggghts.py writes from it (--inlet-record), on 1 and 2 MPI ran
 * stop rules: a time and a deposit-height rule that admit one section where the sections rule
   admits two give the same records in both engines (the rules are the kernel's); so does a
   scene with a second inlet (one record, the inlets' lines of a step in the scene's order).
-* the deck's own trajectory: the unmodified deck writes dump h5md/jdem (FAIL naming the reason
-  while that dump refuses a growing or empty particle set).
+* the deck's own trajectory: the unmodified deck writes dump h5md/jdem, a growing particle set
+  (ids -1 in empty slots), whose live particles at every frame are jdem's, within the same
+  tolerance.
 * bad input: each malformed fix jdem/inlet argument stops LIGGGHTS with its exact message.
 """
 import csv
@@ -98,18 +99,25 @@ def read_custom_dump(path):
     return frames
 
 
-def jdem_frames(path):
-    """{step: {id: row of 9 floats}} of the particles present (finite rows)."""
+def h5md_frames(path):
+    """{step: {id: row of 9 floats}} of the live particles of an H5MD trajectory of either
+    engine (a changing set: the per-frame ids, -1 in empty slots), and the last inlet_energy
+    (None when the file has no such observable)."""
     with h5py.File(path, "r") as h:
-        ids = h["/particles/all/id"][:]
-        steps = h["/particles/all/position/step"][:]
-        data = [h["/particles/all/%s/value" % k][:] for k in ("position", "velocity", "angular_velocity")]
-        inlet_energy = h["/observables/inlet_energy/value"][-1]
+        p = h["/particles/all"]
+        per_frame = isinstance(p["id"], h5py.Group)
+        ids = p["id/value"][:] if per_frame else p["id"][:]
+        steps = p["position/step"][:]
+        data = [p["%s/value" % k][:] for k in ("position", "velocity", "angular_velocity")]
+        obs = h.get("/observables/inlet_energy/value")
+        inlet_energy = float(obs[-1]) if obs is not None else None
     out = {}
     for f, s in enumerate(steps):
         row = np.concatenate([d[f] for d in data], axis=1)
-        out[int(s)] = {int(i): list(row[r]) for r, i in enumerate(ids) if np.all(np.isfinite(row[r]))}
-    return out, float(inlet_energy)
+        frame_ids = ids[f] if per_frame else ids
+        out[int(s)] = {int(i): list(row[r]) for r, i in enumerate(frame_ids)
+                       if i >= 0 and np.all(np.isfinite(row[r]))}
+    return out, inlet_energy
 
 
 def worst_difference(a, b, scales):
@@ -165,7 +173,7 @@ def cross_engine(tmp):
         return None
     deck_text = open(os.path.join(deck_dir, "in.jdem")).read()
     every = int(sc["output"]["every"])
-    jf, jdem_inflow = jdem_frames(jdem_h5)
+    jf, jdem_inflow = h5md_frames(jdem_h5)
     jrec = open(jdem_rec).read()
     R = max(p["radius"] for p in sc["inlets"][0]["section"]["particles"])
     v = math.sqrt(sum(c * c for c in sc["inlets"][0]["velocity"]))
@@ -225,11 +233,13 @@ def cross_engine(tmp):
         check("builtin-stream-identical", rc == 0 and open(brec).read() == jrec,
               "exit %d: %s" % (rc, log[-600:]))
     rc, log = run_deck(deck_dir, "in.jdem", "log.h5md", 1)
-    refused = re.search(r"h5md/jdem needs a fixed particle set|dump h5md/jdem: h5md: frame at step \d+ has no "
-                        r"positions", log)
-    check("deck-trajectory-h5md", rc == 0 and os.path.exists(os.path.join(tmp, "fill.lig.h5")),
-          "dump h5md/jdem refuses the growing particle set (it needs the growing-set dump of the "
-          "output work, issue 24)" if refused else "exit %d:\n%s" % (rc, log[-800:]))
+    lig_h5 = os.path.join(tmp, "fill.lig.h5")
+    if check("deck-trajectory-h5md", rc == 0 and os.path.exists(lig_h5), "exit %d:\n%s" % (rc, log[-800:])):
+        hf, _ = h5md_frames(lig_h5)
+        worst = worst_difference(jf, hf, scales)
+        check("deck-trajectory-h5md-frames", not same_particles(jf, hf) and set(jf) <= set(hf) and
+              worst <= tol, "particle sets differ at %s; largest scaled difference %.3g" % (
+                  same_particles(jf, hf), worst))
     return deck_dir, custom_dump_deck(deck_text, every, "bad.dump")
 
 
