@@ -83,7 +83,8 @@ def check_free_fall(h, sc, rec):
     external force, whatever the collisions inside the section (the big spheres land on the
     small ones behind them as the block tips over the plane)."""
     dt, g = sc["time"]["dt"], np.array(sc["gravity"])
-    ids = h["/particles/all/id"][:]
+    idv = h["/particles/all/id"]  # a growing set: the slots' ids per frame, all live at the end
+    ids = idv["value"][-1] if isinstance(idv, h5py.Group) else idv[:]
     m = h["/particles/all/mass"][:]
     k = np.array([rec[i][0] for i in ids])
     x0 = np.array([rec[i][1] for i in ids])
