@@ -299,15 +299,8 @@ void FixBondJiang::read_bond_file(const char *path) {
       nbad = 1;
     }
   }
-  MPI_Bcast(&nbad, 1, MPI_INT, 0, world);
-  if (nbad) {
-    MPI_Bcast(msg, sizeof msg, MPI_CHAR, 0, world);
-    error->all(FLERR, msg);
-  }
-  int n = (int)pairs.size();
-  MPI_Bcast(&n, 1, MPI_INT, 0, world);
-  pairs.resize(n);
-  if (n) MPI_Bcast(pairs.data(), n, MPI_INT, 0, world);
+  jdem_share_input(lmp, nbad, msg, sizeof msg, pairs);
+  const int n = (int)pairs.size();
 
   /* every id must exist somewhere (each atom is owned by exactly one rank) */
   int found_mine = 0;

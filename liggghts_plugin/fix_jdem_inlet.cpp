@@ -203,15 +203,8 @@ void FixJdemInlet::read_section(const char *path) {
       bad = 1;
     }
   }
-  MPI_Bcast(&bad, 1, MPI_INT, 0, world);
-  if (bad) {
-    MPI_Bcast(msg, sizeof msg, MPI_CHAR, 0, world);
-    error->all(FLERR, msg);
-  }
-  int n = (int)rows.size();
-  MPI_Bcast(&n, 1, MPI_INT, 0, world);
-  rows.resize(n);
-  MPI_Bcast(rows.data(), n, MPI_DOUBLE, 0, world);
+  jdem_share_input(lmp, bad, msg, sizeof msg, rows);
+  const int n = (int)rows.size();
   for (int r = 0; r < n; r += 6) {
     type0.push_back((int32_t)rows[r] - 1);
     radius.push_back(rows[r + 1]);

@@ -82,15 +82,8 @@ void FixJdemLoads::read_file(const char *path) {
       bad = 1;
     }
   }
-  MPI_Bcast(&bad, 1, MPI_INT, 0, world);
-  if (bad) {
-    MPI_Bcast(msg, sizeof msg, MPI_CHAR, 0, world);
-    error->all(FLERR, msg);
-  }
-  int n = (int)rows.size();
-  MPI_Bcast(&n, 1, MPI_INT, 0, world);
-  rows.resize(n);
-  if (n) MPI_Bcast(rows.data(), n, MPI_DOUBLE, 0, world);
+  jdem_share_input(lmp, bad, msg, sizeof msg, rows);
+  const int n = (int)rows.size();
   int mine = 0, all = 0;
   for (int r = 0; r < n; r += 5) {
     const int i = atom->map((int)rows[r]);

@@ -1,11 +1,16 @@
 /* jdem_input_file.cpp — see jdem_input_file.h. */
 #include "jdem_input_file.h"
 
+#include <mpi.h>
+
 #include <sys/stat.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+
+#include "error.h"
+#include "lammps.h"
 
 static std::string named(const char *what, const char *path, const std::string &reason) {
   return std::string(what) + " " + path + ": " + reason;
@@ -39,4 +44,33 @@ std::string jdem_text_line(const char *what, const char *path, int lineno, const
     }
   }
   return "";
+}
+
+namespace {
+
+template <typename T>
+void share_rows(LAMMPS_NS::LAMMPS *lmp, int bad, char *msg, size_t msglen, std::vector<T> &rows,
+                MPI_Datatype type) {
+  MPI_Comm world = lmp->world;
+  MPI_Bcast(&bad, 1, MPI_INT, 0, world);
+  if (bad) {
+    MPI_Bcast(msg, (int)msglen, MPI_CHAR, 0, world);
+    lmp->error->all(FLERR, msg);
+  }
+  int n = (int)rows.size();
+  MPI_Bcast(&n, 1, MPI_INT, 0, world);
+  rows.resize(n);
+  if (n) MPI_Bcast(rows.data(), n, type, 0, world);
+}
+
+}  // namespace
+
+void jdem_share_input(LAMMPS_NS::LAMMPS *lmp, int bad, char *msg, size_t msglen,
+                      std::vector<double> &rows) {
+  share_rows(lmp, bad, msg, msglen, rows, MPI_DOUBLE);
+}
+
+void jdem_share_input(LAMMPS_NS::LAMMPS *lmp, int bad, char *msg, size_t msglen,
+                      std::vector<int> &rows) {
+  share_rows(lmp, bad, msg, msglen, rows, MPI_INT);
 }

@@ -5,8 +5,14 @@
 #ifndef JDEM_INPUT_FILE_H
 #define JDEM_INPUT_FILE_H
 
+#include <cstddef>
 #include <fstream>
 #include <string>
+#include <vector>
+
+namespace LAMMPS_NS {
+class LAMMPS;
+}
 
 /* Largest input file [bytes]: 1 GiB, tens of millions of bonds or loads (the readers hold it on
  * rank 0 before broadcasting it). */
@@ -20,5 +26,13 @@ std::string jdem_open_input(const char *what, const char *path, std::ifstream &i
 /* "" for a line of text, else the message "WHAT PATH line N: binary data (byte 0xXX)": a NUL or
  * another control character other than tab and carriage return. */
 std::string jdem_text_line(const char *what, const char *path, int lineno, const std::string &line);
+
+/* Collective: rank 0's verdict on the file it read and, when it is good, its rows on every rank.
+ * BAD and MSG (MSGLEN bytes) are rank 0's; when BAD, every rank stops with error->all(MSG), else
+ * ROWS becomes rank 0's rows everywhere. */
+void jdem_share_input(LAMMPS_NS::LAMMPS *lmp, int bad, char *msg, size_t msglen,
+                      std::vector<double> &rows);
+void jdem_share_input(LAMMPS_NS::LAMMPS *lmp, int bad, char *msg, size_t msglen,
+                      std::vector<int> &rows);
 
 #endif
