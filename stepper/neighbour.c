@@ -71,14 +71,11 @@ int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
     return 0;
 }
 
-/* Give back what a list holds beyond its entries, a sixteenth more and the 256 a list starts
- * with (sim_list_reserve grows from there): the geometric growth of a build can leave up to a
- * third of its capacity unused, which the run would carry until the next build.  The sixteenth
- * lets the next build's split (which takes this list's buffers) grow by that much without a
- * reallocation.  Every array then holds at least cap entries: shrunk, or as it was if a shrink
- * failed. */
+/* Give back what a list holds beyond twice its entries and the 256 a list starts with: a list
+ * that was once much longer (a burst of candidates) does not keep its room for the rest of the
+ * run, while one that breathes by a few per cent from build to build is never reallocated. */
 static void list_fit(jd_contact_list *l) {
-    const size_t cap = l->n + l->n / 16 + 256;
+    const size_t cap = 2 * l->n + 256;
     if (cap >= l->cap) return;
     if (list_resize(l, cap, l->hw, l->rw) == 0) l->cap = cap; /* if not, the list keeps its room */
 }
@@ -351,12 +348,18 @@ static int build_pair_list_all(jd_sim *s, jd_contact_list *l) {
     return 0;
 }
 
-/* Build a new list into `spare`, carry the history over, swap. */
+/* Build a new list into `spare`, carry the history over, swap.  The spares keep their buffers
+ * between builds, and the pair spare is reserved at once for the last list and an eighth more,
+ * so a build reallocates only when the list grows by more than that. */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
     if (!s->allpairs && !s->opt.no_sort && s->n > 1 && sort_into_cells(s, err, errlen) != 0)
         return -1;
     jd_contact_list *nw = &s->spare;
     nw->n = 0;
+    if (sim_list_reserve(nw, s->pairs.n + s->pairs.n / 8 + 1, list_kind(s)) != 0) {
+        snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", s->pairs.n);
+        return -1;
+    }
     if (s->allpairs) {
         if (build_pair_list_all(s, nw) != 0) {
             snprintf(err, errlen, "out of memory building the all-pairs list (%zu particles)", s->n);
@@ -373,21 +376,22 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
         return -1;
     }
     list_fit(&s->pairs);
-    sim_contact_list_free(nw); /* sized for pairs: the wall list would keep them */
+    list_fit(nw);
 
-    if (build_wall_list(s, nw) != 0) {
+    jd_contact_list *wn = &s->wall_spare;
+    wn->n = 0;
+    if (build_wall_list(s, wn) != 0) {
         snprintf(err, errlen, "out of memory building the wall candidate list");
         return -1;
     }
-    nw->n_touch = nw->n;
-    carry_over(s, &s->wall_pairs, nw);
-    jd_contact_list t = s->wall_pairs;
-    s->wall_pairs = *nw;
+    wn->n_touch = wn->n;
+    carry_over(s, &s->wall_pairs, wn);
+    const jd_contact_list t = s->wall_pairs;
+    s->wall_pairs = *wn;
+    *wn = t;
     list_fit(&s->wall_pairs);
-    *nw = t;
+    list_fit(wn);
 
-    /* the spare buffers are needed only during a build: give them back until the next one */
-    sim_contact_list_free(&s->spare);
     if (sim_forces_partition(s) != 0) {
         snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads);
         return -1;

@@ -94,7 +94,7 @@ static int rekey(jd_contact_list *l, int pairs, const int32_t *new_of_old, size_
 
 static int reorder_list(jd_sim *s, jd_contact_list *l, int pairs, const int32_t *new_of_old) {
     if (l->n == 0) return 0;
-    jd_contact_list *spare = &s->spare;
+    jd_contact_list *spare = pairs ? &s->spare : &s->wall_spare;
     const unsigned kind = (l->rw ? JD_LIST_ROLLING : 0u) | (l->hw == JD_CONTACT_STATE_LEN ? JD_LIST_ENERGY : 0u);
     if (sim_list_reserve(spare, l->n, kind) != 0 ||
         rekey(l, pairs, new_of_old, s->n, spare) != 0)

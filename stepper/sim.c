@@ -289,6 +289,7 @@ void sim_free(jd_sim *s) {
     sim_contact_list_free(&s->pairs);
     sim_contact_list_free(&s->wall_pairs);
     sim_contact_list_free(&s->spare);
+    sim_contact_list_free(&s->wall_spare);
     sim_bonds_free(s);
     sim_loads_free(s);
     sim_inlets_free(s);
@@ -308,7 +309,7 @@ size_t sim_memory_bytes(const jd_sim *s) {
     for (int t = 0; s->shares && t < s->threads; t++) overflow += 6 * s->shares[t].cap * sizeof(double);
     return s->n * per_particle + overflow + sim_bonds_memory_bytes(s->bonds, s->n) +
            s->cell_cap * sizeof(int32_t) + list_bytes(&s->pairs) + list_bytes(&s->wall_pairs) +
-           list_bytes(&s->spare) + s->n_walls * sizeof *s->walls +
+           list_bytes(&s->spare) + list_bytes(&s->wall_spare) + s->n_walls * sizeof *s->walls +
            s->n_materials * s->n_materials * sizeof *s->coeffs;
 }
 

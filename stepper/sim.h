@@ -240,7 +240,10 @@ typedef struct jd_sim {
     int allpairs;      /* opt.allpairs */
     double skin;       /* [m] */
     double *x_build;   /* positions at the last build, 3n */
-    jd_contact_list pairs, wall_pairs, spare;
+    jd_contact_list pairs, wall_pairs;
+    /* the buffers each build fills before its swap (and sim_reorder uses), kept from one build to
+     * the next: a fresh list would grow from empty, copying and faulting in its pages every build */
+    jd_contact_list spare, wall_spare;
     int64_t n_builds;
     int32_t *cell_of, *cell_items, *cell_start;
     size_t cell_cap;   /* capacity of cell_start */
