@@ -20,6 +20,7 @@ import argparse
 import importlib.util
 import json
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -101,8 +102,8 @@ class Times:
         except (OSError, ValueError):
             self.seconds = {}
 
-    def add(self, unit, seconds):
-        self.seconds[unit.name] = {"seconds": seconds, "cost": unit.cost}
+    def add(self, unit, seconds, cpu_seconds):
+        self.seconds[unit.name] = {"seconds": seconds, "cpu_seconds": cpu_seconds, "cost": unit.cost}
         tmp = self.path + ".tmp"
         with open(tmp, "w") as f:
             json.dump(self.seconds, f, indent=1)
@@ -139,6 +140,13 @@ def run_unit(unit):
     return None
 
 
+def children_cpu():
+    """User + system CPU seconds of the finished child processes: a unit's cost on a shared
+    machine, where its wall time also counts the other jobs."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def fmt_seconds(s):
     return f"{s:.1f} s" if s < 120 else f"{s / 60:.1f} min" if s < 7200 else f"{s / 3600:.1f} h"
 
@@ -162,15 +170,15 @@ def run(units, times, everything=None, log=sys.stderr):
         eta = times.eta(todo[i:])
         print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: running"
               + (f"; ETA {fmt_seconds(eta)}" if eta is not None else ""), file=log, flush=True)
-        start = time.monotonic()
+        start, cpu0 = time.monotonic(), children_cpu()
         reason = run_unit(u)
-        took = time.monotonic() - start
+        took, cpu = time.monotonic() - start, children_cpu() - cpu0
         if reason:
             failed += 1
             print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: FAILED after {fmt_seconds(took)}: "
                   f"{reason}", file=log, flush=True)
             continue
-        times.add(u, took)
+        times.add(u, took, cpu)
         eta = times.eta(todo[i + 1:])
         print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: done in {fmt_seconds(took)}; "
               f"{len(todo) - i - 1} left, ETA {fmt_seconds(eta)}", file=log, flush=True)

@@ -392,7 +392,7 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
     const jd_scene *sc = s->scene;
     const int64_t last = sc->steps;
     jd_progress p;
-    progress_start(&p, show_progress, last, s->n);
+    progress_start(&p, show_progress, last);
     const double t_loop = sim_clock();
     int rc = 0;
     for (;;) {
@@ -418,7 +418,7 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
         const int seen = due(s->step + 1, sc->output_every, last) ||
                          due(s->step + 1, sc->observables_every, last);
         if ((rc = sim_step(s, seen, err, errlen)) != 0) break;
-        progress_update(&p, s->step, (double)s->step * s->dt);
+        progress_update(&p, s->step, (double)s->step * s->dt, s->n);
     }
     sim_finish_step(s); /* a run stopped between samples: its stop frame, and the caller */
     s->timing.loop += sim_clock() - t_loop;

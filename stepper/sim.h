@@ -443,12 +443,14 @@ int sim_watchdog_energy(jd_sim *s, const jd_observables *o, char *msg, size_t le
 typedef struct jd_progress {
     int enabled, tty;
     int64_t total;
-    size_t n;
+    size_t n;               /* particles in the run now (an inlet's stream grows it) */
+    double particle_steps;  /* sum of n over the steps done: the rate of a growing set */
     double t_start, t_last; /* CLOCK_MONOTONIC seconds */
     int printed;
 } jd_progress;
-void progress_start(jd_progress *p, int enabled, int64_t total_steps, size_t n_particles);
-void progress_update(jd_progress *p, int64_t step, double sim_time);
+void progress_start(jd_progress *p, int enabled, int64_t total_steps);
+/* After each step: step done, its time [s], the particles it had. */
+void progress_update(jd_progress *p, int64_t step, double sim_time, size_t n_particles);
 void progress_finish(jd_progress *p);
 
 #endif /* JDEM_SIM_H */

@@ -154,7 +154,7 @@ def run_command(engine, scene, out, force):
     """argv running `scene` (a path or a "{...}" placeholder) into `out`."""
     extra = ["--force"] if force else []
     if engine == "jdem":
-        return [jdem(), "run", scene, "-o", out, "--quiet", *extra]
+        return [jdem(), "run", scene, "-o", out, *extra]   # its progress line shows in the log
     return [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out, *extra]
 
 
