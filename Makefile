@@ -219,6 +219,13 @@ mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),bu
 	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
 	    $(if $(DT),-- --dt $(DT))
 
+# The tables of the finished units, seed | jdem | liggghts-jdem (Tables 4-3...4-5, the mixing
+# parameters, run times): out/mixing/ch4/report.md and summary.json, and the committed copy in
+# reference_runs/mixing/ch4/results/ (stamped with the commit).
+.PHONY: mixing-report
+mixing-report:
+	$(PY) scripts/mixing/report_ch4.py --results reference_runs/mixing/ch4/results
+
 clean:
 	rm -rf build out
 

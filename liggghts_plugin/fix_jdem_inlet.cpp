@@ -30,7 +30,7 @@ using namespace FixConst;
 static const char *USAGE =
     "fix ID group jdem/inlet file SECTION origin X Y Z velocity VX VY VZ plane PX PY PZ NX NY NZ "
     "period L [offset D] first_id ID stop sections N|time T|height H [below_speed V] [every N] "
-    "[record FILE|append_record FILE]";
+    "[overlap_tol F] [record FILE|append_record FILE]";
 
 FixJdemInlet::FixJdemInlet(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), spec(), stream(), started(false), stop_time(-1.0), height(-1.0),
@@ -39,6 +39,7 @@ FixJdemInlet::FixJdemInlet(LAMMPS *lmp, int narg, char **arg)
     error->all(FLERR, "fix jdem/inlet needs atom_style granular (radius, density, mass, spin)");
   if (!atom->tag_enable || atom->map_style == 0)
     error->all(FLERR, "fix jdem/inlet needs atom IDs and `atom_modify map array` (or hash)");
+  spec.overlap_tol = JD_INLET_OVERLAP_TOL;
   parse(narg, arg);
   force_reneighbor = 1;
   next_reneighbor = -1; /* set by init() once dt is known */
@@ -124,6 +125,9 @@ void FixJdemInlet::parse(int narg, char **arg) {
       numbers(error, narg, arg, i, 1, key == "period" ? &spec.period : &spec.offset);
       if (key == "period") have[3] = true;
       i += 2;
+    } else if (key == "overlap_tol") { /* a section cut from a settled deposit keeps its contacts */
+      spec.overlap_tol = positive(error, narg, arg, i, "overlap_tol");
+      i += 2;
     } else if (key == "first_id") {
       spec.first_id = integer(error, narg, arg, i, 1, "first_id");
       have[4] = true;
@@ -150,7 +154,7 @@ void FixJdemInlet::parse(int narg, char **arg) {
     } else {
       const std::string msg = "fix jdem/inlet: unknown keyword '" + key.substr(0, 64) +
                               "'; valid: file, origin, velocity, plane, period, offset, first_id, "
-                              "stop, record, append_record";
+                              "stop, overlap_tol, record, append_record";
       error->all(FLERR, msg.c_str());
     }
   }
@@ -263,7 +267,6 @@ void FixJdemInlet::init() {
 
 void FixJdemInlet::start_stream() {
   spec.dt = update->dt;
-  spec.overlap_tol = JD_INLET_OVERLAP_TOL;
   spec.stop_step = stop_time > 0.0 ? jd_inlet_stop_step_of_time(stop_time, spec.dt) : JD_INLET_NO_STOP;
   char msg[512];
   if (jd_inlet_check(&spec, height > 0.0, msg, sizeof msg) != JD_INLET_OK)

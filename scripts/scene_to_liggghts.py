@@ -373,6 +373,9 @@ def inlet_lines(scene, tid, deck_dir, record):
             fname, vec(inlet["origin"]), vec(inlet["velocity"]), vec(plane["point"]), vec(plane["normal"]),
             num(inlet["period"]), num(inlet.get("offset", 0.0)), int(inlet["first_id"]),
             inlet_stop_words(inlet["stop"]))
+        if any(p.get("settled") for p in inlet["section"]["particles"]):
+            # cells cut from a settled deposit keep their contacts (the scene reader's rule)
+            words += " overlap_tol %s" % num(scene["watchdog"]["max_overlap_fraction"])
         if record:
             words += " %s %s" % ("record" if k == 0 else "append_record", word(os.path.abspath(record), "record path"))
         L.append("fix %s all jdem/inlet %s\n" % (ident, words))

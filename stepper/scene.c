@@ -462,6 +462,7 @@ void scene_free(jd_scene *scene) {
     free(scene->velocity);
     free(scene->angular_velocity);
     free(scene->fixed);
+    free(scene->settled);
     free(scene->force);
     free(scene->walls);
     free(scene->bond_types);

@@ -104,6 +104,8 @@ typedef struct jd_inlet {
     double height;            /* JD_INLET_STOP_HEIGHT: deposit top z + R that stops the stream [m] */
     double below_speed;       /* JD_INLET_STOP_HEIGHT: only particles slower than this count [m/s] */
     int64_t every;            /* JD_INLET_STOP_HEIGHT: steps between checks, >= 1 */
+    int settled;              /* the section holds particles of a settled deposit (from_deposit):
+                                 its overlaps are checked against watchdog.max_overlap_fraction */
 } jd_inlet;
 
 typedef struct jd_scene {
@@ -155,6 +157,9 @@ typedef struct jd_scene {
     unsigned char *fixed;     /* n: 1 = force and torque held at zero (moves at its initial
                                  velocity and spin, like LIGGGHTS fix freeze) */
     double *force;            /* 3n: constant external force [N] (LIGGGHTS fix addforce) */
+    unsigned char *settled;   /* n: 1 = from a settled deposit (particles_from): its overlaps with
+                                 other settled particles are contacts, allowed at the start up to
+                                 watchdog.max_overlap_fraction */
     int has_loads;            /* some particle is fixed or has an external force */
 
     size_t n_walls;

@@ -100,11 +100,12 @@ static int read_region(loader *L, deposit_entry *d) {
     return 0;
 }
 
-static int read_entry(loader *L, const yaml_node_t *map, size_t k, deposit_entry *d) {
+static int read_entry(loader *L, const yaml_node_t *map, const char *list_path, size_t k,
+                      deposit_entry *d) {
     memset(d, 0, sizeof *d);
     d->map = map;
     d->frame = -1;
-    sd_join_index(d->path, "particles_from", k);
+    sd_join_index(d->path, list_path, k);
     if (sd_mapping(&L->c, map, d->path, "{file, frame, region, translate, velocities, ids}") ||
         sd_keys(&L->c, map, d->path, ENTRY_KEYS))
         return -1;
@@ -205,6 +206,7 @@ static int add_kept(loader *L, const deposit_entry *d, const dep_frame *fr, int3
         s->id[i] = d->renumber ? (*next_id)++ : fr->id[j];
         s->material[i] = mat;
         s->radius[i] = fr->radius[j];
+        s->settled[i] = 1;
         for (int a = 0; a < 3; a++) {
             s->position[3 * i + a] = fr->position[3 * j + a] + d->shift[a];
             if (d->velocities) {
@@ -226,9 +228,10 @@ static int add_kept(loader *L, const deposit_entry *d, const dep_frame *fr, int3
                    "valid: a region holding at least one particle centre", lo, hi);
 }
 
-static int read_deposit(loader *L, const yaml_node_t *map, size_t k, int64_t *next_id) {
+static int read_deposit(loader *L, const yaml_node_t *map, const char *list_path, size_t k,
+                        int64_t *next_id) {
     deposit_entry d;
-    if (read_entry(L, map, k, &d)) return -1;
+    if (read_entry(L, map, list_path, k, &d)) return -1;
     dep_frame fr;
     char msg[1024];
     if (dep_read_frame(d.file, d.frame, d.velocities, &fr, msg, sizeof msg)) {
@@ -243,16 +246,19 @@ static int read_deposit(loader *L, const yaml_node_t *map, size_t k, int64_t *ne
     return rc ? -1 : 0;
 }
 
-int scene_read_deposits(loader *L) {
-    const yaml_node_t *list = sd_get(&L->c, L->root, "particles_from");
-    if (!list) return 0;
-    if (sd_sequence(&L->c, list, "particles_from", "a list of {file, frame, region, translate, "
-                    "velocities, ids}"))
+int scene_read_deposit_list(loader *L, const yaml_node_t *list, const char *path) {
+    if (sd_sequence(&L->c, list, path, "a list of {file, frame, region, translate, velocities, "
+                    "ids}"))
         return -1;
     int64_t next_id = 1;
     for (size_t i = 0; i < L->s->n_particles; i++)
         next_id = L->s->id[i] >= next_id ? L->s->id[i] + 1 : next_id;
     for (size_t k = 0; k < sd_len(list); k++)
-        if (read_deposit(L, sd_item(&L->c, list, k), k, &next_id)) return -1;
+        if (read_deposit(L, sd_item(&L->c, list, k), path, k, &next_id)) return -1;
     return 0;
+}
+
+int scene_read_deposits(loader *L) {
+    const yaml_node_t *list = sd_get(&L->c, L->root, "particles_from");
+    return list ? scene_read_deposit_list(L, list, "particles_from") : 0;
 }

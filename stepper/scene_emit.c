@@ -178,6 +178,7 @@ static int emit_particles(yaml_emitter_t *e, const jd_scene *s) {
             key_vec(e, "velocity", &s->velocity[3 * i]) ||
             key_vec(e, "angular_velocity", &s->angular_velocity[3 * i]) ||
             (s->fixed[i] && (str(e, "fixed") || scalar(e, "true", YAML_PLAIN_SCALAR_STYLE))) ||
+            (s->settled[i] && (str(e, "settled") || scalar(e, "true", YAML_PLAIN_SCALAR_STYLE))) ||
             ((s->force[3 * i] != 0.0 || s->force[3 * i + 1] != 0.0 || s->force[3 * i + 2] != 0.0) &&
              key_vec(e, "force", &s->force[3 * i])) ||
             map_end(e))
@@ -281,6 +282,7 @@ static int emit_inlets(yaml_emitter_t *e, const jd_scene *s) {
         for (size_t p = 0; p < in->n; p++)
             if (map_start(e, 1) || key_str(e, "material", s->materials[in->material[p]].name) ||
                 key_num(e, "radius", in->radius[p]) || key_vec(e, "position", &in->rel[3 * p]) ||
+                (in->settled && (str(e, "settled") || scalar(e, "true", YAML_PLAIN_SCALAR_STYLE))) ||
                 map_end(e))
                 return 1;
         if (seq_end(e) || map_end(e) || key_vec(e, "origin", in->origin) ||

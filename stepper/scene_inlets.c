@@ -17,8 +17,10 @@
 
 static const char *const INLET_KEYS[] = {"name", "section", "origin", "velocity", "plane",
                                          "period", "offset", "first_id", "stop", NULL};
-static const char *const SECTION_KEYS[] = {"generate", "particles", NULL};
-static const char *const SECTION_PARTICLE_KEYS[] = {"material", "radius", "position", NULL};
+static const char *const SECTION_KEYS[] = {"generate", "particles", "from_deposit", NULL};
+static const char *const SECTION_PARTICLE_KEYS[] = {"material", "radius", "position", "settled",
+                                                    NULL};
+static const char *const BOOLEANS[] = {"false", "true", NULL};
 static const char *const PLANE_KEYS[] = {"point", "normal", NULL};
 static const char *const STOP_KEYS[] = {"sections", "time", "deposit_height", NULL};
 static const char *const HEIGHT_KEYS[] = {"height", "below_speed", "every", NULL};
@@ -41,6 +43,9 @@ static int section_particle(loader *L, const yaml_node_t *p, const char *path) {
     }
     L->by_particle[mat] = 1;
     s->material[i] = mat;
+    int settled = 0;
+    if (sd_opt_enum(&L->c, p, path, "settled", BOOLEANS, &settled)) return -1;
+    s->settled[i] = (unsigned char)settled;
     return 0;
 }
 
@@ -51,7 +56,7 @@ static int take_section(loader *L, size_t from, jd_inlet *in, const yaml_node_t 
     const size_t n = s->n_particles - from;
     if (n == 0)
         return sd_fail(&L->c, at, path, "no particles; valid: at least one particle in "
-                       "section.generate or section.particles");
+                       "section.generate, section.particles or section.from_deposit");
     in->n = n;
     in->rel = malloc(3 * n * sizeof *in->rel);
     in->radius = malloc(n * sizeof *in->radius);
@@ -60,6 +65,7 @@ static int take_section(loader *L, size_t from, jd_inlet *in, const yaml_node_t 
     memcpy(in->rel, &s->position[3 * from], 3 * n * sizeof *in->rel);
     memcpy(in->radius, &s->radius[from], n * sizeof *in->radius);
     memcpy(in->material, &s->material[from], n * sizeof *in->material);
+    for (size_t p = from; p < s->n_particles; p++) in->settled |= s->settled[p];
     s->n_particles = from;
     return 0;
 }
@@ -68,10 +74,13 @@ static int read_section(loader *L, const yaml_node_t *m, const char *path, jd_in
     char sub[SD_PATH_MAX], item[SD_PATH_MAX];
     sd_join(sub, path, "section");
     const yaml_node_t *sec = sd_get(&L->c, m, "section");
-    if (!sec) return sd_missing(&L->c, m, path, "section", "a mapping with generate and/or particles");
+    if (!sec)
+        return sd_missing(&L->c, m, path, "section", "a mapping with generate, particles and/or "
+                          "from_deposit");
     if (sd_keys(&L->c, sec, sub, SECTION_KEYS)) return -1;
     const size_t from = L->s->n_particles;
-    const yaml_node_t *gen = sd_get(&L->c, sec, "generate"), *parts = sd_get(&L->c, sec, "particles");
+    const yaml_node_t *gen = sd_get(&L->c, sec, "generate"), *parts = sd_get(&L->c, sec, "particles"),
+                      *deposits = sd_get(&L->c, sec, "from_deposit");
     int64_t unused_id = 1; /* ids are the stream's */
     sd_join(item, sub, "generate");
     if (gen && scene_generate_list(L, gen, item, 1, &unused_id)) return -1;
@@ -83,6 +92,8 @@ static int read_section(loader *L, const yaml_node_t *m, const char *path, jd_in
         sd_join_index(pp, item, k);
         if (section_particle(L, sd_item(&L->c, parts, k), pp)) return -1;
     }
+    sd_join(item, sub, "from_deposit");
+    if (deposits && scene_read_deposit_list(L, deposits, item)) return -1;
     return take_section(L, from, in, sec, sub);
 }
 
@@ -195,7 +206,9 @@ void scene_inlet_spec(const jd_scene *sc, size_t k, jd_inlet_spec *out) {
                            .species = in->material, .period = in->period, .offset = in->offset,
                            .dt = sc->dt, .first_id = in->first_id,
                            .max_sections = in->stop == JD_INLET_STOP_SECTIONS ? in->sections : 0,
-                           .stop_step = JD_INLET_NO_STOP, .overlap_tol = JD_INLET_OVERLAP_TOL};
+                           .stop_step = JD_INLET_NO_STOP,
+                           .overlap_tol = in->settled ? sc->watchdog.max_overlap_fraction
+                                                      : JD_INLET_OVERLAP_TOL};
     memcpy(out->origin, in->origin, sizeof out->origin);
     memcpy(out->velocity, in->velocity, sizeof out->velocity);
     memcpy(out->plane_point, in->plane_point, sizeof out->plane_point);

@@ -92,6 +92,9 @@ int scene_check_inlets(loader *L);
 #define PSRC_DEPOSIT(k) (INT32_MIN + (int32_t)(k))
 #define PSRC_IS_DEPOSIT(src) ((src) < INT32_MIN / 2)
 int scene_read_deposits(loader *L);
+/* The deposit entries of `list` (at `path`, e.g. an inlet's section.from_deposit) appended to
+ * the scene's particles, each marked settled. */
+int scene_read_deposit_list(loader *L, const yaml_node_t *list, const char *path);
 
 /* scene_walls.c */
 int scene_read_walls(loader *L);

@@ -13,7 +13,8 @@
 #define OVERLAP_TOL 1e-6
 
 static const char *const PARTICLE_KEYS[] = {"id", "material", "radius", "position", "velocity",
-                                            "angular_velocity", "fixed", "force", NULL};
+                                            "angular_velocity", "fixed", "force", "settled",
+                                            NULL};
 static const char *const BOOLEANS[] = {"false", "true", NULL};
 
 /* ---------------------------------------------------------------------------------------- */
@@ -37,6 +38,7 @@ static int grow_particles(loader *L, size_t need) {
     GROW(s->velocity, 3);
     GROW(s->angular_velocity, 3);
     GROW(s->fixed, 1);
+    GROW(s->settled, 1);
     GROW(s->force, 3);
     GROW(L->pnode, 1);
     GROW(L->psrc, 1);
@@ -57,6 +59,7 @@ long scene_add_particle(loader *L, const yaml_node_t *node, int32_t src) {
     memset(&s->angular_velocity[3 * i], 0, 3 * sizeof(double));
     memset(&s->force[3 * i], 0, 3 * sizeof(double));
     s->fixed[i] = 0;
+    s->settled[i] = 0;
     L->pnode[i] = node;
     L->psrc[i] = src;
     return (long)i;
@@ -91,9 +94,12 @@ static int read_particle(loader *L, const yaml_node_t *p, size_t index) {
         sd_opt_vec3(&L->c, p, path, "angular_velocity", &s->angular_velocity[3 * i]) ||
         sd_opt_vec3(&L->c, p, path, "force", &s->force[3 * i]))
         return -1;
-    int fixed = 0;
-    if (sd_opt_enum(&L->c, p, path, "fixed", BOOLEANS, &fixed)) return -1;
+    int fixed = 0, settled = 0;
+    if (sd_opt_enum(&L->c, p, path, "fixed", BOOLEANS, &fixed) ||
+        sd_opt_enum(&L->c, p, path, "settled", BOOLEANS, &settled))
+        return -1;
     s->fixed[i] = (unsigned char)fixed;
+    s->settled[i] = (unsigned char)settled;
     s->has_loads |= fixed || s->force[3 * i] != 0.0 || s->force[3 * i + 1] != 0.0 ||
                     s->force[3 * i + 2] != 0.0;
     s->material[i] = mat;
@@ -153,6 +159,7 @@ static int permute(loader *L, const id_index *perm) {
     PERMUTE(s->velocity, 3);
     PERMUTE(s->angular_velocity, 3);
     PERMUTE(s->fixed, 1);
+    PERMUTE(s->settled, 1);
     PERMUTE(s->force, 3);
     PERMUTE(L->pnode, 1);
     PERMUTE(L->psrc, 1);
@@ -254,6 +261,12 @@ static double overlap(const jd_scene *s, size_t i, size_t j) {
     return s->radius[i] + s->radius[j] - norm3(d);
 }
 
+/* The start overlap allowed between particles i and j, a fraction of the smaller radius: two
+ * particles of a settled deposit keep their contacts, up to the watchdog's limit. */
+static double overlap_tolerance(const jd_scene *s, size_t i, size_t j) {
+    return s->settled[i] && s->settled[j] ? s->watchdog.max_overlap_fraction : OVERLAP_TOL;
+}
+
 /* The smallest j > i (in id order) overlapping particle i beyond the tolerance, or 0. */
 static size_t overlapping(const jd_scene *s, const grid *g, size_t i, double *by) {
     uint64_t c[3];
@@ -276,7 +289,7 @@ static size_t overlapping(const jd_scene *s, const grid *g, size_t i, double *by
                     size_t j = g->e[k].index;
                     double rmin = fmin(s->radius[i], s->radius[j]);
                     double ov = j > i ? overlap(s, i, j) : 0.0;
-                    if (j > i && ov > OVERLAP_TOL * rmin && (!found || j < found)) {
+                    if (j > i && ov > overlap_tolerance(s, i, j) * rmin && (!found || j < found)) {
                         found = j;
                         *by = ov;
                     }
@@ -298,8 +311,10 @@ int scene_check_overlaps(loader *L) {
         char path[SD_PATH_MAX];
         particle_path(L, j, path);
         rc = sd_fail(&L->c, L->pnode[j], path, "particles %lld and %lld overlap by %.3g m at the "
-                     "start; valid: an overlap of at most %g of the smaller radius",
-                     (long long)s->id[i], (long long)s->id[j], by, OVERLAP_TOL);
+                     "start; valid: an overlap of at most %g of the smaller radius%s",
+                     (long long)s->id[i], (long long)s->id[j], by, overlap_tolerance(s, i, j),
+                     s->settled[i] && s->settled[j] ? " (watchdog.max_overlap_fraction, for two "
+                     "particles of a settled deposit)" : "");
     }
     free(g.e);
     return rc;

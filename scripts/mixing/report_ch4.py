@@ -1,0 +1,224 @@
+#!/usr/bin/python3
+"""report_ch4.py — the Chapter 4 tables, seed | jdem | liggghts-jdem, from whatever units of
+`make mixing` have finished (docs/mixing.md §4).
+
+    scripts/mixing/report_ch4.py [--out out/mixing/ch4] [--results DIR]
+
+Reads OUT/ENGINE/modelM/fillP.h5 (the mixing parameters at the 9 points of Table 4-2, from the
+last frame) and OUT/ENGINE/modelM/passP_cubeK.h5 (the compression of cube K: E, nu_xy, nu_xz of
+the orthotropic fit on the best-fit particle strain, and the unambiguous M and K0), and the
+units' wall and CPU seconds from OUT/ENGINE/modelM/.campaign_times.json.  Writes OUT/report.md and
+OUT/summary.json; with --results also there (the small results committed under
+reference_runs/mixing/ch4/results/), stamped with the commit they came from.  A unit not run is
+"—" in the tables and listed under "Not run"; nothing is estimated.
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.dirname(HERE))
+from mixing import compression, deposit, params, stats  # noqa: E402
+
+ENGINES = ("jdem", "liggghts-jdem")
+MODELS = tuple("model%d" % m for m in range(1, 7))
+PASSES = (1, 2)
+PARAMS = ("phi_v", "phi_m", "e", "n", "rho_b", "Z")
+# spec §3.1-3.3 (Tables 4-3, 4-4, 4-5): (1st mean, 1st std, 2nd mean, 2nd std) per model
+SEED = {
+    "E": [(1954, 841, 2249, 782), (2230, 992, 1812, 189), (2842, 1255, 1776, 445),
+          (3211, 1731, 2564, 577), (1817, 367, 2171, 830), (2105, 1046, 1736, 662)],
+    "nu_xy": [(0.631, 0.158, 0.690, 0.075), (0.710, 0.136, 0.633, 0.064), (0.842, 0.224, 0.608, 0.058),
+              (0.861, 0.323, 0.767, 0.077), (0.651, 0.099, 0.688, 0.122), (0.666, 0.204, 0.573, 0.124)],
+    "nu_xz": [(0.320, 0.134, 0.281, 0.079), (0.269, 0.126, 0.328, 0.046), (0.127, 0.210, 0.340, 0.046),
+              (0.095, 0.312, 0.221, 0.077), (0.302, 0.070, 0.272, 0.101), (0.285, 0.182, 0.351, 0.093)],
+}
+TABLES = (("E", "Table 4-3: effective elastic modulus E [Pa]", "%.0f"),
+          ("nu_xy", "Table 4-4: effective Poisson ratio νxy", "%.3f"),
+          ("nu_xz", "Table 4-5: effective Poisson ratio νxz (= νyz)", "%.3f"))
+
+
+def unit_dir(out, engine, model):
+    return os.path.join(out, engine, model)
+
+
+def unit_times(out, engine, model):
+    try:
+        with open(os.path.join(unit_dir(out, engine, model), ".campaign_times.json")) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return {}
+
+
+def fill_result(path):
+    dep = deposit.read_frame(path)
+    points = params.at_points(dep)
+    return {"particles": int(len(dep.radius)), "deposit_height": deposit.deposit_height(dep),
+            "points": [{k: float(p[k]) for k in PARAMS} for p in points],
+            "summary": {k: stats.summary([p[k] for p in points]) for k in PARAMS}}
+
+
+def cube_result(path):
+    r = compression.analyse(path, "top")
+    fit = r["best_fit"]
+    return {"E": fit.get("E", float("nan")), "nu_xy": fit.get("nu_xy", float("nan")),
+            "nu_xz": fit.get("nu_xz", float("nan")), "cond": fit.get("cond", float("nan")),
+            "M_wall": r["M_wall"], "M_best_fit": r["M_best_fit"], "K0": r["K0"],
+            "particles": r["particles"]}
+
+
+def collect(out):
+    """{engine: {model: {"fillP": ..., "passP_cubes": [...], "times": ...}}} of the finished units."""
+    found, missing = {}, []
+    for engine in ENGINES:
+        for model in MODELS:
+            d = unit_dir(out, engine, model)
+            entry = {"times": unit_times(out, engine, model)}
+            for p in PASSES:
+                fill = os.path.join(d, "fill%d.h5" % p)
+                if os.path.exists(fill):
+                    entry["fill%d" % p] = fill_result(fill)
+                else:
+                    missing.append("%s/%s/fill%d" % (engine, model, p))
+                cubes = [os.path.join(d, "pass%d_cube%d.h5" % (p, k)) for k in range(1, 10)]
+                done = [c for c in cubes if os.path.exists(c)]
+                if len(done) == 9:
+                    try:
+                        entry["pass%d_cubes" % p] = [cube_result(c) for c in cubes]
+                    except SystemExit as why:   # compression.py's message: a servo that did not complete
+                        missing.append("%s/%s/pass%d_cubes: %s" % (engine, model, p, why))
+                else:
+                    missing.append("%s/%s/pass%d_cubes (%d of 9)" % (engine, model, p, len(done)))
+            found.setdefault(engine, {})[model] = entry
+    return found, missing
+
+
+def cell(mean, std, fmt):
+    if mean is None or (isinstance(mean, float) and math.isnan(mean)):
+        return "—"
+    return (fmt % mean) + " ± " + (fmt % std)
+
+
+def ours(found, engine, model, p, key):
+    cubes = found[engine][model].get("pass%d_cubes" % p)
+    if not cubes:
+        return None, None
+    s = stats.summary([c[key] for c in cubes])
+    return s["mean"], s["std"]
+
+
+def elastic_table(found, key, title, fmt):
+    head = ("| Model | seed 1st | jdem 1st | liggghts-jdem 1st | seed 2nd | jdem 2nd | "
+            "liggghts-jdem 2nd |\n|---|---|---|---|---|---|---|\n")
+    rows = []
+    for m, model in enumerate(MODELS):
+        s = SEED[key][m]
+        cols = []
+        for p in PASSES:
+            cols.append(cell(s[2 * (p - 1)], s[2 * (p - 1) + 1], fmt))
+            cols += [cell(*ours(found, e, model, p, key), fmt) for e in ENGINES]
+        rows.append("| %d | %s |" % (m + 1, " | ".join(cols)))
+    return "### %s\n\nmean ± std over the 9 cubes, the highest and lowest dropped (docs/mixing.md §3)\n\n%s%s\n" % (
+        title, head, "\n".join(rows))
+
+
+def mixing_table(found):
+    lines = ["### Mixing parameters at the 9 points of Table 4-2 (the seed gives plots only, Figs 4-11/4-12)",
+             "", "trimmed mean ± std (ideal φv = %.4f)" % params.IDEAL_PHI_V, "",
+             "| engine | model | pass | particles | height [m] | φv | e | ρb [kg/m³] | Z |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for engine in ENGINES:
+        for model in MODELS:
+            for p in PASSES:
+                f = found[engine][model].get("fill%d" % p)
+                if not f:
+                    continue
+                s = f["summary"]
+                lines.append("| %s | %s | %d | %d | %.3f | %s | %s | %s | %s |" % (
+                    engine, model, p, f["particles"], f["deposit_height"],
+                    cell(s["phi_v"]["mean"], s["phi_v"]["std"], "%.4f"), cell(s["e"]["mean"], s["e"]["std"], "%.3f"),
+                    cell(s["rho_b"]["mean"], s["rho_b"]["std"], "%.0f"), cell(s["Z"]["mean"], s["Z"]["std"], "%.2f")))
+    return "\n".join(lines) + "\n"
+
+
+def times_table(found):
+    lines = ["### Run times of the finished units", "",
+             "wall time on the shared machine, and the CPU time of the unit's processes",
+             "", "| unit | wall [s] | CPU [s] |", "|---|---|---|"]
+    for engine in ENGINES:
+        for model in MODELS:
+            for name, t in sorted(found[engine][model]["times"].items()):
+                cpu = t.get("cpu_seconds")
+                lines.append("| %s | %.0f | %s |" % (name, t["seconds"], "%.0f" % cpu if cpu is not None else "not recorded"))
+    return "\n".join(lines) + "\n"
+
+
+def claims(found):
+    """The seed's qualitative Chapter 4 claims on phi_v that the finished fills can test."""
+    out = []
+    phi = {(e, m, p): found[e][m]["fill%d" % p]["summary"]["phi_v"]
+           for e in ENGINES for m in MODELS for p in PASSES if found[e][m].get("fill%d" % p)}
+    for e in ENGINES:
+        low = [phi[(e, m, 1)]["mean"] for m in ("model1", "model2") if (e, m, 1) in phi]
+        high = [phi[(e, m, 1)]["mean"] for m in MODELS[2:] if (e, m, 1) in phi]
+        if low and high:
+            held = max(low) < min(high)
+            out.append("- %s: Models 1 and 2 mix worst (trimmed mean φv %s against %s for Models 3–6): %s"
+                       % (e, ", ".join("%.4f" % v for v in low), ", ".join("%.4f" % v for v in high),
+                          "held" if held else "not held"))
+        pairs = [(phi[(e, m, 1)]["std"], phi[(e, m, 2)]["std"]) for m in MODELS
+                 if (e, m, 1) in phi and (e, m, 2) in phi]
+        if pairs:
+            held = all(b < a for a, b in pairs)
+            out.append("- %s: the second pass reduces the spread of φv: std %s: %s" % (
+                e, "; ".join("%.4f → %.4f" % ab for ab in pairs), "held" if held else "not held"))
+    return "\n".join(out) + "\n" if out else "No claim can be checked yet: no fill has finished.\n"
+
+
+def commit():
+    r = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
+    return r.stdout.strip() or "unknown"
+
+
+def report(found, missing, rev):
+    parts = ["# Jiang (2021) Chapter 4 mixing campaign: seed | jdem | liggghts-jdem", "",
+             "Generated by scripts/mixing/report_ch4.py from the finished units of `make mixing` "
+             "(commit %s). Every reconstruction the seed leaves open is a scene parameter "
+             "(docs/mixing.md §1).\n" % rev, mixing_table(found)]
+    parts += [elastic_table(found, k, t, f) for k, t, f in TABLES]
+    parts += ["### The seed's claims\n", claims(found), times_table(found),
+              "### Not run\n", "\n".join("- " + m for m in missing) + "\n" if missing else "nothing\n"]
+    return "\n".join(parts)
+
+
+def write_atomic(path, text):
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "mixing", "ch4"))
+    ap.add_argument("--results", help="also write report.md and summary.json here")
+    a = ap.parse_args()
+    found, missing = collect(a.out)
+    rev = commit()
+    text = report(found, missing, rev)
+    summary = json.dumps({"commit": rev, "results": found, "not_run": missing}, indent=1, default=float)
+    for d in [a.out] + ([a.results] if a.results else []):
+        os.makedirs(d, exist_ok=True)
+        write_atomic(os.path.join(d, "report.md"), text)
+        write_atomic(os.path.join(d, "summary.json"), summary)
+        print("report_ch4.py: wrote %s" % os.path.join(d, "report.md"))
+
+
+if __name__ == "__main__":
+    main()
