@@ -42,11 +42,10 @@ import time
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-from bench import LOOP_RE, guard_dt  # noqa: E402
-from benchmark.cases import JDEM, LIGGGHTS, ROOT  # noqa: E402
-from benchmark.cases import scene_path as chung_ooi_scene  # noqa: E402
-from pour_study import check, timed  # noqa: E402
+from scripts.bench import LOOP_RE, guard_dt
+from scripts.benchmark.cases import JDEM, LIGGGHTS, ROOT
+from scripts.benchmark.cases import scene_path as chung_ooi_scene
+from scripts.pour_study import check, timed
 
 IMPACT_FACTORS = (1 / 8, 1 / 4, 1 / 2, 1, 2, 4, 8)
 BED_FACTORS = (1 / 2, 1, 2, 4, 8)
@@ -305,7 +304,7 @@ def main(argv):
         runs["study_wall_seconds"] = time.monotonic() - t0
         with open(runs_path, "w") as f:
             json.dump(runs, f, indent=1)
-    import accuracy_report
+    from scripts import accuracy_report
     accuracy_report.analyse(out, json.load(open(runs_path)))
     log("wrote %s and %s" % (os.path.join(out, "summary.json"), os.path.join(out, "report.md")))
     return 0

@@ -389,7 +389,7 @@ def make_tiled_bed(out, size, disp, path):
     bed's contact overlap), in a box of side k side + (k - 1) gap.  The whole tiled bed is then
     checked against the stepper's start-overlap rule (every pair and wall contact, cell search)
     and its contacts per particle compared with the base bed's.  Returns its path."""
-    import bench_tiling
+    from scripts import bench_tiling
     base_size, k = TILES[size]
     base = np.load(make_bed(out, base_size, disp))
     binfo = json.loads(str(base["info"]))
@@ -540,7 +540,7 @@ def deck_dir(out, size, variant):
 def make_decks(out, size, variant, scene, bed_path, steps, engines=ENGINES):
     """The LIGGGHTS decks (ours and stock) of `engines` in OUT/decks/SIZE_VARIANT/ENGINE/in.bench,
     from resolved_scene() of the bench scene on its bed."""
-    import scene_to_liggghts
+    from scripts import scene_to_liggghts
     d = deck_dir(out, size, variant)
     wanted = [e for e in ("liggghts-jdem", "liggghts") if e in engines
               and not (e == "liggghts" and is_bonded(variant))]  # stock LIGGGHTS has no parallel bonds
@@ -1061,7 +1061,7 @@ def main():
     if not a.report_only and "jdem" in engines and "soft_mono" in variants:
         feature_check(out, small, steps_of[small], a.repeats)
     if not a.report_only and not a.no_profile and not os.path.exists(os.path.join(out, "profile.json")):
-        import bench_report
+        from scripts import bench_report
         sc = scene_path(out, small, "soft_mono")
         if SIZES[small] > SIZES[PROFILE_MAX_SIZE]:
             log("no callgrind profile: the smallest size run (%s) is above %s" % (small, PROFILE_MAX_SIZE))
@@ -1078,7 +1078,7 @@ def main():
         json.dump(dict(generated=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                        machine=machine_info(), runs=rows, flatness=flatness(rows), beds=beds,
                        failures=failures, feature_check=fc), f, indent=1)
-    import bench_report
+    from scripts import bench_report
     bench_report.write_report(out, rows, machine_info(), fc, flatness(rows), beds, failures)
     log("wrote %s and %s" % (os.path.join(out, "summary.json"), os.path.join(out, "report.md")))
     return 0

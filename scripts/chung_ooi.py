@@ -35,13 +35,12 @@ import json
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from benchmark.analysis import analyse_all  # noqa: E402
-from benchmark import cases  # noqa: E402
-from benchmark.cases import ENGINE_LABEL, LIGGGHTS, LIGGGHTS_RUN, ROOT, TESTS  # noqa: E402
-from benchmark.figures import write_figure  # noqa: E402
-from benchmark.report import write_report  # noqa: E402
-from benchmark.runner import run_all  # noqa: E402
+from scripts.benchmark.analysis import analyse_all
+from scripts.benchmark import cases
+from scripts.benchmark.cases import ENGINE_LABEL, LIGGGHTS, LIGGGHTS_RUN, ROOT, TESTS
+from scripts.benchmark.figures import write_figure
+from scripts.benchmark.report import write_report
+from scripts.benchmark.runner import run_all
 
 
 def analyse_and_report(out, tests, engines, quick, timings):

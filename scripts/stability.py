@@ -43,7 +43,7 @@ import h5py
 import numpy as np
 import yaml
 
-from bond_checks import beam_reference, mean_between_extrema
+from scripts.bond_checks import beam_reference, mean_between_extrema
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)

@@ -23,11 +23,9 @@ import tempfile
 
 import yaml
 
-from engine_common import JDEM, ROOT, Checks, np
+from tests.engine.engine_common import JDEM, ROOT, Checks, np
 
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import bench  # noqa: E402
-import bench_tiling  # noqa: E402
+from scripts import bench, bench_tiling
 
 bench.JDEM = JDEM  # the stepper under test (the sanitized build under make test)
 

@@ -28,10 +28,9 @@ import h5py
 import numpy as np
 import yaml
 
-from engine_common import JDEM, ROOT, Checks, scene
+from tests.engine.engine_common import JDEM, ROOT, Checks, scene
 
-sys.path.insert(0, os.path.join(ROOT, "scripts", "mixing"))
-import deposit  # noqa: E402  (the generators' reader and cutter: the reference wording)
+from scripts.mixing import deposit  # the generators' reader and cutter: the reference wording
 
 PY = sys.executable
 LIG = os.path.join(ROOT, "build", "liggghts-jdem")

@@ -13,7 +13,7 @@ import subprocess
 import tempfile
 
 import yaml
-from engine_common import JDEM, Checks, run, scene
+from tests.engine.engine_common import JDEM, Checks, run, scene
 
 DT_AUTO_FACTOR = 1.0  # the documented default: the guard's safe dt itself
 

@@ -46,15 +46,13 @@ import re
 import tempfile
 
 import subprocess
-import sys
 
 import h5py
 import yaml
 
-from engine_common import Checks, load, np, scene, JDEM, ROOT
+from tests.engine.engine_common import Checks, load, np, scene, JDEM
 
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import bond_checks  # noqa: E402  (the bonded-block scene)
+from scripts import bond_checks  # the bonded-block scene
 
 VECTORS = ("position", "velocity", "angular_velocity")
 POS_TOL, VEL_TOL = 1e-12, 1e-10  # relative to the largest |value| of the frame

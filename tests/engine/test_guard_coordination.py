@@ -22,7 +22,7 @@ import tempfile
 import numpy as np
 import yaml
 
-from engine_common import JDEM, Checks
+from tests.engine.engine_common import JDEM, Checks
 
 E, NU, RHO, R, V = 4.8e10, 0.2, 2800.0, 0.01, 20.0
 MASS = 4.0 / 3.0 * math.pi * R ** 3 * RHO

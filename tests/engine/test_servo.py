@@ -22,7 +22,7 @@ from math import sqrt
 
 import h5py
 
-from engine_common import JDEM, ROOT, Checks, np, run
+from tests.engine.engine_common import JDEM, ROOT, Checks, np, run
 
 R, E, NU = 0.01, 1.0e7, 0.3
 AREA = 0.02 * 0.02

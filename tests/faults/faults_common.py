@@ -5,7 +5,7 @@ Each test file is a script that prints one line per check, "PASS name" or "FAIL 
 any check failed.  tests/faults/run_faults.py runs every tests/faults/test_*.py in turn; it is
 the suite `faults` of tests/run_tests.py, so a new file needs no registration.
 
-API (import with `from faults_common import ...`; the test's directory is on sys.path):
+API (import with `from tests.faults.faults_common import ...`):
 
   ROOT, PY, JDEM, LIGGGHTS_JDEM   repository root, /usr/bin/python3, the binaries ($JDEM and
                                   $LIGGGHTS_JDEM override build/jdem, build/liggghts-jdem)
@@ -52,8 +52,7 @@ import tempfile
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks as EngineChecks  # noqa: E402
+from tests.engine.engine_common import Checks as EngineChecks
 PY = "/usr/bin/python3"
 JDEM = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
 LIGGGHTS_JDEM = os.environ.get("LIGGGHTS_JDEM", os.path.join(ROOT, "build", "liggghts-jdem"))

@@ -25,13 +25,11 @@ import re
 import shutil
 import signal
 import subprocess
-import sys
 import time
 
 import yaml
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from faults_common import (EXIT, JDEM, LIGGGHTS_JDEM, PY, ROOT, Checks, files, h5_frames,  # noqa: E402
+from tests.faults.faults_common import (EXIT, JDEM, LIGGGHTS_JDEM, PY, ROOT, Checks, files, h5_frames,  # noqa: E402
                            h5_readable, run, scratch, signal_exit, start, finish, wait_for,
                            wait_for_file, write_scene)
 

@@ -29,9 +29,8 @@ import time
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-from fuzz_common import ROOT, Findings, start  # noqa: E402
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import scene_to_liggghts  # noqa: E402
+from tests.fuzz.fuzz_common import ROOT, Findings, start  # noqa: E402
+from scripts import scene_to_liggghts
 
 JDEM = os.path.join(ROOT, "build", "jdem")
 LIGGGHTS_JDEM = os.path.join(ROOT, "build", "liggghts-jdem")

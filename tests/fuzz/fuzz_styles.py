@@ -21,7 +21,7 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-from fuzz_common import ROOT, Findings, start  # noqa: E402
+from tests.fuzz.fuzz_common import ROOT, Findings, start  # noqa: E402
 JDEM = os.path.join(ROOT, "build", "jdem")
 LIGGGHTS_JDEM = os.path.join(ROOT, "build", "liggghts-jdem")
 GEN = os.path.join(ROOT, "scripts", "scene_to_liggghts.py")

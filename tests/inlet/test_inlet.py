@@ -19,7 +19,6 @@ import csv
 import math
 import os
 import subprocess
-import sys
 import tempfile
 
 import h5py
@@ -29,8 +28,7 @@ import yaml
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 JDEM = os.path.join(ROOT, "build", "jdem")
 SCENE = os.path.join(ROOT, "tests", "inlet", "fill_small.yaml")
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
+from tests.engine.engine_common import Checks
 
 checks = Checks()
 check = checks.check

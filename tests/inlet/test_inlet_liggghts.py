@@ -43,8 +43,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 JDEM = os.path.join(ROOT, "build", "jdem")
 LIG = os.path.join(ROOT, "build", "liggghts-jdem")
 SCENE = os.path.join(ROOT, "tests", "inlet", "fill_small.yaml")
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
+from tests.engine.engine_common import Checks
 
 checks = Checks()
 check = checks.check

@@ -31,8 +31,7 @@ TANGENTIAL_ERROR = ("pair_style gran/jiang: tangential_stiffness must be jiang20
 ROLLING_ERROR = ("pair_style gran/jiang: coefficientRollingFriction is > 0 for a pair of types in use, "
                  "which needs the rolling law and its history: add 'rolling on' to pair_style "
                  "gran/jiang (or set coefficientRollingFriction to 0)")
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
+from tests.engine.engine_common import Checks
 
 checks = Checks()
 report = checks.check

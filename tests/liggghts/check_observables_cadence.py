@@ -26,8 +26,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 PY = sys.executable
 JDEM = os.path.join(ROOT, "build", "jdem")
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
+from tests.engine.engine_common import Checks
 PILE = os.path.join(HERE, "scenes", "mpi_pile.yaml")
 BLOCK = os.path.join(HERE, "bond_scenes", "block_drop.yaml")
 

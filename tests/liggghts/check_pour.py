@@ -43,8 +43,7 @@ import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import pour_study  # noqa: E402
+from scripts import pour_study
 
 EVERY = 200
 HORIZON = {("lig1", "lig2x"): 0.110, ("jdem", "lig1"): 0.130}   # [s], see above
