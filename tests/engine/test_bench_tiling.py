@@ -18,14 +18,13 @@ import json
 import os
 import re
 import subprocess
-import sys
 import tempfile
 
 import yaml
 
-from tests.engine.engine_common import JDEM, ROOT, Checks, np
+from tests.engine.engine_common import JDEM, Checks, np
 
-from scripts import bench_beds, bench_config, bench_scenes, bench_tiling
+from scripts import bench_beds, bench_config, bench_scenes, bench_tiling, engines
 
 R, n, nz, k = 1.0e-3, 4, 3, 3
 t = bench_config.TOUCH * R
@@ -125,9 +124,8 @@ for variant in ("soft_mono", "soft_mono_bonded"):
         for f in fast:
             os.remove(os.path.join(dd, f))
         resolved = os.path.join(dd, "resolved.yaml")
-        p = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), resolved,
-                            "-o", deck, "--trajectory", os.path.join(dd, "out.h5")]
-                           + (["--builtin"] if engine == "liggghts" else []), capture_output=True, text=True)
+        p = engines.write_deck(resolved, deck, "--trajectory", os.path.join(dd, "out.h5"),
+                               *(["--builtin"] if engine == "liggghts" else []))
         with open(deck) as f:
             text = bench_scenes.adapt_deck(f.read(), engine, 1)
         with open(deck, "w") as f:
