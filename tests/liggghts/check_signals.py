@@ -17,7 +17,6 @@ LIGGGHTS_JDEM selects the binary (default build/liggghts-jdem).
 import argparse
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
@@ -25,7 +24,7 @@ import tempfile
 import time
 
 from scripts import engines
-from tests.liggghts.liggghts_common import HERE, LIGGGHTS_JDEM, Checks, make_deck, part_frames
+from tests.liggghts.liggghts_common import HERE, LIGGGHTS_JDEM, Checks, finish, make_deck, part_frames
 
 SCENE = os.path.join(HERE, "signals_scene.yaml")
 EVERY = 20000
@@ -91,11 +90,7 @@ def main():
     stop_run(tmp, "sigint_np1", signal.SIGINT, 1, 130)
     stop_run(tmp, "sigterm_np1", signal.SIGTERM, 1, 143)
     stop_run(tmp, "sigterm_np2", signal.SIGTERM, 2, 143)
-    if a.keep:
-        print("runs kept in %s" % tmp)
-    else:
-        shutil.rmtree(tmp, ignore_errors=True)
-    return 1 if CHECKS.failed else 0
+    return finish(CHECKS, tmp, a.keep)
 
 
 if __name__ == "__main__":

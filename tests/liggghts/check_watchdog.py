@@ -15,11 +15,10 @@ LIGGGHTS with the watchdog in its deck.  Prints one PASS/FAIL line per check; ex
 import argparse
 import os
 import re
-import shutil
 import sys
 import tempfile
 
-from tests.liggghts.liggghts_common import (ROOT, Checks, edit_deck, jdem_run, liggghts_run,
+from tests.liggghts.liggghts_common import (ROOT, Checks, edit_deck, finish, jdem_run, liggghts_run,
                                             liggghts_run_log, make_deck, part_frames, run_deck)
 
 SCENE = os.path.join(ROOT, "tests", "engine", "scenes", "watchdog_blowup.yaml")
@@ -97,11 +96,7 @@ def main():
     rc, said = liggghts_run(os.path.join(ROOT, "tests", "engine", "scenes", "chung_ooi_1.yaml"), out)
     check("liggghts_resolved_impact_does_not_trip", rc == 0 and os.path.exists(out),
           "exit %d: %s" % (rc, said[-1500:]))
-    if a.keep:
-        print("runs kept in %s" % tmp)
-    else:
-        shutil.rmtree(tmp, ignore_errors=True)
-    return 1 if CHECKS.failed else 0
+    return finish(CHECKS, tmp, a.keep)
 
 
 if __name__ == "__main__":

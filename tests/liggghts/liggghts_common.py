@@ -6,6 +6,7 @@ scripts/engines.py; the binaries are $JDEM and $LIGGGHTS_JDEM when set, else bui
 build/liggghts-jdem.  Checks prints the PASS/FAIL lines that tests/run_tests.py counts.
 """
 import os
+import shutil
 
 import h5py
 import numpy as np
@@ -116,6 +117,15 @@ def part_frames(out):
     return steps, finite, obs_steps
 
 
+def finish(checks, tmp, keep):
+    """Keep TMP (printing where) or remove it; the exit status of CHECKS."""
+    if keep:
+        print("runs kept in %s" % tmp)
+    else:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return 1 if checks.failed else 0
+
+
 __all__ = ["Checks", "ROOT", "HERE", "JDEM", "LIGGGHTS_JDEM", "run", "jdem_run", "liggghts_run",
            "liggghts_run_log", "make_deck", "edit_deck", "run_deck", "last_line", "compare", "observable",
-           "observable_names", "part_frames"]
+           "observable_names", "part_frames", "finish"]
