@@ -17,7 +17,6 @@ Run:  /usr/bin/python3 tests/engine/test_bench_tiling.py      (JDEM=path/to/jdem
 import json
 import os
 import re
-import subprocess
 import tempfile
 
 import yaml
@@ -102,7 +101,7 @@ except RuntimeError as e:
 
 # bonded variant: the rule bonds exactly the pairs in contact, at a dt no longer than without bonds
 sc, dt_b = bench_scenes.make_scene(out, "test", "soft_mono_bonded", bed, 1)
-p = subprocess.run([JDEM, "resolve", sc], capture_output=True, text=True)
+p = engines.resolve(sc, binary=JDEM)
 res = yaml.load(p.stdout, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader)) if p.returncode == 0 else {}
 nb = len(res.get("bonds") or [])
 c.check("bonded_every_contact", nb == pairs, f"{nb} bonds, want {pairs}; {p.stderr.strip()[-300:]}")

@@ -15,7 +15,6 @@
 Run:  /usr/bin/python3 tests/engine/test_servo.py     (JDEM=path/to/jdem to override)
 """
 import os
-import subprocess
 import tempfile
 from math import sqrt
 
@@ -100,8 +99,7 @@ def same_bits(a, b, observables):
 
 def run_threads(c, scene, label, threads, tag=""):
     out = os.path.join(tempfile.mkdtemp(prefix="jdem_servo_"), "%s_t%d%s.h5" % (label, threads, tag))
-    p = subprocess.run([JDEM, "run", scene, "-o", out, "--quiet", "--threads", str(threads)],
-                       capture_output=True, text=True)
+    p = engines.jdem("run", scene, "-o", out, "--quiet", "--threads", str(threads), binary=JDEM)
     ok = c.check("%s: runs on %d thread(s)" % (label, threads), p.returncode == 0,
                  p.stderr.strip()[-400:])
     return out if ok else None
