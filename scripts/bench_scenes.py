@@ -117,8 +117,9 @@ def adapt_deck(text, engine, steps):
     # or one rank would own every particle
     text = re.sub(r"(?m)^(boundary .*)$", r"\1\nprocessors      * * 1", text, count=1)
     if engine == "liggghts":
-        # stock LIGGGHTS has no dump h5md/jdem: count contacts with its own computes instead
-        text = re.sub(r"(?m)^dump .*$\n", "", text)
+        # stock LIGGGHTS has neither dump h5md/jdem nor the fix jdem/observables that samples for
+        # it: count contacts with its own computes instead
+        text = re.sub(r"(?m)^(dump |fix \S+ all jdem/observables ).*$\n", "", text)
         text = text.replace("\nrun ", "\ncompute cc all contact/atom\ncompute csum all reduce sum c_cc\n"
                             "thermo_style    custom step atoms ke c_csum\nrun ", 1)
     return text
