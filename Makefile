@@ -15,6 +15,9 @@
 
 SHELL := /bin/bash
 PY    := /usr/bin/python3
+# The repository root is the module path of every Python recipe: scripts/ and tests/ are
+# packages imported as scripts.NAME and tests.SUITE.NAME (scripts/__init__.py).
+export PYTHONPATH := $(CURDIR)
 CC    := gcc
 CXX   := mpicxx
 

@@ -15,20 +15,20 @@ tunable; the same binary may be listed twice, with and without it.
 import argparse
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 
+from scripts import engines
+
 
 def timing(binary, scene, threads, field, env, out):
-    proc = subprocess.run([binary, "run", scene, "--quiet", "--timing", "--threads", str(threads),
-                           "-o", out], capture_output=True, text=True, env={**os.environ, **env})
-    for line in (proc.stdout + proc.stderr).splitlines():
-        if line.startswith("jdem-timing:"):
-            values = dict(kv.split("=", 1) for kv in line.split()[1:])
-            if field not in values:
-                sys.exit(f"ab_timing: no field '{field}' in jdem-timing; valid: {', '.join(values)}")
-            return float(values[field])
+    proc = engines.jdem("run", scene, "--quiet", "--timing", "--threads", str(threads), "-o", out,
+                        binary=binary, env=env)
+    values = engines.jdem_timing(proc.stdout + proc.stderr)
+    if values is not None:
+        if field not in values:
+            sys.exit(f"ab_timing: no field '{field}' in jdem-timing; valid: {', '.join(values)}")
+        return values[field]
     sys.exit(f"ab_timing: {binary} printed no jdem-timing line (exit status {proc.returncode}):\n"
              + proc.stderr[-2000:])
 

@@ -41,12 +41,10 @@ import time
 
 import yaml
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-from bench import LOOP_RE, guard_dt  # noqa: E402
-from benchmark.cases import JDEM, LIGGGHTS, ROOT  # noqa: E402
-from benchmark.cases import scene_path as chung_ooi_scene  # noqa: E402
-from pour_study import check, timed  # noqa: E402
+from scripts import engines
+from scripts.benchmark.cases import LIGGGHTS, ROOT
+from scripts.benchmark.cases import scene_path as chung_ooi_scene
+from scripts.engines import JDEM, guard_dt
 
 IMPACT_FACTORS = (1 / 8, 1 / 4, 1 / 2, 1, 2, 4, 8)
 BED_FACTORS = (1 / 2, 1, 2, 4, 8)
@@ -96,7 +94,7 @@ def factor_name(f):
 
 def resolved(item):
     case = ITEMS[item][1]
-    return yaml.safe_load(check([JDEM, "resolve", scene_of(item)] + (["--case", case] if case else [])))
+    return yaml.safe_load(engines.resolve(scene_of(item), case, check=True).stdout)
 
 
 def write_yaml(doc, path):
@@ -142,7 +140,7 @@ def seed_scene(out, base, factor, seed):
     src = yaml.safe_load(open(BED_SCENE))
     src["generate"][0]["lattice"]["seed"] = seed
     tmp = write_yaml(src, os.path.join(out, "bed", "seeds", "seed%d.source.yaml" % seed))
-    doc = yaml.safe_load(check([JDEM, "resolve", tmp]))
+    doc = yaml.safe_load(engines.resolve(tmp, check=True).stdout)
     return scene_at("bed", (doc,) + tuple(base[1:]), factor)
 
 
@@ -154,10 +152,9 @@ def engine_command(engine, scene_file, traj):
     if engine == "jdem":
         return [JDEM, "run", scene_file, "-o", traj, "--quiet", "--force"], None
     deck_dir = os.path.join(os.path.dirname(traj), "deck")
-    check([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), scene_file, "-o",
-           os.path.join(deck_dir, "in.jdem"), "--trajectory", traj, "--force"]
-          + (["--builtin"] if engine == "liggghts" else []))
-    return [LIGGGHTS, "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"], deck_dir
+    engines.write_deck(scene_file, os.path.join(deck_dir, "in.jdem"), "--trajectory", traj, "--force",
+                       *(["--builtin"] if engine == "liggghts" else []), check=True)
+    return engines.liggghts_command("in.jdem", binary=LIGGGHTS), deck_dir
 
 
 def run(engine, scene, directory, repeats):
@@ -172,12 +169,11 @@ def run(engine, scene, directory, repeats):
             for stale in (traj, traj + ".part"):
                 if os.path.exists(stale):
                     os.remove(stale)
-            t = timed(cmd, cwd)
+            t = engines.cpu_timed(cmd, cwd)
             for k in ("wall", "cpu", "load"):
                 rec[k].append(t[k])
             if cwd:  # LIGGGHTS: its own time of the run loop
-                with open(os.path.join(cwd, "log.lammps"), errors="replace") as f:
-                    rec["loop"].append(float(LOOP_RE.findall(f.read())[-1][0]))
+                rec["loop"].append(engines.liggghts_loop_seconds(os.path.join(cwd, "log.lammps")))
         rec["status"] = "ok"
     except RuntimeError as e:
         rec["status"] = "failed"
@@ -305,7 +301,7 @@ def main(argv):
         runs["study_wall_seconds"] = time.monotonic() - t0
         with open(runs_path, "w") as f:
             json.dump(runs, f, indent=1)
-    import accuracy_report
+    from scripts import accuracy_report
     accuracy_report.analyse(out, json.load(open(runs_path)))
     log("wrote %s and %s" % (os.path.join(out, "summary.json"), os.path.join(out, "report.md")))
     return 0

@@ -34,8 +34,8 @@ import h5py
 import numpy as np
 import yaml
 
-from benchmark.analysis import ANALYSES
-from benchmark.trajectory import Run
+from scripts.benchmark.analysis import ANALYSES
+from scripts.benchmark.trajectory import Run
 
 IMPACT_METRICS = {1: ("peak_force", "peak_overlap", "contact_duration"), 3: ("e_n",),
                   4: ("e_t", "w_post", "rebound_angle_deg", "e_n")}

@@ -8,9 +8,9 @@ import time
 
 import numpy as np
 
-from accuracy_metrics import (BED_METRICS, BED_STATISTICS, IMPACT_METRICS, BedRun, bed_values,
+from scripts.accuracy_metrics import (BED_METRICS, BED_STATISTICS, IMPACT_METRICS, BedRun, bed_values,
                               impact_values, relative_error)
-from benchmark.cases import ROOT
+from scripts.benchmark.cases import ROOT
 
 TARGET = 0.01
 ENGINE_LABEL = {"jdem": "jdem", "liggghts-jdem": "liggghts-jdem (gran/jiang)",
@@ -298,6 +298,6 @@ def analyse(out, runs):
         runs["items"]["bed"]["guard_dt"] if "bed" in runs["items"] else None
     with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump(summary, f, indent=1)
-    import accuracy_text
+    from scripts import accuracy_text
     with open(os.path.join(out, "report.md"), "w") as f:
         f.write(accuracy_text.report(summary, figures))

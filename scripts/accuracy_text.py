@@ -1,7 +1,7 @@
 """report.md of the work-precision study (scripts/accuracy.py) from its summary."""
 import math
 
-from accuracy_report import ENGINE_LABEL, TARGET, factor_name
+from scripts.accuracy_report import ENGINE_LABEL, TARGET, factor_name
 
 WHAT = {"test1_glass": "Chung–Ooi Test 1, glass: elastic head-on impact of two spheres at ±10 m/s",
         "test3_al_oxide_e050_jiang2021": "Chung–Ooi Test 3, alumina on a plane at 3.9 m/s, e = 0.5 (jiang2021 damping)",

@@ -6,6 +6,8 @@ import re
 import subprocess
 import sys
 
+from scripts import engines
+
 ENGINE_LABEL = {"jdem": "jdem", "jdem/2t": "jdem, 2 threads", "liggghts-jdem": "liggghts-jdem (gran/jiang)",
                 "liggghts": "stock liggghts (hertz/history)"}
 SIZE_ORDER = ["5k", "20k", "80k", "320k", "1M"]
@@ -373,10 +375,9 @@ def profile_jdem(out, scene, n, steps=200):
     sc = os.path.join(d, "profile.yaml")
     open(sc, "w").write(text)
     cg = os.path.join(d, "callgrind.out")
-    jdem = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "build", "jdem")
     # only the time loop (sim_step and what it calls) is collected; 1 thread
     r = subprocess.run(["valgrind", "--tool=callgrind", "--toggle-collect=sim_step", "--callgrind-out-file=" + cg,
-                        jdem, "run", sc, "-o", os.path.join(d, "p.h5"), "--quiet", "--threads", "1"],
+                        engines.JDEM, "run", sc, "-o", os.path.join(d, "p.h5"), "--quiet", "--threads", "1"],
                        capture_output=True, text=True)
     if "unhandled instruction" in r.stderr:  # valgrind decodes at most AVX2
         sys.stderr.write("bench: no callgrind profile: valgrind cannot decode this build's AVX-512 "

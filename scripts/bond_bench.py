@@ -31,13 +31,13 @@ import re
 import statistics
 import subprocess
 import sys
-import time
 
 import yaml
 
+from scripts import engines
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-PY = "/usr/bin/python3"
 ANCHOR_NS = 228.0   # LAMMPS bpm/rotational, examples/bpm/impact log, 1 core (anchors.md §2.1)
 
 
@@ -65,28 +65,18 @@ def write(path, sc):
         yaml.safe_dump(sc, f, sort_keys=False)
 
 
-LOOP_TIME = re.compile(r"^Loop time of (\S+) on")
-
-
 def run_seconds(engine, scene_path, out_h5):
     """Wall time of the run: for jdem the whole process, for liggghts-jdem LIGGGHTS' own "Loop
     time" (the run without set-up; the deck generation in Python would add seconds of noise)."""
     if engine == "jdem":
-        cmd = [os.path.join(ROOT, "build", "jdem"), "run", scene_path, "-o", out_h5, "--quiet",
-               "--force"]
+        cmd = [engines.JDEM, "run", scene_path, "-o", out_h5, "--quiet", "--force"]
     else:
-        cmd = [PY, os.path.join(HERE, "liggghts_run.py"), scene_path, "-o", out_h5]
-    t0 = time.monotonic()
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    t = time.monotonic() - t0
+        cmd = engines.script("liggghts_run", scene_path, "-o", out_h5)
+    r, t = engines.timed(cmd)
     if r.returncode != 0:
         raise RuntimeError("%s failed: %s" % (" ".join(cmd), (r.stderr or r.stdout)[-800:]))
     if engine != "jdem":
-        log = os.path.join(out_h5[:-3] + ".deck", "log.lammps")
-        loops = [float(m.group(1)) for m in map(LOOP_TIME.match, open(log)) if m]
-        if not loops:
-            raise RuntimeError("no 'Loop time' in " + log)
-        t = loops[-1]
+        t = engines.liggghts_loop_seconds(engines.liggghts_log(out_h5))
     return t
 
 
@@ -123,13 +113,11 @@ def callgrind_instructions(d, engine="jdem", counts=(8, 8, 8), steps=50):
     write(p, block_scene(counts, steps, True))
     out = os.path.join(d, "callgrind_%s.out" % engine)
     if engine == "jdem":
-        cmd, cwd = [os.path.join(ROOT, "build", "jdem"), "run", p, "-o", p[:-5] + ".h5", "--quiet",
-                    "--force"], None
+        cmd, cwd = [engines.JDEM, "run", p, "-o", p[:-5] + ".h5", "--quiet", "--force"], None
     else:  # generate the deck by running it once, then profile LIGGGHTS alone on it
         run_seconds(engine, p, p[:-5] + ".h5")
         cwd = p[:-5] + ".deck"
-        cmd = [os.path.join(ROOT, "build", "liggghts-jdem"), "-in", "in.jdem", "-log", "none",
-               "-screen", "none"]
+        cmd = engines.liggghts_command("in.jdem", log="none")
     r = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=" + out] + cmd,
                        capture_output=True, text=True, cwd=cwd)
     if "unhandled instruction" in r.stderr:

@@ -37,16 +37,16 @@ import argparse
 import json
 import math
 import os
-import subprocess
 import sys
 
 import h5py
 import numpy as np
 import yaml
 
+from scripts import engines
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-PY = "/usr/bin/python3"
 
 # Shared material and bond: glass-like spheres of radius 1 mm (SI units).
 R = 1.0e-3
@@ -116,13 +116,11 @@ class Runner:
             yaml.safe_dump(sc, f, sort_keys=False)
         traj = os.path.join(d, "%s.h5" % engine)
         if engine == "jdem":
-            # JDEM: another build of the stepper (tests/run_tests.py: the sanitized one)
-            jdem = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
-            cmd = [os.path.join(ROOT, jdem), "run", path, "-o", traj, "--quiet"]
+            # engines.JDEM: $JDEM, another build of the stepper (tests/run_tests.py: the sanitized one)
+            cmd = [engines.JDEM, "run", path, "-o", traj, "--quiet"]
         else:
-            cmd = [PY, os.path.join(HERE, "liggghts_run.py"), path, "-o", traj, "--np",
-                   str(self.np)]
-        r = subprocess.run(cmd, capture_output=True, text=True)
+            cmd = engines.script("liggghts_run", path, "-o", traj, "--np", str(self.np))
+        r = engines.run(cmd)
         if r.returncode != 0:
             raise RuntimeError("%s failed (exit %d): %s" % (" ".join(cmd), r.returncode,
                                                              (r.stderr or r.stdout)[-1500:]))

@@ -35,13 +35,12 @@ import json
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from benchmark.analysis import analyse_all  # noqa: E402
-from benchmark import cases  # noqa: E402
-from benchmark.cases import ENGINE_LABEL, LIGGGHTS, LIGGGHTS_RUN, ROOT, TESTS  # noqa: E402
-from benchmark.figures import write_figure  # noqa: E402
-from benchmark.report import write_report  # noqa: E402
-from benchmark.runner import run_all  # noqa: E402
+from scripts.benchmark.analysis import analyse_all
+from scripts.benchmark import cases
+from scripts.benchmark.cases import ENGINE_LABEL, LIGGGHTS, ROOT, TESTS
+from scripts.benchmark.figures import write_figure
+from scripts.benchmark.report import write_report
+from scripts.benchmark.runner import run_all
 
 
 def analyse_and_report(out, tests, engines, quick, timings):
@@ -58,8 +57,8 @@ def parse_engines(text):
     unknown = set(engines) - set(ENGINE_LABEL)
     if unknown:
         raise SystemExit(f"unknown engine(s) {sorted(unknown)}; valid: jdem, liggghts")
-    if "liggghts" in engines and not (os.path.exists(LIGGGHTS) and os.path.exists(LIGGGHTS_RUN)):
-        print("liggghts requested but build/liggghts-jdem or scripts/liggghts_run.py is missing: "
+    if "liggghts" in engines and not os.path.exists(LIGGGHTS):
+        print("liggghts requested but build/liggghts-jdem is missing: "
               "running jdem only", file=sys.stderr)
         engines.remove("liggghts")
     return engines

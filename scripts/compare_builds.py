@@ -16,12 +16,13 @@ import argparse
 import fnmatch
 import glob
 import os
-import subprocess
 import sys
 import tempfile
 
 import h5py
 import yaml
+
+from scripts import engines
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -52,14 +53,12 @@ def datasets(path):
 
 
 def run(jdem, scene, out):
-    r = subprocess.run([jdem, "run", scene, "--quiet", "--force", "-o", out], capture_output=True,
-                       text=True, timeout=600)
+    r = engines.jdem("run", scene, "--quiet", "--force", "-o", out, binary=jdem, timeout=600)
     return r.returncode, r.stderr[-300:]
 
 
 def compare_case(a, scene, case, tmp):
-    r = subprocess.run([a.base, "resolve", scene] + (["--case", case] if case else []),
-                       capture_output=True, text=True, cwd=ROOT)
+    r = engines.resolve(scene, case, binary=a.base, cwd=ROOT)
     if r.returncode != 0:
         return "SKIP", "the base does not resolve it: " + r.stderr.strip()[-200:]
     doc = yaml.safe_load(r.stdout)
@@ -96,7 +95,7 @@ def main():
     counts = {"PASS": 0, "FAIL": 0, "SKIP": 0}
     with tempfile.TemporaryDirectory(prefix="compare_builds_") as tmp:
         for scene in scenes(a.only):
-            r = subprocess.run([a.base, "cases", scene], capture_output=True, text=True, cwd=ROOT)
+            r = engines.jdem("cases", scene, binary=a.base, cwd=ROOT)
             for case in (r.stdout.split() if r.returncode == 0 else []) or [None]:
                 verdict, detail = compare_case(a, scene, case, tmp)
                 counts[verdict] += 1

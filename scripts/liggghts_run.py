@@ -28,13 +28,11 @@ import errno
 import fcntl
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+from scripts import engines
 
 EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_IO, EXIT_WATCHDOG, EXIT_MEMORY = 0, 1, 2, 3, 4, 5
 
@@ -115,14 +113,13 @@ class Child:
 
 def resolve(a):
     """The resolved scene (text), or the exit status of `jdem resolve` with its message shown."""
-    cmd = [a.jdem, "resolve", a.scene] + (["--case", a.case] if a.case else [])
     try:
-        r = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
-    except OSError as e:
-        say("cannot run %s: %s" % (a.jdem, e))
+        r = engines.resolve(a.scene, a.case, binary=a.jdem)
+    except engines.EngineError as e:
+        say(str(e))
         return None, EXIT_INTERNAL
     if r.returncode != 0:
-        say("%s failed (exit %d); nothing was written:\n%s" % (" ".join(cmd), r.returncode, r.stderr))
+        say("%s failed (exit %d); nothing was written:\n%s" % (" ".join(r.args), r.returncode, r.stderr))
         return None, r.returncode if 0 < r.returncode < 128 else EXIT_INPUT
     return r.stdout, EXIT_OK
 
@@ -136,9 +133,8 @@ def write_deck(a, text, deck_dir, out):
     except OSError as e:
         say("cannot write %s: %s" % (resolved, e))
         return EXIT_IO
-    r = subprocess.run([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), resolved,
-                        "-o", os.path.join(deck_dir, "in.jdem"), "--trajectory", out] +
-                       (["--force"] if a.force else []), capture_output=True, text=True, errors="replace")
+    r = engines.write_deck(resolved, os.path.join(deck_dir, "in.jdem"), "--trajectory", out,
+                           *(["--force"] if a.force else []))
     if r.returncode != 0:
         say("deck generation failed (exit %d):\n%s" % (r.returncode, r.stderr))
         return r.returncode if r.returncode in (EXIT_INPUT, EXIT_IO) else EXIT_INTERNAL
@@ -146,12 +142,7 @@ def write_deck(a, text, deck_dir, out):
 
 
 def liggghts_command(a):
-    run = [os.path.abspath(a.liggghts), "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"]
-    if a.np > 1:
-        mpirun = shutil.which("mpirun") or "mpirun"
-        flags = ["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []
-        run = [mpirun] + flags + ["-np", str(a.np)] + run
-    return run
+    return engines.liggghts_command("in.jdem", a.np, binary=os.path.abspath(a.liggghts))
 
 
 def main():
@@ -161,8 +152,8 @@ def main():
     ap.add_argument("-o", "--output", required=True, help="trajectory (H5MD) to write")
     ap.add_argument("--np", type=int, default=1, help="MPI ranks (default 1)")
     ap.add_argument("--force", action="store_true", help="run even if the time step is unsafe")
-    ap.add_argument("--jdem", default=os.path.join(ROOT, "build", "jdem"))
-    ap.add_argument("--liggghts", default=os.path.join(ROOT, "build", "liggghts-jdem"))
+    ap.add_argument("--jdem", default=engines.JDEM)
+    ap.add_argument("--liggghts", default=engines.LIGGGHTS_JDEM)
     a = ap.parse_args()
     child = Child()
 

@@ -22,7 +22,6 @@ import argparse
 import json
 import math
 import os
-import subprocess
 import sys
 
 import matplotlib
@@ -32,9 +31,10 @@ import yaml
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 
+from scripts.engines import run as run_command, script  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-PY = sys.executable
 RULES = ("jiang2021", "mindlin")
 ENGINES = ("jdem", "liggghts")
 PUBLISHED = os.path.join(ROOT, "reference_runs", "chung_ooi", "published")
@@ -62,9 +62,9 @@ def run(out, rule):
     runs = [("jdem", [], rule)] + ([(",".join(ENGINES), ["--quick"], rule + "_quick")]
                                    if rule == "mindlin" else [])
     for engines, quick, where in runs:
-        cmd = [PY, os.path.join(HERE, "chung_ooi.py"), "run", "--tests", "5,8", "--engines", engines,
-               "--model", f"tangential_stiffness={rule}", "--out", os.path.join(out, where)] + quick
-        subprocess.run(cmd, check=True)
+        cmd = script("chung_ooi", "run", "--tests", "5,8", "--engines", engines,
+                     "--model", f"tangential_stiffness={rule}", "--out", os.path.join(out, where), *quick)
+        run_command(cmd, check=True, capture=False)
 
 
 def load(out, rule):

@@ -18,8 +18,7 @@ import h5py
 import numpy as np
 import yaml
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mixing import deposit, plots  # noqa: E402
+from scripts.mixing import deposit, plots
 
 
 def scene_geometry(path):

@@ -11,12 +11,10 @@ is quoted in docs/model.md (choice of the tangential limit).
 import argparse
 import collections
 import os
-import sys
 
 import numpy as np
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import chung_ooi  # noqa: E402  (the benchmark's runner and analysis, reused as they are)
-from benchmark import cases  # noqa: E402  (its scene_path is replaced per option value)
+from scripts import chung_ooi  # the benchmark's runner and analysis, reused as they are
+from scripts.benchmark import cases  # its scene_path is replaced per option value
 
 SKIPPED_METRICS = {"run_wall_time_s", "force_at_end"}
 

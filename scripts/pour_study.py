@@ -29,21 +29,16 @@ import argparse
 import json
 import math
 import os
-import resource
-import shutil
-import subprocess
 import sys
-import time
 
 import h5py
 import numpy as np
 import yaml
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+from scripts import engines
+from scripts.engines import ROOT
 
-JDEM = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))   # as tests/engine
-LIG = os.environ.get("LIGGGHTS_JDEM", os.path.join(ROOT, "build", "liggghts-jdem"))
+JDEM, LIG = engines.JDEM, engines.LIGGGHTS_JDEM   # $JDEM and $LIGGGHTS_JDEM when set
 SCENE = os.path.join(ROOT, "reference_runs", "pour", "scene.yaml")
 ROUNDOFF = 1e-10          # scaled difference counted as round-off
 ENGINES = ("jdem", "lig1", "lig2", "lig2x", "builtin")
@@ -68,32 +63,13 @@ def write_scene(src, dst, overrides):
     return dst
 
 
-def check(cmd, cwd=None):
-    r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
-    if r.returncode != 0:
-        raise RuntimeError("%s failed (exit %d):\n%s%s" % (" ".join(cmd), r.returncode,
-                                                        r.stdout[-2000:], r.stderr[-2000:]))
-    return r.stdout
-
-
-def timed(cmd, cwd=None):
-    """Run CMD (check); returns {"wall": s, "cpu": s, "load": 1-minute load average before}, cpu =
-    user + system time of its processes (less sensitive than wall to other jobs on the machine)."""
-    def cpu():
-        r = resource.getrusage(resource.RUSAGE_CHILDREN)
-        return r.ru_utime + r.ru_stime
-    load, wall, cpu0 = os.getloadavg()[0], time.monotonic(), cpu()
-    check(cmd, cwd)
-    return {"wall": time.monotonic() - wall, "cpu": cpu() - cpu0, "load": load}
-
-
 def run_jdem(scene, out):
     """Run build/jdem; returns its times (timed).  --no-sort: the engines are compared in the
     particle order closest to LIGGGHTS' summation order (jdem's default renumbering in cell
     order changes only the order of the force sums, which brings the chaotic divergence from
     LIGGGHTS forward by ~0.02 s; tests/engine/test_fastpaths.py checks the sorted path against
     this one)."""
-    return timed([JDEM, "run", scene, "-o", out, "--quiet", "--no-sort"])
+    return engines.cpu_timed([JDEM, "run", scene, "-o", out, "--quiet", "--no-sort"])
 
 
 def set_processors(deck_dir, grid):
@@ -114,18 +90,14 @@ def run_liggghts(scene, out, np_=1, builtin=False, grid=None):
             os.remove(stale)
     resolved = os.path.join(deck_dir, "resolved.yaml")
     with open(resolved, "w") as f:
-        f.write(check([JDEM, "resolve", scene]))
-    check([sys.executable, os.path.join(HERE, "scene_to_liggghts.py"), resolved, "-o",
-           os.path.join(deck_dir, "in.jdem"), "--trajectory", out] + (["--builtin"] if builtin else []))
+        f.write(engines.resolve(scene, binary=JDEM, check=True).stdout)
+    engines.write_deck(resolved, os.path.join(deck_dir, "in.jdem"), "--trajectory", out,
+                       *(["--builtin"] if builtin else []), check=True)
     if grid:
         set_processors(deck_dir, grid)
-    cmd = [LIG, "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"]
-    if np_ > 1:
-        root = ["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []
-        # idle ranks yield instead of spinning: 2.5x faster on 2 busy cores, same results
-        yield_ = ["--mca", "mpi_yield_when_idle", "1"]
-        cmd = [shutil.which("mpirun") or "mpirun"] + root + yield_ + ["-np", str(np_)] + cmd
-    times = timed(cmd, cwd=deck_dir)
+    # idle ranks yield instead of spinning: 2.5x faster on 2 busy cores, same results
+    cmd = engines.liggghts_command("in.jdem", np_, binary=LIG, mpi_flags=("--mca", "mpi_yield_when_idle", "1"))
+    times = engines.cpu_timed(cmd, cwd=deck_dir)
     if not os.path.exists(out):
         raise RuntimeError("%s wrote no trajectory (see %s/log.lammps)" % (" ".join(cmd), deck_dir))
     return times
@@ -326,7 +298,7 @@ def divergence(a, b):
 
 def analyze(out_dir):
     meta = json.load(open(os.path.join(out_dir, "runs.json")))
-    scene = yaml.safe_load(check([JDEM, "resolve", meta["scene"]]))
+    scene = yaml.safe_load(engines.resolve(meta["scene"], binary=JDEM, check=True).stdout)
     traj = {n: os.path.join(out_dir, n + ".h5") for n in meta["times"]}
     loaded = {n: load(traj[n]) for n in ENGINES}
     curves, div = {}, {}

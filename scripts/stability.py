@@ -35,19 +35,17 @@ import json
 import math
 import os
 import re
-import subprocess
 import sys
-import time
 
 import h5py
 import numpy as np
 import yaml
 
-from bond_checks import beam_reference, mean_between_extrema
+from scripts.bond_checks import beam_reference, mean_between_extrema
+from scripts import engines
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-PY = sys.executable
 SCENES = os.path.join(ROOT, "reference_runs", "stability")
 
 ENERGY_TOL = 1e-3      # the 0.1 %
@@ -59,24 +57,19 @@ NONPHYSICAL_TOL = 1e-9  # attractive force over the peak force: round-off only
 
 
 def run_jdem(jdem, scene, case, out, force=False):
-    cmd = [jdem, "run", scene, "-o", out] + (["--case", case] if case else []) + (["--force"] if force else [])
-    t0 = time.monotonic()
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    return p.returncode, p.stderr, time.monotonic() - t0
+    cmd = [jdem, "run", scene, "-o", out] + engines.case_args(case) + (["--force"] if force else [])
+    p, seconds = engines.timed(cmd)
+    return p.returncode, p.stderr, seconds
 
 
 def run_liggghts(scene, case, out, force=False):
-    cmd = [PY, os.path.join(HERE, "liggghts_run.py"), scene, "-o", out] + \
-        (["--case", case] if case else []) + (["--force"] if force else [])
-    t0 = time.monotonic()
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    return p.returncode, p.stderr, time.monotonic() - t0
+    p, seconds = engines.timed(engines.script("liggghts_run", scene, "-o", out, *engines.case_args(case),
+                                              *(["--force"] if force else [])))
+    return p.returncode, p.stderr, seconds
 
 
 def resolve(jdem, scene, case):
-    p = subprocess.run([jdem, "resolve", scene] + (["--case", case] if case else []),
-                       capture_output=True, text=True, check=True)
-    return yaml.safe_load(p.stdout)
+    return yaml.safe_load(engines.resolve(scene, case, binary=jdem, check=True).stdout)
 
 
 def guard_summary(stderr):
@@ -300,8 +293,7 @@ def cases_of(jdem, patterns):
         if not fn.endswith(".yaml"):
             continue
         path = os.path.join(SCENES, fn)
-        names = subprocess.run([jdem, "cases", path], capture_output=True, text=True, check=True).stdout.split()
-        for c in names:
+        for c in engines.cases(path, binary=jdem):
             key = "%s/%s" % (fn[:-5], c)
             if not patterns or any(fnmatch.fnmatch(key, p) for p in patterns):
                 out.append((fn[:-5], path, c))

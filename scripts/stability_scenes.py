@@ -14,10 +14,11 @@ import copy
 import math
 import os
 import re
-import subprocess
 import tempfile
 
 import yaml
+
+from scripts import engines
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -61,7 +62,7 @@ def safe_dt(jdem, doc):
     doc["time"].pop("end_time", None)
     with open(path, "w") as f:
         yaml.safe_dump(doc, f)
-    p = subprocess.run([jdem, "run", path, "-o", os.path.join(d, "o.h5")], capture_output=True, text=True)
+    p = engines.jdem("run", path, "-o", os.path.join(d, "o.h5"), binary=jdem)
     m = re.search(r"largest safe dt = (\S+) s", p.stderr)
     if p.returncode != 0 or not m:
         raise SystemExit("stability_scenes: %s" % p.stderr)

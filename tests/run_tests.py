@@ -16,6 +16,7 @@ import tempfile
 import time
 
 PY = "/usr/bin/python3"
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 ENGINE_TESTS = ["neighbour", "fastpaths", "free_flight", "hertz_impact", "energy_balance", "guard",
                 "guard_coordination", "dt_auto", "watchdog",
@@ -146,8 +147,10 @@ def run_suite(name, cmd, style, env):
     # fails.
     tmp = tempfile.mkdtemp(prefix="jdem_suite_")  # (no suite name: tests match words in paths)
     start = time.monotonic()
-    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                          env={**os.environ, **env, "TMPDIR": tmp})
+    # From the repository root, which is also the module path: scripts/ and tests/ are packages
+    # (scripts/__init__.py), imported as scripts.NAME and tests.SUITE.NAME.
+    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=ROOT,
+                          env={**os.environ, **env, "TMPDIR": tmp, "PYTHONPATH": ROOT})
     elapsed = time.monotonic() - start
     passed, failed = count(style, proc.stdout)
     if proc.returncode != 0 and not failed:

@@ -4,7 +4,7 @@ import os
 
 import numpy as np
 
-import compare_trajectories  # scripts/ is on sys.path: this package is imported from there
+from scripts import compare_trajectories
 from .cases import ROOT, material_of, selected_cases, trajectory_path
 from .references import (JIANG2021_RESTITUTION, hertz_closed_form, hertz_effective, lever_arm,
                          published_curve, rigid_body_limit, sliding_parameter)

@@ -5,15 +5,13 @@ replace it (use_model_options: chung_ooi.py --model, scripts/model_option_eviden
 runner and the case lists follow.
 """
 import os
-import subprocess
 
 import yaml
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-PY = "/usr/bin/python3"
-JDEM = os.path.join(ROOT, "build", "jdem")
-LIGGGHTS = os.path.join(ROOT, "build", "liggghts-jdem")
-LIGGGHTS_RUN = os.path.join(ROOT, "scripts", "liggghts_run.py")
+from scripts import engines
+from scripts.engines import ROOT
+
+LIGGGHTS = engines.LIGGGHTS_JDEM
 TESTS = range(1, 9)
 ENGINE_LABEL = {"jdem": "jdem", "liggghts": "LIGGGHTS"}
 
@@ -66,9 +64,7 @@ def trajectory_path(out, test, case, engine):
 
 
 def list_cases(test):
-    proc = subprocess.run([JDEM, "cases", scene_path(test)], check=True,
-                          stdout=subprocess.PIPE, text=True)
-    return proc.stdout.split()
+    return engines.cases(scene_path(test))
 
 
 def selected_cases(test, quick):

@@ -1,18 +1,17 @@
 """Running the cases in the engines: one trajectory per case and engine, with wall times."""
 import concurrent.futures
 import os
-import subprocess
 import sys
-import time
 
+from scripts import engines
 from . import cases
-from .cases import JDEM, LIGGGHTS_RUN, PY, ROOT, selected_cases, trajectory_path
+from .cases import ROOT, selected_cases, trajectory_path
 
 
 def engine_command(engine, test, case, path):
     if engine == "jdem":
-        return [JDEM, "run", cases.scene_path(test), "--case", case, "-o", path, "--quiet"]
-    return [PY, LIGGGHTS_RUN, cases.scene_path(test), "--case", case, "-o", path]
+        return [engines.JDEM, "run", cases.scene_path(test), "--case", case, "-o", path, "--quiet"]
+    return engines.script("liggghts_run", cases.scene_path(test), "--case", case, "-o", path)
 
 
 def run_one(job):
@@ -21,10 +20,8 @@ def run_one(job):
     os.makedirs(os.path.dirname(path), exist_ok=True)
     if os.path.exists(path):
         os.remove(path)  # a failed run must not leave an older trajectory to be analysed
-    start = time.monotonic()
-    proc = subprocess.run(engine_command(engine, test, case, path), cwd=ROOT,
-                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    return {"test": test, "case": case, "engine": engine, "seconds": time.monotonic() - start,
+    proc, seconds = engines.timed(engine_command(engine, test, case, path), cwd=ROOT, merge=True)
+    return {"test": test, "case": case, "engine": engine, "seconds": seconds,
             "status": proc.returncode, "log": proc.stdout[-2000:]}
 
 

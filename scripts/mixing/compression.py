@@ -17,15 +17,13 @@ both strains and K0 (scripts/mixing/elastic.py), as JSON.
 """
 import argparse
 import json
-import os
 import sys
 
 import h5py
 import numpy as np
 import yaml
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from mixing import elastic  # noqa: E402
+from scripts.mixing import elastic
 
 
 def series(obs, name):

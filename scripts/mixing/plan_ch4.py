@@ -18,15 +18,13 @@ import functools
 import os
 import shlex
 import subprocess
-import sys
 import tempfile
 
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.dirname(HERE))
-from campaign import Unit  # noqa: E402
+from scripts.campaign import Unit
 
 PY = "/usr/bin/python3"
 SCENE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "models.yaml")

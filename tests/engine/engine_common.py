@@ -1,19 +1,21 @@
 """Helpers shared by the engine tests (tests/engine/test_*.py).
 
-The binary is $JDEM if set, else build/jdem relative to the repository root.  Each test prints
+The binary is $JDEM if set, else build/jdem relative to the repository root (scripts/engines.py,
+which runs it).  Each test prints
 one line per check, "PASS name" or "FAIL name: detail", and exits non-zero if any check failed.
 """
 import os
-import subprocess
 import sys
 import tempfile
 
 import h5py
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from scripts import engines
+
+ROOT = engines.ROOT
 SCENES = os.path.join(ROOT, "tests", "engine", "scenes")
-JDEM = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
+JDEM = engines.JDEM
 
 
 class Checks:
@@ -44,10 +46,7 @@ def scene(name):
 def run(scene_name, *args, env=None, check=True):
     """Run `jdem run SCENE -o TMP/out.h5 --quiet ARGS`; returns (CompletedProcess, output path)."""
     out = os.path.join(tempfile.mkdtemp(prefix="jdem_engine_"), scene_name + ".h5")
-    e = dict(os.environ)
-    e.update(env or {})
-    p = subprocess.run([JDEM, "run", scene(scene_name), "-o", out, *args], env=e,
-                       capture_output=True, text=True)
+    p = engines.jdem("run", scene(scene_name), "-o", out, *args, env=env)
     if check and p.returncode != 0:
         raise RuntimeError(f"jdem run {scene_name} failed ({p.returncode}): {p.stderr.strip()}")
     return p, out

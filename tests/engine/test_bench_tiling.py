@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Engine test: the large bench beds by tiling (scripts/bench_tiling.py, make_tiled_bed in
-scripts/bench.py), on a bed whose tiling has a closed form.
+scripts/bench_beds.py), on a bed whose tiling has a closed form.
 
 The base bed is a simple-cubic lattice of n x n x nz spheres of radius R whose neighbours, and
 the floor and the four side walls, all overlap by the bench's touch overlap t (spacing 2R - t).
@@ -17,22 +17,16 @@ Run:  /usr/bin/python3 tests/engine/test_bench_tiling.py      (JDEM=path/to/jdem
 import json
 import os
 import re
-import subprocess
-import sys
 import tempfile
 
 import yaml
 
-from engine_common import JDEM, ROOT, Checks, np
+from tests.engine.engine_common import JDEM, Checks, np
 
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import bench  # noqa: E402
-import bench_tiling  # noqa: E402
-
-bench.JDEM = JDEM  # the stepper under test (the sanitized build under make test)
+from scripts import bench_beds, bench_config, bench_scenes, bench_tiling, engines
 
 R, n, nz, k = 1.0e-3, 4, 3, 3
-t = bench.TOUCH * R
+t = bench_config.TOUCH * R
 a = 2.0 * R - t
 
 
@@ -67,7 +61,7 @@ c.check("side", abs(side - side_big) <= 1e-15, f"side {side!r}, want {side_big!r
 dev = np.abs(sorted_rows(x) - sorted_rows(xb)).max()
 c.check("positions_are_the_big_lattice", dev <= 1e-15, f"largest deviation {dev:.3g} m")
 
-I, J, _, ov, WI, _, WO = bench.find_contacts(x, r, side)
+I, J, _, ov, WI, _, WO = bench_beds.find_contacts(x, r, side)
 m = k * n
 pairs = 2 * (m - 1) * m * nz + m * m * (nz - 1)
 walls = m * m + 4 * m * nz
@@ -78,25 +72,25 @@ c.check("every_overlap_is_t", worst <= 1e-6 * t, f"largest |overlap - t| {worst:
 bad, badw = bench_tiling.start_overlap_violations(r, I, J, ov, WI, WO)
 c.check("no_violation", not bad and not badw, f"{len(bad)} pairs, {len(badw)} walls")
 
-# the stepper's own refusal rule: bench.make_scene runs build/jdem on the scene (its guard), which
+# the stepper's own refusal rule: bench_scenes.make_scene runs build/jdem on the scene (its guard), which
 # first checks the start overlaps
 bed = save_bed(out, "tiled", x, r, ids, side)
 dt = float("nan")
 try:
-    _, dt = bench.make_scene(out, "test", "soft_mono", bed, 1)
+    _, dt = bench_scenes.make_scene(out, "test", "soft_mono", bed, 1)
     c.check("stepper_accepts_tiled_bed", dt > 0, f"dt {dt}")
 except RuntimeError as e:
     c.check("stepper_accepts_tiled_bed", False, str(e)[-400:])
 
 xc, rc_, idc, sidec = bench_tiling.tile(x0, r0, id0, side0, k, gap - 1.5 * t)
-I, J, _, ov, WI, _, WO = bench.find_contacts(xc, rc_, sidec)
+I, J, _, ov, WI, _, WO = bench_beds.find_contacts(xc, rc_, sidec)
 bad, badw = bench_tiling.start_overlap_violations(rc_, I, J, ov, WI, WO)
 seam_pairs = 2 * (k - 1) * m * nz
 c.check("closer_tiles_flagged", len(bad) == seam_pairs and not badw,
         f"{len(bad)} pairs and {len(badw)} walls flagged, want {seam_pairs} seam pairs")
 bad_ids = {tuple(sorted((int(idc[i]), int(idc[j])))) for i, j, _ in bad}
 try:
-    bench.make_scene(out, "test", "soft_mono_close", save_bed(out, "close", xc, rc_, idc, sidec), 1)
+    bench_scenes.make_scene(out, "test", "soft_mono_close", save_bed(out, "close", xc, rc_, idc, sidec), 1)
     c.check("stepper_refuses_closer_tiles", False, "build/jdem accepted overlaps of 2.5 t")
 except RuntimeError as e:
     msg = str(e)
@@ -106,14 +100,14 @@ except RuntimeError as e:
             f"stepper's message names {named}; flagged {len(bad_ids)} pairs; message: {msg[-300:]}")
 
 # bonded variant: the rule bonds exactly the pairs in contact, at a dt no longer than without bonds
-sc, dt_b = bench.make_scene(out, "test", "soft_mono_bonded", bed, 1)
-p = subprocess.run([JDEM, "resolve", sc], capture_output=True, text=True)
+sc, dt_b = bench_scenes.make_scene(out, "test", "soft_mono_bonded", bed, 1)
+p = engines.resolve(sc, binary=JDEM)
 res = yaml.load(p.stdout, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader)) if p.returncode == 0 else {}
 nb = len(res.get("bonds") or [])
 c.check("bonded_every_contact", nb == pairs, f"{nb} bonds, want {pairs}; {p.stderr.strip()[-300:]}")
 c.check("bonded_dt_from_guard", 0 < dt_b <= dt, f"bonded dt {dt_b}, unbonded {dt}")
 
-# the bench's decks (scene dict built from the bed and jdem's step-0 bonds, bench.resolved_scene)
+# the bench's decks (scene dict built from the bed and jdem's step-0 bonds, bench_scenes.resolved_scene)
 # against the reference path: scene_to_liggghts.py on the whole `jdem resolve` output
 def deck_files(dd):
     return {f: open(os.path.join(dd, f), "rb").read() for f in sorted(os.listdir(dd))
@@ -121,19 +115,18 @@ def deck_files(dd):
 
 
 for variant in ("soft_mono", "soft_mono_bonded"):
-    sc = bench.scene_path(out, "test", variant)
-    decks = bench.make_decks(out, "test", variant, sc, bed, 1)
+    sc = bench_scenes.scene_path(out, "test", variant)
+    decks = bench_scenes.make_decks(out, "test", variant, sc, bed, 1)
     for engine, deck in sorted(decks.items()):
         dd = os.path.dirname(deck)
         fast = deck_files(dd)
         for f in fast:
             os.remove(os.path.join(dd, f))
         resolved = os.path.join(dd, "resolved.yaml")
-        p = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), resolved,
-                            "-o", deck, "--trajectory", os.path.join(dd, "out.h5")]
-                           + (["--builtin"] if engine == "liggghts" else []), capture_output=True, text=True)
+        p = engines.write_deck(resolved, deck, "--trajectory", os.path.join(dd, "out.h5"),
+                               *(["--builtin"] if engine == "liggghts" else []))
         with open(deck) as f:
-            text = bench.adapt_deck(f.read(), engine, 1)
+            text = bench_scenes.adapt_deck(f.read(), engine, 1)
         with open(deck, "w") as f:
             f.write(text)
         ref = deck_files(dd)

@@ -20,21 +20,18 @@ of this test are made from its last frame.  Checks:
     material the scene lacks), each with exit status 2.
 """
 import os
-import subprocess
-import sys
 import tempfile
 
 import h5py
 import numpy as np
 import yaml
 
-from engine_common import JDEM, ROOT, Checks, scene
+from tests.engine.engine_common import JDEM, Checks, scene
 
-sys.path.insert(0, os.path.join(ROOT, "scripts", "mixing"))
-import deposit  # noqa: E402  (the generators' reader and cutter: the reference wording)
+from scripts import engines
+from scripts.mixing import deposit  # the generators' reader and cutter: the reference wording
 
-PY = sys.executable
-LIG = os.path.join(ROOT, "build", "liggghts-jdem")
+LIG = engines.LIGGGHTS_JDEM
 MATERIALS = """materials:
   steel: {youngs_modulus: 2.0e8, poisson_ratio: 0.3, density: 7800, restitution: 0.7, friction: 0.4}
   wall: {restitution: 0.6, friction: 0.5}
@@ -59,7 +56,7 @@ def write_scene(work, name, entry, extra="", materials=MATERIALS):
 
 
 def resolve(path):
-    p = subprocess.run([JDEM, "resolve", path], capture_output=True, text=True)
+    p = engines.resolve(path, binary=JDEM)
     return p.returncode, p.stdout, p.stderr.strip()
 
 
@@ -98,7 +95,7 @@ def check_round_trip(c, work, src):
     c.check("deposit_materials_by_name", [p["material"] for p in got] == [m for m, k in zip(mats, keep) if k],
             "materials differ")
     out_h5 = os.path.join(work, "round_trip.jdem.h5")
-    p = subprocess.run([JDEM, "run", path, "-o", out_h5, "--quiet"], capture_output=True, text=True)
+    p = engines.jdem("run", path, "-o", out_h5, "--quiet", binary=JDEM)
     if c.check("deposit_run", p.returncode == 0, p.stderr.strip()):
         with h5py.File(out_h5, "r") as f:
             a = f["particles/all"]
@@ -145,16 +142,14 @@ def check_liggghts(c, work, path, jdem_h5):
         c.check("deposit_liggghts", False, "build/liggghts-jdem is missing (run make)")
         return
     lig_h5 = os.path.join(work, "round_trip.lig.h5")
-    p = subprocess.run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), path, "-o", lig_h5],
-                       capture_output=True, text=True)
+    p = engines.liggghts_run(path, lig_h5)
     if not c.check("deposit_liggghts_run", p.returncode == 0, (p.stdout + p.stderr).strip()[-800:]):
         return
     with h5py.File(lig_h5, "r") as f, h5py.File(jdem_h5, "r") as g:
         same0 = (np.array_equal(f["particles/all/id"][()], g["particles/all/id"][()]) and
                  np.array_equal(f["particles/all/position/value"][0], g["particles/all/position/value"][0]))
     c.check("deposit_liggghts_same_particles", same0, "frame 0 of liggghts-jdem differs from build/jdem's")
-    p = subprocess.run([PY, os.path.join(ROOT, "scripts", "compare_trajectories.py"), jdem_h5, lig_h5],
-                       capture_output=True, text=True)
+    p = engines.run(engines.script("compare_trajectories", jdem_h5, lig_h5))
     lines = [l for l in (p.stdout + p.stderr).strip().splitlines() if l.strip()]
     c.check("deposit_liggghts_trajectory", p.returncode == 0, lines[-1] if lines else "")
     rc, out, err = resolve(write_scene(work, "from_liggghts", "{file: %s, velocities: keep}" % lig_h5))
@@ -230,7 +225,7 @@ def main():
     c = Checks()
     work = tempfile.mkdtemp(prefix="jdem_deposit_")
     src = os.path.join(work, "source.h5")
-    p = subprocess.run([JDEM, "run", scene("deposit_source"), "-o", src, "--quiet"], capture_output=True, text=True)
+    p = engines.jdem("run", scene("deposit_source"), "-o", src, "--quiet", binary=JDEM)
     if not c.check("deposit_source_run", p.returncode == 0, p.stderr.strip()):
         c.exit()
     done = check_round_trip(c, work, src)

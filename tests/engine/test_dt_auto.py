@@ -9,17 +9,18 @@ Run:  /usr/bin/python3 tests/engine/test_dt_auto.py            (JDEM=path/to/jde
 """
 import math
 import os
-import subprocess
 import tempfile
 
 import yaml
-from engine_common import JDEM, Checks, run, scene
+
+from scripts import engines
+from tests.engine.engine_common import JDEM, Checks, run, scene
 
 DT_AUTO_FACTOR = 1.0  # the documented default: the guard's safe dt itself
 
 
 def resolve(path):
-    p = subprocess.run([JDEM, "resolve", path], capture_output=True, text=True)
+    p = engines.resolve(path, binary=JDEM)
     return p, (yaml.safe_load(p.stdout) if p.returncode == 0 else None)
 
 
@@ -51,7 +52,7 @@ p, out = run("dt_auto", check=False)
 c.check("auto_dt_passes_the_guard", p.returncode == 0 and os.path.exists(out), f"exit {p.returncode}: {p.stderr.strip()!r}")
 p, out = run("dt_auto", "--quiet", check=False)
 c.check("auto_dt_runs_quietly", p.returncode == 0 and p.stderr == "", f"stderr {p.stderr!r}")
-p = subprocess.run([JDEM, "run", scene("dt_auto"), "-o", out + ".2.h5"], capture_output=True, text=True)
+p = engines.jdem("run", scene("dt_auto"), "-o", out + ".2.h5", binary=JDEM)
 c.check("summary_says_auto", "(auto: %g x the guard's safe dt)" % DT_AUTO_FACTOR in p.stderr, f"stderr {p.stderr!r}")
 
 with tempfile.TemporaryDirectory() as d:

@@ -6,7 +6,7 @@ spinning spheres (mu_r = 0.5).
 
 Run:  /usr/bin/python3 tests/engine/test_energy_balance.py   (JDEM=path/to/jdem to override)
 """
-from engine_common import Checks, energy_total, load, np, run
+from tests.engine.engine_common import Checks, energy_total, load, np, run
 
 c = Checks()
 for name, wall in (("oblique_wall", True), ("oblique_pair", False)):

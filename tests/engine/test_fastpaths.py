@@ -45,16 +45,14 @@ import os
 import re
 import tempfile
 
-import subprocess
-import sys
 
 import h5py
 import yaml
 
-from engine_common import Checks, load, np, scene, JDEM, ROOT
+from scripts import engines
+from tests.engine.engine_common import Checks, load, np, scene, JDEM
 
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import bond_checks  # noqa: E402  (the bonded-block scene)
+from scripts import bond_checks  # the bonded-block scene
 
 VECTORS = ("position", "velocity", "angular_velocity")
 POS_TOL, VEL_TOL = 1e-12, 1e-10  # relative to the largest |value| of the frame
@@ -62,8 +60,7 @@ POS_TOL, VEL_TOL = 1e-12, 1e-10  # relative to the largest |value| of the frame
 
 def run_file(path, *args, env=None):
     out = os.path.join(tempfile.mkdtemp(prefix="jdem_fastpaths_"), "out.h5")
-    p = subprocess.run([JDEM, "run", path, "-o", out, "--quiet", "--timing", *args],
-                       env={**os.environ, **(env or {})}, capture_output=True, text=True)
+    p = engines.jdem("run", path, "-o", out, "--quiet", "--timing", *args, binary=JDEM, env=env)
     if p.returncode != 0:
         raise RuntimeError(f"jdem run {path} {' '.join(args)} failed: {p.stderr.strip()}")
     m = re.search(r"jdem-timing: .*builds=(\d+) threads=(\d+)", p.stderr)
@@ -299,8 +296,7 @@ c.check("deferred_kick_same_observables",
 # The block's generator numbers its spheres in lattice order, which is already cell order; the
 # resolved scene with the ids shuffled (bonds renamed alike) makes the renumbering non-trivial.
 gen = variant(yaml.safe_dump(bond_checks.block_scene(True), sort_keys=False), "block_drop_gen")
-resolved = yaml.safe_load(subprocess.run([JDEM, "resolve", gen], capture_output=True, text=True,
-                                         check=True).stdout)
+resolved = yaml.safe_load(engines.resolve(gen, binary=JDEM, check=True).stdout)
 ids = [p["id"] for p in resolved["particles"]]
 rename = dict(zip(ids, np.random.default_rng(3).permutation(ids).tolist()))
 for p in resolved["particles"]:

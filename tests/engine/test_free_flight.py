@@ -6,7 +6,7 @@ the angular velocity stays constant (no torque).  Tolerance: round-off accumulat
 
 Run:  /usr/bin/python3 tests/engine/test_free_flight.py      (JDEM=path/to/jdem to override)
 """
-from engine_common import Checks, load, np, run
+from tests.engine.engine_common import Checks, load, np, run
 
 x0, v0, w0 = np.array([0.1, 0.2, 0.3]), np.array([0.3, -0.2, 1.0]), np.array([1.0, 2.0, 3.0])
 g = np.array([0.5, -1.0, -9.81])

@@ -7,7 +7,7 @@ Run:  /usr/bin/python3 tests/engine/test_guard.py            (JDEM=path/to/jdem 
 """
 import os
 
-from engine_common import Checks, run
+from tests.engine.engine_common import Checks, run
 
 c = Checks()
 p, out = run("guard_unsafe", check=False)

@@ -16,13 +16,13 @@ Run:  /usr/bin/python3 tests/engine/test_guard_coordination.py     (JDEM=... to 
 import math
 import os
 import re
-import subprocess
 import tempfile
 
 import numpy as np
 import yaml
 
-from engine_common import JDEM, Checks
+from scripts import engines
+from tests.engine.engine_common import JDEM, Checks
 
 E, NU, RHO, R, V = 4.8e10, 0.2, 2800.0, 0.01, 20.0
 MASS = 4.0 / 3.0 * math.pi * R ** 3 * RHO
@@ -41,7 +41,7 @@ def guard_limit(particles, walls, coordination, tangential="jiang2021"):
     path = os.path.join(d, "scene.yaml")
     with open(path, "w") as f:
         yaml.safe_dump(sc, f)
-    p = subprocess.run([JDEM, "run", path, "-o", os.path.join(d, "out.h5")], capture_output=True, text=True)
+    p = engines.jdem("run", path, "-o", os.path.join(d, "out.h5"), binary=JDEM)
     m = re.search(r"Verlet limit at coordination number (\S+) = (\S+) s", p.stderr)
     if p.returncode != 0 or not m:
         raise RuntimeError(f"jdem run failed ({p.returncode}): {p.stderr.strip()}")

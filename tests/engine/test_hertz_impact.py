@@ -9,7 +9,7 @@ Run:  /usr/bin/python3 tests/engine/test_hertz_impact.py     (JDEM=path/to/jdem 
 """
 from math import gamma, pi, sqrt
 
-from engine_common import Checks, load, np, run
+from tests.engine.engine_common import Checks, load, np, run
 
 R, E, rho, v = 0.01, 4.8e10, 2800.0, 20.0  # v: approach speed
 m = 4.0 * pi / 3.0 * R**3 * rho

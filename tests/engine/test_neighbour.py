@@ -10,7 +10,7 @@ is checked against the unsorted one in test_fastpaths.py.
 
 Run:  /usr/bin/python3 tests/engine/test_neighbour.py        (JDEM=path/to/jdem to override)
 """
-from engine_common import Checks, load, np, run
+from tests.engine.engine_common import Checks, load, np, run
 
 c = Checks()
 _, verlet = run("lattice_floor", "--no-sort")

@@ -15,14 +15,13 @@
 Run:  /usr/bin/python3 tests/engine/test_servo.py     (JDEM=path/to/jdem to override)
 """
 import os
-import subprocess
-import sys
 import tempfile
 from math import sqrt
 
 import h5py
 
-from engine_common import JDEM, ROOT, Checks, np, run
+from scripts import engines
+from tests.engine.engine_common import JDEM, ROOT, Checks, np, run
 
 R, E, NU = 0.01, 1.0e7, 0.3
 AREA = 0.02 * 0.02
@@ -100,8 +99,7 @@ def same_bits(a, b, observables):
 
 def run_threads(c, scene, label, threads, tag=""):
     out = os.path.join(tempfile.mkdtemp(prefix="jdem_servo_"), "%s_t%d%s.h5" % (label, threads, tag))
-    p = subprocess.run([JDEM, "run", scene, "-o", out, "--quiet", "--threads", str(threads)],
-                       capture_output=True, text=True)
+    p = engines.jdem("run", scene, "-o", out, "--quiet", "--threads", str(threads), binary=JDEM)
     ok = c.check("%s: runs on %d thread(s)" % (label, threads), p.returncode == 0,
                  p.stderr.strip()[-400:])
     return out if ok else None
@@ -136,8 +134,7 @@ def thread_checks(c):
     diff = same_bits(two, again, all_observables(two))
     c.check("mpi_servo_cube: two 2-thread runs give the same bits", diff is None,
             "first difference in %s" % diff)
-    p = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "compare_trajectories.py"),
-                        one, two], capture_output=True, text=True)
+    p = engines.run(engines.script("compare_trajectories", one, two))
     c.check("mpi_servo_cube: 1 vs 2 threads within the round-off tolerance", p.returncode == 0,
             p.stdout.strip().splitlines()[-1] if p.stdout.strip() else p.stderr.strip()[-300:])
 

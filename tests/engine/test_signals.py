@@ -13,7 +13,7 @@ import time
 
 import h5py
 
-from engine_common import JDEM, Checks, scene
+from tests.engine.engine_common import JDEM, Checks, scene
 
 c = Checks()
 

@@ -16,7 +16,7 @@ import re
 
 import h5py
 
-from engine_common import Checks, np, run
+from tests.engine.engine_common import Checks, np, run
 
 PATTERN = (r"jdem: watchdog: step (\d+): {quantity} ([0-9.e+-]+) for particle\(s\) ([0-9, ]+) "
            r"exceeds ([0-9.e+-]+)")

@@ -5,7 +5,7 @@ Each test file is a script that prints one line per check, "PASS name" or "FAIL 
 any check failed.  tests/faults/run_faults.py runs every tests/faults/test_*.py in turn; it is
 the suite `faults` of tests/run_tests.py, so a new file needs no registration.
 
-API (import with `from faults_common import ...`; the test's directory is on sys.path):
+API (import with `from tests.faults.faults_common import ...`):
 
   ROOT, PY, JDEM, LIGGGHTS_JDEM   repository root, /usr/bin/python3, the binaries ($JDEM and
                                   $LIGGGHTS_JDEM override build/jdem, build/liggghts-jdem)
@@ -51,12 +51,9 @@ import sys
 import tempfile
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks as EngineChecks  # noqa: E402
-PY = "/usr/bin/python3"
-JDEM = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
-LIGGGHTS_JDEM = os.environ.get("LIGGGHTS_JDEM", os.path.join(ROOT, "build", "liggghts-jdem"))
+from scripts import engines
+from scripts.engines import JDEM, LIGGGHTS_JDEM, PY, ROOT
+from tests.engine.engine_common import Checks as EngineChecks
 
 # The exit codes of `jdem` by failure class; `jdem --help` and docs/scenes.md document them.
 EXIT = {"ok": 0, "internal": 1, "input": 2, "io": 3, "watchdog": 4, "memory": 5}
@@ -159,10 +156,9 @@ def _limits(mem_bytes):
 
 
 def start(cmd, mem_bytes=None, cwd=None, env=None):
-    e = dict(os.environ)
-    e.update(env or {})
+    # started here, not by engines.run: the checks limit its memory and signal it while it runs
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            errors="replace", cwd=cwd, env=e, preexec_fn=_limits(mem_bytes))
+                            errors="replace", cwd=cwd, env=engines.python_env(env), preexec_fn=_limits(mem_bytes))
 
 
 def finish(proc, timeout=60):

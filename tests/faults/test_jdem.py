@@ -14,7 +14,7 @@ import time
 
 import yaml
 
-from faults_common import (EXIT, JDEM, ROOT, Checks, expect_files, files, finish, h5_frames,
+from tests.faults.faults_common import (EXIT, JDEM, ROOT, Checks, expect_files, files, finish, h5_frames,
                            h5_readable, is_root, read_only, run, scratch, signal_exit,
                            small_scene, start, tmpfs, wait_for, write_scene)
 

@@ -24,16 +24,14 @@ import os
 import re
 import shutil
 import signal
-import subprocess
-import sys
 import time
 
 import yaml
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from faults_common import (EXIT, JDEM, LIGGGHTS_JDEM, PY, ROOT, Checks, files, h5_frames,  # noqa: E402
-                           h5_readable, run, scratch, signal_exit, start, finish, wait_for,
-                           wait_for_file, write_scene)
+from scripts import engines
+from tests.faults.faults_common import (EXIT, JDEM, LIGGGHTS_JDEM, PY, ROOT, Checks, files, h5_frames,
+                                        h5_readable, run, scratch, signal_exit, start, finish,
+                                        wait_for_file, write_scene)
 
 RUN = os.environ.get("LIGGGHTS_RUN", os.path.join(ROOT, "scripts", "liggghts_run.py"))
 GEN = os.environ.get("SCENE_TO_LIGGGHTS", os.path.join(ROOT, "scripts", "scene_to_liggghts.py"))
@@ -114,9 +112,7 @@ def edit_deck(deck, old, new):
 
 def liggghts(deck, np_=1, timeout=120):
     """liggghts-jdem on DECK, stdout and stderr pipes (as under the wrapper, with the screen)."""
-    mpi = [] if np_ == 1 else ["mpirun"] + (["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0
-                                           else []) + ["-np", str(np_)]
-    r = run(mpi + [LIGGGHTS_JDEM, "-in", "in.jdem", "-log", "log.lammps"], cwd=deck, timeout=timeout)
+    r = run(engines.mpirun(np_) + [LIGGGHTS_JDEM, "-in", "in.jdem", "-log", "log.lammps"], cwd=deck, timeout=timeout)
     try:
         with open(os.path.join(deck, "log.lammps"), errors="replace") as f:
             log = f.read()

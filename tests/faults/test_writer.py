@@ -9,8 +9,7 @@ import os
 import signal
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from faults_common import (EXIT, JDEM, PY, ROOT, Checks, NotRoot, files, h5_readable,  # noqa: E402
+from tests.faults.faults_common import (EXIT, JDEM, PY, ROOT, Checks, NotRoot, files, h5_readable,  # noqa: E402
                            read_only, run, scratch, small_scene, start, finish, tmpfs,
                            wait_for, wait_for_file, write_scene)
 

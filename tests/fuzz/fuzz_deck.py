@@ -29,12 +29,10 @@ import time
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-from fuzz_common import ROOT, Findings, start  # noqa: E402
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import scene_to_liggghts  # noqa: E402
+from tests.fuzz.fuzz_common import ROOT, Findings, start  # noqa: E402
+from scripts import engines, scene_to_liggghts
 
-JDEM = os.path.join(ROOT, "build", "jdem")
-LIGGGHTS_JDEM = os.path.join(ROOT, "build", "liggghts-jdem")
+
 COMMANDS = {"units", "hard_particles", "atom_style", "atom_modify", "newton", "communicate", "boundary",
             "read_data", "fix", "pair_style", "pair_coeff", "neighbor", "neigh_modify", "group", "timestep",
             "thermo", "dump", "run"}
@@ -48,7 +46,7 @@ def seeds(tmp):
     out = []
     for path in sorted(glob.glob(os.path.join(ROOT, "tests", "liggghts", "scenes", "*.yaml")) +
                        glob.glob(os.path.join(ROOT, "tests", "liggghts", "bond_scenes", "*.yaml"))):
-        r = subprocess.run([JDEM, "resolve", path], capture_output=True, text=True)
+        r = engines.resolve(path)
         if r.returncode == 0:
             out.append(yaml.load(r.stdout, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader)))
     return out
@@ -155,8 +153,7 @@ def run_deck(deck_dir):
     with open(path, "w") as f:
         f.write(text)
     try:
-        r = subprocess.run([LIGGGHTS_JDEM, "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"],
-                           cwd=deck_dir, capture_output=True, text=True, errors="replace", timeout=60)
+        r = engines.run_deck(deck_dir, timeout=60)
         return r.returncode
     except subprocess.TimeoutExpired:
         return "timeout"

@@ -21,10 +21,8 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-from fuzz_common import ROOT, Findings, start  # noqa: E402
-JDEM = os.path.join(ROOT, "build", "jdem")
-LIGGGHTS_JDEM = os.path.join(ROOT, "build", "liggghts-jdem")
-GEN = os.path.join(ROOT, "scripts", "scene_to_liggghts.py")
+from scripts import engines
+from tests.fuzz.fuzz_common import ROOT, Findings, start  # noqa: E402
 SCENES = ["tests/liggghts/scenes/walls_and_options.yaml", "tests/liggghts/scenes/mpi_pile.yaml",
           "tests/liggghts/bond_scenes/block_drop.yaml", "tests/inlet/fill_small.yaml"]
 OURS = re.compile(r"^(pair_style\s+gran/jiang|fix\s+\S+\s+\S+\s+(wall/jiang|bond/jiang|jdem/watchdog|jdem/guard|"
@@ -45,13 +43,13 @@ def base_decks(tmp):
     for k, scene in enumerate(SCENES):
         d = os.path.join(tmp, "base%d" % k)
         os.makedirs(d)
-        r = subprocess.run([JDEM, "resolve", os.path.join(ROOT, scene)], capture_output=True, text=True)
+        r = engines.resolve(os.path.join(ROOT, scene))
         if r.returncode != 0:
             continue
         with open(os.path.join(d, "resolved.yaml"), "w") as f:
             f.write(r.stdout)
-        r = subprocess.run([sys.executable, GEN, os.path.join(d, "resolved.yaml"), "-o", os.path.join(d, "in.jdem"),
-                            "--trajectory", os.path.join(d, "out.h5"), "--force"], capture_output=True, text=True)
+        r = engines.write_deck(os.path.join(d, "resolved.yaml"), os.path.join(d, "in.jdem"),
+                               "--trajectory", os.path.join(d, "out.h5"), "--force")
         if r.returncode != 0:
             continue
         with open(os.path.join(d, "in.jdem")) as f:
@@ -101,8 +99,7 @@ def run_one(work, base_dir, text):
     with open(os.path.join(work, "in.jdem"), "w") as f:
         f.write(text.replace(base_dir, work))
     try:
-        r = subprocess.run([LIGGGHTS_JDEM, "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"], cwd=work,
-                           capture_output=True, text=True, errors="replace", timeout=60)
+        r = engines.run_deck(work, timeout=60)
     except subprocess.TimeoutExpired:
         return "timeout", ""
     return r.returncode, r.stderr

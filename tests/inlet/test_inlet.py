@@ -18,19 +18,17 @@ One line per check, `PASS name` or `FAIL name: detail`.
 import csv
 import math
 import os
-import subprocess
-import sys
 import tempfile
 
 import h5py
 import numpy as np
 import yaml
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-JDEM = os.path.join(ROOT, "build", "jdem")
+from scripts import engines
+from scripts.engines import JDEM, ROOT
+from tests.engine.engine_common import Checks
+
 SCENE = os.path.join(ROOT, "tests", "inlet", "fill_small.yaml")
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
 
 checks = Checks()
 check = checks.check
@@ -71,13 +69,11 @@ def reference_stream(sc, inlet, steps):
 def main():
     with tempfile.TemporaryDirectory() as tmp:
         traj, rec = os.path.join(tmp, "fill.h5"), os.path.join(tmp, "rec.csv")
-        run = subprocess.run([JDEM, "run", SCENE, "-o", traj, "--inlet-record", rec, "--quiet"],
-                             capture_output=True, text=True)
+        run = engines.jdem("run", SCENE, "-o", traj, "--inlet-record", rec, "--quiet", binary=JDEM)
         check("run", run.returncode == 0, run.stderr.strip())
         if run.returncode:
             return
-        sc = yaml.safe_load(subprocess.run([JDEM, "resolve", SCENE], capture_output=True,
-                                           text=True, check=True).stdout)
+        sc = yaml.safe_load(engines.resolve(SCENE, binary=JDEM, check=True).stdout)
         inlet = sc["inlets"][0]
         steps = math.ceil(sc["time"]["end_time"] / sc["time"]["dt"] - 1e-9) \
             if "end_time" in sc["time"] else sc["time"]["steps"]
@@ -145,7 +141,7 @@ MODEL_CYLINDERS = {"model1": [], "model2": [(0.5, 1.2)], "model3": [(0.3, 1.5)],
 def chapter4_models():
     scene = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "models.yaml")
     for case, want in MODEL_CYLINDERS.items():
-        r = subprocess.run([JDEM, "resolve", scene, "--case", case], capture_output=True, text=True)
+        r = engines.resolve(scene, case, binary=JDEM)
         if not check(f"ch4-{case}-resolves", r.returncode == 0, r.stderr.strip()):
             continue
         walls = yaml.safe_load(r.stdout).get("walls") or []

@@ -31,36 +31,25 @@ import math
 import os
 import re
 import shutil
-import subprocess
-import sys
 import tempfile
 
 import h5py
 import numpy as np
 import yaml
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-JDEM = os.path.join(ROOT, "build", "jdem")
-LIG = os.path.join(ROOT, "build", "liggghts-jdem")
+from scripts import engines
+from scripts.engines import JDEM, ROOT
+from tests.engine.engine_common import Checks
+
 SCENE = os.path.join(ROOT, "tests", "inlet", "fill_small.yaml")
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
 
 checks = Checks()
 check = checks.check
 DUMP_COLUMNS = "id x y z vx vy vz omegax omegay omegaz"
 
 
-def mpirun(np_):
-    if np_ == 1:
-        return []
-    flags = ["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []
-    return [shutil.which("mpirun") or "mpirun"] + flags + ["-np", str(np_)]
-
-
 def run_deck(deck_dir, deck, log, np_=1):
-    r = subprocess.run(mpirun(np_) + [LIG, "-in", deck, "-log", log, "-screen", "none"], cwd=deck_dir,
-                       capture_output=True, text=True)
+    r = engines.run_deck(deck_dir, deck, np_, log=log)
     with open(os.path.join(deck_dir, log), errors="replace") as f:
         return r.returncode, f.read()
 
@@ -156,19 +145,17 @@ def inflow_from_record(rows, sc):
 
 def cross_engine(tmp):
     jdem_h5, jdem_rec = os.path.join(tmp, "fill.jdem.h5"), os.path.join(tmp, "jdem.csv")
-    r = subprocess.run([JDEM, "run", SCENE, "-o", jdem_h5, "--inlet-record", jdem_rec, "--quiet"],
-                       capture_output=True, text=True)
+    r = engines.jdem("run", SCENE, "-o", jdem_h5, "--inlet-record", jdem_rec, "--quiet")
     if not check("jdem-run", r.returncode == 0, r.stderr.strip()):
         return None
     resolved = os.path.join(tmp, "resolved.yaml")
     with open(resolved, "w") as f:
-        f.write(subprocess.run([JDEM, "resolve", SCENE], capture_output=True, text=True, check=True).stdout)
+        f.write(engines.resolve(SCENE, check=True).stdout)
     sc = yaml.safe_load(open(resolved))
     deck_dir = os.path.join(tmp, "deck")
     lig_rec = os.path.join(deck_dir, "lig.csv")
-    r = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), resolved, "-o",
-                        os.path.join(deck_dir, "in.jdem"), "--trajectory", os.path.join(tmp, "fill.lig.h5"),
-                        "--inlet-record", lig_rec], capture_output=True, text=True)
+    r = engines.write_deck(resolved, os.path.join(deck_dir, "in.jdem"), "--trajectory", os.path.join(tmp, "fill.lig.h5"),
+                           "--inlet-record", lig_rec)
     if not check("deck", r.returncode == 0, r.stderr.strip()):
         return None
     deck_text = open(os.path.join(deck_dir, "in.jdem")).read()
@@ -223,9 +210,8 @@ def cross_engine(tmp):
               "largest scaled difference %.3g" % worst)
     builtin = os.path.join(tmp, "builtin")
     brec = os.path.join(builtin, "rec.csv")
-    r = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), resolved, "-o",
-                        os.path.join(builtin, "in.jdem"), "--trajectory", os.path.join(tmp, "b.h5"), "--builtin",
-                        "--inlet-record", brec], capture_output=True, text=True)
+    r = engines.write_deck(resolved, os.path.join(builtin, "in.jdem"), "--trajectory", os.path.join(tmp, "b.h5"),
+                           "--builtin", "--inlet-record", brec)
     if check("builtin-deck", r.returncode == 0, r.stderr.strip()):
         with open(os.path.join(builtin, "in.custom"), "w") as f:
             f.write(custom_dump_deck(open(os.path.join(builtin, "in.jdem")).read(), every, "b.dump"))
@@ -321,18 +307,16 @@ def stop_rules(tmp):
         with open(scene, "w") as f:
             yaml.safe_dump(doc, f)
         rec = os.path.join(tmp, "stop_%s.jdem.csv" % name)
-        r = subprocess.run([JDEM, "run", scene, "-o", os.path.join(tmp, "stop_%s.h5" % name), "--inlet-record", rec,
-                            "--quiet"], capture_output=True, text=True)
+        r = engines.jdem("run", scene, "-o", os.path.join(tmp, "stop_%s.h5" % name), "--inlet-record", rec, "--quiet")
         if not check("stop-%s-jdem" % name, r.returncode == 0, r.stderr.strip()):
             continue
         resolved = os.path.join(tmp, "stop_%s.resolved.yaml" % name)
         with open(resolved, "w") as f:
-            f.write(subprocess.run([JDEM, "resolve", scene], capture_output=True, text=True, check=True).stdout)
+            f.write(engines.resolve(scene, check=True).stdout)
         deck_dir = os.path.join(tmp, "stop_%s.deck" % name)
         lrec = os.path.join(deck_dir, "lig.csv")
-        subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), resolved, "-o",
-                        os.path.join(deck_dir, "in.jdem"), "--trajectory", os.path.join(tmp, "x.h5"),
-                        "--inlet-record", lrec], check=True)
+        engines.write_deck(resolved, os.path.join(deck_dir, "in.jdem"), "--trajectory", os.path.join(tmp, "x.h5"),
+                           "--inlet-record", lrec, check=True)
         with open(os.path.join(deck_dir, "in.custom"), "w") as f:
             f.write(custom_dump_deck(open(os.path.join(deck_dir, "in.jdem")).read(), 1000, "d.dump"))
         rc, log = run_deck(deck_dir, "in.custom", "log.custom")
@@ -345,7 +329,7 @@ def stop_rules(tmp):
 
 
 def main():
-    for exe in (JDEM, LIG):
+    for exe in (JDEM, engines.LIGGGHTS_JDEM):
         if not check("built-" + os.path.basename(exe), os.access(exe, os.X_OK), "run make"):
             return
     tmp = tempfile.mkdtemp(prefix="inlet-cross-")

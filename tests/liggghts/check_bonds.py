@@ -28,7 +28,6 @@ import math
 import os
 import re
 import shutil
-import subprocess
 import sys
 import tempfile
 
@@ -36,42 +35,25 @@ import h5py
 import numpy as np
 import yaml
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-PY = sys.executable
+from tests.liggghts.liggghts_common import (HERE, LIGGGHTS_JDEM, Checks, compare, jdem_run, liggghts_run,
+                                            liggghts_run_log, observable, run_deck)
+
 SCENES = os.path.join(HERE, "bond_scenes")
-RUN = os.path.join(ROOT, "scripts", "liggghts_run.py")
-COMPARE = os.path.join(ROOT, "scripts", "compare_trajectories.py")
-LIG = os.path.join(ROOT, "build", "liggghts-jdem")
-JDEM = os.path.join(ROOT, "build", "jdem")
-
-failed = 0
-
-
-def check(name, ok, detail=""):
-    global failed
-    print(("PASS %s" % name) if ok else ("FAIL %s: %s" % (name, detail)), flush=True)
-    failed += 0 if ok else 1
-    return ok
-
-
-def run(cmd, cwd=None):
-    r = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd)
-    return r.returncode, r.stdout + r.stderr
+CHECKS = Checks()
+check = CHECKS.check
 
 
 def liggghts(scene, out, np_=1):
-    return run([PY, RUN, os.path.join(SCENES, scene + ".yaml"), "-o", out] + (["--np", str(np_)] if np_ > 1 else []))
+    return liggghts_run(os.path.join(SCENES, scene + ".yaml"), out, ranks=np_)
 
 
 def jdem(scene, out):
-    return run([JDEM, "run", os.path.join(SCENES, scene + ".yaml"), "-o", out, "--quiet"])
+    return jdem_run(os.path.join(SCENES, scene + ".yaml"), out, "--quiet")
 
 
-def compare(name, a, b, until=None):
-    rc, text = run([PY, COMPARE, a, b] + (["--until", str(until)] if until is not None else []))
-    last = [l for l in text.strip().splitlines() if l.strip()][-1]
-    return check(name, rc == 0, last + "\n" + text)
+def compare_check(name, a, b, until=None):
+    ok, last, text = compare(a, b, *(["--until", str(until)] if until is not None else []))
+    return check(name, ok, last + "\n" + text)
 
 
 def events(path):
@@ -105,11 +87,6 @@ def fragment_sizes(path):
     return sorted(sizes.values(), reverse=True)
 
 
-def observable(path, name):
-    with h5py.File(path, "r") as f:
-        return f["observables/%s/value" % name][()]
-
-
 def run_three(scene, work):
     """build/jdem, and liggghts-jdem on 1 and 2 ranks; the three trajectories or None."""
     paths = [os.path.join(work, "%s.%s.h5" % (scene, e)) for e in ("jdem", "np1", "np2")]
@@ -126,8 +103,8 @@ def check_slide(work):
     if not paths:
         return
     j, a, b = paths
-    compare("bonds/mpi_bonded_slide: jdem vs liggghts-jdem", j, a)
-    compare("bonds/mpi_bonded_slide: liggghts-jdem 1 rank vs 2 ranks", a, b)
+    compare_check("bonds/mpi_bonded_slide: jdem vs liggghts-jdem", j, a)
+    compare_check("bonds/mpi_bonded_slide: liggghts-jdem 1 rank vs 2 ranks", a, b)
     nb, nf = observable(b, "bonds"), observable(b, "fragments")
     check("bonds/mpi_bonded_slide: 4 bonds (2x2x1 block) intact, 1 fragment, on 2 ranks",
           np.all(nb == 4) and np.all(nf == 1), "bonds %s fragments %s" % (nb, nf))
@@ -150,7 +127,7 @@ def check_block(work):
         return
     first = ej[0][0]
     for label, x, y in (("jdem vs liggghts-jdem", j, a), ("liggghts-jdem 1 rank vs 2 ranks", a, b)):
-        compare("bonds/block_drop: %s up to the first break (step %d)" % (label, first), x, y, until=first)
+        compare_check("bonds/block_drop: %s up to the first break (step %d)" % (label, first), x, y, until=first)
         ex, ey = events(x), events(y)
         check("bonds/block_drop: %s: broken-bond events (step, ids, mode)" % label, ex == ey,
               "%s vs %s" % (summary(ex), summary(ey)))
@@ -176,7 +153,7 @@ def check_ghost_cutoff(work):
     for n in (1, 2):
         out = os.path.join(work, "ghost.np%d.h5" % n)
         rc, text = liggghts("ghost_cutoff", out, n)
-        log = open(os.path.join(work, "ghost.np%d.deck" % n, "log.lammps"), errors="replace").read()
+        log = liggghts_run_log(out)
         hit = CUTOFF.search(log)
         if not check("bonds/ghost_cutoff: the run stops on %d rank(s) with the bond named" % n,
                      rc != 0 and hit is not None, "exit %d, log tail:\n%s" % (rc, log[-800:])):
@@ -201,15 +178,15 @@ def check_guard(work):
     scene = os.path.join(work, "unsafe_dt.yaml")
     with open(scene, "w") as f:
         f.write(text)
-    rc, out = run([JDEM, "run", scene, "-o", os.path.join(work, "unsafe.jdem.h5"), "--quiet"])
+    rc, out = jdem_run(scene, os.path.join(work, "unsafe.jdem.h5"), "--quiet")
     ref = SAFE_DT.search(out)
     if not check("bonds/guard: build/jdem refuses the unsafe bonded scene (bond period)",
                  rc != 0 and ref is not None and "bond period" in out, out[-600:]):
         return
     for n in (1, 2):
         out_h5 = os.path.join(work, "unsafe.np%d.h5" % n)
-        rc, _ = run([PY, RUN, scene, "-o", out_h5] + (["--np", str(n)] if n > 1 else []))
-        log = open(os.path.join(work, "unsafe.np%d.deck" % n, "log.lammps"), errors="replace").read()
+        rc, _ = liggghts_run(scene, out_h5, ranks=n)
+        log = liggghts_run_log(out_h5)
         got = SAFE_DT.search(log)
         check("bonds/guard: liggghts-jdem refuses it on %d rank(s), largest safe dt %s s as jdem" % (n, ref.group(1)),
               rc != 0 and got is not None and got.group(1) == ref.group(1) and "bond period" in log
@@ -224,8 +201,7 @@ def check_bad_file(work):
     deck = os.path.join(work, "bad.deck")
     with open(os.path.join(deck, "bonds_rubber.txt"), "w") as f:
         f.write("# two lines\n1 2\n2\n")
-    rc, _ = run([LIG, "-in", "in.jdem", "-log", "log.bad", "-screen", "none"], cwd=deck)
-    log = open(os.path.join(deck, "log.bad"), errors="replace").read()
+    rc, log, _ = run_deck(deck, log="log.bad")
     check("bonds/bad bond file: stops naming the file and line 3", rc != 0 and
           "bonds_rubber.txt line 3: expected two different atom ids" in log, "exit %d, log tail:\n%s" % (rc, log[-600:]))
 
@@ -235,7 +211,7 @@ def main():
     ap.add_argument("--out", default=None, help="work directory (default: a temporary one)")
     ap.add_argument("--keep", action="store_true", help="keep the temporary work directory")
     a = ap.parse_args()
-    if not os.access(LIG, os.X_OK):
+    if not os.access(LIGGGHTS_JDEM, os.X_OK):
         check("bonds: build/liggghts-jdem present", False, "run make")
         return 1
     work = a.out or tempfile.mkdtemp(prefix="jdem-bonds-")
@@ -245,11 +221,11 @@ def main():
     check_ghost_cutoff(work)
     check_bad_file(work)
     check_guard(work)
-    if not a.out and not a.keep and not failed:
+    if not a.out and not a.keep and not CHECKS.failed:
         shutil.rmtree(work, ignore_errors=True)
     elif not a.out:
         print("work directory: %s" % work)
-    return 1 if failed else 0
+    return 1 if CHECKS.failed else 0
 
 
 if __name__ == "__main__":

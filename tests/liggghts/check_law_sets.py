@@ -16,24 +16,19 @@ import glob
 import json
 import os
 import re
-import subprocess
 import sys
 import tempfile
 
 import yaml
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-JDEM = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
-LIGGGHTS = os.environ.get("LIGGGHTS_JDEM", os.path.join(ROOT, "build", "liggghts-jdem"))
-DECK = os.path.join(ROOT, "scripts", "scene_to_liggghts.py")
+from scripts import engines
+from tests.liggghts.liggghts_common import ROOT, Checks, jdem_run, run_deck
+
 TANGENTIAL_ERROR = ("pair_style gran/jiang: tangential_stiffness must be jiang2021 or mindlin, "
                     "not 'hooke'")
 ROLLING_ERROR = ("pair_style gran/jiang: coefficientRollingFriction is > 0 for a pair of types in use, "
                  "which needs the rolling law and its history: add 'rolling on' to pair_style "
                  "gran/jiang (or set coefficientRollingFriction to 0)")
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
-
 checks = Checks()
 report = checks.check
 
@@ -59,36 +54,31 @@ def signature(doc):
 
 
 def jdem_law_set(resolved, tmp):
-    r = subprocess.run([JDEM, "run", resolved, "--timing", "--quiet", "--force", "-o",
-                        os.path.join(tmp, "j.h5")], capture_output=True, text=True)
-    m = re.search(r"^jdem:   law set (\S+)$", r.stderr, re.M)
-    return m.group(1) if m else "none printed (exit %d): %s" % (r.returncode, r.stderr[-300:])
+    rc, out = jdem_run(resolved, os.path.join(tmp, "j.h5"), "--timing", "--quiet", "--force")
+    m = re.search(r"^jdem:   law set (\S+)$", out, re.M)
+    return m.group(1) if m else "none printed (exit %d): %s" % (rc, out[-300:])
 
 
 def write_deck(resolved, deck_dir):
     os.makedirs(deck_dir, exist_ok=True)
-    r = subprocess.run([sys.executable, DECK, resolved, "-o", os.path.join(deck_dir, "in.jdem"),
-                        "--trajectory", os.path.join(deck_dir, "l.h5")], capture_output=True, text=True)
+    r = engines.write_deck(resolved, os.path.join(deck_dir, "in.jdem"), "--trajectory", os.path.join(deck_dir, "l.h5"))
     return r.returncode == 0, r.stderr[-300:]
 
 
-def liggghts_run(deck_dir):
-    r = subprocess.run([LIGGGHTS, "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"],
-                       cwd=deck_dir, capture_output=True, text=True)
-    log = os.path.join(deck_dir, "log.lammps")
-    text = open(log).read() if os.path.exists(log) else ""
-    return r.returncode, text + r.stdout + r.stderr
+def liggghts_deck_run(deck_dir):
+    """(exit status, log and output) of the deck DECK_DIR/in.jdem."""
+    rc, log, out = run_deck(deck_dir)
+    return rc, log + out
 
 
 def liggghts_law_set(deck_dir):
-    rc, text = liggghts_run(deck_dir)
+    rc, text = liggghts_deck_run(deck_dir)
     m = re.search(r"^gran/jiang: law set (\S+)$", text, re.M)
     return m.group(1) if m else "none printed (exit %d): %s" % (rc, text[-300:])
 
 
 def resolve_short(scene, case, out):
-    cmd = [JDEM, "resolve", scene] + (["--case", case] if case else [])
-    r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
+    r = engines.resolve(scene, case, cwd=ROOT)
     if r.returncode != 0:
         return None, r.stderr.strip()[-300:]
     doc = yaml.safe_load(r.stdout)
@@ -102,7 +92,7 @@ def resolve_short(scene, case, out):
 def every_scene(tmp):
     seen = {}
     for scene in scenes():
-        r = subprocess.run([JDEM, "cases", scene], capture_output=True, text=True, cwd=ROOT)
+        r = engines.jdem("cases", scene, cwd=ROOT)
         cases = r.stdout.split() if r.returncode == 0 else []
         for case in cases or [None]:
             name = "law_set %s%s" % (scene, " --case " + case if case else "")
@@ -127,7 +117,7 @@ def every_scene(tmp):
 def hand_written(tmp):
     """A generated deck with rolling friction, edited as a user might."""
     scene = os.path.join(ROOT, "reference_runs", "stability", "rolling.yaml")
-    case = subprocess.run([JDEM, "cases", scene], capture_output=True, text=True).stdout.split()[-1]
+    case = engines.cases(scene)[-1]
     resolved = os.path.join(tmp, "rolling.yaml")
     doc, err = resolve_short(scene, case, resolved)
     deck = os.path.join(tmp, "hand")
@@ -140,7 +130,7 @@ def hand_written(tmp):
     for label, edited in (("rolling off", text.replace(" rolling on", " rolling off")),
                           ("no rolling keyword", text.replace(" rolling on", ""))):
         open(path, "w").write(edited)
-        rc, out = liggghts_run(deck)
+        rc, out = liggghts_deck_run(deck)
         report("hand_written rolling friction with %s: exact error" % label,
                rc != 0 and ("ERROR: " + ROLLING_ERROR) in out,
                "exit %d, log tail: %s" % (rc, out[-400:]))
@@ -175,7 +165,7 @@ def hand_written(tmp):
            "jdem selects %s, liggghts-jdem %s" % (mine, theirs))
     # a bad tangential_stiffness value stops with the exact error
     open(path, "w").write(text.replace(" tangential_stiffness jiang2021", " tangential_stiffness hooke"))
-    rc, out = liggghts_run(deck)
+    rc, out = liggghts_deck_run(deck)
     report("hand_written tangential_stiffness hooke: exact error",
            rc != 0 and ("ERROR: " + TANGENTIAL_ERROR) in out, "exit %d, log tail: %s" % (rc, out[-400:]))
 

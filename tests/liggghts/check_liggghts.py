@@ -20,48 +20,17 @@ import argparse
 import glob
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 
-import h5py
 import yaml
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-PY = sys.executable
-JDEM = os.path.join(ROOT, "build", "jdem")
-LIG = os.path.join(ROOT, "build", "liggghts-jdem")
-
-
-def run(cmd):
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    return r.returncode, r.stdout + r.stderr
-
-
-def last_line(text):
-    lines = [l for l in text.strip().splitlines() if l.strip()]
-    line = lines[-1] if lines else ""
-    for tag in ("PASS ", "FAIL "):  # keep one PASS/FAIL per check (tests/run_tests.py counts them)
-        if line.startswith(tag):
-            line = line[len(tag):]
-    return line
+from tests.liggghts.liggghts_common import (HERE, JDEM, LIGGGHTS_JDEM, ROOT, compare, jdem_run, last_line,
+                                            liggghts_run, observable_names, run, run_deck)
 
 
 def indented(text):
     return "".join("    " + l + "\n" for l in text.rstrip().splitlines())
-
-
-def compare(a, b, tol=None):
-    # the tolerance is each scene's output.compare_tolerance (default 1e-10), unless given
-    rc, out = run([PY, os.path.join(ROOT, "scripts", "compare_trajectories.py"), a, b] +
-                  ([] if tol is None else ["--tol", repr(tol)]))
-    return rc == 0, last_line(out), out
-
-
-def observable_names(path):
-    with h5py.File(path, "r") as f:
-        return sorted(f["observables"]) if "observables" in f else []
 
 
 def energy_off_checks(scene, stem, label):
@@ -74,11 +43,11 @@ def energy_off_checks(scene, stem, label):
     full = stem + ".energy_on.yaml"
     with open(full, "w") as f:
         yaml.safe_dump(doc, f)
-    rc, out = run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), full, "-o", stem + ".energy_on.h5"])
+    rc, out = liggghts_run(full, stem + ".energy_on.h5")
     if rc != 0:
         print("FAIL %s: liggghts_run.py with energy on:\n%s" % (label, indented(out.strip()[-1500:])))
         return 1
-    ok, summary, text = compare(stem + ".energy_on.h5", stem + ".lig.h5", tol=0.0)
+    ok, summary, text = compare(stem + ".energy_on.h5", stem + ".lig.h5", "--tol", repr(0.0))
     print("%s %s: liggghts-jdem short history (energy no) vs full history: %s" % (
         "PASS" if ok else "FAIL", label, summary))
     if not ok:
@@ -102,20 +71,17 @@ def energy_off_checks(scene, stem, label):
         text = deck.replace(old, new, 1).replace(os.path.abspath(stem + ".lig.h5"), traj)
         with open(bad, "w") as f:
             f.write(text)
-        log = os.path.join(deck_dir, "log.%s_wants_energy" % what)
-        for p in (traj, traj + ".part", log):  # from an earlier run in the same --out
+        log = "log.%s_wants_energy" % what
+        for p in (traj, traj + ".part", os.path.join(deck_dir, log)):  # from an earlier run in the same --out
             if os.path.exists(p):
                 os.remove(p)
-        r = subprocess.run([LIG, "-in", bad, "-log", log, "-screen", "none"], cwd=deck_dir,
-                           capture_output=True, text=True)
-        with open(log, errors="replace") as f:  # the screen of an aborted run is not flushed
-            said = f.read()
+        rc, said, _ = run_deck(deck_dir, bad, log=log)  # the log: the screen of an aborted run is not flushed
         left = [p for p in (traj, traj + ".part") if os.path.exists(p)]
-        ok = r.returncode != 0 and "pair_style gran/jiang energy no" in said and expect in said and not left
+        ok = rc != 0 and "pair_style gran/jiang energy no" in said and expect in said and not left
         print("%s %s: energy no with the %s asking for energies: %s" % (
             "PASS" if ok else "FAIL", label, what,
-            "exit %d, clear message, no trajectory" % r.returncode if ok else
-            "exit %d, files left %s, output:\n%s" % (r.returncode, left, indented(said.strip()[-800:]))))
+            "exit %d, clear message, no trajectory" % rc if ok else
+            "exit %d, files left %s, output:\n%s" % (rc, left, indented(said.strip()[-800:]))))
         failures += 0 if ok else 1
     return failures
 
@@ -126,7 +92,7 @@ def main():
     ap.add_argument("--chung-ooi", action="store_true", help="also check the Chung-Ooi scenes")
     ap.add_argument("--keep", action="store_true", help="keep the temporary work directory")
     a = ap.parse_args()
-    for exe in (JDEM, LIG):
+    for exe in (JDEM, LIGGGHTS_JDEM):
         if not os.access(exe, os.X_OK):
             print("FAIL liggghts: %s is missing (run make)" % os.path.relpath(exe, ROOT))
             return 1
@@ -149,14 +115,12 @@ def main():
             name = os.path.basename(os.path.dirname(scene))
         label = name + ("/" + case if case else "")
         stem = os.path.join(work, label.replace("/", "_"))
-        caseopt = ["--case", case] if case else []
-        rc, out = run([JDEM, "run", scene] + caseopt + ["-o", stem + ".jdem.h5", "--quiet"])
+        rc, out = jdem_run(scene, stem + ".jdem.h5", *(["--case", case] if case else []), "--quiet")
         if rc != 0:
             print("FAIL %s: build/jdem run: %s" % (label, last_line(out)))
             failures += 1
             continue
-        rc, out = run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene] + caseopt +
-                      ["-o", stem + ".lig.h5"])
+        rc, out = liggghts_run(scene, stem + ".lig.h5", case=case)
         if rc != 0:
             print("FAIL %s: liggghts_run.py:\n%s" % (label, indented(out.strip()[-1500:])))
             failures += 1
@@ -174,8 +138,7 @@ def main():
         if not energy and case is None:
             failures += energy_off_checks(scene, stem, label)
         if name.startswith("mpi_"):
-            rc, out = run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene] + caseopt +
-                          ["-o", stem + ".np2.h5", "--np", "2"])
+            rc, out = liggghts_run(scene, stem + ".np2.h5", case=case, ranks=2)
             if rc != 0:
                 print("FAIL %s: liggghts_run.py --np 2:\n%s" % (label, indented(out.strip()[-1500:])))
                 failures += 1

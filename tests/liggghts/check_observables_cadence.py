@@ -15,26 +15,16 @@ scripts/compare_trajectories.py at the scene's tolerance, and the bond and fragm
 the same integers at every sample.  One PASS/FAIL line per check.
 """
 import os
-import subprocess
 import sys
 import tempfile
 
 import h5py
 import yaml
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-PY = sys.executable
-JDEM = os.path.join(ROOT, "build", "jdem")
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
+from tests.liggghts.liggghts_common import HERE, Checks, compare, jdem_run, liggghts_run
+
 PILE = os.path.join(HERE, "scenes", "mpi_pile.yaml")
 BLOCK = os.path.join(HERE, "bond_scenes", "block_drop.yaml")
-
-
-def run(cmd):
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    return r.returncode, (r.stdout + r.stderr).strip()
 
 
 def observable_steps(path):
@@ -62,11 +52,9 @@ def check(c, tmp, source, steps, every, obs_every, ranks=1):
     with open(path, "w") as f:
         yaml.safe_dump(scene, f)
     a, b = os.path.join(tmp, label + ".jdem.h5"), os.path.join(tmp, label + ".liggghts.h5")
-    np_args = ["--np", str(ranks)] if ranks > 1 else []
-    for cmd, what in (([JDEM, "run", path, "-o", a, "--quiet"], "build/jdem"),
-                      ([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), path, "-o", b] + np_args,
-                       "liggghts_run.py")):
-        rc, out = run(cmd)
+    for (rc, out), what in ((jdem_run(path, a, "--quiet"), "build/jdem"),
+                            (liggghts_run(path, b, ranks=ranks), "liggghts_run.py")):
+        out = out.strip()
         if rc != 0:
             c.check(label, False, "%s exit %d:\n%s" % (what, rc, out[-1500:]))
             return
@@ -79,9 +67,9 @@ def check(c, tmp, source, steps, every, obs_every, ranks=1):
     c.check("%s_steps (%d observables, %d samples each)" % (label, len(sa), len(want)), not bad,
             n and "%s: jdem %d samples %s..., liggghts %d samples %s..., want %d %s..."
             % (n, len(sa[n]), sa[n][:6], len(sb[n]), sb[n][:6], len(want), want[:6]))
-    rc, out = run([PY, os.path.join(ROOT, "scripts", "compare_trajectories.py"), a, b])
-    line = out.splitlines()[-1] if out else ""
-    c.check("%s_values: %s" % (label, line.split(" ", 1)[-1]), rc == 0, "the trajectories differ")
+    same, _, out = compare(a, b)
+    line = out.strip().splitlines()[-1] if out.strip() else ""
+    c.check("%s_values: %s" % (label, line.split(" ", 1)[-1]), same, "the trajectories differ")
     for name in ("bonds", "fragments"):
         if name in sa:
             va, vb = observable_values(a, name), observable_values(b, name)

@@ -15,27 +15,16 @@ the last half kick, as it does for LIGGGHTS' own pairs: velocity-dependent force
 the ones applied during the step.)  One PASS/FAIL line per check.
 """
 import os
-import subprocess
 import sys
 import tempfile
 
 import h5py
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
+from scripts.engines import EngineError
+from tests.liggghts.liggghts_common import HERE, Checks, edit_deck, jdem_run, make_deck, run_deck
 
-PY = sys.executable
-JDEM = os.path.join(ROOT, "build", "jdem")
-LIG = os.path.join(ROOT, "build", "liggghts-jdem")
 EVERY = 10  # the scene's output.every
-
-
-def run(cmd, cwd=None):
-    r = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd)
-    return r.returncode, r.stdout + r.stderr
 
 
 def local_rows(path):
@@ -57,34 +46,33 @@ def local_rows(path):
     return rows
 
 
+def with_pair_local(text):
+    """The deck with compute pair/gran/local dumped (full precision) every EVERY steps."""
+    at = text.rindex("\nrun ")
+    return (text[:at] + "\ncompute pgl all pair/gran/local id force torque\n"
+            "dump dl all local %d pgl.txt c_pgl[1] c_pgl[2] c_pgl[3] c_pgl[4] c_pgl[5] "
+            "c_pgl[6] c_pgl[7] c_pgl[8] c_pgl[9]\ndump_modify dl format \"%s\"" % (EVERY, " ".join(["%.17g"] * 9)) +
+            text[at:])
+
+
 def check_scene(c, name, exact):
     """Runs scene NAME in both engines; checks the rows (and their values when EXACT)."""
     scene = os.path.join(HERE, "scenes", name + ".yaml")
     with tempfile.TemporaryDirectory() as tmp:
         ref = os.path.join(tmp, "jdem.h5")
-        rc, out = run([JDEM, "run", scene, "-o", ref, "--quiet"])
+        rc, out = jdem_run(scene, ref, "--quiet")
         if not c.check(name + ": build/jdem runs", rc == 0, out[-1500:]):
             return
-        rc, resolved = run([JDEM, "resolve", scene])
-        with open(os.path.join(tmp, "resolved.yaml"), "w") as f:
-            f.write(resolved)
-        deck = os.path.join(tmp, "in.jdem")
-        rc, out = run([PY, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"),
-                       os.path.join(tmp, "resolved.yaml"), "-o", deck,
-                       "--trajectory", os.path.join(tmp, "lig.h5")])
-        if not c.check(name + ": the deck is generated", rc == 0, out[-1500:]):
+        try:
+            make_deck(scene, tmp, trajectory=os.path.join(tmp, "lig.h5"))
+        except EngineError as e:
+            c.check(name + ": the deck is generated", False, str(e)[-1500:])
             return
-        text = open(deck).read()
-        at = text.rindex("\nrun ")
-        text = (text[:at] + "\ncompute pgl all pair/gran/local id force torque\n"
-                "dump dl all local %d pgl.txt c_pgl[1] c_pgl[2] c_pgl[3] c_pgl[4] c_pgl[5] "
-                "c_pgl[6] c_pgl[7] c_pgl[8] c_pgl[9]\ndump_modify dl format \"%s\"" % (EVERY, " ".join(["%.17g"] * 9)) +
-                text[at:])
-        with open(deck, "w") as f:
-            f.write(text)
-        rc, out = run([LIG, "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"], cwd=tmp)
+        c.check(name + ": the deck is generated", True)
+        edit_deck(tmp, with_pair_local)
+        rc, log, out = run_deck(tmp)
         if not c.check(name + ": liggghts-jdem runs the deck with compute pair/gran/local", rc == 0,
-                       out[-1500:] + open(os.path.join(tmp, "log.lammps")).read()[-1500:]):
+                       out[-1500:] + log[-1500:]):
             return
         rows = local_rows(os.path.join(tmp, "pgl.txt"))
         with h5py.File(ref, "r") as f:

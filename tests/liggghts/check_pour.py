@@ -43,8 +43,7 @@ import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import pour_study  # noqa: E402
+from scripts import engines, pour_study
 
 EVERY = 200
 HORIZON = {("lig1", "lig2x"): 0.110, ("jdem", "lig1"): 0.130}   # [s], see above
@@ -90,7 +89,7 @@ def main():
         return 1
     traj = {n: pour_study.load(os.path.join(work, n + ".h5")) for n in RUNS}
     ok = all([check_horizon(traj, a_, b_, until) for (a_, b_), until in HORIZON.items()])
-    resolved = yaml.safe_load(pour_study.check([pour_study.JDEM, "resolve", scene]))
+    resolved = yaml.safe_load(engines.resolve(scene, binary=pour_study.JDEM, check=True).stdout)
     ok &= check_statistics({n: pour_study.settled_stats(os.path.join(work, n + ".h5"), resolved) for n in RUNS})
     if not a.out:
         shutil.rmtree(work, ignore_errors=True)

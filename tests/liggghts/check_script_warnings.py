@@ -12,16 +12,10 @@ And poissonsRatio 0.5 (incompressible) is accepted.  One PASS/FAIL line per chec
 """
 import os
 import re
-import subprocess
 import sys
 import tempfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
-
-LIG = os.path.join(ROOT, "build", "liggghts-jdem")
+from tests.liggghts.liggghts_common import Checks, run_deck
 
 DECK = """atom_style granular
 atom_modify map array
@@ -62,16 +56,13 @@ PROPERTY_WARNING = ("WARNING: fix m5 (property/global coefficientPlasticityDepth
                     "no effect on the contacts")
 
 
-def run_deck(tmp, name, **fields):
+def run_script(tmp, name, **fields):
+    """DECK with FIELDS in TMP/NAME/in.deck, run: (exit status, log, output)."""
     d = os.path.join(tmp, name)
     os.mkdir(d)
     with open(os.path.join(d, "in.deck"), "w") as f:
         f.write(DECK.format(**fields))
-    r = subprocess.run([LIG, "-in", "in.deck", "-log", "log.lammps", "-screen", "none"], cwd=d,
-                       capture_output=True, text=True)
-    log = open(os.path.join(d, "log.lammps")).read() if os.path.exists(
-        os.path.join(d, "log.lammps")) else ""
-    return r.returncode, log, r.stdout + r.stderr
+    return run_deck(d, "in.deck")
 
 
 def count(log, line):
@@ -81,14 +72,14 @@ def count(log, line):
 def main():
     c = Checks()
     with tempfile.TemporaryDirectory() as tmp:
-        rc, log, out = run_deck(tmp, "stock", nu="0.45", extra=PLASTICITY, wall=STOCK_WALL)
+        rc, log, out = run_script(tmp, "stock", nu="0.45", extra=PLASTICITY, wall=STOCK_WALL)
         c.check("stock wall/gran and a foreign property: the run completes", rc == 0,
                 out[-800:] + log[-1500:])
         c.check("the wall/gran warning, once in two runs (%d)" % count(log, WALL_WARNING),
                 count(log, WALL_WARNING) == 1, log[-2500:])
         c.check("the property warning, once in two runs (%d)" % count(log, PROPERTY_WARNING),
                 count(log, PROPERTY_WARNING) == 1, log[-2500:])
-        rc, log, out = run_deck(tmp, "ours", nu="0.5", extra="", wall=OUR_WALL)
+        rc, log, out = run_script(tmp, "ours", nu="0.5", extra="", wall=OUR_WALL)
         c.check("fix wall/jiang, no foreign property, poissonsRatio 0.5: the run completes",
                 rc == 0, out[-800:] + log[-1500:])
         c.check("... and no warning", "WARNING" not in log,

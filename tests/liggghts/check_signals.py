@@ -17,40 +17,19 @@ LIGGGHTS_JDEM selects the binary (default build/liggghts-jdem).
 import argparse
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
 import tempfile
 import time
 
-import h5py
-import numpy as np
+from scripts import engines
+from tests.liggghts.liggghts_common import HERE, LIGGGHTS_JDEM, Checks, finish, make_deck, part_frames
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-PY = sys.executable
-JDEM = os.path.join(ROOT, "build", "jdem")
-LIG = os.environ.get("LIGGGHTS_JDEM", os.path.join(ROOT, "build", "liggghts-jdem"))
 SCENE = os.path.join(HERE, "signals_scene.yaml")
 EVERY = 20000
-
-failed = 0
-
-
-def check(name, ok, detail=""):
-    global failed
-    print(("PASS %s" % name) if ok else ("FAIL %s: %s" % (name, detail)), flush=True)
-    failed += 0 if ok else 1
-    return ok
-
-
-def make_deck(d, out):
-    r = subprocess.run([JDEM, "resolve", SCENE], capture_output=True, text=True, check=True)
-    with open(os.path.join(d, "resolved.yaml"), "w") as f:
-        f.write(r.stdout)
-    subprocess.run([PY, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), os.path.join(d, "resolved.yaml"),
-                    "-o", os.path.join(d, "in.jdem"), "--trajectory", out], check=True)
+CHECKS = Checks()
+check = CHECKS.check
 
 
 def children(pid):
@@ -65,12 +44,10 @@ def stop_run(tmp, name, sig, ranks, status):
     d = os.path.join(tmp, name)
     os.makedirs(d)
     out = os.path.join(d, "out.h5")
-    make_deck(d, out)
-    cmd = [LIG, "-in", "in.jdem", "-log", "log.lammps", "-screen", "none"]
-    if ranks > 1:
-        cmd = ["mpirun"] + (["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []) + \
-              ["-np", str(ranks)] + cmd
-    p = subprocess.Popen(cmd, cwd=d, stderr=subprocess.PIPE, text=True)
+    make_deck(SCENE, d, trajectory=out)
+    # started here, not by engines.run: the check signals it while it runs
+    p = subprocess.Popen(engines.liggghts_command("in.jdem", ranks, binary=LIGGGHTS_JDEM), cwd=d,
+                         stderr=subprocess.PIPE, text=True)
     # the run has started once the dump created OUT.part (at set-up); then let it write frames
     # (one every 20000 steps, dozens per second on one core)
     t0 = time.time()
@@ -95,11 +72,7 @@ def stop_run(tmp, name, sig, ranks, status):
     step = int(m.group(1))
     check(name + "_no_final_file", not os.path.exists(out), "a file under the final name")
     try:
-        with h5py.File(out + ".part", "r") as f:
-            steps = f["particles/all/position/step"][()]
-            finite = all(np.isfinite(f["particles/all/%s/value" % k][()]).all()
-                         for k in ("position", "velocity", "angular_velocity", "force", "torque"))
-            obs_steps = f["observables/kinetic_energy/step"][()]
+        steps, finite, obs_steps = part_frames(out)
     except OSError as e:
         check(name + "_part_readable", False, str(e))
         return
@@ -117,11 +90,7 @@ def main():
     stop_run(tmp, "sigint_np1", signal.SIGINT, 1, 130)
     stop_run(tmp, "sigterm_np1", signal.SIGTERM, 1, 143)
     stop_run(tmp, "sigterm_np2", signal.SIGTERM, 2, 143)
-    if a.keep:
-        print("runs kept in %s" % tmp)
-    else:
-        shutil.rmtree(tmp, ignore_errors=True)
-    return 1 if failed else 0
+    return finish(CHECKS, tmp, a.keep)
 
 
 if __name__ == "__main__":

@@ -15,39 +15,23 @@ LIGGGHTS with the watchdog in its deck.  Prints one PASS/FAIL line per check; ex
 import argparse
 import os
 import re
-import shutil
-import subprocess
 import sys
 import tempfile
 
-import h5py
-import numpy as np
+from tests.liggghts.liggghts_common import (ROOT, Checks, edit_deck, finish, jdem_run, liggghts_run,
+                                            liggghts_run_log, make_deck, part_frames, run_deck)
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-PY = sys.executable
-JDEM = os.path.join(ROOT, "build", "jdem")
 SCENE = os.path.join(ROOT, "tests", "engine", "scenes", "watchdog_blowup.yaml")
 TRIP = re.compile(r"jdem: watchdog: step (\d+): [^;]*")
-
-failed = 0
-
-
-def check(name, ok, detail=""):
-    global failed
-    print(("PASS %s" % name) if ok else ("FAIL %s: %s" % (name, detail)), flush=True)
-    failed += 0 if ok else 1
-    return ok
+CHECKS = Checks()
+check = CHECKS.check
 
 
 def check_part(name, out, step):
     """OUT.part readable, OUT absent, last frame at `step`, every value finite."""
     check(name + "_no_final_file", not os.path.exists(out), "a file under the final name")
     try:
-        with h5py.File(out + ".part", "r") as f:
-            steps = f["particles/all/position/step"][()]
-            finite = all(np.isfinite(f["particles/all/%s/value" % k][()]).all()
-                         for k in ("position", "velocity", "angular_velocity", "force", "torque"))
+        steps, finite, _ = part_frames(out)
     except OSError as e:
         return check(name + "_part_readable", False, str(e))
     check(name + "_last_frame", len(steps) > 0 and steps[-1] == step, "frame steps %s, trip at %d" % (steps, step))
@@ -56,11 +40,8 @@ def check_part(name, out, step):
 
 def liggghts(tmp, case, np_):
     out = os.path.join(tmp, "%s_np%d.h5" % (case, np_))
-    r = subprocess.run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), SCENE, "--case", case,
-                        "-o", out, "--np", str(np_), "--force"], capture_output=True, text=True)
-    with open(os.path.join(tmp, "%s_np%d.deck" % (case, np_), "log.lammps"), errors="replace") as f:
-        log = f.read()
-    return r.returncode, log, out
+    rc, _ = liggghts_run(SCENE, out, "--force", case=case, ranks=np_)
+    return rc, liggghts_run_log(out), out
 
 
 def nonfinite_force(tmp, np_):
@@ -72,26 +53,17 @@ def nonfinite_force(tmp, np_):
     d = os.path.join(tmp, name)
     os.makedirs(d)
     out = os.path.join(d, "out.h5")
-    r = subprocess.run([JDEM, "resolve", SCENE, "--case", "energy"], capture_output=True, text=True)
-    with open(os.path.join(d, "resolved.yaml"), "w") as f:
-        f.write(r.stdout)
-    subprocess.run([PY, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), os.path.join(d, "resolved.yaml"),
-                    "-o", os.path.join(d, "in.jdem"), "--trajectory", out, "--force"], check=True)
-    with open(os.path.join(d, "in.jdem")) as f:
-        deck = f.read()
-    deck = deck.replace("\nrun ", "\ngroup boom id 2\nvariable fx equal step*1e300*1e300\n"
-                        "fix boom boom addforce v_fx 0 0\nrun ", 1)
-    if np_ > 1:  # particle 2 (x > 0) on rank 1
-        deck = re.sub(r"(?m)^(boundary .*)$", r"\1\nprocessors 2 1 1", deck, count=1)
-    with open(os.path.join(d, "in.jdem"), "w") as f:
-        f.write(deck)
-    mpi = [] if np_ == 1 else ["mpirun"] + (["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []) + \
-        ["-np", str(np_)]
-    r = subprocess.run(mpi + [os.path.join(ROOT, "build", "liggghts-jdem"), "-in", "in.jdem", "-log", "log.lammps",
-                              "-screen", "none"], cwd=d, capture_output=True, text=True)
-    with open(os.path.join(d, "log.lammps"), errors="replace") as f:
-        log = f.read()
-    check(name + "_fails", r.returncode != 0, "exit status 0")
+    make_deck(SCENE, d, "--force", case="energy", trajectory=out)
+
+    def boom(deck):
+        deck = deck.replace("\nrun ", "\ngroup boom id 2\nvariable fx equal step*1e300*1e300\n"
+                            "fix boom boom addforce v_fx 0 0\nrun ", 1)
+        if np_ > 1:  # particle 2 (x > 0) on rank 1
+            deck = re.sub(r"(?m)^(boundary .*)$", r"\1\nprocessors 2 1 1", deck, count=1)
+        return deck
+    edit_deck(d, boom)
+    rc, log, _ = run_deck(d, ranks=np_)
+    check(name + "_fails", rc != 0, "exit status 0")
     want = ("jdem: watchdog: step 1: force inf for particle(s) 2 is not finite; the trajectory up to step 0 "
             "is kept, closed, as %s.part (the run failed)" % out)
     if check(name + "_message", want in log, "expected %r in the log: %r" % (want, log[-1500:])):
@@ -105,10 +77,9 @@ def main():
     tmp = tempfile.mkdtemp(prefix="jdem_watchdog_")
     for case, ranks in (("overlap", (1, 2)), ("energy", (1,))):
         out = os.path.join(tmp, case + ".jdem.h5")
-        r = subprocess.run([JDEM, "run", SCENE, "--case", case, "--force", "--quiet", "-o", out],
-                           capture_output=True, text=True)
-        m = TRIP.search(r.stderr)
-        if not check("jdem_%s_trips" % case, r.returncode == 4 and m, "exit %d: %r" % (r.returncode, r.stderr)):
+        rc, said = jdem_run(SCENE, out, "--case", case, "--force", "--quiet")
+        m = TRIP.search(said)
+        if not check("jdem_%s_trips" % case, rc == 4 and m, "exit %d: %r" % (rc, said)):
             continue
         for n in ranks:
             name = "liggghts_%s_np%d" % (case, n)
@@ -122,16 +93,10 @@ def main():
     for n in (1, 2):
         nonfinite_force(tmp, n)
     out = os.path.join(tmp, "impact.h5")
-    r = subprocess.run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"),
-                        os.path.join(ROOT, "tests", "engine", "scenes", "chung_ooi_1.yaml"), "-o", out],
-                       capture_output=True, text=True)
-    check("liggghts_resolved_impact_does_not_trip", r.returncode == 0 and os.path.exists(out),
-          "exit %d: %s" % (r.returncode, r.stderr[-1500:]))
-    if a.keep:
-        print("runs kept in %s" % tmp)
-    else:
-        shutil.rmtree(tmp, ignore_errors=True)
-    return 1 if failed else 0
+    rc, said = liggghts_run(os.path.join(ROOT, "tests", "engine", "scenes", "chung_ooi_1.yaml"), out)
+    check("liggghts_resolved_impact_does_not_trip", rc == 0 and os.path.exists(out),
+          "exit %d: %s" % (rc, said[-1500:]))
+    return finish(CHECKS, tmp, a.keep)
 
 
 if __name__ == "__main__":

@@ -7,8 +7,8 @@ import tempfile
 import numpy as np
 from scipy import integrate
 
-from common import check, close, finish
-from mixing import deposit, elastic, lens, params, stats
+from tests.mixing.common import check, close, finish
+from scripts.mixing import deposit, elastic, lens, params, stats
 
 # ------------------------------------------------------------------------------------------
 # Lens volume against quadrature: slices normal to the line of centres are two concentric

@@ -8,7 +8,7 @@ import sys
 import tempfile
 import time
 
-from common import ROOT, check, finish
+from tests.mixing.common import ROOT, check, finish
 
 CAMPAIGN = os.path.join(ROOT, "scripts", "campaign.py")
 
@@ -16,8 +16,7 @@ CAMPAIGN = os.path.join(ROOT, "scripts", "campaign.py")
 # writes "ok" (or the content of CONTENT_<name>) to its output.
 PLAN = '''
 import os, sys
-sys.path.insert(0, {scripts!r})
-from campaign import Unit
+from scripts.campaign import Unit
 
 HERE = {here!r}
 WORKER = [sys.executable, "-c", """
@@ -158,8 +157,7 @@ def test_ch4_plan():
     """The plan of make mixing (docs/mixing.md §4): 2 engines x 6 models x (2 fills, 1 second-
     pass scene, 2 x (1 cube-scene unit + 9 compressions)) = 276 units, unique names, and every
     need an earlier unit."""
-    sys.path.insert(0, os.path.join(ROOT, "scripts"))
-    from mixing import plan_ch4
+    from scripts.mixing import plan_ch4
     units = plan_ch4.units([])
     seen = set()
     order_ok = True
@@ -177,7 +175,7 @@ def test_ch4_dt_variants():
     """The plan's time-step variants: the seed's 1e-4 s forced, the guard's dt as jdem states it
     when it refuses the seed's, and half of it, each in its own output tree."""
     import re
-    from mixing import plan_ch4
+    from scripts.mixing import plan_ch4
     refused = subprocess.run([plan_ch4.jdem(), "run", plan_ch4.SCENE, "--case", "model1", "-o",
                               os.path.join(tempfile.mkdtemp(), "x.h5")], capture_output=True,
                              text=True)

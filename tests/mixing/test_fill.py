@@ -32,11 +32,10 @@ import numpy as np
 import yaml
 from scipy.spatial import cKDTree
 
-from common import ROOT, check, finish
-from mixing import deposit, params
+from tests.mixing.common import ROOT, check, finish
+from scripts.mixing import deposit, params
 
-sys.path.insert(0, os.path.join(ROOT, "tests", "inlet"))
-from test_inlet import reference_stream  # noqa: E402
+from tests.inlet.test_inlet import reference_stream
 
 JDEM = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
 GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "generate.py")

@@ -11,7 +11,7 @@ import h5py
 import numpy as np
 import yaml
 
-from common import ROOT, check, finish
+from tests.mixing.common import ROOT, check, finish
 
 GEN = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "generate.py")
 

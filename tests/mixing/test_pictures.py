@@ -8,8 +8,8 @@ import tempfile
 import matplotlib.image as mpimg
 import numpy as np
 
-from common import check, finish
-from mixing import deposit, plots
+from tests.mixing.common import check, finish
+from scripts.mixing import deposit, plots
 
 
 def colour_fraction(img, hex_colour, tol=0.08):

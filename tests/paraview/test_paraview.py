@@ -30,6 +30,8 @@ import h5py
 import matplotlib.image as mpimg
 import numpy as np
 
+from scripts import engines
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PROBE = os.path.join(ROOT, "tests", "paraview", "pv_probe.py")
 ARRAYS = sorted(["radius", "id", "species", "velocity", "angular_velocity", "force", "torque"])
@@ -61,13 +63,12 @@ def short_pour(tmp):
 
 def run_case(engine, scene, out):
     if scene.endswith(".in"):  # a LIGGGHTS deck of its own; LIGGGHTS writes its log in cwd
-        cmd = [os.path.join(ROOT, "build", "liggghts-jdem"), "-in", scene, "-var", "out", out,
-               "-log", "none"]
+        cmd = [engines.LIGGGHTS_JDEM, "-in", scene, "-var", "out", out, "-log", "none"]
     elif engine == "jdem":
-        cmd = [os.path.join(ROOT, "build", "jdem"), "run", "--quiet", scene, "-o", out]
+        cmd = [engines.JDEM, "run", "--quiet", scene, "-o", out]
     else:
-        cmd = ["/usr/bin/python3", os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out]
-    return subprocess.run(cmd, capture_output=True, text=True, cwd=os.path.dirname(out))
+        cmd = engines.script("liggghts_run", scene, "-o", out)
+    return engines.run(cmd, cwd=os.path.dirname(out))
 
 
 def probe(xdmf, png):
@@ -162,8 +163,7 @@ def one(case, scene, engine, tmp, pngs):
     r = run_case(engine, scene, out)
     if not check(f"{tag} run", r.returncode == 0, (r.stderr or r.stdout)[-400:]):
         return
-    c = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "scripts", "h5md_check.py"), out],
-                       capture_output=True, text=True)
+    c = engines.run(engines.script("h5md_check", out))
     check(f"{tag} H5MD conformance", c.returncode == 0,
           "; ".join(l for l in c.stdout.splitlines() if l.startswith("FAIL"))[-400:])
     steps, live, bonds, walls = expected(out)
@@ -188,10 +188,8 @@ def refuses_without_grow(tmp):
     the keyword, and no trajectory is published."""
     out = os.path.join(tmp, "grow_no", "g.h5")
     os.makedirs(os.path.dirname(out))
-    r = subprocess.run([os.path.join(ROOT, "build", "liggghts-jdem"), "-in",
-                        os.path.join(ROOT, "tests", "paraview", "insert_pack.in"), "-var", "out",
-                        out, "-var", "dumpkw", "grow no", "-log", "none"], capture_output=True, text=True,
-                       cwd=os.path.dirname(out))
+    r = engines.run([engines.LIGGGHTS_JDEM, "-in", os.path.join(ROOT, "tests", "paraview", "insert_pack.in"),
+                     "-var", "out", out, "-var", "dumpkw", "grow no", "-log", "none"], cwd=os.path.dirname(out))
     want = ("ERROR: dump h5md/jdem: the number of atoms changed (0 -> 12); give the dump "
             "'grow yes' for a particle set that changes")
     check("liggghts-jdem grow no: a growing set is refused by name",
@@ -205,11 +203,11 @@ def main(argv):
         check("paraview installed", False, "pvbatch or xvfb-run missing: run make paraview-deps")
         return 1
     tmp = tempfile.mkdtemp(prefix="jdem_paraview_")
-    for case, scene, engines in CASES:
+    for case, scene, case_engines in CASES:
         path = os.path.join(ROOT, scene)
         if case == "pour" and not pngs:
             path = short_pour(tmp)
-        for engine in engines:
+        for engine in case_engines:
             one(case, path, engine, tmp, pngs)
     refuses_without_grow(tmp)
     if not failed:

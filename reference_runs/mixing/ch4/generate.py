@@ -31,9 +31,8 @@ import sys
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "..", "scripts"))
-from mixing import deposit, params  # noqa: E402
-from stability_scenes import set_path  # noqa: E402  (the sweep's dotted-path override)
+from scripts.mixing import deposit, params
+from scripts.stability_scenes import set_path  # the sweep's dotted-path override
 
 MODELS = os.path.join(HERE, "models.yaml")
 CELL = (1.0, 0.5, 0.25)   # [RECON] orientation, spec §1.7

@@ -1,0 +1,1 @@
+"""tests/engine as a package: its helpers are imported as tests.engine.NAME."""

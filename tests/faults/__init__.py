@@ -1,0 +1,1 @@
+"""tests/faults as a package: its helpers are imported as tests.faults.NAME."""

@@ -1,0 +1,1 @@
+"""tests/fuzz as a package: its helpers are imported as tests.fuzz.NAME."""

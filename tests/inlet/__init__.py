@@ -1,0 +1,1 @@
+"""tests/inlet as a package: its helpers are imported as tests.inlet.NAME."""

@@ -1,0 +1,1 @@
+"""tests/mixing as a package: its helpers are imported as tests.mixing.NAME."""
