@@ -120,6 +120,8 @@ SUITES += [("campaign", [PY, "tests/mixing/test_campaign.py"], "lines", {})]
 # A reduced Chapter 4 fill in jdem (3 sections, 0.8 s): stream, free fall, energy, and the
 # analysis on its deposit against Monte Carlo and all-pairs counts.
 SUITES += [("mixing-fill", [PY, "tests/mixing/test_fill.py"], "lines", {})]
+# Runs from a settled deposit (particles_from, an inlet's from_deposit) in both engines.
+SUITES += [("mixing-settled", [PY, "tests/mixing/test_settled.py"], "lines", {})]
 
 CMOCKA_OK = re.compile(r"^\[\s+OK\s+\] (\S+)")
 CMOCKA_FAIL = re.compile(r"^\[\s+FAILED\s+\] (\S+)$")

@@ -17,14 +17,12 @@ import json
 import math
 import os
 import subprocess
-import sys
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.dirname(HERE))
-from mixing import compression, deposit, params, stats  # noqa: E402
+from scripts.mixing import compression, deposit, params, stats
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 ENGINES = ("jdem", "liggghts-jdem")
 MODELS = tuple("model%d" % m for m in range(1, 7))
