@@ -2,7 +2,7 @@
 """report_ch4.py — the Chapter 4 tables, seed | jdem | liggghts-jdem, from whatever units of
 `make mixing` have finished (docs/mixing.md §4).
 
-    scripts/mixing/report_ch4.py [--out out/mixing/ch4] [--results DIR]
+    /usr/bin/python3 -m scripts.mixing.report_ch4 [--out out/mixing/ch4] [--results DIR]
 
 Reads OUT/ENGINE/modelM/fillP.h5 (the mixing parameters at the 9 points of Table 4-2, from the
 last frame) and OUT/ENGINE/modelM/passP_cubeK.h5 (the compression of cube K: E, nu_xy, nu_xz of
