@@ -336,17 +336,24 @@ static double wall_overlap(const jd_scene *s, size_t i, const jd_wall *w) {
     return jd_geom_cylinder(&c, x, s->radius[i], &g) ? g.delta : 0.0;
 }
 
+/* A settled particle keeps its contact with the walls it rested on, up to the watchdog's limit. */
+static double wall_overlap_tolerance(const jd_scene *s, size_t i) {
+    return s->settled[i] ? s->watchdog.max_overlap_fraction : OVERLAP_TOL;
+}
+
 int scene_check_wall_overlaps(loader *L) {
     const jd_scene *s = L->s;
     for (size_t i = 0; i < s->n_particles; i++)
         for (size_t k = 0; k < s->n_walls; k++) {
             const double by = wall_overlap(s, i, &s->walls[k]);
-            if (!(by > OVERLAP_TOL * s->radius[i])) continue;
+            if (!(by > wall_overlap_tolerance(s, i) * s->radius[i])) continue;
             char path[SD_PATH_MAX];
             particle_path(L, i, path);
             return sd_fail(&L->c, L->pnode[i], path, "particle %lld overlaps wall '%s' by %.3g m "
-                           "at the start; valid: an overlap of at most %g of its radius",
-                           (long long)s->id[i], s->walls[k].name, by, OVERLAP_TOL);
+                           "at the start; valid: an overlap of at most %g of its radius%s",
+                           (long long)s->id[i], s->walls[k].name, by, wall_overlap_tolerance(s, i),
+                           s->settled[i] ? " (watchdog.max_overlap_fraction, for a particle of a "
+                           "settled deposit)" : "");
         }
     return 0;
 }

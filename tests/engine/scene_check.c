@@ -84,7 +84,7 @@ static void first_error(const char *path, char *err, size_t errlen) {
 }
 
 static void check_bad(const char *dir) {
-    char bad[1024], **names;
+    char bad[1024], **names = NULL; /* stays NULL when the directory cannot be read */
     snprintf(bad, sizeof bad, "%s/bad", dir);
     int n = list_yaml(bad, &names);
     if (n < 15) fail("bad scenes", "%s", "fewer than 15 files in bad/");
@@ -383,7 +383,7 @@ static void check_good_file(const char *dir, const char *file, const char *tmpdi
 }
 
 static void check_good(const char *dir) {
-    char good[1024], tmpdir[] = "/tmp/scene_check.XXXXXX", **names;
+    char good[1024], tmpdir[] = "/tmp/scene_check.XXXXXX", **names = NULL;
     snprintf(good, sizeof good, "%s/good", dir);
     if (!mkdtemp(tmpdir)) {
         fail("good scenes", "%s", "cannot create a temporary directory");

@@ -233,7 +233,7 @@ def cross_engine(tmp):
 BAD = [
     ("unknown-keyword", lambda l: l.rstrip("\n") + " speed 3\n",
      "fix jdem/inlet: unknown keyword 'speed'; valid: file, origin, velocity, plane, period, offset, "
-     "first_id, stop, record, append_record"),
+     "first_id, stop, overlap_tol, record, append_record"),
     ("missing-period", lambda l: re.sub(r" period \S+", "", l),
      "fix jdem/inlet: missing keyword 'period'; usage: fix ID group jdem/inlet file SECTION"),
     ("not-a-number", lambda l: re.sub(r" origin (\S+) (\S+) (\S+)", r" origin \1 \2 abc", l),
