@@ -67,6 +67,13 @@ class FixBondJiang : public Fix {
   int pack_reverse_comm(int, int, double *);
   void unpack_reverse_comm(int, int *, double *);
   double memory_usage();
+  /* restart files (jdem_restart.h) */
+  void write_restart(FILE *);
+  void restart(char *);
+  int pack_restart(int, double *);
+  void unpack_restart(int, int);
+  int size_restart(int);
+  int maxsize_restart();
   /* thermo output: f_ID = intact bonds, f_ID[1..3] = intact, broken in tension, in shear */
   double compute_scalar();
   double compute_vector(int);

@@ -64,6 +64,14 @@ class FixWallJiang : public Fix {
   int unpack_exchange(int, double *);
   double memory_usage();
 
+  /* restart files (jdem_restart.h) */
+  void write_restart(FILE *);
+  void restart(char *);
+  int pack_restart(int, double *);
+  void unpack_restart(int, int);
+  int size_restart(int);
+  int maxsize_restart();
+
   /* Observables of this rank: cumulative dissipation and wall work [J]; at the last force
    * evaluation the elastic energy [J] and the number of wall contacts carrying force. */
   double e_damp_cum, e_fric_cum, work_cum, e_elastic_now, contacts_now;
