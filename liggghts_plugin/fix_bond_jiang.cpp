@@ -6,6 +6,7 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -28,6 +29,7 @@
 #include "pair.h"
 #include "update.h"
 
+#include "dump_h5md_jdem.h"
 #include "jdem_input_file.h"
 #include "jdem_observables.h"
 #include "jdem_restart.h"
@@ -639,6 +641,18 @@ void FixBondJiang::write_restart(FILE *fp) {
   st.shared.push_back((double)rules_done_at);
   const double sums[BOND_SUMS] = {e_elastic_now, e_damp_cum, e_broken_cum, nbroken[0], nbroken[1]};
   st.sums.assign(sums, sums + BOND_SUMS);
+  /* rank 0: the particles ever bonded, as the first dump h5md/jdem (or the file read) knows them */
+  std::vector<int> ever = ever_bonded_read;
+  for (int k = 0; k < output->ndump; k++) {
+    DumpH5mdJdem *d = dynamic_cast<DumpH5mdJdem *>(output->dump[k]);
+    if (!d) continue;
+    const std::vector<int> seen = d->ever_bonded_ids();
+    ever.insert(ever.end(), seen.begin(), seen.end());
+    break;
+  }
+  std::sort(ever.begin(), ever.end());
+  ever.erase(std::unique(ever.begin(), ever.end()), ever.end());
+  if (comm->me == 0) st.tail.assign(ever.begin(), ever.end());
   jdem_restart_write_state(lmp, fp, st);
 }
 
@@ -652,6 +666,7 @@ void FixBondJiang::restart(char *buf) {
   e_broken_cum = st.sums[2];
   nbroken[0] = st.sums[3];
   nbroken[1] = st.sums[4];
+  ever_bonded_read.assign(st.tail.begin(), st.tail.end());
 }
 
 int FixBondJiang::pack_restart(int i, double *buf) { return jdem_pack_restart(this, i, buf); }

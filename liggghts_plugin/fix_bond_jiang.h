@@ -67,7 +67,9 @@ class FixBondJiang : public Fix {
   int pack_reverse_comm(int, int, double *);
   void unpack_reverse_comm(int, int *, double *);
   double memory_usage();
-  /* restart files (jdem_restart.h) */
+  /* restart files (jdem_restart.h); the ids of the particles ever bonded before the file was
+   * written (rank 0), for dump h5md/jdem's fragments */
+  const std::vector<int> &restored_ever_bonded() const { return ever_bonded_read; }
   void write_restart(FILE *);
   void restart(char *);
   int pack_restart(int, double *);
@@ -159,6 +161,7 @@ class FixBondJiang : public Fix {
   std::vector<Event> events;
   std::vector<Formed> formed;
   double nbroken[2]; /* this rank's bonds broken in tension, in shear (cumulative) */
+  std::vector<int> ever_bonded_read; /* restored_ever_bonded() */
 };
 
 }  // namespace LAMMPS_NS
