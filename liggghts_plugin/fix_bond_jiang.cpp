@@ -638,7 +638,7 @@ enum { BOND_SHARED = 2, BOND_SUMS = 5 };
 void FixBondJiang::write_restart(FILE *fp) {
   JdemRestartState st;
   st.shared.push_back(file_read ? 1.0 : 0.0);
-  st.shared.push_back((double)rules_done_at);
+  st.shared.push_back(jdem_restart_pack_i64(rules_done_at));
   const double sums[BOND_SUMS] = {e_elastic_now, e_damp_cum, e_broken_cum, nbroken[0], nbroken[1]};
   st.sums.assign(sums, sums + BOND_SUMS);
   /* rank 0: the particles ever bonded, as the first dump h5md/jdem (or the file read) knows them */
@@ -660,7 +660,7 @@ void FixBondJiang::restart(char *buf) {
   const JdemRestartState st = jdem_restart_read_state(
       lmp, buf, std::string("fix ") + id + " (bond/jiang)", BOND_SHARED, BOND_SUMS);
   file_read = st.shared[0] != 0.0;
-  rules_done_at = (bigint)st.shared[1];
+  rules_done_at = jdem_restart_unpack_i64(st.shared[1]);
   e_elastic_now = st.sums[0];
   e_damp_cum = st.sums[1];
   e_broken_cum = st.sums[2];

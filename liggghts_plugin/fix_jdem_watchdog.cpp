@@ -77,7 +77,7 @@ void FixJdemWatchdog::write_restart(FILE *fp) {
                            ref.damping, ref.friction, ref.wall_work};
   st.shared.push_back(has_ref ? 1.0 : 0.0);
   st.shared.insert(st.shared.end(), terms, terms + 7);
-  st.shared.push_back((double)ref_step);
+  st.shared.push_back(jdem_restart_pack_i64(ref_step));
   jdem_restart_write_state(lmp, fp, st);
 }
 
@@ -93,7 +93,7 @@ void FixJdemWatchdog::restart(char *buf) {
   ref.damping = s[5];
   ref.friction = s[6];
   ref.wall_work = s[7];
-  ref_step = (bigint)s[8];
+  ref_step = jdem_restart_unpack_i64(s[8]);
 }
 
 void FixJdemWatchdog::end_of_step() { check(); }

@@ -392,7 +392,7 @@ void FixWallJiang::write_restart(FILE *fp) {
   s.insert(s.end(), cyl.a1, cyl.a1 + 3);
   s.insert(s.end(), vel, vel + 3);
   s.insert(s.end(), force_all, force_all + 3);
-  s.push_back((double)servo_state.held);
+  s.push_back(jdem_restart_pack_i64(servo_state.held));
   s.push_back(servo_state.done);
   s.push_back(servo_stress);
   s.push_back(servo_speed);
@@ -424,7 +424,7 @@ void FixWallJiang::restart(char *buf) {
   std::memcpy(cyl.a1, s + 20, 3 * sizeof(double));
   std::memcpy(vel, s + 23, 3 * sizeof(double));
   std::memcpy(force_all, s + 26, 3 * sizeof(double));
-  servo_state.held = (int64_t)s[29];
+  servo_state.held = jdem_restart_unpack_i64(s[29]);
   servo_state.done = (int)s[30];
   servo_stress = s[31];
   servo_speed = s[32];

@@ -5,6 +5,7 @@
 #include <dlfcn.h>
 #include <mpi.h>
 
+#include <cmath>
 #include <cstring>
 #include <map>
 
@@ -90,6 +91,12 @@ JdemRestartState jdem_restart_read_state(LAMMPS *lmp, const char *buf, const std
     from += n;
   }
   return st;
+}
+
+double jdem_restart_peek_shared(const char *buf, size_t k) {
+  const double *b = reinterpret_cast<const double *>(buf);
+  if (b[0] != state_magic || b[1] != state_version || (double)k >= b[2]) return NAN;
+  return b[5 + k];
 }
 
 /* ---- per-atom records ---- */

@@ -17,7 +17,9 @@
 #ifndef JDEM_RESTART_H
 #define JDEM_RESTART_H
 
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -45,6 +47,23 @@ void jdem_restart_write_state(LAMMPS *lmp, FILE *fp, const JdemRestartState &min
  * other counts (another version of the style) stops with a message. */
 JdemRestartState jdem_restart_read_state(LAMMPS *lmp, const char *buf, const std::string &who,
                                          size_t nshared, size_t nsums);
+
+/* An int64 carried bit for bit in a double of a state block (steps such as INT64_MAX, "never",
+ * are not exact as a double's value). */
+static inline double jdem_restart_pack_i64(int64_t v) {
+  double d;
+  std::memcpy(&d, &v, sizeof d);
+  return d;
+}
+static inline int64_t jdem_restart_unpack_i64(double d) {
+  int64_t v;
+  std::memcpy(&v, &d, sizeof v);
+  return v;
+}
+
+/* Value k of the shared part of block `buf` (before its counts are known; k must be within
+ * the part), or NAN for a block that is not ours. */
+double jdem_restart_peek_shared(const char *buf, size_t k);
 
 /* Per-atom restart data through a fix's exchange packers: the record is the pack_exchange
  * record after a length word.  jdem_unpack_restart returns the length of the stored record

@@ -15,6 +15,8 @@ stress tensor, bond energies) -- on 1 and 2 MPI ranks:
          during the impact, while bonds break (the bond lists and bond states, the fragments);
   servo  the servo cube of tests/liggghts/scenes/mpi_servo_cube.yaml (the servo wall's
          position, speed and hold count);
+  inlet  a conveyor inlet (fix jdem/inlet) written with sections still to come (the stream's
+         position; the continued run inserts the same particles at the same steps);
 each written by `restart N` (half way; the block at a quarter) and continued with read_restart; and the bed killed with
 SIGKILL while it writes a restart file every 400 steps, continued from the last complete one.
 The continued deck is the same deck: LIGGGHTS' `restart N` rebuilds the neighbour lists at the
@@ -94,6 +96,8 @@ def particles(case, path):
         pts = lattice([-0.003, -0.003, 0.00102], 0.002, [4, 4, 4], 0.0, rng)
         atoms = [(1, 0.002, 2500.0, p) for p in pts]
         write_data(path, [(-0.05, 0.05), (-0.05, 0.05), (-0.01, 0.02)], atoms, velocity=(1.5, 0.5, -4.0))
+    elif case == "inlet":
+        return  # the box starts empty: fix jdem/inlet brings the particles
     else:
         pts = lattice([0.0295, 0.0295, 0.0145], 0.0282, [6, 6, 6], 0.05, rng)
         atoms = [(1, 2 * (0.013 if rng.uniform() < 0.5 else 0.014), 2500.0, p) for p in pts]
@@ -101,7 +105,8 @@ def particles(case, path):
 
 
 # steps, restart cadence (half way), dump cadence of each case
-CASES = {"bed": (3000, 1500, 100), "block": (1200, 300, 100), "servo": (3000, 1500, 100)}
+CASES = {"bed": (3000, 1500, 100), "block": (1200, 300, 100), "servo": (3000, 1500, 100),
+         "inlet": (6000, 3000, 500)}
 
 
 # ---- running -------------------------------------------------------------------------------
@@ -152,7 +157,9 @@ def frame(path, index=-1):
         step = int(part["position/step"][index])
         ids = part["id"][()] if isinstance(part["id"], h5py.Dataset) else part["id/value"][index]
         order = np.argsort(ids)
+        order = order[ids[order] >= 0]  # a growing set's empty slots have id -1
         q = {k: part[k + "/value"][index][order] for k in ("position", "velocity", "angular_velocity")}
+        q["id"] = ids[order]
         obs = {}
 
         def visit(name, node):
