@@ -10,7 +10,8 @@ tolerance) in the final frame of its dump h5md/jdem -- positions, velocities and
 velocities by atom id, and every observable (energies, contacts, wall forces, servo state,
 stress tensor, bond energies) -- on 1 and 2 MPI ranks:
   bed    96 spheres settle with friction and rolling resistance on a plane in a cylinder that
-         moves sideways (contact, rolling and wall histories, a moving wall's position);
+         moves sideways, one held, one pushed (contact, rolling and wall histories, a moving
+         wall's position, fix jdem/loads' work);
   block  a bonded 4x4x4 block thrown onto a plate: bonds formed at step 0, the file written
          during the impact, while bonds break (the bond lists and bond states, the fragments);
   servo  the servo cube of tests/liggghts/scenes/mpi_servo_cube.yaml (the servo wall's
@@ -257,7 +258,7 @@ def stock_bed(tmp):
         text = f.read()
     text = text.replace("pair_style      gran/jiang rolling on", STOCK_PAIR)
     text = re.sub(r"(?m)^fix floor .*\n^fix can .*\n", STOCK_WALLS, text)
-    text = re.sub(r"(?m)^fix (watchdog|observables) .*\n", "", text)
+    text = re.sub(r"(?m)^fix (watchdog|observables|loads) .*\n", "", text)
     text = text.replace("h5md/jdem ${dump_every} ${out}", "h5md/jdem ${dump_every} ${out} energy no")
     path = os.path.join(tmp, "stock_bed.in")
     with open(path, "w") as f:
