@@ -34,6 +34,8 @@
  *     it (`communicate single vel yes cutoff X` raises the cutoff);
  *   - a bond that fails is removed on the spot and recorded as an event (dump h5md/jdem writes
  *     them); the pair then interacts through gran/jiang alone.
+ * Restart files (jdem_restart.h) carry the bonds, their states and the counts: a fix of the same
+ * ID continues from them (the bond file is not read again, the rules already applied not again).
  * Thermo: f_ID is the number of intact bonds, f_ID[1], f_ID[2], f_ID[3] the intact bonds and the
  * bonds broken in tension and in shear so far. */
 #ifndef JDEM_FIX_BOND_JIANG_H

@@ -25,6 +25,9 @@
  * V [m/s] (inf: no cap), H [s]; after every force evaluation the speed for the next step is set
  * from the measured stress; observables servo_stress/NAME and servo_position/NAME.
  *
+ * Restart files (jdem_restart.h) carry where the wall is, how it moves, the servo's state, the
+ * energies and the per-atom history: a wall of the same ID continues from them.
+ *
  * Cost: each step only the particles found near the wall at the last neighbour build are
  * evaluated (with neigh_modify every 1 delay 0; see refresh_candidates). */
 #ifndef JDEM_FIX_WALL_JIANG_H

@@ -176,7 +176,8 @@ static void drop_stored(Modify *modify, const char *style) {
     }
 }
 
-void jdem_restart_check_pair_style(LAMMPS *lmp, bool gran_jiang, int history_len) {
+void jdem_restart_check_pair_style(LAMMPS *lmp, const char *style, int history_len) {
+  const bool gran_jiang = std::strcmp(style, "gran/jiang") == 0;
   Modify *modify = lmp->modify;
   const char *history = stored_state(modify, "contacthistory");
   const char *ours = stored_state(modify, "jdem/restart");
@@ -196,7 +197,8 @@ void jdem_restart_check_pair_style(LAMMPS *lmp, bool gran_jiang, int history_len
   }
   if (!gran_jiang && !ours) return; /* LIGGGHTS' own file for LIGGGHTS' own pair style */
   const std::string writer = ours ? "pair_style gran/jiang" : "LIGGGHTS' own pair_style gran";
-  const std::string reader = gran_jiang ? "pair_style gran/jiang" : "LIGGGHTS' own pair_style gran";
+  const std::string reader = std::strcmp(style, "gran") == 0 ? "LIGGGHTS' own pair_style gran"
+                                                             : std::string("pair_style ") + style;
   lmp->error->warning(FLERR, ("read_restart: the contact history in the restart file belongs to " +
                               writer + ", which " + reader + " cannot continue: every contact "
                               "starts from zero history (positions, velocities and the other "
@@ -251,7 +253,7 @@ void Force::create_pair(const char *style, const char *suffix) {
     void *sym = library_function(error, "_ZN9LAMMPS_NS5Force11create_pairEPKcS2_");
     std::memcpy(&original, &sym, sizeof original);
   }
-  if (std::strcmp(style, "gran/jiang") != 0) jdem_restart_check_pair_style(lmp, false, 0);
+  if (std::strcmp(style, "gran/jiang") != 0) jdem_restart_check_pair_style(lmp, style, 0);
   original(this, style, suffix);
 }
 

@@ -77,12 +77,12 @@ void jdem_unpack_restart(LAMMPS *lmp, Fix *fix, int nlocal, int nth);
 bool jdem_restart_resuming(LAMMPS *lmp);
 
 /* The restart file that was read (if any) against the pair style the script now defines,
- * called when pair_style is given (gran_jiang: it is pair_style gran/jiang, with `history_len`
- * doubles per contact; otherwise LIGGGHTS' own).  A file whose contact history belongs to the
+ * called when pair_style is given (`style`; for gran/jiang with `history_len` doubles per
+ * contact).  A file whose contact history belongs to the
  * other kind of pair style: its contact history is dropped and a warning says so (contacts
  * then start from zero history).  Our pair style with another history layout than the file's:
  * an error that names the options to use. */
-void jdem_restart_check_pair_style(LAMMPS *lmp, bool gran_jiang, int history_len);
+void jdem_restart_check_pair_style(LAMMPS *lmp, const char *style, int history_len);
 
 }  // namespace LAMMPS_NS
 

@@ -82,7 +82,7 @@ void PairGranJiang::settings(int narg, char **arg) {
   }
 
   register_history();
-  jdem_restart_check_pair_style(lmp, true, state_len());
+  jdem_restart_check_pair_style(lmp, "gran/jiang", state_len());
   present_as_gran();
 }
 
