@@ -67,6 +67,8 @@ class DumpH5mdJdem : public Dump {
   /* The contact and bond observables of this step, between frames (collective; error->all on
    * failure). */
   void write_observable_sample();
+  /* The ids of the particles ever bonded so far (rank 0; restart files keep them). */
+  std::vector<int> ever_bonded_ids() const { return bonds.ever_bonded_ids(); }
 
  protected:
   virtual void init_style();

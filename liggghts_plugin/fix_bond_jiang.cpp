@@ -6,6 +6,7 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -28,8 +29,10 @@
 #include "pair.h"
 #include "update.h"
 
+#include "dump_h5md_jdem.h"
 #include "jdem_input_file.h"
 #include "jdem_observables.h"
+#include "jdem_restart.h"
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -111,12 +114,15 @@ FixBondJiang::FixBondJiang(LAMMPS *lmp, int narg, char **arg)
   extscalar = extvector = 0;
   create_attribute = 1;
   comm_reverse = 6;
+  restart_global = restart_peratom = 1; /* jdem_restart.h */
   grow_arrays(atom->nmax);
   atom->add_callback(0);
+  atom->add_callback(1);
 }
 
 FixBondJiang::~FixBondJiang() {
   atom->delete_callback(id, 0);
+  atom->delete_callback(id, 1);
   memory->destroy(nbond);
   memory->destroy(partner);
   memory->destroy(bstate);
@@ -191,6 +197,7 @@ void FixBondJiang::init() {
 /* Explicit bonds are formed at the first set-up; the set-up evaluation does not advance the
  * bond states (as gran/jiang's contact history). */
 void FixBondJiang::setup(int vflag) {
+  if (jdem_restart_resuming(lmp)) return; /* the bonds read from the file stand */
   if (!file_read && !bond_file.empty()) {
     read_bond_file(bond_file.c_str());
     check_reach(); /* setup_pre_neighbor ran before these bonds existed */
@@ -619,3 +626,60 @@ double FixBondJiang::memory_usage() {
   return (double)nmax_b * (sizeof(int) + max_bonds * (sizeof(int) + REC_LEN * sizeof(double))) +
          (double)nmax_ghost * 6 * sizeof(double);
 }
+
+/* ---------------------------------------------------------------------------------------- */
+/* Restart files (jdem_restart.h): whether the bond file was read and the rules applied, each
+ * rank's energies and counts of broken bonds; per atom its bonds (the exchange record).       */
+
+namespace {
+enum { BOND_SHARED = 2, BOND_SUMS = 5 };
+}
+
+void FixBondJiang::write_restart(FILE *fp) {
+  JdemRestartState st;
+  st.shared.push_back(file_read ? 1.0 : 0.0);
+  st.shared.push_back(jdem_restart_pack_i64(rules_done_at));
+  const double sums[BOND_SUMS] = {e_elastic_now, e_damp_cum, e_broken_cum, nbroken[0], nbroken[1]};
+  st.sums.assign(sums, sums + BOND_SUMS);
+  /* rank 0: the particles ever bonded, as the first dump h5md/jdem (or the file read) knows them */
+  std::vector<int> ever = ever_bonded_read;
+  for (int k = 0; k < output->ndump; k++) {
+    DumpH5mdJdem *d = dynamic_cast<DumpH5mdJdem *>(output->dump[k]);
+    if (!d) continue;
+    const std::vector<int> seen = d->ever_bonded_ids();
+    ever.insert(ever.end(), seen.begin(), seen.end());
+    break;
+  }
+  std::sort(ever.begin(), ever.end());
+  ever.erase(std::unique(ever.begin(), ever.end()), ever.end());
+  if (comm->me == 0) st.tail.assign(ever.begin(), ever.end());
+  jdem_restart_write_state(lmp, fp, st);
+}
+
+void FixBondJiang::restart(char *buf) {
+  const JdemRestartState st = jdem_restart_read_state(
+      lmp, buf, std::string("fix ") + id + " (bond/jiang)", BOND_SHARED, BOND_SUMS);
+  file_read = st.shared[0] != 0.0;
+  rules_done_at = jdem_restart_unpack_i64(st.shared[1]);
+  e_elastic_now = st.sums[0];
+  e_damp_cum = st.sums[1];
+  e_broken_cum = st.sums[2];
+  nbroken[0] = st.sums[3];
+  nbroken[1] = st.sums[4];
+  ever_bonded_read.assign(st.tail.begin(), st.tail.end());
+}
+
+int FixBondJiang::pack_restart(int i, double *buf) { return jdem_pack_restart(this, i, buf); }
+
+void FixBondJiang::unpack_restart(int nlocal, int nth) {
+  const int len = jdem_stored_restart_len(lmp, nlocal, nth);
+  if (len < 1 || (len - 1) % (1 + REC_LEN) != 0 || (len - 1) / (1 + REC_LEN) > max_bonds)
+    error->one(FLERR, (std::string("fix ") + id + " (bond/jiang): an atom of the restart file "
+                       "holds more bonds than max_bonds, or records of another length: give "
+                       "the max_bonds of the run that wrote it").c_str());
+  jdem_unpack_restart(lmp, this, nlocal, nth);
+}
+
+int FixBondJiang::size_restart(int i) { return 2 + nbond[i] * (1 + REC_LEN); }
+
+int FixBondJiang::maxsize_restart() { return 2 + max_bonds * (1 + REC_LEN); }

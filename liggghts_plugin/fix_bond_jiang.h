@@ -34,6 +34,8 @@
  *     it (`communicate single vel yes cutoff X` raises the cutoff);
  *   - a bond that fails is removed on the spot and recorded as an event (dump h5md/jdem writes
  *     them); the pair then interacts through gran/jiang alone.
+ * Restart files (jdem_restart.h) carry the bonds, their states and the counts: a fix of the same
+ * ID continues from them (the bond file is not read again, the rules already applied not again).
  * Thermo: f_ID is the number of intact bonds, f_ID[1], f_ID[2], f_ID[3] the intact bonds and the
  * bonds broken in tension and in shear so far. */
 #ifndef JDEM_FIX_BOND_JIANG_H
@@ -67,6 +69,15 @@ class FixBondJiang : public Fix {
   int pack_reverse_comm(int, int, double *);
   void unpack_reverse_comm(int, int *, double *);
   double memory_usage();
+  /* restart files (jdem_restart.h); the ids of the particles ever bonded before the file was
+   * written (rank 0), for dump h5md/jdem's fragments */
+  const std::vector<int> &restored_ever_bonded() const { return ever_bonded_read; }
+  void write_restart(FILE *);
+  void restart(char *);
+  int pack_restart(int, double *);
+  void unpack_restart(int, int);
+  int size_restart(int);
+  int maxsize_restart();
   /* thermo output: f_ID = intact bonds, f_ID[1..3] = intact, broken in tension, in shear */
   double compute_scalar();
   double compute_vector(int);
@@ -152,6 +163,7 @@ class FixBondJiang : public Fix {
   std::vector<Event> events;
   std::vector<Formed> formed;
   double nbroken[2]; /* this rank's bonds broken in tension, in shear (cumulative) */
+  std::vector<int> ever_bonded_read; /* restored_ever_bonded() */
 };
 
 }  // namespace LAMMPS_NS

@@ -21,6 +21,7 @@
 #include "update.h"
 
 #include "jdem_input_file.h"
+#include "jdem_restart.h"
 #include "jdem_kernel.h"
 #include "jdem_observables.h"
 
@@ -44,6 +45,7 @@ FixJdemInlet::FixJdemInlet(LAMMPS *lmp, int narg, char **arg)
   force_reneighbor = 1;
   next_reneighbor = -1; /* set by init() once dt is known */
   nevery = 1;
+  restart_global = 1; /* the position in the stream (jdem_restart.h) */
 }
 
 FixJdemInlet::~FixJdemInlet() {
@@ -403,4 +405,51 @@ void FixJdemInlet::post_run() {
                 n ? 1e9 * slowest / (double)n : 0.0);
   if (screen) std::fputs(line, screen);
   if (logfile) std::fputs(line, logfile);
+}
+
+/* ---- restart files: the position in the stream (every rank computes the whole stream) ---- */
+
+namespace {
+enum { INLET_SHARED_HEAD = 9 }; /* then 2 per section particle: its cursor */
+}
+
+void FixJdemInlet::write_restart(FILE *fp) {
+  JdemRestartState st;
+  const double head[INLET_SHARED_HEAD] = {
+      started ? 1.0 : 0.0, spec.dt, jdem_restart_pack_i64(spec.stop_step), (double)spec.n,
+      jdem_restart_pack_i64(stream.started), jdem_restart_pack_i64(stream.stop_step),
+      jdem_restart_pack_i64(stream.next_step), jdem_restart_pack_i64(stream.inserted), energy_in};
+  st.shared.assign(head, head + INLET_SHARED_HEAD);
+  for (size_t p = 0; p < spec.n; p++) {
+    st.shared.push_back(jdem_restart_pack_i64(started ? cursor[p].copy : 0));
+    st.shared.push_back(jdem_restart_pack_i64(started ? cursor[p].step : 0));
+  }
+  jdem_restart_write_state(lmp, fp, st);
+}
+
+void FixJdemInlet::restart(char *buf) {
+  const std::string who = std::string("fix ") + id + " (jdem/inlet)";
+  if (jdem_restart_peek_shared(buf, 3) != (double)spec.n)
+    error->all(FLERR, (who + ": the restart file's stream has another section (another number "
+                             "of particles): give the SECTION file of the run that wrote it").c_str());
+  const JdemRestartState st =
+      jdem_restart_read_state(lmp, buf, who, INLET_SHARED_HEAD + 2 * spec.n, 0);
+  const double *s = st.shared.data();
+  if (s[0] == 0.0) return; /* written before the stream started */
+  spec.dt = s[1];
+  spec.overlap_tol = JD_INLET_OVERLAP_TOL;
+  spec.stop_step = jdem_restart_unpack_i64(s[2]);
+  cursor.resize(spec.n);
+  for (size_t p = 0; p < spec.n; p++) {
+    cursor[p].copy = jdem_restart_unpack_i64(s[INLET_SHARED_HEAD + 2 * p]);
+    cursor[p].step = jdem_restart_unpack_i64(s[INLET_SHARED_HEAD + 2 * p + 1]);
+  }
+  stream.cursor = cursor.data();
+  stream.started = jdem_restart_unpack_i64(s[4]);
+  stream.stop_step = jdem_restart_unpack_i64(s[5]);
+  stream.next_step = jdem_restart_unpack_i64(s[6]);
+  stream.inserted = jdem_restart_unpack_i64(s[7]);
+  energy_in = s[8];
+  next_reneighbor = stream.next_step == JD_INLET_NEVER ? -1 : stream.next_step;
+  started = true;
 }

@@ -62,6 +62,9 @@ class FixJdemInlet : public Fix {
   void pre_exchange();
   void end_of_step();
   void post_run();
+  /* restart files (jdem_restart.h) */
+  void write_restart(FILE *);
+  void restart(char *);
   /* the largest section radius of atom type t [m] (0 for a type the section lacks): LIGGGHTS'
    * granular pair styles size the neighbour and ghost cutoffs of future particles with it */
   double max_rad(int t);

@@ -20,6 +20,7 @@
 
 #include "jdem_input_file.h"
 #include "jdem_kernel.h"
+#include "jdem_restart.h"
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -31,13 +32,16 @@ FixJdemLoads::FixJdemLoads(LAMMPS *lmp, int narg, char **arg)
   if (!atom->tag_enable || atom->map_style == 0)
     error->all(FLERR, "fix jdem/loads needs atom IDs and `atom_modify map array` (or hash)");
   create_attribute = 1;
+  restart_global = restart_peratom = 1; /* jdem_restart.h */
   grow_arrays(atom->nmax);
   atom->add_callback(0);
+  atom->add_callback(1);
   path = arg[4];
 }
 
 FixJdemLoads::~FixJdemLoads() {
   atom->delete_callback(id, 0);
+  atom->delete_callback(id, 1);
   memory->destroy(load);
 }
 
@@ -99,6 +103,7 @@ void FixJdemLoads::read_file(const char *path) {
  * (set_arrays) after its constructor.  The set-up evaluation applies the loads (as the
  * stepper's) but books no work. */
 void FixJdemLoads::setup(int vflag) {
+  if (jdem_restart_resuming(lmp)) return; /* the loads and forces read from the file stand */
   if (!path.empty()) read_file(path.c_str());
   path.clear();
   apply(false);
@@ -154,3 +159,29 @@ int FixJdemLoads::unpack_exchange(int nlocal, double *buf) {
 }
 
 double FixJdemLoads::memory_usage() { return (double)nmax_l * L_N * sizeof(double); }
+
+/* ---- restart files (jdem_restart.h): whether the file was read, each rank's work; per atom
+ * the load and the force and torque applied at the last step ---- */
+
+void FixJdemLoads::write_restart(FILE *fp) {
+  JdemRestartState st;
+  st.shared.push_back(path.empty() ? 1.0 : 0.0);
+  st.sums.push_back(work_cum);
+  jdem_restart_write_state(lmp, fp, st);
+}
+
+void FixJdemLoads::restart(char *buf) {
+  const JdemRestartState st =
+      jdem_restart_read_state(lmp, buf, std::string("fix ") + id + " (jdem/loads)", 1, 1);
+  if (st.shared[0] != 0.0) path.clear(); /* the loads come with the atoms */
+  work_cum = st.sums[0];
+}
+
+int FixJdemLoads::pack_restart(int i, double *buf) { return jdem_pack_restart(this, i, buf); }
+
+void FixJdemLoads::unpack_restart(int nlocal, int nth) {
+  if (jdem_stored_restart_len(lmp, nlocal, nth) != L_N)
+    error->one(FLERR, (std::string("fix ") + id + " (jdem/loads): the restart file's per-atom "
+                       "record has another length: continue with the version that wrote it").c_str());
+  jdem_unpack_restart(lmp, this, nlocal, nth);
+}

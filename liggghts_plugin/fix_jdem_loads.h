@@ -33,6 +33,13 @@ class FixJdemLoads : public Fix {
   int pack_exchange(int, double *);
   int unpack_exchange(int, double *);
   double memory_usage();
+  /* restart files (jdem_restart.h) */
+  void write_restart(FILE *);
+  void restart(char *);
+  int pack_restart(int, double *);
+  void unpack_restart(int, int);
+  int size_restart(int) { return L_N + 1; }
+  int maxsize_restart() { return L_N + 1; }
 
   /* work done on this rank's atoms since the start [J] (an observable: wall_work) */
   double work_cum;

@@ -23,6 +23,7 @@
 #include "fix_jdem_inlet.h"
 #include "fix_wall_jiang.h"
 #include "jdem_observables.h"
+#include "jdem_restart.h"
 #include "jdem_stop.h"
 #include "pair_gran_jiang.h"
 
@@ -47,6 +48,7 @@ FixJdemWatchdog::FixJdemWatchdog(LAMMPS *lmp, int narg, char **arg)
     else error->all(FLERR, "fix jdem/watchdog: unknown keyword (valid: overlap, energy)");
   }
   nevery = 1; /* the cheap checks run every step; the energy check every energy_every */
+  restart_global = 1; /* the energy account continues (jdem_restart.h) */
 }
 
 int FixJdemWatchdog::setmask() { return FixConst::END_OF_STEP; }
@@ -63,6 +65,36 @@ void FixJdemWatchdog::init() {
 }
 
 void FixJdemWatchdog::setup(int) { check(); }
+
+/* Restart files: the energy account of the last check (the reference of the next one). */
+namespace {
+enum { WATCHDOG_SHARED = 9 };
+}
+
+void FixJdemWatchdog::write_restart(FILE *fp) {
+  JdemRestartState st;
+  const double terms[7] = {ref.kinetic, ref.rotational, ref.elastic, ref.gravitational,
+                           ref.damping, ref.friction, ref.wall_work};
+  st.shared.push_back(has_ref ? 1.0 : 0.0);
+  st.shared.insert(st.shared.end(), terms, terms + 7);
+  st.shared.push_back(jdem_restart_pack_i64(ref_step));
+  jdem_restart_write_state(lmp, fp, st);
+}
+
+void FixJdemWatchdog::restart(char *buf) {
+  const JdemRestartState st = jdem_restart_read_state(
+      lmp, buf, std::string("fix ") + id + " (jdem/watchdog)", WATCHDOG_SHARED, 0);
+  const double *s = st.shared.data();
+  has_ref = s[0] != 0.0;
+  ref.kinetic = s[1];
+  ref.rotational = s[2];
+  ref.elastic = s[3];
+  ref.gravitational = s[4];
+  ref.damping = s[5];
+  ref.friction = s[6];
+  ref.wall_work = s[7];
+  ref_step = jdem_restart_unpack_i64(s[8]);
+}
 
 void FixJdemWatchdog::end_of_step() { check(); }
 

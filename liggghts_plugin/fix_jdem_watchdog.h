@@ -17,6 +17,7 @@
 #ifndef JDEM_FIX_JDEM_WATCHDOG_H
 #define JDEM_FIX_JDEM_WATCHDOG_H
 
+#include <cstdio>
 #include <string>
 
 #include "fix.h"
@@ -32,6 +33,8 @@ class FixJdemWatchdog : public Fix {
   void init();
   void setup(int);
   void end_of_step();
+  void write_restart(FILE *);
+  void restart(char *);
   bool checks_energy() const { return max_energy_jump > 0.0; }
 
  private:

@@ -17,6 +17,7 @@
 #include "h5md.h"
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
+#include "jdem_restart.h"
 #include "jdem_watchdog.h"
 #include "pair_gran_jiang.h"
 
@@ -109,8 +110,10 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
   slen = pair->state_len();
 
   create_attribute = 1;
+  restart_global = restart_peratom = 1; /* jdem_restart.h */
   grow_arrays(atom->nmax);
   atom->add_callback(0);
+  atom->add_callback(1);
 }
 
 /* servo target S gain G tolerance E max_speed V hold H, all five, in this order (the deck
@@ -136,6 +139,7 @@ void FixWallJiang::parse_servo(int narg, char **arg, int &iarg) {
 
 FixWallJiang::~FixWallJiang() {
   atom->delete_callback(id, 0);
+  atom->delete_callback(id, 1);
   memory->destroy(hist);
 }
 
@@ -167,6 +171,7 @@ void FixWallJiang::init() {
  * tests every particle; the first step of the run builds the candidate list. */
 void FixWallJiang::setup(int vflag) {
   cand_ncalls = -1;
+  if (jdem_restart_resuming(lmp)) return; /* the state read from the file stands */
   compute(false);
   sum_force_and_servo();
 }
@@ -367,3 +372,86 @@ void FixWallJiang::output_geometry(jd_h5md_wall *w, double time) const {
   w->radius = cyl.rc;
   w->inside = cyl.inside;
 }
+
+/* ---------------------------------------------------------------------------------------- */
+/* Restart files (jdem_restart.h): where the wall is and how it moves, the servo's state, the
+ * force and contacts of the last evaluation, each rank's energies; per atom the history.      */
+
+namespace {
+enum { WALL_SHARED = 34, WALL_SUMS = 5 };
+}
+
+void FixWallJiang::write_restart(FILE *fp) {
+  JdemRestartState st;
+  std::vector<double> &s = st.shared;
+  s.push_back(shape);
+  s.push_back(slen);
+  s.insert(s.end(), &plane.p[0][0], &plane.p[0][0] + 12);
+  s.insert(s.end(), plane.n, plane.n + 3);
+  s.insert(s.end(), cyl.a0, cyl.a0 + 3);
+  s.insert(s.end(), cyl.a1, cyl.a1 + 3);
+  s.insert(s.end(), vel, vel + 3);
+  s.insert(s.end(), force_all, force_all + 3);
+  s.push_back(jdem_restart_pack_i64(servo_state.held));
+  s.push_back(servo_state.done);
+  s.push_back(servo_stress);
+  s.push_back(servo_speed);
+  s.push_back(servo_position);
+  const double sums[WALL_SUMS] = {e_damp_cum, e_fric_cum, work_cum, e_elastic_now, contacts_now};
+  st.sums.assign(sums, sums + WALL_SUMS);
+  for (size_t c = 0; c < contact_f.size(); c += 3) {
+    st.tail.insert(st.tail.end(), &contact_x[c], &contact_x[c] + 3);
+    st.tail.insert(st.tail.end(), &contact_f[c], &contact_f[c] + 3);
+  }
+  jdem_restart_write_state(lmp, fp, st);
+}
+
+void FixWallJiang::restart(char *buf) {
+  const std::string who = std::string("fix ") + id + " (wall/jiang)";
+  const JdemRestartState st = jdem_restart_read_state(lmp, buf, who, WALL_SHARED, WALL_SUMS);
+  const double *s = st.shared.data();
+  if ((int)s[0] != shape)
+    error->all(FLERR, (who + ": the restart file's wall of this ID is a " +
+                       (s[0] == 0 ? "plane" : "cylinder") + ", not a " +
+                       (shape == 0 ? "plane" : "cylinder")).c_str());
+  if ((int)s[1] != slen)
+    error->all(FLERR, (who + ": the restart file's wall history has another length: give "
+                             "pair_style gran/jiang the rolling and energy options of the run "
+                             "that wrote it").c_str());
+  std::memcpy(&plane.p[0][0], s + 2, 12 * sizeof(double));
+  std::memcpy(plane.n, s + 14, 3 * sizeof(double));
+  std::memcpy(cyl.a0, s + 17, 3 * sizeof(double));
+  std::memcpy(cyl.a1, s + 20, 3 * sizeof(double));
+  std::memcpy(vel, s + 23, 3 * sizeof(double));
+  std::memcpy(force_all, s + 26, 3 * sizeof(double));
+  servo_state.held = jdem_restart_unpack_i64(s[29]);
+  servo_state.done = (int)s[30];
+  servo_stress = s[31];
+  servo_speed = s[32];
+  servo_position = s[33];
+  e_damp_cum = st.sums[0];
+  e_fric_cum = st.sums[1];
+  work_cum = st.sums[2];
+  e_elastic_now = st.sums[3];
+  contacts_now = st.sums[4];
+  contact_x.clear();
+  contact_f.clear();
+  for (size_t c = 0; c + 6 <= st.tail.size(); c += 6) {
+    contact_x.insert(contact_x.end(), &st.tail[c], &st.tail[c] + 3);
+    contact_f.insert(contact_f.end(), &st.tail[c + 3], &st.tail[c + 3] + 3);
+  }
+}
+
+int FixWallJiang::pack_restart(int i, double *buf) { return jdem_pack_restart(this, i, buf); }
+
+void FixWallJiang::unpack_restart(int nlocal, int nth) {
+  if (jdem_stored_restart_len(lmp, nlocal, nth) != slen)
+    error->one(FLERR, (std::string("fix ") + id + " (wall/jiang): the restart file's wall "
+                       "history has another length: give pair_style gran/jiang the rolling and "
+                       "energy options of the run that wrote it").c_str());
+  jdem_unpack_restart(lmp, this, nlocal, nth);
+}
+
+int FixWallJiang::size_restart(int) { return slen + 1; }
+
+int FixWallJiang::maxsize_restart() { return slen + 1; }

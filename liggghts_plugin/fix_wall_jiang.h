@@ -25,6 +25,9 @@
  * V [m/s] (inf: no cap), H [s]; after every force evaluation the speed for the next step is set
  * from the measured stress; observables servo_stress/NAME and servo_position/NAME.
  *
+ * Restart files (jdem_restart.h) carry where the wall is, how it moves, the servo's state, the
+ * energies and the per-atom history: a wall of the same ID continues from them.
+ *
  * Cost: each step only the particles found near the wall at the last neighbour build are
  * evaluated (with neigh_modify every 1 delay 0; see refresh_candidates). */
 #ifndef JDEM_FIX_WALL_JIANG_H
@@ -63,6 +66,14 @@ class FixWallJiang : public Fix {
   int pack_exchange(int, double *);
   int unpack_exchange(int, double *);
   double memory_usage();
+
+  /* restart files (jdem_restart.h) */
+  void write_restart(FILE *);
+  void restart(char *);
+  int pack_restart(int, double *);
+  void unpack_restart(int, int);
+  int size_restart(int);
+  int maxsize_restart();
 
   /* Observables of this rank: cumulative dissipation and wall work [J]; at the last force
    * evaluation the elastic energy [J] and the number of wall contacts carrying force. */

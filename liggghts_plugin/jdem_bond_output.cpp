@@ -90,6 +90,7 @@ int JdemBondOutput::write(LAMMPS *lmp, jd_h5md *h, char *err, size_t errlen) {
   int me = 0;
   MPI_Comm_rank(world, &me);
   if (me != 0) return 0;
+  mark_restored(lmp);
 
   formed = sorted_rows(formed, F_N, F_B + 1); /* step, rule, then (type), ids */
   std::vector<jd_h5md_bond> nb(formed.size() / F_N);
@@ -150,7 +151,27 @@ void JdemBondOutput::count(LAMMPS *lmp) {
   intact = jdem_gather_rows(world, intact);
   int me = 0;
   MPI_Comm_rank(world, &me);
-  if (me == 0) count_intact(formed_pairs, intact);
+  if (me != 0) return;
+  mark_restored(lmp);
+  count_intact(formed_pairs, intact);
+}
+
+void JdemBondOutput::mark_restored(LAMMPS *lmp) {
+  for (int k = 0; k < lmp->modify->nfix; k++) {
+    FixBondJiang *b = dynamic_cast<FixBondJiang *>(lmp->modify->fix[k]);
+    for (size_t i = 0; b && i < b->restored_ever_bonded().size(); i++) {
+      const size_t id = (size_t)b->restored_ever_bonded()[i];
+      if (id >= ever_bonded_.size()) ever_bonded_.resize(id + 1, 0);
+      ever_bonded_[id] = 1;
+    }
+  }
+}
+
+std::vector<int> JdemBondOutput::ever_bonded_ids() const {
+  std::vector<int> ids;
+  for (size_t i = 0; i < ever_bonded_.size(); i++)
+    if (ever_bonded_[i]) ids.push_back((int)i);
+  return ids;
 }
 
 /* fragments: union-find over the ever-bonded particles along the intact bonds */

@@ -35,11 +35,15 @@ class JdemBondOutput {
   bool active() const { return active_; }
   double bonds() const { return bonds_; }
   double fragments() const { return fragments_; }
+  /* The ids of the particles ever bonded, as far as this output has seen (rank 0). */
+  std::vector<int> ever_bonded_ids() const;
 
  private:
   /* Marks the atoms of both lists of (lower id, higher id) pairs as ever bonded, then counts the intact bonds
    * and the fragments over the concatenated (lower id, higher id) pairs (rank 0). */
   void count_intact(const std::vector<double> &formed_pairs, const std::vector<double> &intact);
+  /* Marks the particles a restart file lists as ever bonded (FixBondJiang, rank 0). */
+  void mark_restored(LAMMPS *lmp);
   bool active_ = false;
   double bonds_ = 0.0, fragments_ = 0.0;
   std::vector<char> ever_bonded_; /* by particle id (rank 0) */

@@ -10,6 +10,7 @@
  *   fix jdem/guard          idem
  *   fix jdem/observables    idem
  *   fix jdem/inlet          idem
+ *   fix jdem/restart        idem (defined by pair_style gran/jiang itself: fix_jdem_restart.h)
  *   dump h5md/jdem          LIGGGHTS 3.8 has no dump map: Output::add_dump() is an if-else chain
  *                           over style_dump.h.  We interpose Output::add_dump (libliggghts.so
  *                           calls it through its PLT, so the executable's definition wins) and
@@ -45,6 +46,7 @@
 #include "fix_jdem_guard.h"
 #include "fix_jdem_inlet.h"
 #include "fix_jdem_observables.h"
+#include "fix_jdem_restart.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_wall_jiang.h"
 #include "jdem_error.h"
@@ -96,6 +98,10 @@ static Fix *create_fix_jdem_inlet(LAMMPS *lmp, int narg, char **arg) {
   return new FixJdemInlet(lmp, narg, arg);
 }
 
+static Fix *create_fix_jdem_restart(LAMMPS *lmp, int narg, char **arg) {
+  return new FixJdemRestart(lmp, narg, arg);
+}
+
 static void register_jdem_styles(LAMMPS *lmp) {
   (*lmp->force->pair_map)["gran/jiang"] = &create_pair_gran_jiang;
   FixMap *fix_map = lmp->modify->*get(ModifyFixMap());
@@ -106,6 +112,7 @@ static void register_jdem_styles(LAMMPS *lmp) {
   (*fix_map)["jdem/guard"] = &create_fix_jdem_guard;
   (*fix_map)["jdem/observables"] = &create_fix_jdem_observables;
   (*fix_map)["jdem/inlet"] = &create_fix_jdem_inlet;
+  (*fix_map)["jdem/restart"] = &create_fix_jdem_restart;
 }
 
 /* ---- dump h5md/jdem: interposed Output::add_dump ---- */
@@ -185,7 +192,8 @@ static const char *jdem_help =
     "                           [below_speed V] [every N] [record FILE]   (conveyor inlet)\n"
     "* Dump styles:  h5md/jdem    N FILE.h5 [scene NAME] [case NAME] [scene_yaml PATH]\n"
     "                             [energy yes|no]\n"
-    "(gran/jiang presents itself as \"gran\" to LIGGGHTS; do not use `clear` or restart files.)\n\n";
+    "(gran/jiang presents itself as \"gran\" to LIGGGHTS; do not use `clear`.  Restart files:\n"
+    " docs/liggghts.md, \"Restarts\".)\n\n";
 
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);

@@ -26,6 +26,8 @@
 #include "jdem_laws.h"
 #include "jdem_history.h"
 #include "jdem_observables.h"
+#include "jdem_restart.h"
+#include "fix_jdem_restart.h"
 #include "jdem_script_checks.h"
 #include "jdem_geometry.h"
 #include "jdem_watchdog.h"
@@ -79,9 +81,15 @@ void PairGranJiang::settings(int narg, char **arg) {
     }
   }
 
-  /* Per-contact history (jdem_history.h): jd_contact_state, then jd_rolling_state when rolling
-   * is on, or only their law fields without energy accounts, with the kernel's sign-flip flags.
-   * (settings() may run again for a repeated pair_style line.) */
+  register_history();
+  jdem_restart_check_pair_style(lmp, "gran/jiang", state_len());
+  present_as_gran();
+}
+
+/* Per-contact history (jdem_history.h): jd_contact_state, then jd_rolling_state when rolling is
+ * on, or only their law fields without energy accounts, with the kernel's sign-flip flags.
+ * (settings() may run again for a repeated pair_style line.) */
+void PairGranJiang::register_history() {
   history_arg.clear();
   dnum_pairgran = 0;
   char name[32];
@@ -90,8 +98,10 @@ void PairGranJiang::settings(int narg, char **arg) {
                   k < rolling_at() ? k : k - rolling_at());
     add_history_value(name, jd_history_newton(energy_accounts, k) ? "1" : "0");
   }
+}
 
-  /* FixContactHistory and check/timestep/gran find the pair by the exact name "gran". */
+/* FixContactHistory and check/timestep/gran find the pair by the exact name "gran". */
+void PairGranJiang::present_as_gran() {
   if (force->pair == this && std::strcmp(force->pair_style, "gran") != 0) {
     delete[] force->pair_style;
     force->pair_style = new char[5];
@@ -341,4 +351,63 @@ void PairGranJiang::report_pair(int i, int j, bool carries, const jd_contact_res
       ti[d] = out.ta[d];
     }
   cpl()->add_pair(i, j, fi[0], fi[1], fi[2], ti[0], ti[1], ti[2], hist, NULL);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Restart files (jdem_restart.h).                                                            */
+
+/* LIGGGHTS' set-up of the granular pair (contact history fix, neighbour requests), then the fix
+ * that carries the rest of our state through restart files (fix_jdem_restart.h). */
+void PairGranJiang::init_style() {
+  PairGran::init_style();
+  FixJdemRestart::define(lmp);
+}
+
+/* A run resuming from a restart file keeps the history and observables that were read: no
+ * set-up evaluation (fix jdem/restart sets the forces of the step the file was written at). */
+void PairGranJiang::compute(int eflag, int vflag) {
+  if (update->setupflag && jdem_restart_resuming(lmp)) return;
+  PairGran::compute(eflag, vflag);
+}
+
+/* The pair section of the file (rank 0): our hashcode, a layout version, the options. */
+namespace {
+enum { PAIR_RESTART_VERSION = 1, PAIR_RESTART_OPTIONS = 6 };
+}
+
+void PairGranJiang::write_restart_settings(FILE *fp) {
+  const int64_t mark = hashcode();
+  const int version = PAIR_RESTART_VERSION;
+  const int options[PAIR_RESTART_OPTIONS] = {wall_rule, damping_map, xi_limit, tangential_rule,
+                                             rolling ? 1 : 0, energy_accounts ? 1 : 0};
+  std::fwrite(&mark, sizeof mark, 1, fp);
+  std::fwrite(&version, sizeof version, 1, fp);
+  std::fwrite(options, sizeof(int), PAIR_RESTART_OPTIONS, fp);
+  std::fwrite(&mu_r, sizeof mu_r, 1, fp);
+}
+
+void PairGranJiang::read_restart_settings(FILE *fp, const int, const int) {
+  int64_t mark = 0;
+  int version = 0, options[PAIR_RESTART_OPTIONS] = {0};
+  int ok = 1;
+  if (comm->me == 0)
+    ok = std::fread(&mark, sizeof mark, 1, fp) == 1 && std::fread(&version, sizeof version, 1, fp) == 1 &&
+         std::fread(options, sizeof(int), PAIR_RESTART_OPTIONS, fp) == PAIR_RESTART_OPTIONS &&
+         std::fread(&mu_r, sizeof mu_r, 1, fp) == 1 && mark == hashcode() &&
+         version == PAIR_RESTART_VERSION;
+  MPI_Bcast(&ok, 1, MPI_INT, 0, world);
+  if (!ok)
+    error->all(FLERR, "read_restart: the pair section of the restart file is not one of "
+                      "pair_style gran/jiang (another version of liggghts-jdem wrote it, or the "
+                      "file is truncated)");
+  MPI_Bcast(options, PAIR_RESTART_OPTIONS, MPI_INT, 0, world);
+  MPI_Bcast(&mu_r, 1, MPI_DOUBLE, 0, world);
+  wall_rule = options[0];
+  damping_map = options[1];
+  xi_limit = options[2];
+  tangential_rule = options[3];
+  rolling = options[4] != 0;
+  energy_accounts = options[5] != 0;
+  register_history();
+  present_as_gran();
 }

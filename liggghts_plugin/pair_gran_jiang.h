@@ -16,7 +16,7 @@
  * geometry is kernel/jdem_geometry.h, the laws kernel/jdem_kernel.h.
  *
  * The style registers itself as "gran" (FixContactHistory and check/timestep/gran look the pair
- * up by that name), so restart files are not supported. */
+ * up by that name); restart files name it "gran/jiang" (jdem_restart.h). */
 #ifndef JDEM_PAIR_GRAN_JIANG_H
 #define JDEM_PAIR_GRAN_JIANG_H
 
@@ -37,6 +37,12 @@ class PairGranJiang : public PairGran {
 
   virtual void settings(int, char **);
   virtual void init_granular();
+  /* Restart files (jdem_restart.h): the options in the pair section; init_style defines fix
+   * jdem/restart; compute skips the set-up evaluation of a run resuming from a file. */
+  virtual void init_style();
+  virtual void compute(int eflag, int vflag);
+  virtual void write_restart_settings(FILE *fp);
+  virtual void read_restart_settings(FILE *fp, const int major, const int minor);
   virtual bool contact_match(const std::string, const std::string) { return false; }
   virtual int64_t hashcode() { return 0x6a6469616e67LL; } /* "jdiang": not a built-in model */
   virtual double stressStrainExponent() { return 1.5; }
@@ -82,6 +88,8 @@ class PairGranJiang : public PairGran {
   template <unsigned F> JD_SPECIALISED void loop(int eflag, int vflag, int addflag);
 
  private:
+  void register_history();
+  void present_as_gran();
   void update_law_set(bool report);
   void report_pair(int i, int j, bool carries, const jd_contact_result &out, double *hist);
   unsigned features_;

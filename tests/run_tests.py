@@ -51,6 +51,9 @@ SUITES += [("liggghts-pair-local", [PY, "tests/liggghts/check_pair_local.py"], "
 SUITES += [("liggghts-script-warnings", [PY, "tests/liggghts/check_script_warnings.py"], "lines", {})]
 # The watchdog in LIGGGHTS (fix jdem/watchdog): the same trips as the stepper's.
 SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "lines", {})]
+# Restart files in LIGGGHTS: continued runs == the uninterrupted run bit for bit on 1 and 2 ranks
+# (history, bonds, servo, kill -9), and restart files across stock and our pair styles.
+SUITES += [("liggghts-restart", [PY, "tests/liggghts/check_restart.py"], "lines", {})]
 # SIGINT/SIGTERM stop liggghts-jdem cleanly (exit 130/143, OUT.part kept), on 1 and 2 ranks.
 SUITES += [("liggghts-signals", [PY, "tests/liggghts/check_signals.py"], "lines", {})]
 # Parallel bonds in LIGGGHTS (fix bond/jiang): 1 vs 2 MPI ranks, the ghost-cutoff guard, bad input.

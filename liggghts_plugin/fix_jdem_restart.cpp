@@ -1,0 +1,142 @@
+/* fix_jdem_restart.cpp — see fix_jdem_restart.h. */
+#include "fix_jdem_restart.h"
+
+#include <cstdio>
+
+#include "atom.h"
+#include "error.h"
+#include "force.h"
+#include "memory.h"
+#include "modify.h"
+
+#include "jdem_kernel.h"
+#include "jdem_restart.h"
+#include "pair_gran_jiang.h"
+
+using namespace LAMMPS_NS;
+
+FixJdemRestart::FixJdemRestart(LAMMPS *lmp, int narg, char **arg)
+    : Fix(lmp, narg, arg), resuming_(false), saved(NULL), nmax_saved(0) {
+  if (narg != 3) error->all(FLERR, "Illegal fix jdem/restart command: fix ID group jdem/restart");
+  restart_global = 1;
+  restart_peratom = 1;
+  grow_arrays(atom->nmax);
+  atom->add_callback(0);
+  atom->add_callback(1);
+}
+
+FixJdemRestart::~FixJdemRestart() {
+  atom->delete_callback(id, 0);
+  atom->delete_callback(id, 1);
+  memory->destroy(saved);
+}
+
+void FixJdemRestart::define(LAMMPS *lmp) {
+  if (lmp->modify->find_fix("jdem_restart") >= 0) return;
+  char *args[3] = {(char *)"jdem_restart", (char *)"all", (char *)"jdem/restart"};
+  lmp->modify->add_fix(3, args);
+}
+
+/* The last fix's set-up: the forces and torques of the step the file was written at. */
+void FixJdemRestart::setup(int) {
+  if (!resuming_) return;
+  double **f = atom->f, **torque = atom->torque;
+  for (int i = 0; i < atom->nlocal; i++)
+    for (int d = 0; d < 3; d++) {
+      f[i][d] = saved[i][d];
+      torque[i][d] = saved[i][3 + d];
+    }
+  resuming_ = false;
+}
+
+/* ---- global state: the pair style's options and contact observables ---- */
+
+void FixJdemRestart::write_restart(FILE *fp) {
+  PairGranJiang *pair = dynamic_cast<PairGranJiang *>(force->pair);
+  JdemRestartState st;
+  if (pair) {
+    const double shared[NSHARED] = {(double)pair->wall_rule, (double)pair->damping_map,
+                                    (double)pair->xi_limit, (double)pair->tangential_rule,
+                                    pair->mu_r, pair->rolling ? 1.0 : 0.0,
+                                    pair->energy_accounts ? 1.0 : 0.0};
+    const double sums[NSUMS] = {pair->e_damp_cum, pair->e_fric_cum, pair->e_elastic_now,
+                                pair->contacts_now};
+    st.shared.assign(shared, shared + NSHARED);
+    st.sums.assign(sums, sums + NSUMS);
+  } else {
+    st.shared.assign(NSHARED, -1.0);
+    st.sums.assign(NSUMS, 0.0);
+  }
+  jdem_restart_write_state(lmp, fp, st);
+}
+
+/* pair_style gran/jiang (the one this run defines) defines this fix at its set-up: it takes
+ * the file's contact observables. */
+void FixJdemRestart::restart(char *buf) {
+  const JdemRestartState st = jdem_restart_read_state(lmp, buf, "fix jdem_restart (jdem/restart)",
+                                                      NSHARED, NSUMS);
+  PairGranJiang *pair = dynamic_cast<PairGranJiang *>(force->pair);
+  if (!pair) return;
+  pair->e_damp_cum = st.sums[0];
+  pair->e_fric_cum = st.sums[1];
+  pair->e_elastic_now = st.sums[2];
+  pair->contacts_now = st.sums[3];
+  resuming_ = true;
+}
+
+std::string FixJdemRestart::describe_pair_options(LAMMPS *lmp, const char *state) {
+  const JdemRestartState st = jdem_restart_read_state(lmp, state, "fix jdem_restart (jdem/restart)",
+                                                      NSHARED, NSUMS);
+  const double *o = st.shared.data();
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "wall_rule %s damping %s tangential_limit %s tangential_stiffness %s mu_r %.17g "
+                "rolling %s energy %s",
+                o[0] == JD_WALL_HERTZ ? "hertz" : "jiang2021",
+                o[1] == JD_DAMP_JIANG2021 ? "jiang2021" : "exact_restitution",
+                o[2] == JD_XI_COULOMB ? "coulomb" : "unconstrained",
+                o[3] == JD_KT_JIANG2021 ? "jiang2021" : "mindlin", o[4], o[5] != 0.0 ? "on" : "off",
+                o[6] != 0.0 ? "yes" : "no");
+  return text;
+}
+
+/* ---- per atom: force and torque ---- */
+
+int FixJdemRestart::pack_restart(int i, double *buf) {
+  buf[0] = 1 + SAVED;
+  for (int d = 0; d < 3; d++) {
+    buf[1 + d] = atom->f[i][d];
+    buf[4 + d] = atom->torque[i][d];
+  }
+  return 1 + SAVED;
+}
+
+void FixJdemRestart::unpack_restart(int nlocal, int nth) {
+  if (jdem_stored_restart_len(lmp, nlocal, nth) != SAVED)
+    error->one(FLERR, "fix jdem_restart (jdem/restart): the restart file's per-atom record has "
+                      "another length: continue the run with the version that wrote it");
+  jdem_unpack_restart(lmp, this, nlocal, nth);
+}
+
+void FixJdemRestart::grow_arrays(int nmax) {
+  memory->grow(saved, nmax, SAVED, "jdem/restart:saved");
+  for (int i = nmax_saved; i < nmax; i++)
+    for (int k = 0; k < SAVED; k++) saved[i][k] = 0.0;
+  nmax_saved = nmax;
+}
+
+void FixJdemRestart::copy_arrays(int i, int j, int) {
+  for (int k = 0; k < SAVED; k++) saved[j][k] = saved[i][k];
+}
+
+int FixJdemRestart::pack_exchange(int i, double *buf) {
+  for (int k = 0; k < SAVED; k++) buf[k] = saved[i][k];
+  return SAVED;
+}
+
+int FixJdemRestart::unpack_exchange(int nlocal, double *buf) {
+  for (int k = 0; k < SAVED; k++) saved[nlocal][k] = buf[k];
+  return SAVED;
+}
+
+double FixJdemRestart::memory_usage() { return (double)nmax_saved * SAVED * sizeof(double); }
