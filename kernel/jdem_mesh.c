@@ -268,3 +268,46 @@ size_t jd_mesh_contacts(const jd_mesh *m, size_t n, const jd_mesh_closest *c, do
     }
     return found;
 }
+
+/* ---------------------------------------------------------------------------------------- */
+/* History slots and wall velocity                                                            */
+
+void jd_mesh_match_history(size_t nold, const double (*old_n)[3], size_t nnew,
+                           const double (*new_n)[3], int *from) {
+    unsigned char used[JD_MESH_SLOTS] = {0};
+    for (size_t k = 0; k < nnew; k++) from[k] = -1;
+    for (;;) {
+        double best = JD_MESH_HISTORY_COS;
+        int bk = -1, bj = -1;
+        for (size_t k = 0; k < nnew; k++) {
+            if (from[k] >= 0) continue;
+            for (size_t j = 0; j < nold; j++) {
+                if (used[j]) continue;
+                const double c = jd_dot(old_n[j], new_n[k]);
+                if (c > best) {
+                    best = c;
+                    bk = (int)k;
+                    bj = (int)j;
+                }
+            }
+        }
+        if (bk < 0) return;
+        from[bk] = bj;
+        used[bj] = 1;
+    }
+}
+
+void jd_mesh_point_velocity(const jd_mesh *m, const jd_mesh_closest *c, const double vnode[3][3],
+                            double v[3]) {
+    const int32_t *tv = m->tri_vertex[c->tri];
+    const double *a = m->vertex[tv[0]], *b = m->vertex[tv[1]], *cc = m->vertex[tv[2]];
+    const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double e2[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
+    const double ep[3] = {c->point[0] - a[0], c->point[1] - a[1], c->point[2] - a[2]};
+    const double d11 = jd_dot(e1, e1), d12 = jd_dot(e1, e2), d22 = jd_dot(e2, e2);
+    const double dp1 = jd_dot(ep, e1), dp2 = jd_dot(ep, e2);
+    const double det = d11 * d22 - d12 * d12;
+    const double b1 = (d22 * dp1 - d12 * dp2) / det, b2 = (d11 * dp2 - d12 * dp1) / det;
+    for (int d = 0; d < 3; d++)
+        v[d] = vnode[0][d] + b1 * (vnode[1][d] - vnode[0][d]) + b2 * (vnode[2][d] - vnode[0][d]);
+}
