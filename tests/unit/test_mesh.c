@@ -387,6 +387,30 @@ static void wall_velocity_at_the_point(void **state) {
     free(b);
 }
 
+/* A centre a hair off a grid vertex, along a grid line: the distances to that line's edge and
+ * to a diagonal edge through the vertex differ by far less than the rounding of the squared
+ * height, yet the contact must be the foot of the perpendicular, exactly, as for a plane. */
+static void near_vertex_the_contact_is_the_exact_foot(void **state) {
+    (void)state;
+    double(*tri)[3][3] = calloc(2 * 16, sizeof *tri);
+    const size_t n = grid(4, tri);
+    built *b = build(n, (const double(*)[3][3])tri);
+    jd_mesh_closest c[32];
+    unsigned char contact[32];
+    const double off[4][2] = {{1e-9, 0}, {-1e-9, 0}, {0, 1e-9}, {0, -1e-9}};
+    for (int k = 0; k < 4; k++) {
+        const double p[3] = {2.0 + off[k][0], 2.0 + off[k][1], 0.4};
+        assert_int_equal(contacts_of(&b->m, p, 0.5, c, contact), 1);
+        for (size_t t = 0; t < n; t++)
+            if (contact[t]) {
+                assert_true(c[t].point[0] == p[0] && c[t].point[1] == p[1] && c[t].point[2] == 0.0);
+                assert_true(c[t].dist2 == 0.4 * 0.4);
+            }
+    }
+    free(b);
+    free(tri);
+}
+
 int run_mesh_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(cube_topology_obeys_euler),
@@ -399,6 +423,7 @@ int run_mesh_tests(void) {
         cmocka_unit_test(degenerate_triangles_are_named),
         cmocka_unit_test(geometry_of_a_face_contact),
         cmocka_unit_test(history_follows_the_normal),
+        cmocka_unit_test(near_vertex_the_contact_is_the_exact_foot),
         cmocka_unit_test(wall_velocity_at_the_point),
     };
     return cmocka_run_group_tests_name("mesh", tests, NULL, NULL);
