@@ -206,7 +206,7 @@ void FixWallJiangMesh::sphere_contacts(int im, int i, size_t first, size_t last,
   const double R = atom->radius[i], mass = atom->rmass[i];
   const size_t n = last - first;
   closest.resize(n);
-  std::vector<unsigned char> is_contact(n);
+  is_contact.resize(n);
   for (size_t k = 0; k < n; k++) jd_mesh_closest_feature(&m.topo, cand[first + k].t, x[i], &closest[k]);
   jd_mesh_contacts(&m.topo, n, closest.data(), R, is_contact.data());
 
@@ -232,7 +232,7 @@ void FixWallJiangMesh::sphere_contacts(int im, int i, size_t first, size_t last,
   for (size_t c = 0; c < nc; c++) jd_copy3(new_n[c], g[c].n);
   int from[JD_MESH_SLOTS];
   jd_mesh_match_history(JD_MESH_SLOTS, old_n, nc, new_n, from);
-  std::vector<double> next((size_t)JD_MESH_SLOTS * stride, 0.0);
+  next.assign((size_t)JD_MESH_SLOTS * stride, 0.0);
   for (size_t c = 0; c < nc; c++)
     if (from[c] >= 0) std::memcpy(&next[c * stride + 3], h + from[c] * stride + 3, state_len * sizeof(double));
 

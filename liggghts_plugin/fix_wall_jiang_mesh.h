@@ -67,7 +67,9 @@ class FixWallJiangMesh : public FixWallJiang {
 
   std::vector<Mesh> meshes;
   std::vector<Candidate> cand;
-  std::vector<jd_mesh_closest> closest;
+  std::vector<jd_mesh_closest> closest; /* per candidate of the sphere in hand: its feature, */
+  std::vector<unsigned char> is_contact; /* whether it is a contact                        */
+  std::vector<double> next;              /* the sphere's history slots being rewritten     */
   std::vector<unsigned char> touched; /* per local atom: had contacts on this mesh */
   int state_len;                      /* doubles of a contact's state (gran/jiang's) */
 };
