@@ -277,5 +277,6 @@ void FixWallJiangMesh::sphere_contacts(int im, int i, size_t first, size_t last,
     jd_sub3(f[i], out.f);
     jd_add3(torque[i], out.ta);
   }
-  if (commit) std::memcpy(h, next.data(), next.size() * sizeof(double));
+  /* also after the set-up evaluation: JdHistory has then changed only the energy reference */
+  std::memcpy(h, next.data(), next.size() * sizeof(double));
 }
