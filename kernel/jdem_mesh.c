@@ -146,22 +146,19 @@ static double edge_side(const double a[3], const double b[3], const double p[3],
     return jd_dot(c, n);
 }
 
-static int face_feature(const jd_mesh *m, int32_t t, const double p[3], jd_mesh_closest *c) {
+/* The foot of p on triangle t's plane, in foot (returns 1 when it lies strictly inside). */
+static int plane_foot(const jd_mesh *m, int32_t t, const double p[3], double foot[3]) {
     const int32_t *v = m->tri_vertex[t];
     const double *a = m->vertex[v[0]], *b = m->vertex[v[1]], *cc = m->vertex[v[2]];
     const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double ac[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
     double n[3];
     jd_cross(ab, ac, n);
-    if (!(edge_side(a, b, p, n) > 0.0 && edge_side(b, cc, p, n) > 0.0 &&
-          edge_side(cc, a, p, n) > 0.0))
-        return 0;
     const double ap[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
     const double s = jd_dot(ap, n) / jd_dot(n, n);
-    for (int d = 0; d < 3; d++) c->point[d] = p[d] - s * n[d];
-    c->kind = JD_MESH_FACE;
-    c->feature = t;
-    return 1;
+    for (int d = 0; d < 3; d++) foot[d] = p[d] - s * n[d];
+    return edge_side(a, b, p, n) > 0.0 && edge_side(b, cc, p, n) > 0.0 &&
+           edge_side(cc, a, p, n) > 0.0;
 }
 
 /* Edge e's parameter from its lower vertex, clamped: -1 (ends at lo), +1 (ends at hi) or 0
@@ -188,7 +185,12 @@ static void set_vertex(const jd_mesh *m, int32_t v, jd_mesh_closest *c) {
     for (int d = 0; d < 3; d++) c->point[d] = m->vertex[v][d];
 }
 
-static void boundary_feature(const jd_mesh *m, int32_t t, const double p[3], jd_mesh_closest *c) {
+/* The open edges are ranked by the distance of their points from the foot of p on the
+ * triangle's plane: the same order as by the distance from p (Pythagoras), without the
+ * common out-of-plane part that would round small in-plane differences away (a sphere on a
+ * flat mesh would take a slanted neighbouring edge by a tie). */
+static void boundary_feature(const jd_mesh *m, int32_t t, const double p[3], const double foot[3],
+                             jd_mesh_closest *c) {
     int end[3];
     double q[3][3];
     for (int k = 0; k < 3; k++) end[k] = edge_param(m, m->tri_edge[t][k], p, q[k]);
@@ -206,7 +208,7 @@ static void boundary_feature(const jd_mesh *m, int32_t t, const double p[3], jd_
     double best_d2 = INFINITY;
     for (int k = 0; k < 3; k++) {
         if (end[k] != 0) continue;
-        const double d2 = dist2_to(p, q[k]);
+        const double d2 = dist2_to(foot, q[k]);
         if (best < 0 || d2 < best_d2 ||
             (d2 == best_d2 && m->tri_edge[t][k] < m->tri_edge[t][best])) {
             best = k;
@@ -224,7 +226,7 @@ static void boundary_feature(const jd_mesh *m, int32_t t, const double p[3], jd_
     int32_t v = m->tri_vertex[t][0];
     for (int k = 1; k < 3; k++) {
         const int32_t w = m->tri_vertex[t][k];
-        const double dw = dist2_to(p, m->vertex[w]), dv = dist2_to(p, m->vertex[v]);
+        const double dw = dist2_to(foot, m->vertex[w]), dv = dist2_to(foot, m->vertex[v]);
         if (dw < dv || (dw == dv && w < v)) v = w;
     }
     set_vertex(m, v, c);
@@ -232,7 +234,14 @@ static void boundary_feature(const jd_mesh *m, int32_t t, const double p[3], jd_
 
 void jd_mesh_closest_feature(const jd_mesh *m, int32_t t, const double p[3], jd_mesh_closest *c) {
     c->tri = t;
-    if (!face_feature(m, t, p, c)) boundary_feature(m, t, p, c);
+    double foot[3];
+    if (plane_foot(m, t, p, foot)) {
+        for (int d = 0; d < 3; d++) c->point[d] = foot[d];
+        c->kind = JD_MESH_FACE;
+        c->feature = t;
+    } else {
+        boundary_feature(m, t, p, foot, c);
+    }
     c->dist2 = dist2_to(p, c->point);
 }
 
@@ -267,4 +276,47 @@ size_t jd_mesh_contacts(const jd_mesh *m, size_t n, const jd_mesh_closest *c, do
         }
     }
     return found;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* History slots and wall velocity                                                            */
+
+void jd_mesh_match_history(size_t nold, const double (*old_n)[3], size_t nnew,
+                           const double (*new_n)[3], int *from) {
+    unsigned char used[JD_MESH_SLOTS] = {0};
+    for (size_t k = 0; k < nnew; k++) from[k] = -1;
+    for (;;) {
+        double best = JD_MESH_HISTORY_COS;
+        int bk = -1, bj = -1;
+        for (size_t k = 0; k < nnew; k++) {
+            if (from[k] >= 0) continue;
+            for (size_t j = 0; j < nold; j++) {
+                if (used[j]) continue;
+                const double c = jd_dot(old_n[j], new_n[k]);
+                if (c > best) {
+                    best = c;
+                    bk = (int)k;
+                    bj = (int)j;
+                }
+            }
+        }
+        if (bk < 0) return;
+        from[bk] = bj;
+        used[bj] = 1;
+    }
+}
+
+void jd_mesh_point_velocity(const jd_mesh *m, const jd_mesh_closest *c, const double vnode[3][3],
+                            double v[3]) {
+    const int32_t *tv = m->tri_vertex[c->tri];
+    const double *a = m->vertex[tv[0]], *b = m->vertex[tv[1]], *cc = m->vertex[tv[2]];
+    const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double e2[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
+    const double ep[3] = {c->point[0] - a[0], c->point[1] - a[1], c->point[2] - a[2]};
+    const double d11 = jd_dot(e1, e1), d12 = jd_dot(e1, e2), d22 = jd_dot(e2, e2);
+    const double dp1 = jd_dot(ep, e1), dp2 = jd_dot(ep, e2);
+    const double det = d11 * d22 - d12 * d12;
+    const double b1 = (d22 * dp1 - d12 * dp2) / det, b2 = (d11 * dp2 - d12 * dp1) / det;
+    for (int d = 0; d < 3; d++)
+        v[d] = vnode[0][d] + b1 * (vnode[1][d] - vnode[0][d]) + b2 * (vnode[2][d] - vnode[0][d]);
 }

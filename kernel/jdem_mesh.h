@@ -96,6 +96,32 @@ void jd_mesh_closest_feature(const jd_mesh *m, int32_t t, const double p[3], jd_
 size_t jd_mesh_contacts(const jd_mesh *m, size_t n, const jd_mesh_closest *c, double R,
                         unsigned char *contact);
 
+/* Contact history across triangles.  A sphere's contacts with one mesh keep their history in a
+ * few slots per sphere (JD_MESH_SLOTS), each holding the contact's normal at its last
+ * evaluation next to the law's state.  The contact point moves continuously over a flat or
+ * convex region (face -> edge -> face of the next triangle: the feature changes, the normal
+ * turns by little per step), so a slot is keyed by its normal, not by a triangle: a contact
+ * found now takes the slot whose normal is closest to its own, provided the two normals make
+ * less than 60 degrees (cosine above JD_MESH_HISTORY_COS); the pairs are taken in decreasing
+ * cosine (ties: lower new index, then lower slot), each slot and each contact at most once.  A
+ * concave corner's contacts (normals 60 degrees or more apart) keep separate slots. */
+#define JD_MESH_SLOTS 6
+#define JD_MESH_HISTORY_COS 0.5
+
+/* from[k] (k < nnew) = the slot j < nold whose normal old_n[j] continues new_n[k] (unit
+ * vectors), or -1 (a new contact: fresh history).  Requires nold, nnew <= JD_MESH_SLOTS;
+ * an empty slot has normal (0, 0, 0) and is never chosen. */
+void jd_mesh_match_history(size_t nold, const double (*old_n)[3], size_t nnew,
+                           const double (*new_n)[3], int *from);
+
+/* The wall's velocity [m/s] at c's point: the velocities vnode[k] [m/s] of the corners k of
+ * triangle c->tri (the order of its corners given to jd_mesh_build) interpolated linearly,
+ * v = v0 + b1 (v1 - v0) + b2 (v2 - v0) with (b1, b2) the point's barycentric coordinates, so a
+ * translating mesh (three equal corner velocities) gives that velocity exactly and a rigid
+ * rotation the rotation's velocity at the point. */
+void jd_mesh_point_velocity(const jd_mesh *m, const jd_mesh_closest *c, const double vnode[3][3],
+                            double v[3]);
+
 /* The geometric fields of jd_contact_geom (jdem_geometry.h conventions: a the particle, b the
  * wall) for a contact of a sphere of centre x [m] and radius R [m] with feature c: n from the
  * centre towards the point, delta = R - |point - x|, ra = (R - delta) n, rb = 0, r_roll = R.

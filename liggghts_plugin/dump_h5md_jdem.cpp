@@ -263,7 +263,7 @@ int DumpH5mdJdem::create_file(const std::vector<double> &all, const std::vector<
   const double now = update->atime + (double)(update->ntimestep - update->atimestep) * dt;
   for (int k = 0; k < modify->nfix; k++) {
     const FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
-    if (!w) continue;
+    if (!w || w->is_mesh()) continue;
     walls.push_back(jd_h5md_wall());
     w->output_geometry(&walls.back(), now);
   }

@@ -17,6 +17,7 @@
 #include "h5md.h"
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
+#include "jdem_mesh.h"
 #include "jdem_restart.h"
 #include "jdem_watchdog.h"
 #include "pair_gran_jiang.h"
@@ -36,7 +37,7 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
       "Illegal fix wall/jiang command: fix ID group wall/jiang plane corners x1 y1 z1 x2 y2 z2 "
       "x3 y3 z3 x4 y4 z4 type T [velocity vx vy vz] [name NAME] [servo target S gain G tolerance "
       "E max_speed V hold H] | cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T "
-      "[velocity vx vy vz] [name NAME]";
+      "[velocity vx vy vz] [name NAME] | mesh n_meshes N meshes ID1 ... IDN";
   std::memset(&plane, 0, sizeof plane);
   std::memset(&cyl, 0, sizeof cyl);
   vel[0] = vel[1] = vel[2] = 0.0;
@@ -61,6 +62,9 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
     for (int k = 0; k < 3; k++) cyl.a1[k] = force->numeric(FLERR, arg[iarg++]);
     cyl.rc = -1.0;
     cyl.inside = 0;
+  } else if (kind == "mesh") {
+    shape = 2; /* FixWallJiangMesh reads the rest */
+    iarg = narg;
   } else {
     error->all(FLERR, usage);
   }
@@ -90,7 +94,7 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
       error->all(FLERR, usage);
     }
   }
-  if (wtype < 1 || wtype > atom->ntypes)
+  if (shape != 2 && (wtype < 1 || wtype > atom->ntypes))
     error->all(FLERR, "fix wall/jiang: 'type T' is required, 1 <= T <= ntypes");
   if (shape == 1) {
     if (!(cyl.rc > 0.0)) error->all(FLERR, "fix wall/jiang: cylinder needs 'radius R' > 0");
@@ -107,7 +111,7 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
 
   pair = dynamic_cast<PairGranJiang *>(force->pair);
   if (!pair) error->all(FLERR, "fix wall/jiang requires pair_style gran/jiang (defined before the fix)");
-  slen = pair->state_len();
+  slen = shape == 2 ? JD_MESH_SLOTS * (3 + pair->state_len()) : pair->state_len();
 
   create_attribute = 1;
   restart_global = restart_peratom = 1; /* jdem_restart.h */

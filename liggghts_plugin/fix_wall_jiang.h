@@ -50,6 +50,7 @@ namespace LAMMPS_NS {
 class FixWallJiang : public Fix {
  public:
   int wall_type() const { return wtype; } /* the wall's atom type (material) */
+  bool is_mesh() const { return shape == 2; } /* fix wall/jiang mesh (not in the trajectory yet) */
   /* The wall for the trajectory (io/h5md.h): its geometry at time 0, i.e. now (`time` [s])
    * less velocity x time, its velocity, and the fix ID as its name. */
   void output_geometry(jd_h5md_wall *w, double time) const;
@@ -97,19 +98,19 @@ class FixWallJiang : public Fix {
   double overlap_limit;
   JdOverlapTrip overlap_trip;
 
- private:
+ protected:
   template <unsigned F> JD_SPECIALISED void loop(bool commit);
   void compute(bool commit);
   void refresh_candidates();
   void sum_force_and_servo();
   void parse_servo(int narg, char **arg, int &iarg);
 
-  int shape; /* 0 plane, 1 cylinder */
+  int shape; /* 0 plane, 1 cylinder, 2 mesh (FixWallJiangMesh) */
   jd_plane plane;
   jd_cylinder cyl;
   double vel[3];
   int wtype;
-  int slen; /* doubles of history per atom */
+  int slen; /* doubles of history per atom (a mesh: JD_MESH_SLOTS x (normal, state)) */
   double **hist;
   int nmax_hist;
   class PairGranJiang *pair;

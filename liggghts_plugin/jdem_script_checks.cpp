@@ -41,7 +41,7 @@ int jdem_warn_script(LAMMPS *lmp) {
     if (std::strncmp(f->style, "wall/gran", 9) == 0) {
       msg = std::string("fix ") + f->id + " (" + f->style + ") evaluates its wall with LIGGGHTS' "
             "own contact model, not the Jiang (2021) law of pair_style gran/jiang: the run mixes "
-            "two contact laws; use fix wall/jiang for plane and cylinder walls (docs/liggghts.md)";
+            "two contact laws; use fix wall/jiang for plane, cylinder and mesh walls (docs/liggghts.md)";
     } else if (FixPropertyGlobal *p = dynamic_cast<FixPropertyGlobal *>(f)) {
       const char *name = foreign_property(p);
       if (name)

@@ -49,6 +49,7 @@
 #include "fix_jdem_restart.h"
 #include "fix_jdem_watchdog.h"
 #include "fix_wall_jiang.h"
+#include "fix_wall_jiang_mesh.h"
 #include "jdem_error.h"
 #include "jdem_input_file.h"
 #include "jdem_stop.h"
@@ -71,6 +72,7 @@ template struct Rob<ModifyFixMap, &Modify::fix_map>;
 
 static Pair *create_pair_gran_jiang(LAMMPS *lmp) { return new PairGranJiang(lmp); }
 static Fix *create_fix_wall_jiang(LAMMPS *lmp, int narg, char **arg) {
+  if (narg > 3 && std::strcmp(arg[3], "mesh") == 0) return new FixWallJiangMesh(lmp, narg, arg);
   return new FixWallJiang(lmp, narg, arg);
 }
 
@@ -185,6 +187,7 @@ static const char *jdem_help =
     "* Fix styles:   wall/jiang   plane corners x1 y1 z1 ... x4 y4 z4 type T [velocity vx vy vz]\n"
     "                             cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T\n"
     "                                 [velocity vx vy vz]\n"
+    "                             mesh n_meshes N meshes ID1 ... IDN   (fix mesh/surface IDs)\n"
     "                jdem/watchdog N [overlap F] [energy J|off]   (stop a run that goes wrong)\n"
     "                jdem/guard vmax V [coordination C] [force]   (refuse an unsafe timestep)\n"
     "                jdem/inlet file SECTION origin X Y Z velocity VX VY VZ plane PX PY PZ NX NY NZ\n"

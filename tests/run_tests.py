@@ -42,6 +42,9 @@ SUITES += [("inlet-cross-engine", [PY, "tests/inlet/test_inlet_liggghts.py"], "l
 SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {})]
 # The /observables cadence (output.observables_every below, at and not dividing every) in both engines.
 SUITES += [("observables-cadence", [PY, "tests/liggghts/check_observables_cadence.py"], "lines", {})]
+# STL mesh walls in LIGGGHTS (fix wall/jiang mesh) against our plane primitive, bit for bit:
+# resting, sliding across edges, a concave corner, a conveyor; move/mesh motion; bad input.
+SUITES += [("mesh-liggghts", [PY, "tests/mesh/test_mesh_liggghts.py"], "lines", {})]
 # The law set (kernel/jdem_laws.h) each engine selects, for every scene of reference_runs/ and
 # tests/, and hand-written decks that leave out `rolling on`.
 SUITES += [("law-sets", [PY, "tests/liggghts/check_law_sets.py"], "lines", {})]

@@ -50,7 +50,7 @@ OUR_WALL = ("fix floor all wall/jiang plane corners -0.1 -0.1 0 0.1 -0.1 0 0.1 0
 PLASTICITY = "fix m5 all property/global coefficientPlasticityDepth peratomtypepair 2 0.5 0.5 0.5 0.5"
 WALL_WARNING = ("WARNING: fix floor (wall/gran) evaluates its wall with LIGGGHTS' own contact "
                 "model, not the Jiang (2021) law of pair_style gran/jiang: the run mixes two "
-                "contact laws; use fix wall/jiang for plane and cylinder walls (docs/liggghts.md)")
+                "contact laws; use fix wall/jiang for plane, cylinder and mesh walls (docs/liggghts.md)")
 PROPERTY_WARNING = ("WARNING: fix m5 (property/global coefficientPlasticityDepth) is not used by "
                     "pair_style gran/jiang: the Jiang (2021) law has no such parameter, so it has "
                     "no effect on the contacts")

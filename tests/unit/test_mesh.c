@@ -9,6 +9,7 @@
 #include "jdem_mesh.h"
 
 #define MAXTRI 512
+#define JD_TEST_PI 3.14159265358979323846
 
 typedef struct built {
     double vertex[3 * MAXTRI][3];
@@ -332,6 +333,84 @@ static void geometry_of_a_face_contact(void **state) {
     assert_int_equal(jd_geom_mesh(&far, x, 0.05, &g), 0);
 }
 
+/* History slots: a normal turned by a small angle keeps its slot, the two faces of a concave
+ * corner (90 degrees apart) keep theirs even listed in the other order, and a normal 60 degrees
+ * or more from every slot starts afresh (cos 60 = JD_MESH_HISTORY_COS). */
+static void history_follows_the_normal(void **state) {
+    (void)state;
+    const double a = 0.01;
+    const double old_n[3][3] = {{0, 0, -1}, {-1, 0, 0}, {0, 0, 0}};
+    const double new_n[3][3] = {{-1, 0, 0}, {sin(a), 0, -cos(a)}, {0, -1, 0}};
+    int from[3];
+    jd_mesh_match_history(3, old_n, 3, new_n, from);
+    assert_int_equal(from[0], 1);
+    assert_int_equal(from[1], 0);
+    assert_int_equal(from[2], -1);
+    const double at60[1][3] = {{sin((JD_TEST_PI / 3.0) + 1e-9), 0, -cos((JD_TEST_PI / 3.0) + 1e-9)}};
+    const double at59[1][3] = {{sin((JD_TEST_PI / 3.0) - 1e-3), 0, -cos((JD_TEST_PI / 3.0) - 1e-3)}};
+    jd_mesh_match_history(1, old_n, 1, at60, from);
+    assert_int_equal(from[0], -1);
+    jd_mesh_match_history(1, old_n, 1, at59, from);
+    assert_int_equal(from[0], 0);
+    /* one slot, two candidates: the closer normal takes it, whatever the order */
+    const double two[2][3] = {{sin(0.3), 0, -cos(0.3)}, {sin(0.1), 0, -cos(0.1)}};
+    jd_mesh_match_history(1, old_n, 2, two, from);
+    assert_int_equal(from[0], -1);
+    assert_int_equal(from[1], 0);
+}
+
+/* The wall velocity at a contact point: a translation exactly, a rigid rotation as omega x
+ * (point - centre) of the closed form. */
+static void wall_velocity_at_the_point(void **state) {
+    (void)state;
+    const double tri[1][3][3] = {{{0.1, 0.2, 0.3}, {1.3, 0.1, 0.5}, {0.4, 1.1, -0.2}}};
+    built *b = build(1, tri);
+    jd_mesh_closest c;
+    const double p[3] = {0.6, 0.46, 0.25};
+    jd_mesh_closest_feature(&b->m, 0, p, &c);
+    assert_int_equal(c.kind, JD_MESH_FACE);
+    const double u[3] = {0.3, -1.7, 2.9};
+    const double same[3][3] = {{0.3, -1.7, 2.9}, {0.3, -1.7, 2.9}, {0.3, -1.7, 2.9}};
+    double v[3];
+    jd_mesh_point_velocity(&b->m, &c, same, v);
+    for (int d = 0; d < 3; d++) assert_true(v[d] == u[d]);
+    const double w[3] = {0.7, -0.2, 1.9}, o[3] = {-0.3, 0.8, 0.1};
+    double vn[3][3], r[3], ref[3];
+    for (int k = 0; k < 3; k++) {
+        for (int d = 0; d < 3; d++) r[d] = tri[0][k][d] - o[d];
+        jd_cross(w, r, vn[k]);
+    }
+    for (int d = 0; d < 3; d++) r[d] = c.point[d] - o[d];
+    jd_cross(w, r, ref);
+    jd_mesh_point_velocity(&b->m, &c, (const double(*)[3])vn, v);
+    for (int d = 0; d < 3; d++) assert_true(fabs(v[d] - ref[d]) < 1e-14);
+    free(b);
+}
+
+/* A centre a hair off a grid vertex, along a grid line: the distances to that line's edge and
+ * to a diagonal edge through the vertex differ by far less than the rounding of the squared
+ * height, yet the contact must be the foot of the perpendicular, exactly, as for a plane. */
+static void near_vertex_the_contact_is_the_exact_foot(void **state) {
+    (void)state;
+    double(*tri)[3][3] = calloc(2 * 16, sizeof *tri);
+    const size_t n = grid(4, tri);
+    built *b = build(n, (const double(*)[3][3])tri);
+    jd_mesh_closest c[32];
+    unsigned char contact[32];
+    const double off[4][2] = {{1e-9, 0}, {-1e-9, 0}, {0, 1e-9}, {0, -1e-9}};
+    for (int k = 0; k < 4; k++) {
+        const double p[3] = {2.0 + off[k][0], 2.0 + off[k][1], 0.4};
+        assert_int_equal(contacts_of(&b->m, p, 0.5, c, contact), 1);
+        for (size_t t = 0; t < n; t++)
+            if (contact[t]) {
+                assert_true(c[t].point[0] == p[0] && c[t].point[1] == p[1] && c[t].point[2] == 0.0);
+                assert_true(c[t].dist2 == 0.4 * 0.4);
+            }
+    }
+    free(b);
+    free(tri);
+}
+
 int run_mesh_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(cube_topology_obeys_euler),
@@ -343,6 +422,9 @@ int run_mesh_tests(void) {
         cmocka_unit_test(contacts_do_not_depend_on_candidate_order),
         cmocka_unit_test(degenerate_triangles_are_named),
         cmocka_unit_test(geometry_of_a_face_contact),
+        cmocka_unit_test(history_follows_the_normal),
+        cmocka_unit_test(near_vertex_the_contact_is_the_exact_foot),
+        cmocka_unit_test(wall_velocity_at_the_point),
     };
     return cmocka_run_group_tests_name("mesh", tests, NULL, NULL);
 }

@@ -1,0 +1,282 @@
+/* fix_wall_jiang_mesh.cpp — see fix_wall_jiang_mesh.h.  Glue only: the triangle rule and the
+ * history matching are kernel/jdem_mesh.h, the law jd_contact(). */
+#include "fix_wall_jiang_mesh.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "atom.h"
+#include "error.h"
+#include "fix_mesh_surface.h"
+#include "fix_neighlist_mesh.h"
+#include "force.h"
+#include "modify.h"
+#include "neighbor.h"
+#include "tri_mesh.h"
+#include "update.h"
+
+#include "jdem_dispatch.h"
+#include "jdem_history.h"
+#include "jdem_watchdog.h"
+#include "pair_gran_jiang.h"
+
+using namespace LAMMPS_NS;
+
+static const char *const mesh_usage =
+    "Illegal fix wall/jiang mesh command: fix ID group wall/jiang mesh n_meshes N meshes ID1 ... IDN "
+    "(IDs of fix mesh/surface, all of the same type)";
+
+FixWallJiangMesh::FixWallJiangMesh(LAMMPS *lmp, int narg, char **arg)
+    : FixWallJiang(lmp, narg, arg), state_len(pair->state_len()) {
+  if (narg < 7 || std::strcmp(arg[4], "n_meshes") != 0 || std::strcmp(arg[6], "meshes") != 0)
+    error->all(FLERR, mesh_usage);
+  const int n = force->inumeric(FLERR, arg[5]);
+  if (n < 1 || narg != 7 + n) error->all(FLERR, mesh_usage);
+  for (int k = 0; k < n; k++) {
+    const int f = modify->find_fix(arg[7 + k]);
+    FixMeshSurface *fm = f < 0 ? NULL : dynamic_cast<FixMeshSurface *>(modify->fix[f]);
+    if (!fm)
+      error->all(FLERR, (std::string("fix wall/jiang mesh: '") + arg[7 + k] +
+                         "' is not the ID of a fix mesh/surface defined before this fix").c_str());
+    if (k > 0 && fm->atomTypeWall() != wtype)
+      error->all(FLERR, "fix wall/jiang mesh: all meshes of one fix need the same 'type' (make one fix per type)");
+    wtype = fm->atomTypeWall();
+    Mesh m;
+    m.fix = fm;
+    m.built = false;
+    meshes.push_back(m);
+  }
+  if (wtype < 1 || wtype > atom->ntypes)
+    error->all(FLERR, "fix wall/jiang mesh: the mesh's 'type T' must be 1 <= T <= ntypes");
+}
+
+/* LIGGGHTS' mesh neighbour list (particles of the group near each triangle), as wall/gran. */
+void FixWallJiangMesh::post_create() {
+  for (size_t k = 0; k < meshes.size(); k++) meshes[k].fix->createWallNeighList(igroup);
+}
+
+void FixWallJiangMesh::pre_delete(bool unfixflag) {
+  if (!unfixflag) return;
+  for (size_t k = 0; k < meshes.size(); k++) meshes[k].fix->deleteWallNeighList();
+}
+
+void FixWallJiangMesh::init() {
+  pair = dynamic_cast<PairGranJiang *>(force->pair);
+  if (!pair) error->all(FLERR, "fix wall/jiang mesh requires pair_style gran/jiang");
+  if (pair->state_len() != state_len)
+    error->all(FLERR, "fix wall/jiang: pair_style gran/jiang changed its rolling or energy option after the wall was defined");
+  if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
+    error->all(FLERR, "fix wall/jiang requires atom_style granular (sphere)");
+  for (size_t k = 0; k < meshes.size(); k++) meshes[k].built = false;
+}
+
+void FixWallJiangMesh::setup(int vflag) { compute_mesh(false); }
+
+void FixWallJiangMesh::post_force(int vflag) { compute_mesh(true); }
+
+/* The kernel's topology of the triangles this rank holds (owned and ghost), ordered by their
+ * ids (the STL's order), so that edge and vertex contacts belong to the same triangle as in the
+ * standalone engine.  Rebuilt when the mesh moves (the welding compares coordinates) or the
+ * rank's set of triangles changes. */
+void FixWallJiangMesh::rebuild_topology(Mesh &m) {
+  TriMesh *tm = m.fix->triMesh();
+  const int nall = tm->sizeLocal() + tm->sizeGhost();
+  if (m.built && !tm->isMoving() && (int)m.tri_of.size() == nall) {
+    bool same = true;
+    for (int k = 0; k < nall && same; k++) same = m.lig_of[m.tri_of[k]] == k;
+    if (same) return;
+  }
+  std::vector<std::pair<int, int> > by_id((size_t)nall);
+  for (int k = 0; k < nall; k++) by_id[k] = std::make_pair(tm->id(k), k);
+  std::sort(by_id.begin(), by_id.end());
+  const size_t n = (size_t)nall;
+  m.lig_of.resize(n);
+  m.tri_of.resize(n);
+  m.corner.resize(9 * n);
+  for (size_t t = 0; t < n; t++) {
+    m.lig_of[t] = by_id[t].second;
+    m.tri_of[by_id[t].second] = (int32_t)t;
+    for (int c = 0; c < 3; c++) tm->node(by_id[t].second, c, &m.corner[9 * t + 3 * c]);
+  }
+  m.vertex.resize(9 * n + 3);
+  m.tri_vertex.resize(3 * n + 3);
+  m.tri_edge.resize(3 * n + 3);
+  m.edge_vertex.resize(6 * n + 2);
+  m.edge_valence.resize(3 * n + 1);
+  m.vertex_valence.resize(3 * n + 1);
+  m.scratch.resize(3 * n + 1);
+  const jd_mesh_storage st = {(double(*)[3])m.vertex.data(), (int32_t(*)[3])m.tri_vertex.data(),
+                              (int32_t(*)[3])m.tri_edge.data(), (int32_t(*)[2])m.edge_vertex.data(),
+                              m.edge_valence.data(), m.vertex_valence.data(), m.scratch.data()};
+  size_t bad = 0;
+  const int rc = jd_mesh_build(n, (const double(*)[3][3])m.corner.data(), &st, &m.topo, &bad);
+  if (rc == JD_MESH_DEGENERATE) {
+    char msg[256];
+    std::snprintf(msg, sizeof msg,
+                  "fix wall/jiang mesh: triangle id %d of mesh '%s' has zero area or two equal corners",
+                  tm->id(m.lig_of[bad]), m.fix->id);
+    error->one(FLERR, msg);
+  }
+  if (rc == JD_MESH_TOO_LARGE) error->one(FLERR, "fix wall/jiang mesh: too many triangles");
+  m.built = true;
+}
+
+/* (atom, triangle) pairs from LIGGGHTS' mesh neighbour list: owned atoms of the group.  The
+ * set-up evaluation (every_pair) pairs every atom with every triangle instead: LIGGGHTS fills
+ * a moving mesh's neighbour list only from the first step on. */
+void FixWallJiangMesh::gather_candidates(Mesh &m, bool every_pair) {
+  TriMesh *tm = m.fix->triMesh();
+  FixNeighlistMesh *nl = m.fix->meshNeighlist();
+  const int nall = tm->sizeLocal() + tm->sizeGhost();
+  const int nlocal = atom->nlocal;
+  const int *mask = atom->mask;
+  if (every_pair) {
+    for (int i = 0; i < nlocal; i++)
+      for (int k = 0; k < nall && (mask[i] & groupbit); k++) {
+        Candidate cd = {i, m.tri_of[k]};
+        cand.push_back(cd);
+      }
+    return;
+  }
+  for (int k = 0; k < nall; k++) {
+    const std::vector<int> &list = nl->get_contact_list(k);
+    for (size_t c = 0; c < list.size(); c++) {
+      const int i = list[c];
+      if (i >= nlocal || !(mask[i] & groupbit)) continue;
+      Candidate cd = {i, m.tri_of[k]};
+      cand.push_back(cd);
+    }
+  }
+}
+
+void FixWallJiangMesh::compute_mesh(bool commit) {
+#define JD_MESH_LOOP(b) \
+  case (b): mesh_loop<(b)>(commit); break;
+  JD_DISPATCH(pair->features(), JD_MESH_LOOP)
+#undef JD_MESH_LOOP
+}
+
+/* Every mesh's candidates, then each atom's contacts (sphere_contacts) in ascending atom
+ * index; atoms without candidates lose their history. */
+template <unsigned F>
+void FixWallJiangMesh::mesh_loop(bool commit) {
+  pair->refresh_prefactors();
+  overlap_trip = JdOverlapTrip();
+  contact_x.clear();
+  contact_f.clear();
+  const int nlocal = atom->nlocal;
+  touched.assign((size_t)nlocal, 0);
+  double sums[5] = {0.0, 0.0, 0.0, 0.0, 0.0}; /* e_damp, e_fric, e_el, contacts, work */
+  for (size_t im = 0; im < meshes.size(); im++) {
+    rebuild_topology(meshes[im]);
+    cand.clear();
+    gather_candidates(meshes[im], !commit);
+    std::sort(cand.begin(), cand.end());
+    for (size_t a = 0; a < cand.size();) {
+      size_t b = a;
+      while (b < cand.size() && cand[b].i == cand[a].i) b++;
+      sphere_contacts<F>((int)im, cand[a].i, a, b, commit, sums);
+      a = b;
+    }
+  }
+  if (commit)
+    for (int i = 0; i < nlocal; i++)
+      if (!touched[i])
+        for (int k = 0; k < slen; k++) hist[i][k] = 0.0;
+  if (commit) {
+    e_damp_cum += sums[0];
+    e_fric_cum += sums[1];
+    work_cum += sums[4];
+  }
+  e_elastic_now = sums[2];
+  contacts_now = sums[3];
+}
+
+/* Atom i's contacts with mesh im (candidates cand[first, last)): the kernel's rule picks the
+ * contacts; each takes the history slot its normal continues; the slots are rewritten in the
+ * contacts' order (ascending triangle). */
+template <unsigned F>
+void FixWallJiangMesh::sphere_contacts(int im, int i, size_t first, size_t last, bool commit,
+                                       double *sums) {
+  Mesh &m = meshes[(size_t)im];
+  double **x = atom->x, **v = atom->v, **f = atom->f;
+  double **omega = atom->omega, **torque = atom->torque;
+  const double R = atom->radius[i], mass = atom->rmass[i];
+  const size_t n = last - first;
+  closest.resize(n);
+  is_contact.resize(n);
+  for (size_t k = 0; k < n; k++) jd_mesh_closest_feature(&m.topo, cand[first + k].t, x[i], &closest[k]);
+  jd_mesh_contacts(&m.topo, n, closest.data(), R, is_contact.data());
+
+  jd_contact_geom g[JD_MESH_SLOTS];
+  const jd_mesh_closest *which[JD_MESH_SLOTS];
+  size_t nc = 0;
+  for (size_t k = 0; k < n; k++) {
+    if (!is_contact[k]) continue;
+    if (nc == JD_MESH_SLOTS)
+      error->one(FLERR, "fix wall/jiang mesh: a sphere touches more than 6 faces of one mesh at once");
+    if (!jd_geom_mesh(&closest[k], x[i], R, &g[nc])) continue;
+    which[nc++] = &closest[k];
+  }
+  if (nc == 0) return;
+  if (meshes.size() > 1 && touched[i])
+    error->one(FLERR, "fix wall/jiang mesh: a sphere touches two meshes of one fix at once; use one fix per mesh");
+  touched[i] = 1;
+
+  const int stride = 3 + state_len;
+  double *h = hist[i];
+  double old_n[JD_MESH_SLOTS][3], new_n[JD_MESH_SLOTS][3];
+  for (int s = 0; s < JD_MESH_SLOTS; s++) jd_copy3(old_n[s], h + s * stride);
+  for (size_t c = 0; c < nc; c++) jd_copy3(new_n[c], g[c].n);
+  int from[JD_MESH_SLOTS];
+  jd_mesh_match_history(JD_MESH_SLOTS, old_n, nc, new_n, from);
+  next.assign((size_t)JD_MESH_SLOTS * stride, 0.0);
+  for (size_t c = 0; c < nc; c++)
+    if (from[c] >= 0) std::memcpy(&next[c * stride + 3], h + from[c] * stride + 3, state_len * sizeof(double));
+
+  TriMesh *tm = m.fix->triMesh();
+  MultiVectorContainer<double, 3, 3> *vprop =
+      tm->prop().getElementProperty<MultiVectorContainer<double, 3, 3> >("v");
+  double ***vnode = vprop ? vprop->begin() : NULL;
+  const int roll_at = pair->rolling_at();
+  const double kw = pair->wall_prefactors()[i];
+  const jd_pair_coeffs co = jd_wall_coeffs(&pair->coeffs(atom->type[i], wtype));
+  for (size_t c = 0; c < nc; c++) {
+    if (g[c].delta > overlap_limit * R && jd_overlap_excessive(g[c].delta, R, INFINITY, overlap_limit))
+      overlap_trip.note(g[c].delta, R, atom->tag[i], 0, id);
+    jd_geom_wall_material(F, &g[c], kw, mass, jd_sphere_inertia(mass, R));
+    jd_kinematics k;
+    jd_copy3(k.va, v[i]);
+    jd_copy3(k.wa, omega[i]);
+    k.vb[0] = k.vb[1] = k.vb[2] = 0.0;
+    if (vnode) {
+      const int lt = m.lig_of[which[c]->tri];
+      const double vt[3][3] = {{vnode[lt][0][0], vnode[lt][0][1], vnode[lt][0][2]},
+                               {vnode[lt][1][0], vnode[lt][1][1], vnode[lt][1][2]},
+                               {vnode[lt][2][0], vnode[lt][2][1], vnode[lt][2][2]}};
+      jd_mesh_point_velocity(&m.topo, which[c], vt, k.vb);
+    }
+    k.wb[0] = k.wb[1] = k.wb[2] = 0.0;
+    double *slot = &next[c * stride];
+    jd_copy3(slot, g[c].n);
+    JdHistory<F> hs(slot + 3, roll_at, commit);
+    double f_prev[3] = {0.0, 0.0, 0.0};
+    if (F & JD_F_ENERGY) jd_copy3(f_prev, hs.st->f_prev);
+    jd_contact_result out;
+    const int carries = jd_contact(F, &co, &g[c], &k, update->dt, hs.st, hs.rs, &out);
+    if (F & JD_F_ENERGY) {
+      sums[4] += jd_wall_work(f_prev, out.f, k.vb, update->dt);
+      jd_contact_harvest(hs.st, 1.0, &sums[0], &sums[1]);
+      if (carries) sums[2] += jd_contact_elastic_energy(hs.st);
+    }
+    hs.finish();
+    if (!carries) continue;
+    sums[3] += 1.0;
+    jd_sub3(f[i], out.f);
+    jd_add3(torque[i], out.ta);
+  }
+  /* also after the set-up evaluation: JdHistory has then changed only the energy reference */
+  std::memcpy(h, next.data(), next.size() * sizeof(double));
+}
