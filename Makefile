@@ -40,7 +40,8 @@ OPT      := -O3 $(ARCH) -fno-trapping-math -ffp-contract=off
 CFLAGS   := -std=c11 $(OPT) -g $(WARN) -D_POSIX_C_SOURCE=200809L -DJDEM_VERSION=\"$(VERSION)\" \
             -Ikernel -Iio -Istepper $(PKG_CFLAGS)
 # The sanitizer build compiles the force loops once, with the feature set as a run-time value
-# (stepper/forces.c, JD_ONE_FORCE_LOOP): 32 inlined copies of the law take minutes under ASan+UBSan.
+# (stepper/forces.c, JD_ONE_FORCE_LOOP): it checks the code, not its speed, so one inlined copy
+# of the law under ASan+UBSan instead of one per law set (build times: docs/performance.md).
 SANFLAGS := -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer \
             -DJD_ONE_FORCE_LOOP
 # OpenMP threads in the standalone engine's force and integration loops (stepper/ only: the
@@ -105,7 +106,7 @@ build/san/stepper/%.o: stepper/%.c
 	$(CC) $(CFLAGS) $(OMPFLAGS) $(SANFLAGS) $(DEPFLAGS) -c $< -o $@
 
 # The bond loop is scalar code (a bond per iteration); GCC's straight-line vectoriser packs its
-# 3-vectors into 512-bit registers with shuffles, which made it a sixth slower (docs/performance.md).
+# 3-vectors into 512-bit registers with shuffles, which made it slower (docs/performance.md).
 # The same bits: the vectoriser never reorders floating-point operations here (no fast-math).
 build/obj/stepper/bonds.o: CFLAGS += -fno-tree-slp-vectorize
 
@@ -187,7 +188,8 @@ mixing-demo: build/jdem
 # Performance benchmark (reference_runs/bench/README.md): settled beds, 3 engines, medians of 3.
 #   make bench [BENCH_SIZES=5k,20k,80k,320k,1M] [BENCH_VARIANTS=soft_mono,soft_mono_bonded]
 #              [BENCH_REPEATS=3]                              report: out/bench/report.md
-# 80k, 320k and 1M are tiled from the 20k bed; every variant at every size takes hours.
+# 80k, 320k and 1M are tiled from the 20k bed; every variant at every size is a long run
+# (durations: docs/performance.md).
 .PHONY: bench
 bench: all
 	$(PY) scripts/bench.py $(if $(BENCH_SIZES),--sizes $(BENCH_SIZES)) $(if $(BENCH_REPEATS),--repeats $(BENCH_REPEATS)) \
@@ -205,7 +207,8 @@ bonds: all
 
 # Error against run time: Chung–Ooi tests 1, 3, 4 and a settling bed, dt swept over
 # factors of the time-step guard's dt, in jdem, liggghts-jdem and LIGGGHTS hertz/history; timings
-# medians of ACCURACY_REPEATS (default 3).  ~11 min on 2 busy cores.  Report: out/accuracy/report.md
+# medians of ACCURACY_REPEATS (default 3); its duration: docs/performance.md.  Report:
+# out/accuracy/report.md
 .PHONY: accuracy
 accuracy: all
 	$(PY) scripts/accuracy.py run $(if $(ACCURACY_REPEATS),--repeats $(ACCURACY_REPEATS))

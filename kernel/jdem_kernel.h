@@ -594,7 +594,8 @@ static JD_ALWAYS_INLINE void jd_contact_assemble(const unsigned features, const 
 
 /* One evaluation of a contact (the reference algorithm of docs/model.md §9).
  *
- * features: a law set (jdem_laws.h, JD_LAW_SETS), a compile-time constant at the call site.
+ * features: a law set (jdem_laws.h, JD_LAW_SETS), a compile-time constant at the call site but
+ *           for the run-time laws (JD_F_RUN_TIME: a branch, jd_law_set_of_loop).
  * c, g, k:  coefficients, geometry (g->delta > 0) and kinematics.
  * dt:       time step [s] (the springs accumulate rate * dt).
  * s:        contact history, updated.   r: rolling history (NULL unless JD_F_ROLLING).

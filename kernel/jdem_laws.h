@@ -21,12 +21,12 @@ extern "C" {
 
 /* ------------------------------------------------------------------------------------------ */
 /* The valid law sets.  X(bits) once per set, bits a constant expression of JD_F_* flags; a    */
-/* dispatcher expands JD_LAW_SETS(X) into its cases (a switch, template instantiations), so    */
-/* that each set has one specialised copy of the force loops and no other copy is compiled.   */
-/* A new law set is one line of JD_LAW_SETS_WITH.  mu_R modifies the tangential law only, so   */
-/* JD_F_MU_R comes with JD_F_FRICTION; so does JD_F_MINDLIN, which changes the tangential      */
-/* spring only (JD_LAW_SETS_TANGENTIAL); every set exists with and without the energy          */
-/* bookkeeping.                                                                                */
+/* dispatcher expands JD_LAW_LOOPS(X) into its cases (a switch, template instantiations), so   */
+/* that each compiled set has one specialised copy of the force loops and no other copy is     */
+/* compiled.  A new law set is one line of JD_LAW_SETS_WITH.  mu_R modifies the tangential     */
+/* law only, so JD_F_MU_R comes with JD_F_FRICTION; so does JD_F_MINDLIN, which changes the    */
+/* tangential spring only (JD_LAW_SETS_TANGENTIAL); every set exists with and without the      */
+/* energy bookkeeping.                                                                         */
 /* ------------------------------------------------------------------------------------------ */
 #define JD_LAW_SETS_TANGENTIAL(X, E)                                           \
     X((E) | JD_F_FRICTION)                                                     \
@@ -42,9 +42,29 @@ extern "C" {
     X((E) | JD_F_DAMPING)                                                      \
     X((E) | JD_F_ROLLING)                                                      \
     X((E) | JD_F_DAMPING | JD_F_ROLLING)                                       \
-    JD_LAW_SETS_TANGENTIAL(X, E)                                               \
-    JD_LAW_SETS_TANGENTIAL(X, (E) | JD_F_MINDLIN)
-#define JD_LAW_SETS(X) JD_LAW_SETS_WITH(X, 0u) JD_LAW_SETS_WITH(X, JD_F_ENERGY)
+    JD_LAW_SETS_TANGENTIAL(X, E)
+#define JD_LAW_LOOPS(X) JD_LAW_SETS_WITH(X, 0u) JD_LAW_SETS_WITH(X, JD_F_ENERGY)
+#define JD_LAW_SETS(X)                                                         \
+    JD_LAW_LOOPS(X)                                                            \
+    JD_LAW_SETS_TANGENTIAL(X, JD_F_MINDLIN)                                    \
+    JD_LAW_SETS_TANGENTIAL(X, JD_F_ENERGY | JD_F_MINDLIN)
+
+/* The laws a force loop takes as a run-time part of its law set rather than compiling a copy
+ * for: Mindlin's K_t changes one scalar per contact (jd_tangential_stiffness), so a branch on
+ * the bit costs less than doubling the tangential copies (docs/performance.md, "Build time").
+ * JD_LAW_LOOPS holds every law set without these bits. */
+#define JD_F_RUN_TIME JD_F_MINDLIN
+
+/* The compiled loop that runs law set bits: a dispatcher switches on this and expands
+ * JD_LAW_LOOPS; the loop then passes jd_law_set_of_loop to the kernel. */
+static inline unsigned jd_law_set_loop(unsigned bits) { return bits & ~(unsigned)JD_F_RUN_TIME; }
+
+/* The law set inside the compiled loop `loop` (a literal of JD_LAW_LOOPS) of a run whose law
+ * set is bits: the loop's constant bits and the run-time ones of bits.  A loop without friction
+ * has no run-time law (JD_F_MINDLIN comes with JD_F_FRICTION), so that its law set stays a
+ * compile-time constant. */
+#define jd_law_set_of_loop(loop, bits) \
+    ((loop) | (((loop) & JD_F_FRICTION) ? (bits) & (unsigned)JD_F_RUN_TIME : 0u))
 
 /* Every JD_F_* bit, for masking a law set. */
 #define JD_F_ALL (JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY | JD_F_MINDLIN)

@@ -268,6 +268,7 @@ void FixWallJiang::loop(bool commit) {
   const double dt = update->dt;
   const int roll_at = pair->rolling_at();
   pair->refresh_prefactors();
+  const unsigned laws = jd_law_set_of_loop(F, pair->features()); /* with the run-time laws */
   const double *kw = pair->wall_prefactors();
   double e_damp = 0.0, e_fric = 0.0, e_el = 0.0, ncontacts = 0.0, work = 0.0;
   const int *tag = atom->tag;
@@ -305,7 +306,7 @@ void FixWallJiang::loop(bool commit) {
     double f_prev[3] = {0.0, 0.0, 0.0};
     if (F & JD_F_ENERGY) jd_copy3(f_prev, hs.st->f_prev);
     const jd_pair_coeffs co = jd_wall_coeffs(&pair->coeffs(type[i], wtype));
-    const int carries = jd_contact(F, &co, &g, &k, dt, hs.st, hs.rs, &out);
+    const int carries = jd_contact(laws, &co, &g, &k, dt, hs.st, hs.rs, &out);
     if (F & JD_F_ENERGY) {
       /* f_prev is booked only with the energies; the work also over the step a contact ends */
       work += jd_wall_work(f_prev, out.f, vel, dt);

@@ -266,6 +266,7 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
   overlap_trip = JdOverlapTrip();
 
   const double *kp = pair_prefactors();
+  const unsigned laws = jd_law_set_of_loop(F, features_); /* with the run-time laws */
 
   for (int ii = 0; ii < inum; ii++) {
     const int i = ilist[ii];
@@ -305,8 +306,7 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
       /* the stored history itself or a local copy (jdem_history.h) */
       JdHistory<F> h(hist, roll_at, commit);
       jd_contact_result out;
-      const int carries = jd_contact(F, &coeffs_i[type[j]], &g, &k,
-                                     dt_run, h.st, h.rs, &out);
+      const int carries = jd_contact(laws, &coeffs_i[type[j]], &g, &k, dt_run, h.st, h.rs, &out);
       /* a pair with a ghost partner is evaluated on both ranks: count it half on each */
       const double w = j < nlocal ? 1.0 : 0.5;
       if (F & JD_F_ENERGY) {

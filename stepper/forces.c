@@ -1,8 +1,9 @@
 /*
  * forces.c — force loops.  The scene's law set (JD_F_* bits, kernel/jdem_laws.h) is fixed for a
- * run; the loop body is instantiated once per law set of the kernel's list with the bits as a
- * literal constant, so that jd_contact() compiles away every law the scene does not use (a
- * scene pays only for what it uses).  Order as LIGGGHTS: pair forces in list order (the candidates that
+ * run; the loop body is instantiated once per compiled law set of the kernel's list
+ * (JD_LAW_LOOPS) with the bits as a constant, so that jd_contact() compiles away every law the
+ * scene does not use (a scene pays only for what it uses); the run-time laws (JD_F_RUN_TIME)
+ * are a branch inside.  The sets with energy bookkeeping are compiled in forces_energy.c.  Order as LIGGGHTS: pair forces in list order (the candidates that
  * touched at the build, then the others: sim.h, jd_contact_list), wall forces, gravity.
  *
  * Threads (sim.h, "Threads"): each thread zeroes the forces of the particles it owns, evaluates
@@ -29,11 +30,13 @@
 #include "geometry.h"
 #include "sim.h"
 
+#ifndef JD_FORCE_LOOPS_ENERGY
 double sim_clock(void) {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
+#endif
 
 
 /* Where a thread adds its forces and torques: f and torque for particles below hi, its
@@ -169,6 +172,7 @@ static JD_ALWAYS_INLINE void lane_history_write(const unsigned F, const batch *B
         }
 }
 
+#ifndef JD_FORCE_LOOPS_ENERGY
 /* The force loops' per-thread state (sim_init). */
 int sim_forces_init(jd_sim *s) {
     s->shares = calloc((size_t)s->threads, sizeof *s->shares);
@@ -247,6 +251,8 @@ int sim_forces_partition(jd_sim *s) {
     }
     return 0;
 }
+
+#endif
 
 /* How alike the particles of a scene are (sim.h: pair_row, alike), a compile-time constant of the
  * pair loops: any mix; one material (one coefficient row); one material and one radius (the
@@ -408,7 +414,7 @@ static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, 
 #define JD_PREFETCH_MIN_N 65536
 /* The list's own streams (indices and history, read and written back) cross a 4 KiB page every
  * 100 entries or so, where the hardware prefetchers stop; the pair loop fetches them
- * JD_ENTRIES_AHEAD entries ahead (docs/performance.md; 256 or 1024 measured the same). */
+ * JD_ENTRIES_AHEAD entries ahead (docs/performance.md, "list prefetch"). */
 #define JD_ENTRIES_AHEAD 512
 
 /* Prefetch the five arrays' lines of particles [*done, upto) (x, v, omega to read, f and torque
@@ -602,6 +608,7 @@ static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0,
     return work;
 }
 
+#ifndef JD_FORCE_LOOPS_ENERGY
 /* The reference path (--plain-loops): one contact at a time, as the loops were before they
  * were batched, with the features as a run-time value.  The batched loops must give the same
  * bits (tests/engine/test_fastpaths.py). */
@@ -699,8 +706,11 @@ static double plain_contact_loops(jd_sim *s, int tid, double *t_pairs_end) {
     return plain_wall_loop(s, F, h->wall_lo, h->wall_hi, a, trip);
 }
 
-/* This thread's share of the contact loops; returns its wall work.  *t_pairs_end: when thread 0
- * finished its share of the pairs (with threads, the split of the timing is thread 0's). */
+#endif
+
+/* This thread's share of the contact loops under law set F (jd_law_set_of_loop: constant but
+ * for the run-time laws); returns its wall work.  *t_pairs_end: when thread 0 finished its
+ * share of the pairs (with threads, the split of the timing is thread 0's). */
 static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int tid,
                                              double *t_pairs_end) {
     const acc a = acc_of(s, tid);
@@ -719,12 +729,37 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
     return wall_loop(s, F, h->wall_lo, h->wall_hi, a, trip);
 }
 
-/* One instantiation per law set (the kernel's list, jdem_laws.h): the switch maps the run-time
- * bits to a literal constant. */
-#define JD_FORCE_CASE(bits)                                                     \
-    case (bits):                                                                \
-        work = contact_loops(s, (bits), tid, &t_pairs_end);                     \
-        break;
+/* One instantiation per compiled law set (the kernel's list, jdem_laws.h: JD_LAW_LOOPS): the
+ * switch maps the run's bits to a constant law set, and the loop passes the run-time laws
+ * (JD_F_RUN_TIME) of the run's bits on to the kernel. */
+#define JD_FORCE_CASE(loop)                                                                   \
+    case (loop):                                                                              \
+        *work = contact_loops(s, jd_law_set_of_loop((loop), s->features), tid, t_pairs_end);  \
+        return 1;
+
+/* The compiled law sets with energy bookkeeping are instantiated in a translation unit of their
+ * own (forces_energy.c includes this file with JD_FORCE_LOOPS_ENERGY; the rest of this file is
+ * compiled here only), the others here, so that a parallel make compiles the two halves side by
+ * side.  Each returns 0, without evaluating, when the run's law set is not one of its half. */
+int sim_force_loops_energy(jd_sim *s, int tid, double *work, double *t_pairs_end);
+#ifdef JD_FORCE_LOOPS_ENERGY
+int sim_force_loops_energy(jd_sim *s, int tid, double *work, double *t_pairs_end) {
+    switch (jd_law_set_loop(s->features)) {
+        JD_LAW_SETS_WITH(JD_FORCE_CASE, JD_F_ENERGY)
+    default:
+        return 0;
+    }
+}
+#else
+#ifndef JD_ONE_FORCE_LOOP
+static int force_loops_without_energy(jd_sim *s, int tid, double *work, double *t_pairs_end) {
+    switch (jd_law_set_loop(s->features)) {
+        JD_LAW_SETS_WITH(JD_FORCE_CASE, 0u)
+    default:
+        return 0;
+    }
+}
+#endif
 
 static double dispatch(jd_sim *s, int tid, double *t_pairs_end_out) {
     double work = 0.0, t_pairs_end = 0.0;
@@ -735,15 +770,14 @@ static double dispatch(jd_sim *s, int tid, double *t_pairs_end_out) {
     }
 #ifdef JD_ONE_FORCE_LOOP
     /* one copy of the loops, with the features as a run-time value: the sanitizer build
-     * (Makefile), where 32 inlined copies of the law under ASan+UBSan take minutes to compile;
-     * the same source, hence the same checks */
+     * (Makefile), which checks the code rather than its speed, compiles the law once instead of
+     * once per law set; the same source, hence the same checks */
     work = contact_loops(s, s->features & JD_F_ALL, tid, &t_pairs_end);
 #else
-    switch (s->features) {
-        JD_LAW_SETS(JD_FORCE_CASE)
-    default: /* not a law set (jd_law_set_select never returns one): the reference path */
+    if (!force_loops_without_energy(s, tid, &work, &t_pairs_end) &&
+        !sim_force_loops_energy(s, tid, &work, &t_pairs_end))
+        /* not a law set (jd_law_set_select never returns one): the reference path */
         work = plain_contact_loops(s, tid, &t_pairs_end);
-    }
 #endif
     if (tid == 0) *t_pairs_end_out = t_pairs_end;
     return work;
@@ -820,3 +854,4 @@ void sim_compute_forces(jd_sim *s) {
     s->timing.pairs += (t_pairs_end - t0) + (t1 - t_walls_end);
     s->timing.walls += t_walls_end - t_pairs_end;
 }
+#endif /* JD_FORCE_LOOPS_ENERGY */

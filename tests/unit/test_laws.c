@@ -217,6 +217,30 @@ static void law_sets_are_the_combinations_with_mu_r_and_mindlin_only_with_fricti
     assert_int_equal(jd_law_set_valid(ALL + 1), 0);
 }
 
+/* The compiled loops (JD_LAW_LOOPS) are the valid sets without a run-time law, and each valid
+ * law set runs in exactly one of them, whose law set inside is the run's own again. */
+#define COUNT_LOOP(bits)                              \
+    n_loops++;                                        \
+    assert_int_equal((bits) & JD_F_RUN_TIME, 0u);     \
+    assert_true(jd_law_set_valid(bits));
+#define MATCH_LOOP(bits) matches += (bits) == loop;
+static void every_law_set_runs_in_one_compiled_loop(void **state) {
+    (void)state;
+    int n_loops = 0;
+    JD_LAW_LOOPS(COUNT_LOOP)
+    assert_int_equal(n_loops, 24); /* 2 (energy) x (4 without friction + 8 with it) */
+    for (unsigned b = 0; b <= ALL; b++) {
+        if (!jd_law_set_valid(b)) continue;
+        const unsigned loop = jd_law_set_loop(b);
+        int matches = 0;
+        JD_LAW_LOOPS(MATCH_LOOP)
+        assert_int_equal(matches, 1);
+        assert_int_equal(jd_law_set_of_loop(loop, b), b);
+    }
+}
+#undef COUNT_LOOP
+#undef MATCH_LOOP
+
 static void law_set_select_counts_only_interactions_that_occur(void **state) {
     (void)state;
     /* materials: 0 and 1 for particles, 2 for walls only, 3 unused */
@@ -415,6 +439,7 @@ int run_laws_tests(void) {
         cmocka_unit_test(rolling_law_spring_and_cap),
         cmocka_unit_test(energy_law_books_work_and_luding_end),
         cmocka_unit_test(law_sets_are_the_combinations_with_mu_r_and_mindlin_only_with_friction),
+        cmocka_unit_test(every_law_set_runs_in_one_compiled_loop),
         cmocka_unit_test(law_set_select_counts_only_interactions_that_occur),
         cmocka_unit_test(law_set_names),
         cmocka_unit_test(pair_coeffs_table_maps_each_restitution),
