@@ -265,7 +265,8 @@ void FixWallJiangMesh::sphere_contacts(int im, int i, size_t first, size_t last,
     double f_prev[3] = {0.0, 0.0, 0.0};
     if (F & JD_F_ENERGY) jd_copy3(f_prev, hs.st->f_prev);
     jd_contact_result out;
-    const int carries = jd_contact(F, &co, &g[c], &k, update->dt, hs.st, hs.rs, &out);
+    const unsigned laws = jd_law_set_of_loop(F, pair->features()); /* with the run-time laws */
+    const int carries = jd_contact(laws, &co, &g[c], &k, update->dt, hs.st, hs.rs, &out);
     if (F & JD_F_ENERGY) {
       sums[4] += jd_wall_work(f_prev, out.f, k.vb, update->dt);
       jd_contact_harvest(hs.st, 1.0, &sums[0], &sums[1]);
