@@ -93,9 +93,9 @@ static int out_reserve(jd_bonds *b) {
 }
 
 /* Append an intact bond between particle indices i and j (a = the smaller id). */
-static int add_bond(jd_sim *s, int32_t i, int32_t j, int32_t type, int64_t step) {
-    jd_bonds *b = s->bonds;
-    if (sim_particle_id(s, (size_t)j) < sim_particle_id(s, (size_t)i)) {
+static int add_bond(jd_bonds *b, const jd_particles *ps, int32_t i, int32_t j, int32_t type,
+                    int64_t step) {
+    if (sim_particle_id(ps, (size_t)j) < sim_particle_id(ps, (size_t)i)) {
         const int32_t t = i;
         i = j;
         j = t;
@@ -112,7 +112,7 @@ static int add_bond(jd_sim *s, int32_t i, int32_t j, int32_t type, int64_t step)
     state_set(b, b->sw, k, &fresh);
     b->ever[i] = b->ever[j] = 1;
     b->formed[b->n_formed++] =
-        (jd_h5md_bond){{sim_particle_id(s, (size_t)i), sim_particle_id(s, (size_t)j)}, type, step};
+        (jd_h5md_bond){{sim_particle_id(ps, (size_t)i), sim_particle_id(ps, (size_t)j)}, type, step};
     return 0;
 }
 
@@ -125,16 +125,16 @@ static long index_of_id(const jd_scene *sc, int64_t id) {
     return lo < sc->n_particles && sc->id[lo] == id ? (long)lo : -1;
 }
 
-int sim_bonds_init(jd_sim *s, char *err, size_t errlen) {
-    const jd_scene *sc = s->scene;
+int sim_bonds_init(jd_bonds **bonds, const jd_particles *ps, const jd_scene *sc, char *err,
+                   size_t errlen) {
     if (!sc->n_bond_types) return 0;
     jd_bonds *b = calloc(1, sizeof *b);
-    if (!b || !(b->ever = calloc(s->n ? s->n : 1, 1))) {
+    if (!b || !(b->ever = calloc(ps->n ? ps->n : 1, 1))) {
         free(b);
         snprintf(err, errlen, "out of memory for the bonds");
         return -1;
     }
-    s->bonds = b;
+    *bonds = b;
     b->n_types = sc->n_bond_types;
     jd_bond_params *p = malloc(b->n_types * sizeof *p);
     if (!p) goto oom;
@@ -146,17 +146,18 @@ int sim_bonds_init(jd_sim *s, char *err, size_t errlen) {
     }
     b->params = p;
     int one_radius = 1;
-    for (size_t i = 1; i < s->n; i++) one_radius &= s->radius[i] == s->radius[0];
-    if (one_radius && s->n) {
+    for (size_t i = 1; i < ps->n; i++) one_radius &= ps->radius[i] == ps->radius[0];
+    if (one_radius && ps->n) {
         jd_bond_section *sec = malloc(b->n_types * sizeof *sec);
         if (!sec) goto oom;
-        for (size_t t = 0; t < b->n_types; t++) sec[t] = jd_bond_section_of(p[t].lambda, s->radius[0], s->radius[0]);
+        for (size_t t = 0; t < b->n_types; t++)
+            sec[t] = jd_bond_section_of(p[t].lambda, ps->radius[0], ps->radius[0]);
         b->sec_type = sec;
     }
     for (size_t k = 0; k < sc->n_bonds; k++) {
         /* indices equal ids' positions: the scene's particles are sorted by id */
         const long i = index_of_id(sc, sc->bond_ids[2 * k]), j = index_of_id(sc, sc->bond_ids[2 * k + 1]);
-        if (i < 0 || j < 0 || add_bond(s, (int32_t)i, (int32_t)j, sc->bond_type[k], 0)) goto oom;
+        if (i < 0 || j < 0 || add_bond(b, ps, (int32_t)i, (int32_t)j, sc->bond_type[k], 0)) goto oom;
     }
     fit(b);
     return 0;
@@ -165,8 +166,8 @@ oom:
     return -1;
 }
 
-void sim_bonds_free(jd_sim *s) {
-    jd_bonds *b = s->bonds;
+void sim_bonds_free(jd_bonds **bonds) {
+    jd_bonds *b = *bonds;
     if (!b) return;
     free((void *)b->params);
     free((void *)b->sec_type);
@@ -179,7 +180,7 @@ void sim_bonds_free(jd_sim *s) {
     free(b->formed);
     free(b->events);
     free(b);
-    s->bonds = NULL;
+    *bonds = NULL;
 }
 
 size_t sim_bonds_memory_bytes(const jd_bonds *b, size_t n_particles) {
@@ -202,24 +203,24 @@ static int by_pair(const void *x, const void *y) {
 /* Bond the pairs of one rule that are not bonded already (intact).  Out of memory is recorded
  * in b->failed and stops the run at the next sim_bonds_output. */
 /* Positions in scene order (x, 3n) and where[p]: the engine index of scene particle p. */
-static void positions_in_scene_order(const jd_sim *s, double *x, int32_t *where) {
-    for (size_t i = 0; i < s->n; i++) {
-        const size_t p = (size_t)s->orig[i];
-        for (int d = 0; d < 3; d++) x[3 * p + d] = s->x[3 * i + d];
+static void positions_in_scene_order(const jd_particles *ps, double *x, int32_t *where) {
+    for (size_t i = 0; i < ps->n; i++) {
+        const size_t p = (size_t)ps->orig[i];
+        for (int d = 0; d < 3; d++) x[3 * p + d] = ps->x[3 * i + d];
         where[p] = (int32_t)i;
     }
 }
 
-static void apply_rule(jd_sim *s, const jd_bond_rule *rule, int64_t step) {
-    jd_bonds *b = s->bonds;
+static void apply_rule(jd_bonds *b, const jd_particles *ps, const jd_scene *sc,
+                       const jd_bond_rule *rule, int64_t step) {
     int32_t *pairs = NULL;
     /* the rule is evaluated in the scene's particle order (the engine renumbers the particles,
      * reorder.c): positions into it, the pairs' indices back */
-    const size_t n1 = s->n ? s->n : 1;
+    const size_t n1 = ps->n ? ps->n : 1;
     double *x = malloc(3 * n1 * sizeof *x);
     int32_t *where = malloc(n1 * sizeof *where);
-    const long np = x && where ? (positions_in_scene_order(s, x, where),
-                                  jd_bond_rule_pairs(s->scene, rule, x, &pairs))
+    const long np = x && where ? (positions_in_scene_order(ps, x, where),
+                                  jd_bond_rule_pairs(sc, rule, x, &pairs))
                                : -1;
     for (long q = 0; q < 2 * np; q++) pairs[q] = where[pairs[q]];
     free(x);
@@ -239,7 +240,7 @@ static void apply_rule(jd_sim *s, const jd_bond_rule *rule, int64_t step) {
     for (long p = 0; p < np; p++) {
         const int32_t i = pairs[2 * p], j = pairs[2 * p + 1];
         const int32_t key[2] = {i < j ? i : j, i < j ? j : i};
-        if (!bsearch(key, have, b->n, 2 * sizeof *have, by_pair) && add_bond(s, i, j, rule->type, step)) {
+        if (!bsearch(key, have, b->n, 2 * sizeof *have, by_pair) && add_bond(b, ps, i, j, rule->type, step)) {
             b->failed = "out of memory forming the bonds of a rule";
             break;
         }
@@ -252,20 +253,20 @@ static void apply_rule(jd_sim *s, const jd_bond_rule *rule, int64_t step) {
 /* ---------------------------------------------------------------------------------------- */
 /* The bond loop                                                                             */
 
-/* A broken bond's event; xc: the bond point x_C at failure [m]. */
-static void record_break(jd_sim *s, size_t k, const jd_bond_result *out, const double xc[3],
-                         int64_t step) {
-    jd_bonds *b = s->bonds;
+/* A broken bond's event; xc: the bond point x_C at failure [m]; dt: the run's [s]; none at step
+ * 0 (in_setup). */
+static void record_break(jd_bonds *b, const jd_particles *ps, double dt, int in_setup, size_t k,
+                         const jd_bond_result *out, const double xc[3], int64_t step) {
     b->n_broken[out->mode]++;
-    if (s->in_setup) return;
+    if (in_setup) return;
     if (grow((void **)&b->events, &b->events_cap, b->n_events + 1, sizeof *b->events)) {
         b->failed = "out of memory recording a broken bond";
         return;
     }
     jd_h5md_bond_break *e = &b->events[b->n_events++];
     const int32_t i = b->i[k], j = b->j[k];
-    *e = (jd_h5md_bond_break){.step = step, .time = (double)step * s->dt,
-                              .id = {sim_particle_id(s, (size_t)i), sim_particle_id(s, (size_t)j)},
+    *e = (jd_h5md_bond_break){.step = step, .time = (double)step * dt,
+                              .id = {sim_particle_id(ps, (size_t)i), sim_particle_id(ps, (size_t)j)},
                               .mode = out->mode,
                               .normal_force = out->fn, .shear_force = out->ft,
                               .twisting_moment = out->mn, .bending_moment = out->mt,
@@ -276,23 +277,23 @@ static void record_break(jd_sim *s, size_t k, const jd_bond_result *out, const d
 /* Evaluate bond k (state updated in place).  Returns the kernel's mode, or -1 when the centres
  * coincide (no direction: skipped; the contact watchdog reports it).  xc: the bond point, set
  * only when the bond failed. */
-static JD_ALWAYS_INLINE int bond_eval(jd_sim *s, const unsigned F, const double dt, size_t k,
-                                      jd_bond_result *out, double xc[3]) {
-    jd_bonds *b = s->bonds;
+static JD_ALWAYS_INLINE int bond_eval(jd_bonds *b, const jd_particles *ps, const unsigned F,
+                                      const double dt, size_t k, jd_bond_result *out,
+                                      double xc[3]) {
     const int sw = jd_bond_record_len(F); /* = b->sw */
     const int32_t i = b->i[k], j = b->j[k];
     jd_bond_geom g;
-    if (!jd_bond_geom_spheres(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
-                              s->radius[j], &g))
+    if (!jd_bond_geom_spheres(ps->x + 3 * (size_t)i, ps->radius[i], ps->x + 3 * (size_t)j,
+                              ps->radius[j], &g))
         return -1;
     const jd_bond_params *p = &b->params[b->type[k]];
     g.sec = b->sec_type ? b->sec_type[b->type[k]]
-                        : jd_bond_section_of(p->lambda, s->radius[i], s->radius[j]);
+                        : jd_bond_section_of(p->lambda, ps->radius[i], ps->radius[j]);
     if (F & JD_B_DAMPING)
-        jd_bond_set_masses(&g, s->mass[i], s->mass[j], s->inertia[i], s->inertia[j]);
+        jd_bond_set_masses(&g, ps->mass[i], ps->mass[j], ps->inertia[i], ps->inertia[j]);
     jd_kinematics kin;
-    const double *va = s->v + 3 * (size_t)i, *wa = s->omega + 3 * (size_t)i;
-    const double *vb = s->v + 3 * (size_t)j, *wb = s->omega + 3 * (size_t)j;
+    const double *va = ps->v + 3 * (size_t)i, *wa = ps->omega + 3 * (size_t)i;
+    const double *vb = ps->v + 3 * (size_t)j, *wb = ps->omega + 3 * (size_t)j;
     for (int d = 0; d < 3; d++) {
         kin.va[d] = va[d];
         kin.wa[d] = wa[d];
@@ -303,7 +304,7 @@ static JD_ALWAYS_INLINE int bond_eval(jd_sim *s, const unsigned F, const double 
     const int mode = jd_bond(F, p, &g, &kin, dt, &st, out);
     state_set(b, sw, k, &st);
     if (mode != JD_BOND_INTACT)
-        for (int d = 0; d < 3; d++) xc[d] = s->x[3 * (size_t)i + d] + g.ra[d];
+        for (int d = 0; d < 3; d++) xc[d] = ps->x[3 * (size_t)i + d] + g.ra[d];
     return mode;
 }
 
@@ -321,22 +322,22 @@ static inline void bond_add(double *f, double *t, int32_t i, int32_t j, const do
 }
 
 /* One thread: evaluate and add as it goes.  Returns the number of bonds that broke. */
-static JD_ALWAYS_INLINE size_t bond_loop(jd_sim *s, const unsigned F, int64_t step) {
-    jd_bonds *b = s->bonds;
+static JD_ALWAYS_INLINE size_t bond_loop(jd_bonds *b, jd_particles *ps, double run_dt, int in_setup,
+                                         const unsigned F, int64_t step) {
     /* Step 0 (LIGGGHTS `setup`): no increment, the force is the stored one (bonds.h) */
-    const double dt = s->in_setup ? 0.0 : s->dt;
+    const double dt = in_setup ? 0.0 : run_dt;
     size_t broke = 0;
     for (size_t k = 0; k < b->n; k++) {
         jd_bond_result out;
         double xc[3];
-        const int mode = bond_eval(s, F, dt, k, &out, xc);
+        const int mode = bond_eval(b, ps, F, dt, k, &out, xc);
         if (mode < 0) continue;
         if (mode != JD_BOND_INTACT) {
-            record_break(s, k, &out, xc, step);
+            record_break(b, ps, run_dt, in_setup, k, &out, xc, step);
             broke++;
             continue;
         }
-        bond_add(s->f, s->torque, b->i[k], b->j[k], out.f, out.ta, out.tb);
+        bond_add(ps->f, ps->torque, b->i[k], b->j[k], out.f, out.ta, out.tb);
     }
     return broke;
 }
@@ -346,9 +347,9 @@ static JD_ALWAYS_INLINE size_t bond_loop(jd_sim *s, const unsigned F, int64_t st
  * bonds' forces to the particles it owns (jd_thread_share), scanning the bonds in order, so that
  * every particle's sum has the one-thread order: the same bits for any thread count.  The
  * breaks are recorded afterwards, in bond order (bond_breaks). */
-static JD_ALWAYS_INLINE void bond_loop_threads(jd_sim *s, const unsigned F, int tid) {
-    jd_bonds *b = s->bonds;
-    const double dt = s->in_setup ? 0.0 : s->dt;
+static JD_ALWAYS_INLINE void bond_loop_threads(jd_bonds *b, jd_particles *ps,
+                                               const jd_thread_share *share, double dt,
+                                               const unsigned F) {
     jd_bond_out *o = b->out;
     const long n = (long)b->n;
 #ifdef _OPENMP
@@ -357,7 +358,7 @@ static JD_ALWAYS_INLINE void bond_loop_threads(jd_sim *s, const unsigned F, int 
     for (long k = 0; k < n; k++) {
         jd_bond_result r;
         double xc[3];
-        o[k].mode = bond_eval(s, F, dt, (size_t)k, &r, xc);
+        o[k].mode = bond_eval(b, ps, F, dt, (size_t)k, &r, xc);
         if (o[k].mode == JD_BOND_INTACT) {
             for (int d = 0; d < 3; d++) {
                 o[k].force.f[d] = r.f[d];
@@ -369,27 +370,27 @@ static JD_ALWAYS_INLINE void bond_loop_threads(jd_sim *s, const unsigned F, int 
             for (int d = 0; d < 3; d++) o[k].broke.xc[d] = xc[d];
         }
     }
-    const size_t lo = s->shares[tid].p_lo, hi = s->shares[tid].p_hi;
+    const size_t lo = share->p_lo, hi = share->p_hi;
     for (long k = 0; k < n; k++) {
         if (o[k].mode != JD_BOND_INTACT) continue;
         const size_t i = (size_t)b->i[k], j = (size_t)b->j[k];
         const double *fb = o[k].force.f;
         if (i >= lo && i < hi)
             for (int d = 0; d < 3; d++) {
-                s->f[3 * i + d] -= fb[d];
-                s->torque[3 * i + d] += o[k].force.ta[d];
+                ps->f[3 * i + d] -= fb[d];
+                ps->torque[3 * i + d] += o[k].force.ta[d];
             }
         if (j >= lo && j < hi)
             for (int d = 0; d < 3; d++) {
-                s->f[3 * j + d] += fb[d];
-                s->torque[3 * j + d] += o[k].force.tb[d];
+                ps->f[3 * j + d] += fb[d];
+                ps->torque[3 * j + d] += o[k].force.tb[d];
             }
     }
 }
 
 /* The breaks the threaded loop found, in bond order; returns their number. */
-static size_t bond_breaks(jd_sim *s, int64_t step) {
-    jd_bonds *b = s->bonds;
+static size_t bond_breaks(jd_bonds *b, const jd_particles *ps, double dt, int in_setup,
+                          int64_t step) {
     size_t broke = 0;
     for (size_t k = 0; k < b->n; k++) {
         const jd_bond_out *o = &b->out[k];
@@ -398,7 +399,7 @@ static size_t bond_breaks(jd_sim *s, int64_t step) {
         const jd_bond_result r = {.fn = q->fn, .ft = q->ft, .mn = q->mn, .mt = q->mt,
                                   .sigma_max = q->sigma_max, .tau_max = q->tau_max,
                                   .mode = o->mode};
-        record_break(s, k, &r, o->broke.xc, step);
+        record_break(b, ps, dt, in_setup, k, &r, o->broke.xc, step);
         broke++;
     }
     return broke;
@@ -424,15 +425,15 @@ static void compact(jd_bonds *b) {
     b->n = w;
 }
 
-void sim_bonds_forces(jd_sim *s) {
-    jd_bonds *b = s->bonds;
-    const jd_scene *sc = s->scene;
-    const int64_t step = s->step + (s->in_setup ? 0 : 1); /* the step whose forces these are */
-    while (!s->in_setup && b->next_rule < sc->n_bond_rules &&
+void sim_bonds_forces(jd_bonds *b, jd_particles *ps, const jd_run_constants *run,
+                      const jd_thread_layout *threads, int64_t steps_done, int in_setup) {
+    const jd_scene *sc = run->scene;
+    const int64_t step = steps_done + (in_setup ? 0 : 1); /* the step whose forces these are */
+    while (!in_setup && b->next_rule < sc->n_bond_rules &&
            sc->bond_rules[b->next_rule].step <= step)
-        apply_rule(s, &sc->bond_rules[b->next_rule++], step);
+        apply_rule(b, ps, sc, &sc->bond_rules[b->next_rule++], step);
     size_t broke = 0;
-    if (s->threads > 1 && b->n > 0) {
+    if (threads->n > 1 && b->n > 0) {
         if (out_reserve(b) != 0) {
             b->failed = "out of memory for the threaded bond loop";
             return;
@@ -440,7 +441,7 @@ void sim_bonds_forces(jd_sim *s) {
         /* the region around the switch, so that each copy of the loop has its features as a
          * literal (a region inside a copy would pass them to its threads as a value) */
 #ifdef _OPENMP
-#pragma omp parallel num_threads(s->threads)
+#pragma omp parallel num_threads(threads->n)
 #endif
         {
 #ifdef _OPENMP
@@ -450,7 +451,7 @@ void sim_bonds_forces(jd_sim *s) {
 #endif
 #define JD_BOND_LOOP_THREADS(bits) \
     case (bits):                   \
-        bond_loop_threads(s, (bits), tid); \
+        bond_loop_threads(b, ps, &threads->shares[tid], in_setup ? 0.0 : run->dt, (bits)); \
         break;
             switch (b->features) {
                 JD_BOND_LAW_SETS(JD_BOND_LOOP_THREADS)
@@ -459,11 +460,11 @@ void sim_bonds_forces(jd_sim *s) {
             }
 #undef JD_BOND_LOOP_THREADS
         }
-        broke = bond_breaks(s, step);
+        broke = bond_breaks(b, ps, run->dt, in_setup, step);
     } else {
 #define JD_BOND_LOOP(bits)                  \
     case (bits):                            \
-        broke = bond_loop(s, (bits), step); \
+        broke = bond_loop(b, ps, run->dt, in_setup, (bits), step); \
         break;
         switch (b->features) {
             JD_BOND_LAW_SETS(JD_BOND_LOOP)
@@ -472,7 +473,7 @@ void sim_bonds_forces(jd_sim *s) {
         }
 #undef JD_BOND_LOOP
     }
-    if (broke && !s->in_setup) compact(b);
+    if (broke && !in_setup) compact(b);
 }
 
 /* ---------------------------------------------------------------------------------------- */
@@ -485,17 +486,16 @@ static int by_event(const void *x, const void *y) {
     return p->id[1] < q->id[1] ? -1 : p->id[1] > q->id[1];
 }
 
-int sim_bonds_output(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
-    jd_bonds *b = s->bonds;
+int sim_bonds_output(jd_bonds *b, int64_t step, jd_h5md *h, char *err, size_t errlen) {
     if (b->failed) {
-        snprintf(err, errlen, "step %lld: %s", (long long)s->step, b->failed);
+        snprintf(err, errlen, "step %lld: %s", (long long)step, b->failed);
         return -1;
     }
     if (b->n_events) qsort(b->events, b->n_events, sizeof *b->events, by_event);
     int rc = 0; /* step 0 creates the (possibly empty) datasets */
-    if (h && (b->n_formed || s->step == 0))
+    if (h && (b->n_formed || step == 0))
         rc = jd_h5md_write_bonds(h, b->n_formed, b->formed, err, errlen);
-    if (h && rc == 0 && (b->n_events || s->step == 0))
+    if (h && rc == 0 && (b->n_events || step == 0))
         rc = jd_h5md_write_bond_breaks(h, b->n_events, b->events, err, errlen);
     b->n_formed = b->n_events = 0;
     /* a scene's bonds all form in one step (step 0, or a rule's): do not keep their records'
@@ -516,8 +516,7 @@ static int32_t find(int32_t *parent, int32_t x) {
     return x;
 }
 
-void sim_bonds_observables(const jd_sim *s, jd_bond_observables *o) {
-    const jd_bonds *b = s->bonds;
+void sim_bonds_observables(const jd_bonds *b, size_t n_particles, jd_bond_observables *o) {
     *o = (jd_bond_observables){.bonds = (double)b->n,
                                .damping_dissipation = b->e_damp_dropped,
                                .breakage_energy = b->e_break_dropped};
@@ -527,12 +526,12 @@ void sim_bonds_observables(const jd_sim *s, jd_bond_observables *o) {
         jd_bond_harvest(&st, &o->damping_dissipation, &o->breakage_energy);
     }
     /* fragments: union-find over the intact bonds; components among the particles ever bonded */
-    int32_t *parent = malloc((s->n ? s->n : 1) * sizeof *parent);
+    int32_t *parent = malloc((n_particles ? n_particles : 1) * sizeof *parent);
     if (!parent) {
         o->fragments = NAN;
         return;
     }
-    for (size_t i = 0; i < s->n; i++) parent[i] = (int32_t)i;
+    for (size_t i = 0; i < n_particles; i++) parent[i] = (int32_t)i;
     size_t merges = 0, ever = 0;
     for (size_t k = 0; k < b->n; k++) {
         const int32_t x = find(parent, b->i[k]), y = find(parent, b->j[k]);
@@ -541,7 +540,7 @@ void sim_bonds_observables(const jd_sim *s, jd_bond_observables *o) {
             merges++;
         }
     }
-    for (size_t i = 0; i < s->n; i++) ever += b->ever[i];
+    for (size_t i = 0; i < n_particles; i++) ever += b->ever[i];
     o->fragments = (double)(ever - merges);
     free(parent);
 }

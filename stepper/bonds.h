@@ -21,7 +21,9 @@
 #include "jdem_laws.h"
 #include "jdem_observable_names.h"
 
-struct jd_sim;
+struct jd_particles;
+struct jd_run_constants;
+struct jd_thread_layout;
 struct jd_scene;
 
 /* A bond's state is the kernel's record (jdem_laws.h, jd_bond_record_len: without the energy
@@ -91,25 +93,29 @@ typedef struct jd_bond_observables {
 /* The values in the order of jd_bond_observable_names (kernel/jdem_observables.h). */
 void sim_bond_observables_values(const jd_bond_observables *o, double out[JD_N_BOND_OBSERVABLES]);
 
-/* Set up s->bonds from the scene (NULL when the scene has no bond types).  0 or -1 with err. */
-int sim_bonds_init(struct jd_sim *s, char *err, size_t errlen);
-void sim_bonds_free(struct jd_sim *s);
+/* Set up *bonds from the scene and its particles ps (NULL when the scene has no bond types).  0
+ * or -1 with err. */
+int sim_bonds_init(jd_bonds **bonds, const struct jd_particles *ps, const struct jd_scene *sc,
+                   char *err, size_t errlen);
+void sim_bonds_free(jd_bonds **bonds);
 /* Bytes the bonds hold (the bond arrays at their capacity, the output not yet written); 0 for
  * NULL. */
 size_t sim_bonds_memory_bytes(const jd_bonds *b, size_t n_particles);
 
-/* Form the bonds of rules due at the step being computed (s->step + 1), then add every intact
- * bond's force and torques to s->f and s->torque.  Called by sim_compute_forces.  At step 0
- * (s->in_setup, LIGGGHTS `setup`) the bonds are evaluated with dt = 0: no increment, the force
+/* Form the bonds of rules due at the step being computed (steps_done + 1), then add every intact
+ * bond's force and torques to ps->f and ps->torque.  Called by sim_compute_forces.  At step 0
+ * (in_setup, LIGGGHTS `setup`) the bonds are evaluated with dt = 0: no increment, the force
  * is the stored one (zero for a new bond) plus the dashpots, and no rule is applied. */
-void sim_bonds_forces(struct jd_sim *s);
+void sim_bonds_forces(jd_bonds *b, struct jd_particles *ps, const struct jd_run_constants *run,
+                      const struct jd_thread_layout *threads, int64_t steps_done, int in_setup);
 
 /* Write the bonds formed and the bonds broken since the last call to /connectivity (h may be
  * NULL: only forget them).  0; JD_RUN_OUTPUT with err on a write error; -1 with err when the
  * bond loop ran out of memory. */
-int sim_bonds_output(struct jd_sim *s, jd_h5md *h, char *err, size_t errlen);
+int sim_bonds_output(jd_bonds *b, int64_t step, jd_h5md *h, char *err, size_t errlen);
 
-void sim_bonds_observables(const struct jd_sim *s, jd_bond_observables *o);
+/* The bond observables of a set of n_particles particles. */
+void sim_bonds_observables(const jd_bonds *b, size_t n_particles, jd_bond_observables *o);
 
 /* Remap the particle indices after a re-sort (reorder.c): particle k < n is now new_index[k]. */
 void sim_bonds_permute(jd_bonds *b, const int32_t *new_index, size_t n);

@@ -47,9 +47,9 @@ typedef struct acc {
     size_t hi, span;
 } acc;
 
-static acc acc_of(const jd_sim *s, int tid) {
-    const jd_thread_share *h = &s->shares[tid];
-    return (acc){s->f, s->torque, h->ovf, h->ovf + 3 * h->cap, h->p_hi, h->span};
+static acc acc_of(const jd_particles *ps, const jd_thread_layout *threads, int tid) {
+    const jd_thread_share *h = &threads->shares[tid];
+    return (acc){ps->f, ps->torque, h->ovf, h->ovf + 3 * h->cap, h->p_hi, h->span};
 }
 
 /* History widths of a law set (the kernel's records, jdem_laws.h), compile-time constants in the
@@ -174,16 +174,16 @@ static JD_ALWAYS_INLINE void lane_history_write(const unsigned F, const batch *B
 
 #ifndef JD_FORCE_LOOPS_ENERGY
 /* The force loops' per-thread state (sim_init). */
-int sim_forces_init(jd_sim *s) {
-    s->shares = calloc((size_t)s->threads, sizeof *s->shares);
-    s->trips = calloc((size_t)s->threads, sizeof *s->trips);
-    return !s->shares || !s->trips ? -1 : 0;
+int sim_forces_init(jd_thread_layout *threads) {
+    threads->shares = calloc((size_t)threads->n, sizeof *threads->shares);
+    threads->trips = calloc((size_t)threads->n, sizeof *threads->trips);
+    return !threads->shares || !threads->trips ? -1 : 0;
 }
 
-void sim_forces_free(jd_sim *s) {
-    for (int t = 0; s->shares && t < s->threads; t++) free(s->shares[t].ovf);
-    free(s->shares);
-    free(s->trips);
+void sim_forces_free(jd_thread_layout *threads) {
+    for (int t = 0; threads->shares && t < threads->n; t++) free(threads->shares[t].ovf);
+    free(threads->shares);
+    free(threads->trips);
 }
 
 /* First entry in [lo, hi) of list l with i >= p (a sorted run of the list). */
@@ -206,24 +206,24 @@ enum { COST_TOUCH = 4, COST_NEAR = 2, COST_WALL = 7 };
 /* The threads' shares of the current lists (sim.h, "Threads"): contiguous particle ranges of
  * about equal estimated cost, the entries of their particles in each sorted run of the lists,
  * and overflow buffers large enough for the partners past each range. */
-int sim_forces_partition(jd_sim *s) {
-    const int nt = s->threads;
-    const jd_contact_list *P = &s->pairs, *W = &s->wall_pairs;
+int sim_forces_partition(jd_thread_layout *threads, const jd_neighbour_lists *lists, size_t n) {
+    const int nt = threads->n;
+    const jd_contact_list *P = &lists->pairs, *W = &lists->wall_pairs;
     const size_t total = COST_TOUCH * P->n_touch + COST_NEAR * (P->n - P->n_touch) + COST_WALL * W->n;
     /* thread t begins after the particle where the running cost passes t / nt of the total */
     size_t a = 0, q = P->n_touch, w = 0, cost = 0;
     int t = 1;
-    s->shares[0].p_lo = 0;
-    for (size_t p = 0; p < s->n && t < nt; p++) {
+    threads->shares[0].p_lo = 0;
+    for (size_t p = 0; p < n && t < nt; p++) {
         for (; a < P->n_touch && (size_t)P->i[a] == p; a++) cost += COST_TOUCH;
         for (; q < P->n && (size_t)P->i[q] == p; q++) cost += COST_NEAR;
         for (; w < W->n && (size_t)W->i[w] == p; w++) cost += COST_WALL;
-        for (; t < nt && cost * (size_t)nt >= total * (size_t)t; t++) s->shares[t].p_lo = p + 1;
+        for (; t < nt && cost * (size_t)nt >= total * (size_t)t; t++) threads->shares[t].p_lo = p + 1;
     }
-    for (; t < nt; t++) s->shares[t].p_lo = s->n;
+    for (; t < nt; t++) threads->shares[t].p_lo = n;
     for (t = 0; t < nt; t++) {
-        jd_thread_share *h = &s->shares[t];
-        h->p_hi = t + 1 < nt ? s->shares[t + 1].p_lo : s->n;
+        jd_thread_share *h = &threads->shares[t];
+        h->p_hi = t + 1 < nt ? threads->shares[t + 1].p_lo : n;
         h->pair_lo = first_entry_of(P, 0, P->n_touch, h->p_lo);
         h->pair_hi = first_entry_of(P, h->pair_lo, P->n_touch, h->p_hi);
         h->near_lo = first_entry_of(P, P->n_touch, P->n, h->p_lo);
@@ -285,29 +285,30 @@ static JD_ALWAYS_INLINE void sphere_test(const double *restrict x, const double 
  * loop's.  The SIMD loops write only the batch (stores to the list there would be stores the
  * compiler cannot tell apart from the particle arrays it gathers from); the history goes to the
  * list in a loop of its own.  The kernel's geometry and law have no data-dependent branches. */
-static JD_ALWAYS_INLINE int batch_evaluate(jd_sim *s, const unsigned F, const int kinds,
-                                           const int packed, batch *restrict B, size_t c0, int nb) {
-    jd_contact_list *L = &s->pairs;
-    const double *restrict x = s->x, *restrict v = s->v, *restrict w = s->omega,
-                           *restrict rad = s->radius;
+static JD_ALWAYS_INLINE int batch_evaluate(const jd_particles *ps, const jd_run_constants *run,
+                                           const jd_fast_paths *fast, jd_contact_list *L,
+                                           const unsigned F, const int kinds, const int packed,
+                                           batch *restrict B, size_t c0, int nb) {
+    const double *restrict x = ps->x, *restrict v = ps->v, *restrict w = ps->omega,
+                           *restrict rad = ps->radius;
     double *hist = L->hist, *rhist = L->rhist;
     const int32_t *restrict li = L->i + c0, *restrict lj = L->j + c0;
-    const double *restrict kp = s->kp, *restrict mass = s->mass, *restrict inertia = s->inertia;
-    const size_t nm = s->n_materials;
-    const jd_pair_coeffs *restrict coeffs = s->coeffs;
-    const int32_t *restrict species = s->species;
-    const double dt = s->dt, max_overlap = s->max_overlap;
+    const double *restrict kp = ps->kp, *restrict mass = ps->mass, *restrict inertia = ps->inertia;
+    const size_t nm = run->n_materials;
+    const jd_pair_coeffs *restrict coeffs = run->coeffs;
+    const int32_t *restrict species = ps->species;
+    const double dt = run->dt, max_overlap = run->max_overlap;
     /* what is the same for every lane, loaded once: saves gathers and the per-pair reads */
     const int one_row = kinds != JD_KINDS_ANY, alike = kinds == JD_KINDS_ALIKE;
-    const jd_pair_const pc1 = s->pc_alike;
-    const jd_pair_const_roll pcr1 = s->pcr_alike;
-    const double r1 = s->r_alike;
+    const jd_pair_const pc1 = fast->pc_alike;
+    const jd_pair_const_roll pcr1 = fast->pcr_alike;
+    const double r1 = fast->r_alike;
     int m = nb;
     if (packed) {
         /* this copy serves any particles; a bed of alike ones still takes the radius sum from
          * the scene rather than from two gathers per entry */
-        if (s->alike)
-            sphere_test(x, NULL, s->r_alike + s->r_alike, 1, li, lj, B, nb);
+        if (fast->alike)
+            sphere_test(x, NULL, fast->r_alike + fast->r_alike, 1, li, lj, B, nb);
         else
             sphere_test(x, rad, 0.0, 0, li, lj, B, nb);
         m = 0;
@@ -334,7 +335,7 @@ static JD_ALWAYS_INLINE int batch_evaluate(jd_sim *s, const unsigned F, const in
             jd_geom_pair_material(F, &g, kp[i], kp[j], mass[i], mass[j], inertia[i], inertia[j]);
             g.r_roll = (F & JD_F_READS_R_STAR) ? jd_rolling_radius(ri, rj) : 0.0;
         }
-        const int32_t k_co = one_row ? s->pair_row : species[i] * (int32_t)nm + species[j];
+        const int32_t k_co = one_row ? fast->pair_row : species[i] * (int32_t)nm + species[j];
         const jd_pair_coeffs co = coeffs[k_co];
         jd_kinematics k;
         for (int d = 0; d < 3; d++) {
@@ -370,7 +371,7 @@ static JD_ALWAYS_INLINE int batch_evaluate(jd_sim *s, const unsigned F, const in
  * carry no force are dropped first, also without a branch (a third of the candidates of a
  * settled bed do not touch, in no predictable pattern).  One copy for every law set, not
  * inlined: on its own the loop keeps its pointers in registers. */
-static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, int nb,
+static JD_NOINLINE void batch_scatter(const double *radius, const batch *restrict B, int nb,
                                       double *restrict f, double *restrict t, double *restrict of,
                                       double *restrict ot, size_t hi, jd_overlap_trip *trip) {
     int32_t live[JD_BATCH];
@@ -380,7 +381,7 @@ static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, 
         m += B->carries[b];
         if (B->excessive[b]) {
             const int32_t i = B->i[b], j = B->j[b];
-            sim_watchdog_overlap(trip, i, j, B->delta[b], fmin(s->radius[i], s->radius[j]));
+            sim_watchdog_overlap(trip, i, j, B->delta[b], fmin(radius[i], radius[j]));
         }
     }
     for (int q = 0; q < m; q++) {
@@ -421,17 +422,17 @@ static JD_NOINLINE void batch_scatter(const jd_sim *s, const batch *restrict B, 
  * to write), and advance *done.  packed (a literal; the entries that did not touch at the
  * build): x alone, which the sphere test reads for every entry; the few entries that pass it
  * are not worth four more lines per particle (docs/performance.md). */
-static JD_ALWAYS_INLINE void prefetch_particles(const jd_sim *s, const int packed, size_t *done,
+static JD_ALWAYS_INLINE void prefetch_particles(const jd_particles *ps, const int packed, size_t *done,
                                                 size_t upto) {
-    if (upto > s->n) upto = s->n;
+    if (upto > ps->n) upto = ps->n;
     if (upto <= *done) return;
     for (size_t k = (3 * *done) & ~(size_t)7; k < 3 * upto; k += 8) {
-        __builtin_prefetch(s->x + k, 0, 3);
+        __builtin_prefetch(ps->x + k, 0, 3);
         if (packed) continue;
-        __builtin_prefetch(s->v + k, 0, 3);
-        __builtin_prefetch(s->omega + k, 0, 3);
-        __builtin_prefetch(s->f + k, 1, 3);
-        __builtin_prefetch(s->torque + k, 1, 3);
+        __builtin_prefetch(ps->v + k, 0, 3);
+        __builtin_prefetch(ps->omega + k, 0, 3);
+        __builtin_prefetch(ps->f + k, 1, 3);
+        __builtin_prefetch(ps->torque + k, 1, 3);
     }
     *done = upto;
 }
@@ -456,19 +457,20 @@ static JD_ALWAYS_INLINE void prefetch_entries(const jd_contact_list *L, const un
  * evaluated (SIMD) and scattered back.  kinds: a literal JD_KINDS_*; packed: a literal, 1 for
  * the entries that did not touch at the build (batch_evaluate).  Each contact's arithmetic is exactly that of a plain loop over
  * the list calling jd_geom_spheres_contact and jd_contact. */
-static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int kinds,
-                                       const int packed, size_t c0, size_t c1, acc a,
-                                       jd_overlap_trip *trip) {
+static JD_ALWAYS_INLINE void pair_loop(const jd_particles *ps, const jd_run_constants *run,
+                                       const jd_fast_paths *fast, jd_contact_list *L,
+                                       const unsigned F, const int kinds, const int packed,
+                                       size_t c0, size_t c1, acc a, jd_overlap_trip *trip) {
     batch lanes; /* on the stack: the compiler then knows that no list or particle array aliases it */
-    size_t pf = c0 < c1 ? (size_t)s->pairs.i[c0] : 0;
+    size_t pf = c0 < c1 ? (size_t)L->i[c0] : 0;
     for (size_t c = c0; c < c1; c += JD_BATCH) {
         const int nb = c1 - c < JD_BATCH ? (int)(c1 - c) : JD_BATCH;
-        if (s->n >= JD_PREFETCH_MIN_N)
-            prefetch_particles(s, packed, &pf,
-                               (size_t)s->pairs.i[c + (size_t)nb - 1] + a.span + JD_PREFETCH_AHEAD);
-        if (c + JD_ENTRIES_AHEAD + JD_BATCH <= c1) prefetch_entries(&s->pairs, F, c + JD_ENTRIES_AHEAD);
-        const int m = batch_evaluate(s, F, kinds, packed, &lanes, c, nb);
-        batch_scatter(s, &lanes, m, a.f, a.t, a.of, a.ot, a.hi, trip);
+        if (ps->n >= JD_PREFETCH_MIN_N)
+            prefetch_particles(ps, packed, &pf,
+                               (size_t)L->i[c + (size_t)nb - 1] + a.span + JD_PREFETCH_AHEAD);
+        if (c + JD_ENTRIES_AHEAD + JD_BATCH <= c1) prefetch_entries(L, F, c + JD_ENTRIES_AHEAD);
+        const int m = batch_evaluate(ps, run, fast, L, F, kinds, packed, &lanes, c, nb);
+        batch_scatter(ps->radius, &lanes, m, a.f, a.t, a.of, a.ot, a.hi, trip);
     }
 }
 
@@ -478,28 +480,29 @@ static JD_ALWAYS_INLINE void pair_loop(jd_sim *s, const unsigned F, const int ki
 #define JD_WALL_AHEAD 16
 
 /* Prefetch what the wall loop reads and writes of particle i. */
-static JD_ALWAYS_INLINE void prefetch_wall_particle(const jd_sim *s, size_t i) {
-    __builtin_prefetch(s->x + 3 * i, 0, 3);
-    __builtin_prefetch(s->v + 3 * i, 0, 3);
-    __builtin_prefetch(s->omega + 3 * i, 0, 3);
-    __builtin_prefetch(s->f + 3 * i, 1, 3);
-    __builtin_prefetch(s->torque + 3 * i, 1, 3);
-    __builtin_prefetch(s->radius + i, 0, 3);
-    __builtin_prefetch(s->kw + i, 0, 3);
-    __builtin_prefetch(s->mass + i, 0, 3);
-    __builtin_prefetch(s->inertia + i, 0, 3);
-    __builtin_prefetch(s->species + i, 0, 3);
+static JD_ALWAYS_INLINE void prefetch_wall_particle(const jd_particles *ps, size_t i) {
+    __builtin_prefetch(ps->x + 3 * i, 0, 3);
+    __builtin_prefetch(ps->v + 3 * i, 0, 3);
+    __builtin_prefetch(ps->omega + 3 * i, 0, 3);
+    __builtin_prefetch(ps->f + 3 * i, 1, 3);
+    __builtin_prefetch(ps->torque + 3 * i, 1, 3);
+    __builtin_prefetch(ps->radius + i, 0, 3);
+    __builtin_prefetch(ps->kw + i, 0, 3);
+    __builtin_prefetch(ps->mass + i, 0, 3);
+    __builtin_prefetch(ps->inertia + i, 0, 3);
+    __builtin_prefetch(ps->species + i, 0, 3);
 }
 
 /* Geometry lanes of a wall batch: the law for lanes [0, nb), vectorised like the pairs'. */
-static JD_ALWAYS_INLINE void wall_batch_evaluate(const jd_sim *s, const unsigned F,
+static JD_ALWAYS_INLINE void wall_batch_evaluate(const jd_particles *ps,
+                                                 const jd_run_constants *run,
+                                                 const jd_contact_list *L, const unsigned F,
                                                  batch *restrict B, int nb) {
-    const jd_contact_list *L = &s->wall_pairs;
-    const double *restrict v = s->v, *restrict w = s->omega, *restrict rad = s->radius;
-    const double *restrict kw = s->kw, *restrict mass = s->mass, *restrict inertia = s->inertia;
+    const double *restrict v = ps->v, *restrict w = ps->omega, *restrict rad = ps->radius;
+    const double *restrict kw = ps->kw, *restrict mass = ps->mass, *restrict inertia = ps->inertia;
     const double *restrict hist = L->hist, *restrict rhist = L->rhist;
-    const jd_pair_coeffs *restrict coeffs = s->coeffs;
-    const double dt = s->dt;
+    const jd_pair_coeffs *restrict coeffs = run->coeffs;
+    const double dt = run->dt;
     for (int b = 0; b < nb; b++) {
         const int32_t c = B->c[b], i = B->i[b];
         jd_contact_geom g;
@@ -526,32 +529,32 @@ static JD_ALWAYS_INLINE void wall_batch_evaluate(const jd_sim *s, const unsigned
 
 /* Wall-list entry c (particle i) carries force f [N] on the wall at x_i + ra [m] (sim.h,
  * wall_forces). */
-static JD_ALWAYS_INLINE void record_wall_force(jd_sim *s, size_t c, int32_t i, const double f[3],
-                                               const double ra[3]) {
+static JD_ALWAYS_INLINE void record_wall_force(jd_walls *walls, const double *x, size_t c, int32_t i,
+                                               const double f[3], const double ra[3]) {
     for (int d = 0; d < 3; d++) {
-        s->wall_f[3 * c + d] = f[d];
-        s->wall_x[3 * c + d] = s->x[3 * (size_t)i + d] + ra[d];
+        walls->f[3 * c + d] = f[d];
+        walls->x[3 * c + d] = x[3 * (size_t)i + d] + ra[d];
     }
 }
 
 /* Lanes [0, nb) of a wall batch back: history, watchdog, the walls' work (energy bookkeeping:
  * also over the step a contact ends; added to *work one contact at a time, the plain loop's
  * order) and the forces on the particles, in list order. */
-static JD_ALWAYS_INLINE void wall_batch_scatter(jd_sim *s, const unsigned F, const batch *B,
-                                                int nb, acc a, jd_overlap_trip *trip,
-                                                double *work) {
-    jd_contact_list *L = &s->wall_pairs;
+static JD_ALWAYS_INLINE void wall_batch_scatter(const jd_particles *ps, const jd_run_constants *run,
+                                                jd_walls *walls, jd_contact_list *L,
+                                                const unsigned F, const batch *B, int nb, acc a,
+                                                jd_overlap_trip *trip, double *work) {
     for (int b = 0; b < nb; b++) {
         const size_t c = (size_t)B->c[b];
         const int32_t i = B->i[b];
         lane_history_write(F, B, b, L->hist, L->rhist, c);
-        if (jd_overlap_excessive(B->delta[b], s->radius[i], INFINITY, s->max_overlap))
-            sim_watchdog_overlap(trip, i, -1 - B->j[b], B->delta[b], s->radius[i]);
+        if (jd_overlap_excessive(B->delta[b], ps->radius[i], INFINITY, run->max_overlap))
+            sim_watchdog_overlap(trip, i, -1 - B->j[b], B->delta[b], ps->radius[i]);
         if (F & JD_F_ENERGY) {
             const double f_before[3] = {B->f_before[0][b], B->f_before[1][b], B->f_before[2][b]};
             const double f[3] = {B->f[0][b], B->f[1][b], B->f[2][b]};
             const double vw[3] = {B->vw[0][b], B->vw[1][b], B->vw[2][b]};
-            *work += jd_wall_work(f_before, f, vw, s->dt);
+            *work += jd_wall_work(f_before, f, vw, run->dt);
         }
         if (!B->carries[b]) continue;
         double *fa = a.f + 3 * (size_t)i, *ta = a.t + 3 * (size_t)i;
@@ -559,10 +562,10 @@ static JD_ALWAYS_INLINE void wall_batch_scatter(jd_sim *s, const unsigned F, con
             fa[d] -= B->f[d][b];
             ta[d] += B->ta[d][b];
         }
-        if (s->wall_forces) {
+        if (walls->forces) {
             const double f[3] = {B->f[0][b], B->f[1][b], B->f[2][b]};
             const double ra[3] = {B->ra[0][b], B->ra[1][b], B->ra[2][b]};
-            record_wall_force(s, c, i, f, ra);
+            record_wall_force(walls, ps->x, c, i, f, ra);
         }
     }
 }
@@ -570,20 +573,20 @@ static JD_ALWAYS_INLINE void wall_batch_scatter(jd_sim *s, const unsigned F, con
 /* The wall loop over entries [c0, c1), in batches like the pair loop: the wall's own test
  * (plane or cylinder) decides the touching entries and fills their geometry lanes.  Returns
  * the work the walls did on the particles of the chunk. */
-static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
-                                         jd_overlap_trip *trip) {
-    jd_contact_list *L = &s->wall_pairs;
-    const int32_t nm = (int32_t)s->n_materials;
+static JD_ALWAYS_INLINE double wall_loop(const jd_particles *ps, const jd_run_constants *run,
+                                         jd_walls *walls, jd_contact_list *L, const unsigned F,
+                                         size_t c0, size_t c1, acc a, jd_overlap_trip *trip) {
+    const int32_t nm = (int32_t)run->n_materials;
     batch lanes;
     batch *B = &lanes;
     double work = 0.0;
     int nb = 0;
     for (size_t c = c0; c < c1; c++) {
-        if (c + JD_WALL_AHEAD < c1) prefetch_wall_particle(s, (size_t)L->i[c + JD_WALL_AHEAD]);
+        if (c + JD_WALL_AHEAD < c1) prefetch_wall_particle(ps, (size_t)L->i[c + JD_WALL_AHEAD]);
         const int32_t i = L->i[c];
-        const jd_sim_wall *w = &s->walls[L->j[c]];
+        const jd_sim_wall *w = &walls->wall[L->j[c]];
         jd_contact_geom g;
-        if (!sim_wall_geom(s, i, w, &g)) {
+        if (!sim_wall_geom(ps, i, w, &g)) {
             hist_separate(L, F, c);
             continue;
         }
@@ -591,20 +594,20 @@ static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0,
         B->i[nb] = i;
         B->j[nb] = L->j[c];
         B->delta[nb] = g.delta;
-        B->k_co[nb] = s->species[i] * nm + (int32_t)w->material;
+        B->k_co[nb] = ps->species[i] * nm + (int32_t)w->material;
         for (int d = 0; d < 3; d++) {
             B->n[d][nb] = g.n[d];
             B->ra[d][nb] = g.ra[d];
             B->vw[d][nb] = w->v[d];
         }
         if (++nb == JD_BATCH) {
-            wall_batch_evaluate(s, F, B, nb);
-            wall_batch_scatter(s, F, B, nb, a, trip, &work);
+            wall_batch_evaluate(ps, run, L, F, B, nb);
+            wall_batch_scatter(ps, run, walls, L, F, B, nb, a, trip, &work);
             nb = 0;
         }
     }
-    wall_batch_evaluate(s, F, B, nb);
-    wall_batch_scatter(s, F, B, nb, a, trip, &work);
+    wall_batch_evaluate(ps, run, L, F, B, nb);
+    wall_batch_scatter(ps, run, walls, L, F, B, nb, a, trip, &work);
     return work;
 }
 
@@ -612,32 +615,32 @@ static JD_ALWAYS_INLINE double wall_loop(jd_sim *s, const unsigned F, size_t c0,
 /* The reference path (--plain-loops): one contact at a time, as the loops were before they
  * were batched, with the features as a run-time value.  The batched loops must give the same
  * bits (tests/engine/test_fastpaths.py). */
-static void plain_pair_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
-                            jd_overlap_trip *trip) {
-    jd_contact_list *L = &s->pairs;
-    const size_t nm = s->n_materials;
+static void plain_pair_loop(const jd_particles *ps, const jd_run_constants *run,
+                            const jd_fast_paths *fast, jd_contact_list *L, const unsigned F,
+                            size_t c0, size_t c1, acc a, jd_overlap_trip *trip) {
+    const size_t nm = run->n_materials;
     for (size_t c = c0; c < c1; c++) {
         const int32_t i = L->i[c], j = L->j[c];
         jd_contact_geom g;
-        if (!sim_pair_geom(s, F, i, j, &g)) {
+        if (!sim_pair_geom(ps, fast, F, i, j, &g)) {
             hist_separate(L, F, c);
             continue;
         }
-        if (jd_overlap_excessive(g.delta, s->radius[i], s->radius[j], s->max_overlap))
-            sim_watchdog_overlap(trip, i, j, g.delta, fmin(s->radius[i], s->radius[j]));
+        if (jd_overlap_excessive(g.delta, ps->radius[i], ps->radius[j], run->max_overlap))
+            sim_watchdog_overlap(trip, i, j, g.delta, fmin(ps->radius[i], ps->radius[j]));
         jd_kinematics k;
         for (int d = 0; d < 3; d++) {
-            k.va[d] = s->v[3 * (size_t)i + d];
-            k.wa[d] = s->omega[3 * (size_t)i + d];
-            k.vb[d] = s->v[3 * (size_t)j + d];
-            k.wb[d] = s->omega[3 * (size_t)j + d];
+            k.va[d] = ps->v[3 * (size_t)i + d];
+            k.wa[d] = ps->omega[3 * (size_t)i + d];
+            k.vb[d] = ps->v[3 * (size_t)j + d];
+            k.wb[d] = ps->omega[3 * (size_t)j + d];
         }
-        const jd_pair_coeffs *co = &s->coeffs[(size_t)s->species[i] * nm + (size_t)s->species[j]];
+        const jd_pair_coeffs *co = &run->coeffs[(size_t)ps->species[i] * nm + (size_t)ps->species[j]];
         jd_contact_state st;
         jd_rolling_state rs;
         hist_load(L, F, c, &st, &rs);
         jd_contact_result out;
-        const int carries = jd_contact(F, co, &g, &k, s->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
+        const int carries = jd_contact(F, co, &g, &k, run->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
         hist_store(L, F, c, &st, &rs);
         if (!carries) continue;
         const int own = (size_t)j < a.hi;
@@ -652,58 +655,60 @@ static void plain_pair_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, a
     }
 }
 
-static double plain_wall_loop(jd_sim *s, const unsigned F, size_t c0, size_t c1, acc a,
+static double plain_wall_loop(const jd_particles *ps, const jd_run_constants *run, jd_walls *walls,
+                              jd_contact_list *L, const unsigned F, size_t c0, size_t c1, acc a,
                               jd_overlap_trip *trip) {
-    jd_contact_list *L = &s->wall_pairs;
-    const size_t nm = s->n_materials;
+    const size_t nm = run->n_materials;
     double work = 0.0;
     for (size_t c = c0; c < c1; c++) {
         const int32_t i = L->i[c];
-        const jd_sim_wall *w = &s->walls[L->j[c]];
+        const jd_sim_wall *w = &walls->wall[L->j[c]];
         jd_contact_geom g;
-        if (!sim_wall_geom(s, i, w, &g)) {
+        if (!sim_wall_geom(ps, i, w, &g)) {
             hist_separate(L, F, c);
             continue;
         }
-        if (jd_overlap_excessive(g.delta, s->radius[i], INFINITY, s->max_overlap))
-            sim_watchdog_overlap(trip, i, -1 - L->j[c], g.delta, s->radius[i]);
+        if (jd_overlap_excessive(g.delta, ps->radius[i], INFINITY, run->max_overlap))
+            sim_watchdog_overlap(trip, i, -1 - L->j[c], g.delta, ps->radius[i]);
         jd_kinematics k;
         for (int d = 0; d < 3; d++) {
-            k.va[d] = s->v[3 * (size_t)i + d];
-            k.wa[d] = s->omega[3 * (size_t)i + d];
+            k.va[d] = ps->v[3 * (size_t)i + d];
+            k.wa[d] = ps->omega[3 * (size_t)i + d];
             k.vb[d] = w->v[d];
             k.wb[d] = 0.0;
         }
         const jd_pair_coeffs co =
-            jd_wall_coeffs(&s->coeffs[(size_t)s->species[i] * nm + (size_t)w->material]);
+            jd_wall_coeffs(&run->coeffs[(size_t)ps->species[i] * nm + (size_t)w->material]);
         jd_contact_state st;
         jd_rolling_state rs;
         hist_load(L, F, c, &st, &rs);
         jd_contact_result out;
         const double f_prev[3] = {st.f_prev[0], st.f_prev[1], st.f_prev[2]};
-        const int carries = jd_contact(F, &co, &g, &k, s->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
+        const int carries = jd_contact(F, &co, &g, &k, run->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
         hist_store(L, F, c, &st, &rs);
-        if (F & JD_F_ENERGY) work += jd_wall_work(f_prev, out.f, w->v, s->dt);
+        if (F & JD_F_ENERGY) work += jd_wall_work(f_prev, out.f, w->v, run->dt);
         if (!carries) continue;
         for (int d = 0; d < 3; d++) {
             a.f[3 * (size_t)i + d] -= out.f[d];
             a.t[3 * (size_t)i + d] += out.ta[d];
         }
-        if (s->wall_forces) record_wall_force(s, c, i, out.f, g.ra);
+        if (walls->forces) record_wall_force(walls, ps->x, c, i, out.f, g.ra);
     }
     return work;
 }
 
 /* contact_loops on the reference path, compiled once (the features a run-time value). */
 static double plain_contact_loops(jd_sim *s, int tid, double *t_pairs_end) {
-    const unsigned F = s->features;
-    const acc a = acc_of(s, tid);
-    const jd_thread_share *h = &s->shares[tid];
-    jd_overlap_trip *trip = &s->trips[tid];
-    plain_pair_loop(s, F, h->pair_lo, h->pair_hi, a, trip);
-    plain_pair_loop(s, F, h->near_lo, h->near_hi, a, trip);
+    const unsigned F = s->run.features;
+    const jd_particles *ps = &s->particles;
+    const acc a = acc_of(ps, &s->threads, tid);
+    const jd_thread_share *h = &s->threads.shares[tid];
+    jd_overlap_trip *trip = &s->threads.trips[tid];
+    jd_contact_list *P = &s->lists.pairs, *W = &s->lists.wall_pairs;
+    plain_pair_loop(ps, &s->run, &s->fast, P, F, h->pair_lo, h->pair_hi, a, trip);
+    plain_pair_loop(ps, &s->run, &s->fast, P, F, h->near_lo, h->near_hi, a, trip);
     if (tid == 0) *t_pairs_end = sim_clock();
-    return plain_wall_loop(s, F, h->wall_lo, h->wall_hi, a, trip);
+    return plain_wall_loop(ps, &s->run, &s->walls, W, F, h->wall_lo, h->wall_hi, a, trip);
 }
 
 #endif
@@ -713,20 +718,24 @@ static double plain_contact_loops(jd_sim *s, int tid, double *t_pairs_end) {
  * share of the pairs (with threads, the split of the timing is thread 0's). */
 static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int tid,
                                              double *t_pairs_end) {
-    const acc a = acc_of(s, tid);
-    const jd_thread_share *h = &s->shares[tid];
-    jd_overlap_trip *trip = &s->trips[tid];
+    const jd_particles *ps = &s->particles;
+    const jd_run_constants *run = &s->run;
+    const jd_fast_paths *fast = &s->fast;
+    const acc a = acc_of(ps, &s->threads, tid);
+    const jd_thread_share *h = &s->threads.shares[tid];
+    jd_overlap_trip *trip = &s->threads.trips[tid];
+    jd_contact_list *P = &s->lists.pairs, *W = &s->lists.wall_pairs;
     /* the entries that touched at the build, then those that did not: their few touching
      * lanes packed, whatever the particles (one copy: compile time) */
-    if (s->alike)
-        pair_loop(s, F, JD_KINDS_ALIKE, 0, h->pair_lo, h->pair_hi, a, trip);
-    else if (s->pair_row >= 0)
-        pair_loop(s, F, JD_KINDS_ONE_MATERIAL, 0, h->pair_lo, h->pair_hi, a, trip);
+    if (fast->alike)
+        pair_loop(ps, run, fast, P, F, JD_KINDS_ALIKE, 0, h->pair_lo, h->pair_hi, a, trip);
+    else if (fast->pair_row >= 0)
+        pair_loop(ps, run, fast, P, F, JD_KINDS_ONE_MATERIAL, 0, h->pair_lo, h->pair_hi, a, trip);
     else
-        pair_loop(s, F, JD_KINDS_ANY, 0, h->pair_lo, h->pair_hi, a, trip);
-    pair_loop(s, F, JD_KINDS_ANY, 1, h->near_lo, h->near_hi, a, trip);
+        pair_loop(ps, run, fast, P, F, JD_KINDS_ANY, 0, h->pair_lo, h->pair_hi, a, trip);
+    pair_loop(ps, run, fast, P, F, JD_KINDS_ANY, 1, h->near_lo, h->near_hi, a, trip);
     if (tid == 0) *t_pairs_end = sim_clock();
-    return wall_loop(s, F, h->wall_lo, h->wall_hi, a, trip);
+    return wall_loop(ps, run, &s->walls, W, F, h->wall_lo, h->wall_hi, a, trip);
 }
 
 /* One instantiation per compiled law set (the kernel's list, jdem_laws.h: JD_LAW_LOOPS): the
@@ -734,7 +743,7 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
  * (JD_F_RUN_TIME) of the run's bits on to the kernel. */
 #define JD_FORCE_CASE(loop)                                                                   \
     case (loop):                                                                              \
-        *work = contact_loops(s, jd_law_set_of_loop((loop), s->features), tid, t_pairs_end);  \
+        *work = contact_loops(s, jd_law_set_of_loop((loop), s->run.features), tid, t_pairs_end);  \
         return 1;
 
 /* The compiled law sets with energy bookkeeping are instantiated in a translation unit of their
@@ -744,7 +753,7 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
 int sim_force_loops_energy(jd_sim *s, int tid, double *work, double *t_pairs_end);
 #ifdef JD_FORCE_LOOPS_ENERGY
 int sim_force_loops_energy(jd_sim *s, int tid, double *work, double *t_pairs_end) {
-    switch (jd_law_set_loop(s->features)) {
+    switch (jd_law_set_loop(s->run.features)) {
         JD_LAW_SETS_WITH(JD_FORCE_CASE, JD_F_ENERGY)
     default:
         return 0;
@@ -753,7 +762,7 @@ int sim_force_loops_energy(jd_sim *s, int tid, double *work, double *t_pairs_end
 #else
 #ifndef JD_ONE_FORCE_LOOP
 static int force_loops_without_energy(jd_sim *s, int tid, double *work, double *t_pairs_end) {
-    switch (jd_law_set_loop(s->features)) {
+    switch (jd_law_set_loop(s->run.features)) {
         JD_LAW_SETS_WITH(JD_FORCE_CASE, 0u)
     default:
         return 0;
@@ -772,7 +781,7 @@ static double dispatch(jd_sim *s, int tid, double *t_pairs_end_out) {
     /* one copy of the loops, with the features as a run-time value: the sanitizer build
      * (Makefile), which checks the code rather than its speed, compiles the law once instead of
      * once per law set; the same source, hence the same checks */
-    work = contact_loops(s, s->features & JD_F_ALL, tid, &t_pairs_end);
+    work = contact_loops(s, s->run.features & JD_F_ALL, tid, &t_pairs_end);
 #else
     if (!force_loops_without_energy(s, tid, &work, &t_pairs_end) &&
         !sim_force_loops_energy(s, tid, &work, &t_pairs_end))
@@ -785,35 +794,35 @@ static double dispatch(jd_sim *s, int tid, double *t_pairs_end_out) {
 
 /* With threads: thread tid adds the earlier threads' overflow into the particles it owns, in
  * thread order, and zeroes it for the next evaluation. */
-static void reduce(jd_sim *s, int tid) {
-    const jd_thread_share *me = &s->shares[tid];
+static void reduce(jd_particles *ps, const jd_thread_layout *threads, int tid) {
+    const jd_thread_share *me = &threads->shares[tid];
     for (int u = 0; u < tid; u++) {
-        const jd_thread_share *h = &s->shares[u];
+        const jd_thread_share *h = &threads->shares[u];
         const size_t lo = h->p_hi > me->p_lo ? h->p_hi : me->p_lo;
         const size_t hi = h->p_hi + h->win < me->p_hi ? h->p_hi + h->win : me->p_hi;
         double *of = h->ovf, *ot = h->ovf + 3 * h->cap;
         for (size_t k = 3 * lo; k < 3 * hi; k++) {
             const size_t o = k - 3 * h->p_hi;
-            s->f[k] += of[o];
-            s->torque[k] += ot[o];
+            ps->f[k] += of[o];
+            ps->torque[k] += ot[o];
             of[o] = ot[o] = 0.0;
         }
     }
 }
 
-void sim_gravity(jd_sim *s) {
-    const double *g = s->g;
+void sim_gravity(jd_particles *ps, const jd_run_constants *run, const jd_thread_layout *threads) {
+    const double *g = run->g;
     if (g[0] == 0.0 && g[1] == 0.0 && g[2] == 0.0) return;
-    const long n = (long)s->n;
-    double *f = s->f;
-    const double *mass = s->mass;
-#pragma omp parallel for schedule(static) num_threads(s->threads) if (s->threads > 1)
+    const long n = (long)ps->n;
+    double *f = ps->f;
+    const double *mass = ps->mass;
+#pragma omp parallel for schedule(static) num_threads(threads->n) if (threads->n > 1)
     for (long i = 0; i < n; i++)
         for (int d = 0; d < 3; d++) f[3 * i + d] += mass[i] * g[d];
 }
 
 void sim_compute_forces(jd_sim *s) {
-    const int nt = s->threads;
+    const int nt = s->threads.n;
     double work[nt > 0 ? nt : 1];
     double t_pairs_end = 0.0, t_walls_end = 0.0;
     const double t0 = sim_clock();
@@ -825,33 +834,34 @@ void sim_compute_forces(jd_sim *s) {
         const int tid = 0;
 #endif
         /* only this thread writes its particles' f and torque directly (the others' overflow) */
-        const jd_thread_share *h = &s->shares[tid];
-        memset(s->f + 3 * h->p_lo, 0, 3 * (h->p_hi - h->p_lo) * sizeof *s->f);
-        memset(s->torque + 3 * h->p_lo, 0, 3 * (h->p_hi - h->p_lo) * sizeof *s->torque);
-        s->trips[tid].fraction = 0.0;
+        const jd_thread_share *h = &s->threads.shares[tid];
+        memset(s->particles.f + 3 * h->p_lo, 0, 3 * (h->p_hi - h->p_lo) * sizeof *s->particles.f);
+        memset(s->particles.torque + 3 * h->p_lo, 0, 3 * (h->p_hi - h->p_lo) * sizeof *s->particles.torque);
+        s->threads.trips[tid].fraction = 0.0;
         work[tid] = dispatch(s, tid, &t_pairs_end);
         if (nt > 1) {
 #pragma omp barrier
-            reduce(s, tid);
+            reduce(&s->particles, &s->threads, tid);
         }
         if (tid == 0) t_walls_end = sim_clock();
     }
     /* the worst overlap of this evaluation (the first thread's on a tie, as in serial order) */
-    s->overlap_trip.fraction = 0.0;
+    s->watch.overlap_trip.fraction = 0.0;
     for (int t = 0; t < nt; t++) {
-        if (s->trips[t].fraction > s->overlap_trip.fraction) s->overlap_trip = s->trips[t];
-        s->wall_work += work[t];
+        if (s->threads.trips[t].fraction > s->watch.overlap_trip.fraction) s->watch.overlap_trip = s->threads.trips[t];
+        s->accounts.wall_work += work[t];
     }
     /* then in LIGGGHTS' order: bonds (in parallel with the contacts, bonds.c), gravity, and the
      * post-force loads (loads.c); without loads, the weight is added by the half kick that
      * follows (integrate.c), which reads f anyway: the same sums, one pass less (sim.h,
      * weight_in_kick) */
-    if (s->wall_forces) sim_walls_sum(s);
-    if (s->bonds) sim_bonds_forces(s);
-    if (s->in_setup || !s->weight_in_kick) sim_gravity(s);
-    if (s->loads) sim_loads_apply(s);
+    if (s->walls.forces) sim_walls_sum(&s->walls, &s->lists.wall_pairs);
+    if (s->bonds)
+        sim_bonds_forces(s->bonds, &s->particles, &s->run, &s->threads, s->step, s->in_setup);
+    if (s->in_setup || !s->fast.weight_in_kick) sim_gravity(&s->particles, &s->run, &s->threads);
+    if (s->loads) sim_loads_apply(s->loads, &s->particles, &s->run, &s->accounts, s->in_setup);
     const double t1 = sim_clock();
-    s->timing.pairs += (t_pairs_end - t0) + (t1 - t_walls_end);
-    s->timing.walls += t_walls_end - t_pairs_end;
+    s->accounts.timing.pairs += (t_pairs_end - t0) + (t1 - t_walls_end);
+    s->accounts.timing.walls += t_walls_end - t_pairs_end;
 }
 #endif /* JD_FORCE_LOOPS_ENERGY */

@@ -13,24 +13,24 @@
 /* The constants of pair (i, j) as jd_geom_pair_material and jd_geom_spheres compute them (the
  * force loops compute the same per lane, or read the scene's single set).  pcr may be NULL (no
  * rolling). */
-static inline void sim_pair_constants(const jd_sim *s, int32_t i, int32_t j, jd_pair_const *pc,
+static inline void sim_pair_constants(const jd_particles *ps, int32_t i, int32_t j, jd_pair_const *pc,
                                       jd_pair_const_roll *pcr) {
     jd_contact_geom g;
-    jd_geom_pair_material(pcr ? JD_F_ROLLING : 0u, &g, s->kp[i], s->kp[j], s->mass[i], s->mass[j],
-                          s->inertia[i], s->inertia[j]);
+    jd_geom_pair_material(pcr ? JD_F_ROLLING : 0u, &g, ps->kp[i], ps->kp[j], ps->mass[i], ps->mass[j],
+                          ps->inertia[i], ps->inertia[j]);
     pc->k_n = g.k_n;
     pc->m_eff = g.m_eff;
     if (pcr) {
         pcr->i_eff = g.i_eff;
-        pcr->r_roll = jd_rolling_radius(s->radius[i], s->radius[j]);
+        pcr->r_roll = jd_rolling_radius(ps->radius[i], ps->radius[j]);
     }
 }
 
 /* Do spheres i and j overlap (LIGGGHTS' test, rsq < radsum^2, as jd_geom_spheres_contact)? */
-static inline int sim_pair_touching(const jd_sim *s, int32_t i, int32_t j) {
-    const double *xi = s->x + 3 * (size_t)i, *xj = s->x + 3 * (size_t)j;
+static inline int sim_pair_touching(const jd_particles *ps, int32_t i, int32_t j) {
+    const double *xi = ps->x + 3 * (size_t)i, *xj = ps->x + 3 * (size_t)j;
     const double dx[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
-    const double radsum = s->radius[i] + s->radius[j];
+    const double radsum = ps->radius[i] + ps->radius[j];
     return jd_dot(dx, dx) < radsum * radsum;
 }
 
@@ -39,14 +39,15 @@ static inline int sim_pair_touching(const jd_sim *s, int32_t i, int32_t j) {
  * scene's single set when the particles are all alike; i_eff is only read by the rolling law
  * and r_roll by it and Mindlin's K_t, so they are filled only with JD_F_ROLLING and
  * JD_F_READS_R_STAR in features (a compile-time constant at the call sites). */
-static inline int sim_pair_geom(const jd_sim *s, const unsigned features, int32_t i,
-                                int32_t j, jd_contact_geom *g) {
-    if (!jd_geom_spheres_contact(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
-                                 s->radius[j], g))
+static inline int sim_pair_geom(const jd_particles *ps, const jd_fast_paths *fast,
+                                const unsigned features, int32_t i, int32_t j,
+                                jd_contact_geom *g) {
+    if (!jd_geom_spheres_contact(ps->x + 3 * (size_t)i, ps->radius[i], ps->x + 3 * (size_t)j,
+                                 ps->radius[j], g))
         return 0;
-    jd_pair_const pc = s->pc_alike;
-    jd_pair_const_roll pcr = s->pcr_alike;
-    if (!s->alike) sim_pair_constants(s, i, j, &pc, &pcr);
+    jd_pair_const pc = fast->pc_alike;
+    jd_pair_const_roll pcr = fast->pcr_alike;
+    if (!fast->alike) sim_pair_constants(ps, i, j, &pc, &pcr);
     g->k_n = pc.k_n;
     g->m_eff = pc.m_eff;
     g->i_eff = (features & JD_F_ROLLING) ? pcr.i_eff : 0.0;
@@ -56,14 +57,14 @@ static inline int sim_pair_geom(const jd_sim *s, const unsigned features, int32_
 
 /* Particle i against wall w (the wall is body b; its current position is in w).  Edge and corner
  * contacts of a finite plane are not modelled (the kernel's plane test). */
-static inline int sim_wall_geom(const jd_sim *s, int32_t i, const jd_sim_wall *w,
+static inline int sim_wall_geom(const jd_particles *ps, int32_t i, const jd_sim_wall *w,
                                 jd_contact_geom *g) {
-    const double *x = s->x + 3 * (size_t)i;
-    const double R = s->radius[i];
+    const double *x = ps->x + 3 * (size_t)i;
+    const double R = ps->radius[i];
     const int touch = w->type == JD_WALL_PLANE ? jd_geom_plane(&w->plane, x, R, g)
                                                : jd_geom_cylinder(&w->cyl, x, R, g);
     if (!touch) return 0;
-    jd_geom_wall_material(JD_F_ROLLING, g, s->kw[i], s->mass[i], s->inertia[i]);
+    jd_geom_wall_material(JD_F_ROLLING, g, ps->kw[i], ps->mass[i], ps->inertia[i]);
     return 1;
 }
 

@@ -121,7 +121,7 @@ size_t sim_inlets_capacity(const jd_scene *sc) {
 }
 
 int sim_inlets_init(jd_sim *s, char *err, size_t errlen) {
-    const jd_scene *sc = s->scene;
+    const jd_scene *sc = s->run.scene;
     if (!sc->n_inlets) return 0;
     jd_sim_inlets *in = calloc(1, sizeof *in);
     if (!in) goto oom;
@@ -150,7 +150,7 @@ int sim_inlets_init(jd_sim *s, char *err, size_t errlen) {
     in->buf = malloc(in->buf_cap * sizeof *in->buf);
     if (!in->buf) goto oom;
     make_rows(in, sc);
-    s->ids = in->id;
+    s->particles.ids = in->id;
     return 0;
 oom:
     snprintf(err, errlen, "out of memory for the inlets");
@@ -182,21 +182,21 @@ void sim_inlets_log(jd_sim *s, FILE *log) {
  * kick (after sim_finish_step every force holds the weight, also when the kicks add it). */
 static void append(jd_sim *s, const jd_inlet_particle *p) {
     jd_sim_inlets *in = s->inlets;
-    const size_t i = s->n++;
-    sim_particle_constants(s, i, p->species, p->radius);
-    s->orig[i] = (int32_t)i;
+    const size_t i = s->particles.n++;
+    sim_particle_constants(&s->particles, &s->run, i, p->species, p->radius);
+    s->particles.orig[i] = (int32_t)i;
     in->id[i] = p->id;
     const jd_row *hit = bsearch(&p->id, in->rows, in->cap, sizeof *in->rows, by_id);
     in->slot[i] = (int32_t)(hit - in->rows);
     for (int d = 0; d < 3; d++) {
-        s->x[3 * i + d] = p->position[d];
-        s->v[3 * i + d] = p->velocity[d];
-        s->omega[3 * i + d] = 0.0;
-        s->f[3 * i + d] = s->mass[i] * s->g[d];
-        s->torque[3 * i + d] = 0.0;
+        s->particles.x[3 * i + d] = p->position[d];
+        s->particles.v[3 * i + d] = p->velocity[d];
+        s->particles.omega[3 * i + d] = 0.0;
+        s->particles.f[3 * i + d] = s->particles.mass[i] * s->run.g[d];
+        s->particles.torque[3 * i + d] = 0.0;
     }
-    in->energy_in += 0.5 * s->mass[i] * jd_dot(p->velocity, p->velocity) -
-                     s->mass[i] * jd_dot(s->g, p->position);
+    in->energy_in += 0.5 * s->particles.mass[i] * jd_dot(p->velocity, p->velocity) -
+                     s->particles.mass[i] * jd_dot(s->run.g, p->position);
     if (in->log) {
         char line[JD_INLET_RECORD_LINE_MAX];
         jd_inlet_record_line(p, line, sizeof line);
@@ -208,10 +208,11 @@ static void append(jd_sim *s, const jd_inlet_particle *p) {
  * insertions. */
 static void check_height(jd_sim *s, size_t k) {
     inlet_run *r = &s->inlets->run[k];
-    const jd_inlet *def = &s->scene->inlets[k];
+    const jd_inlet *def = &s->run.scene->inlets[k];
     if (def->stop != JD_INLET_STOP_HEIGHT || !jd_inlet_height_due(s->step, def->every)) return;
     sim_finish_step(s); /* the speeds at this step */
-    const double top = jd_inlet_deposit_top(s->n, s->x, s->v, s->radius, def->below_speed);
+    const jd_particles *ps = &s->particles;
+    const double top = jd_inlet_deposit_top(ps->n, ps->x, ps->v, ps->radius, def->below_speed);
     jd_inlet_height_stop(&r->st, s->step, top, def->height);
 }
 
@@ -227,14 +228,14 @@ static int insert_due(jd_sim *s, char *err, size_t errlen) {
         size_t got;
         while (r->st.next_step == s->step &&
                (got = jd_inlet_pop(&r->spec, &r->st, s->step, in->buf, in->buf_cap)) > 0) {
-            for (size_t q = 0; q < got && s->n < in->cap; q++) append(s, &in->buf[q]);
+            for (size_t q = 0; q < got && s->particles.n < in->cap; q++) append(s, &in->buf[q]);
             added += got;
         }
         in->next_step = r->st.next_step < in->next_step ? r->st.next_step : in->next_step;
     }
     int rc = 0;
     if (added) {
-        sim_particle_kinds(s);
+        sim_particle_kinds(&s->fast, &s->particles, s->run.n_materials, s->opt.plain_loops);
         rc = sim_neighbour_build(s, err, errlen);
     }
     in->seconds += sim_clock() - t0;
@@ -248,7 +249,7 @@ int sim_inlets_step(jd_sim *s, char *err, size_t errlen) {
 }
 
 int64_t sim_inlets_inserted(const jd_sim *s) {
-    return s->inlets ? (int64_t)(s->n - s->inlets->n_scene) : 0;
+    return s->inlets ? (int64_t)(s->particles.n - s->inlets->n_scene) : 0;
 }
 
 double sim_inlets_seconds(const jd_sim *s) { return s->inlets ? s->inlets->seconds : 0.0; }
@@ -268,13 +269,13 @@ int sim_inlets_particles(const jd_sim *s, int64_t *id, int32_t *species, double 
     return 0;
 }
 
-size_t sim_inlets_rows(const jd_sim *s) { return s->inlets ? s->inlets->cap : s->n; }
+size_t sim_inlets_rows(const jd_sim *s) { return s->inlets ? s->inlets->cap : s->particles.n; }
 
 double *sim_inlets_frame_rows(const jd_sim *s, int k, const double *scene_ordered) {
     const jd_sim_inlets *in = s->inlets;
     double *out = in->frame + (size_t)k * 3 * in->cap;
     for (size_t r = 0; r < 3 * in->cap; r++) out[r] = NAN;
-    for (size_t j = 0; j < s->n; j++)
+    for (size_t j = 0; j < s->particles.n; j++)
         memcpy(&out[3 * (size_t)in->slot[j]], &scene_ordered[3 * j], 3 * sizeof *out);
     return out;
 }
@@ -282,6 +283,6 @@ double *sim_inlets_frame_rows(const jd_sim *s, int k, const double *scene_ordere
 const int64_t *sim_inlets_frame_ids(const jd_sim *s) {
     const jd_sim_inlets *in = s->inlets;
     for (size_t r = 0; r < in->cap; r++) in->frame_id[r] = -1;
-    for (size_t j = 0; j < s->n; j++) in->frame_id[in->slot[j]] = in->id[j];
+    for (size_t j = 0; j < s->particles.n; j++) in->frame_id[in->slot[j]] = in->id[j];
     return in->frame_id;
 }

@@ -29,15 +29,15 @@ static inline int not_finite(double x) { return x - x != 0.0; }
 typedef struct pass_consts {
     double dt;                 /* [s] */
     double lim;                /* (skin/2)^2 [m^2]: the rebuild check */
-    double g[3];               /* gravity [m/s^2], for the weight m g (s->weight_in_kick) */
-    double dtfm, dtirot, mass; /* every particle's, when they are uniform (s->uniform_mass) */
+    double g[3];               /* gravity [m/s^2], for the weight m g (s->fast.weight_in_kick) */
+    double dtfm, dtirot, mass; /* every particle's, when they are uniform (s->fast.uniform_mass) */
 } pass_consts;
 
 /* The literal flags of a pass's compiled copies: twice, the last step's final half kick first
- * (s->kick_pending); weight, add m g to the force the kicks use (s->weight_in_kick); uniform,
+ * (s->kick_pending); weight, add m g to the force the kicks use (s->fast.weight_in_kick); uniform,
  * take dtfm, dtirot and m from pass_consts rather than streaming their arrays; check, compare
  * each new position with x_build (the rebuild check) rather than only find the largest speed
- * (s->drift_bound). */
+ * (s->lists.drift_bound). */
 enum { P_TWICE = 1, P_WEIGHT = 2, P_UNIFORM = 4, P_CHECK = 8 };
 
 /* The rebuild check of particle i: 1 when it moved more than half the skin since the last
@@ -175,13 +175,14 @@ static int kick(int flags, long lo, long hi, double *restrict v, double *restric
 #undef JD_KICK
 }
 
-static pass_consts consts_of(const jd_sim *s) {
-    pass_consts c = {.dt = s->dt, .lim = 0.25 * s->skin * s->skin,
-                     .g = {s->g[0], s->g[1], s->g[2]}};
-    if (s->uniform_mass) {
-        c.dtfm = s->dtfm[0];
-        c.dtirot = s->dtirot[0];
-        c.mass = s->mass[0];
+static pass_consts consts_of(const jd_particles *ps, const jd_run_constants *run,
+                             const jd_fast_paths *fast, double skin) {
+    pass_consts c = {.dt = run->dt, .lim = 0.25 * skin * skin,
+                     .g = {run->g[0], run->g[1], run->g[2]}};
+    if (fast->uniform_mass) {
+        c.dtfm = ps->dtfm[0];
+        c.dtirot = ps->dtirot[0];
+        c.mass = ps->mass[0];
     }
     return c;
 }
@@ -197,7 +198,7 @@ static void share(long n, long *lo, long *hi) {
     *hi = n * (tid + 1) / nt;
 }
 
-/* While s->drift_bound is at most this fraction of half the skin, no particle can have moved
+/* While s->lists.drift_bound is at most this fraction of half the skin, no particle can have moved
  * half the skin since the last build, and the passes need not read x_build. */
 #define JD_DRIFT_SAFE 0.5
 
@@ -211,42 +212,44 @@ static void share(long n, long *lo, long *hi) {
  * The rebuild check (LIGGGHTS' `neigh_modify check yes`): *moved when some particle moved more
  * than half the skin since the last neighbour build.  Exactly that test decides, but it reads
  * x_build, a stream as large as x; so while the sum over the steps of dt times the largest
- * speed (s->drift_bound, which no particle's displacement can exceed) stays within
+ * speed (s->lists.drift_bound, which no particle's displacement can exceed) stays within
  * JD_DRIFT_SAFE of half the skin, the pass only finds the largest speed, and on the step the
  * sum passes that mark the exact test runs on its own (far_check), then in the pass until the
  * next build.  The rebuilds come at the same steps either way: in a settled bed the sum stays
  * far below the mark, in a pour it passes it a few steps after each build.
  *
- * Returns bit 0: some new x is not finite; bit 2: the pending kick left some v or omega not
- * finite. */
-static int initial_integrate(jd_sim *s, int *moved) {
-    const pass_consts c = consts_of(s);
-    const int pending = s->kick_pending;
-    const double safe = JD_DRIFT_SAFE * 0.5 * s->skin;
-    const int check = s->opt.plain_loops || !(s->drift_bound <= safe); /* plain: the reference */
-    const int flags = (pending ? P_TWICE : 0) | (pending && s->weight_in_kick ? P_WEIGHT : 0) |
-                      (s->uniform_mass ? P_UNIFORM : 0) | (check ? P_CHECK : 0);
+ * pending: the last step's final half kick is still to do; plain: the reference path (the exact
+ * check at every step).  Returns bit 0: some new x is not finite; bit 2: the pending kick left
+ * some v or omega not finite. */
+static int initial_integrate(jd_particles *ps, jd_neighbour_lists *lists,
+                             const jd_run_constants *run, const jd_fast_paths *fast,
+                             const jd_thread_layout *threads, int pending, int plain,
+                             int *moved) {
+    const pass_consts c = consts_of(ps, run, fast, lists->skin);
+    const double safe = JD_DRIFT_SAFE * 0.5 * lists->skin;
+    const int check = plain || !(lists->drift_bound <= safe); /* plain: the reference */
+    const int flags = (pending ? P_TWICE : 0) | (pending && fast->weight_in_kick ? P_WEIGHT : 0) |
+                      (fast->uniform_mass ? P_UNIFORM : 0) | (check ? P_CHECK : 0);
     int bits = 0;
     double vmax2 = 0.0;
-#pragma omp parallel num_threads(s->threads) if (s->threads > 1) reduction(| : bits) reduction(max : vmax2)
+#pragma omp parallel num_threads(threads->n) if (threads->n > 1) reduction(| : bits) reduction(max : vmax2)
     {
         long lo, hi;
         double vm = 0.0;
-        share((long)s->n, &lo, &hi);
-        bits |= kick_drift(flags, lo, hi, s->x, s->v, s->omega, s->x_build, s->f, s->torque,
-                           s->dtfm, s->dtirot, s->mass, &c, &vm);
+        share((long)ps->n, &lo, &hi);
+        bits |= kick_drift(flags, lo, hi, ps->x, ps->v, ps->omega, lists->x_build, ps->f, ps->torque,
+                           ps->dtfm, ps->dtirot, ps->mass, &c, &vm);
         if (vm > vmax2) vmax2 = vm;
     }
-    s->kick_pending = 0;
     if (!check) {
-        s->drift_bound += s->dt * sqrt(vmax2);
-        if (!(s->drift_bound <= safe)) {
+        lists->drift_bound += run->dt * sqrt(vmax2);
+        if (!(lists->drift_bound <= safe)) {
             int far = 0;
-#pragma omp parallel num_threads(s->threads) if (s->threads > 1) reduction(| : far)
+#pragma omp parallel num_threads(threads->n) if (threads->n > 1) reduction(| : far)
             {
                 long lo, hi;
-                share((long)s->n, &lo, &hi);
-                far |= far_check(lo, hi, s->x, s->x_build, c.lim);
+                share((long)ps->n, &lo, &hi);
+                far |= far_check(lo, hi, ps->x, lists->x_build, c.lim);
             }
             bits |= far << 1;
         }
@@ -257,16 +260,17 @@ static int initial_integrate(jd_sim *s, int *moved) {
 
 /* final_integrate: the same half kick, returning 1 when some new v or omega is not finite.  The
  * force it follows is always a fresh evaluation's (sim_step, sim_finish_step): with
- * s->weight_in_kick the weight is added to it here, and kept. */
-static int final_integrate(jd_sim *s) {
-    const pass_consts c = consts_of(s);
-    const int flags = (s->weight_in_kick ? P_WEIGHT : 0) | (s->uniform_mass ? P_UNIFORM : 0);
+ * s->fast.weight_in_kick the weight is added to it here, and kept. */
+static int final_integrate(jd_particles *ps, const jd_run_constants *run,
+                           const jd_fast_paths *fast, const jd_thread_layout *threads) {
+    const pass_consts c = consts_of(ps, run, fast, 0.0);
+    const int flags = (fast->weight_in_kick ? P_WEIGHT : 0) | (fast->uniform_mass ? P_UNIFORM : 0);
     int bad = 0;
-#pragma omp parallel num_threads(s->threads) if (s->threads > 1) reduction(| : bad)
+#pragma omp parallel num_threads(threads->n) if (threads->n > 1) reduction(| : bad)
     {
         long lo, hi;
-        share((long)s->n, &lo, &hi);
-        bad |= kick(flags, lo, hi, s->v, s->omega, s->f, s->torque, s->dtfm, s->dtirot, s->mass,
+        share((long)ps->n, &lo, &hi);
+        bad |= kick(flags, lo, hi, ps->v, ps->omega, ps->f, ps->torque, ps->dtfm, ps->dtirot, ps->mass,
                     &c);
     }
     return bad;
@@ -275,43 +279,48 @@ static int final_integrate(jd_sim *s) {
 void sim_finish_step(jd_sim *s) {
     if (!s->kick_pending) return;
     const double t0 = sim_clock();
-    s->nonfinite |= final_integrate(s);
+    s->watch.nonfinite |= final_integrate(&s->particles, &s->run, &s->fast, &s->threads);
     s->kick_pending = 0;
-    s->timing.integration += sim_clock() - t0;
+    s->accounts.timing.integration += sim_clock() - t0;
 }
 
 int sim_step(jd_sim *s, int seen, char *err, size_t errlen) {
     const double t0 = sim_clock();
     int moved;
-    const int bad = initial_integrate(s, &moved);
+    const int bad = initial_integrate(&s->particles, &s->lists, &s->run, &s->fast, &s->threads,
+                                      s->kick_pending, s->opt.plain_loops, &moved);
+    s->kick_pending = 0;
     if (bad & 4) {
         /* the last step's forces gave a non-finite v or omega: that step's state is the one to
          * report (as without the deferred kick); the watchdog names the force or torque, which
          * gets its weight as final_integrate would have given it */
-        if (s->weight_in_kick) sim_gravity(s);
-        s->nonfinite = 1;
+        if (s->fast.weight_in_kick) sim_gravity(&s->particles, &s->run, &s->threads);
+        s->watch.nonfinite = 1;
         return 0;
     }
     /* A non-finite position stops the step here, before the neighbour search bins it: the run
      * loop's watchdog reports it (sim_watchdog_step) and the run ends. */
     if (bad) {
-        s->nonfinite = 1;
+        s->watch.nonfinite = 1;
         s->step++;
         return 0;
     }
-    sim_walls_move(s); /* fix move/mesh moves the walls in the same phase as the particles */
+    /* fix move/mesh moves the walls in the same phase as the particles */
+    sim_walls_move(&s->walls, s->run.dt);
     const double t1 = sim_clock();
-    if ((moved || sim_neighbour_walls_moved(s)) && sim_neighbour_build(s, err, errlen) != 0) return -1;
+    if ((moved || sim_neighbour_walls_moved(&s->walls, s->lists.skin)) &&
+        sim_neighbour_build(s, err, errlen) != 0)
+        return -1;
     const double t2 = sim_clock();
     sim_compute_forces(s);
     const double t3 = sim_clock();
     if (seen)
-        s->nonfinite = final_integrate(s);
+        s->watch.nonfinite = final_integrate(&s->particles, &s->run, &s->fast, &s->threads);
     else
         s->kick_pending = 1;
     s->step++;
     const double t4 = sim_clock();
-    s->timing.integration += (t1 - t0) + (t4 - t3);
-    s->timing.neighbour += t2 - t1;
+    s->accounts.timing.integration += (t1 - t0) + (t4 - t3);
+    s->accounts.timing.neighbour += t2 - t1;
     return 0;
 }

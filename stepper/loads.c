@@ -22,12 +22,11 @@ struct jd_loads {
                          evaluation (external force, or the constraint's reaction) */
 };
 
-int sim_loads_init(jd_sim *s, char *err, size_t errlen) {
-    const jd_scene *sc = s->scene;
+int sim_loads_init(jd_loads **loads, const jd_scene *sc, char *err, size_t errlen) {
     if (!sc->has_loads) return 0;
     jd_loads *l = calloc(1, sizeof *l);
     size_t n = 0;
-    for (size_t i = 0; i < s->n; i++) {
+    for (size_t i = 0; i < sc->n_particles; i++) {
         const double *F = &sc->force[3 * i];
         n += sc->fixed[i] || F[0] != 0.0 || F[1] != 0.0 || F[2] != 0.0;
     }
@@ -44,20 +43,20 @@ int sim_loads_init(jd_sim *s, char *err, size_t errlen) {
         snprintf(err, errlen, "out of memory for the particle loads");
         return -1;
     }
-    for (size_t i = 0; i < s->n; i++) {
+    for (size_t i = 0; i < sc->n_particles; i++) {
         const double *F = &sc->force[3 * i];
         if (sc->fixed[i] || F[0] != 0.0 || F[1] != 0.0 || F[2] != 0.0) l->index[l->n++] = (int32_t)i;
     }
-    s->loads = l;
+    *loads = l;
     return 0;
 }
 
-void sim_loads_free(jd_sim *s) {
-    if (!s->loads) return;
-    free(s->loads->index);
-    free(s->loads->f_prev);
-    free(s->loads);
-    s->loads = NULL;
+void sim_loads_free(jd_loads **loads) {
+    if (!*loads) return;
+    free((*loads)->index);
+    free((*loads)->f_prev);
+    free(*loads);
+    *loads = NULL;
 }
 
 void sim_loads_permute(jd_loads *l, const int32_t *new_index) {
@@ -65,13 +64,13 @@ void sim_loads_permute(jd_loads *l, const int32_t *new_index) {
     for (size_t k = 0; k < l->n; k++) l->index[k] = new_index[l->index[k]];
 }
 
-void sim_loads_apply(jd_sim *s) {
-    jd_loads *l = s->loads;
-    const jd_scene *sc = s->scene;
+void sim_loads_apply(jd_loads *l, jd_particles *ps, const jd_run_constants *run,
+                     jd_accounts *accounts, int in_setup) {
+    const jd_scene *sc = run->scene;
     double work = 0.0;
     for (size_t k = 0; k < l->n; k++) {
-        const size_t i = (size_t)l->index[k], p = (size_t)s->orig[i]; /* engine, scene index */
-        double *f = s->f + 3 * i, *t = s->torque + 3 * i, *prev = l->f_prev + 6 * k;
+        const size_t i = (size_t)l->index[k], p = (size_t)ps->orig[i]; /* engine, scene index */
+        double *f = ps->f + 3 * i, *t = ps->torque + 3 * i, *prev = l->f_prev + 6 * k;
         double applied[6];
         for (int d = 0; d < 3; d++) {
             f[d] += sc->force[3 * p + d];
@@ -80,9 +79,9 @@ void sim_loads_apply(jd_sim *s) {
             applied[3 + d] = sc->fixed[p] ? -t[d] : 0.0;
             if (sc->fixed[p]) f[d] = t[d] = 0.0;
         }
-        const double *v = s->v + 3 * i, *w = s->omega + 3 * i;
-        work += jd_load_work(prev, applied, v, w, s->dt);
+        const double *v = ps->v + 3 * i, *w = ps->omega + 3 * i;
+        work += jd_load_work(prev, applied, v, w, run->dt);
         memcpy(prev, applied, sizeof applied);
     }
-    if (!s->in_setup) s->wall_work += work;
+    if (!in_setup) accounts->wall_work += work;
 }

@@ -336,7 +336,7 @@ static int report_unfinished(int rc, const jd_sim *sim, const char *err, const c
 
 /* One line per part of the time loop, and a machine-readable summary line (scripts/bench.py). */
 static void print_timing(const jd_sim *s) {
-    const jd_timing *t = &s->timing;
+    const jd_timing *t = &s->accounts.timing;
     const double total = t->neighbour + t->pairs + t->walls + t->integration + t->output;
     const struct {
         const char *name;
@@ -344,9 +344,9 @@ static void print_timing(const jd_sim *s) {
     } part[] = {{"neighbour search", t->neighbour}, {"pair forces", t->pairs},
                 {"wall forces", t->walls}, {"integration", t->integration}, {"output", t->output}};
     fprintf(stderr, "jdem: timing of %lld steps, %zu particles, %d thread(s), %lld neighbour builds:\n",
-            (long long)s->step, s->n, s->threads, (long long)s->n_builds);
+            (long long)s->step, s->particles.n, s->threads.n, (long long)s->lists.n_builds);
     char laws[96];
-    fprintf(stderr, "jdem:   law set %s\n", jd_law_set_describe(s->features, laws, sizeof laws));
+    fprintf(stderr, "jdem:   law set %s\n", jd_law_set_describe(s->run.features, laws, sizeof laws));
     for (size_t k = 0; k < sizeof part / sizeof *part; k++)
         fprintf(stderr, "jdem:   %-17s %10.4f s  %5.1f %%\n", part[k].name, part[k].v,
                 total > 0.0 ? 100.0 * part[k].v / total : 0.0);
@@ -354,12 +354,13 @@ static void print_timing(const jd_sim *s) {
             t->loop);
     fprintf(stderr, "jdem:   engine memory %.1f MB (%.0f bytes per particle; the scene and the "
             "libraries come on top)\n", (double)sim_memory_bytes(s) / 1e6,
-            s->n ? (double)sim_memory_bytes(s) / (double)s->n : 0.0);
+            s->particles.n ? (double)sim_memory_bytes(s) / (double)s->particles.n : 0.0);
     fprintf(stderr, "jdem-timing: neighbour=%.6f pairs=%.6f walls=%.6f integration=%.6f output=%.6f "
             "loop=%.6f steps=%lld builds=%lld threads=%d pair_entries=%zu wall_entries=%zu "
             "engine_bytes=%zu\n",
             t->neighbour, t->pairs, t->walls, t->integration, t->output, t->loop, (long long)s->step,
-            (long long)s->n_builds, s->threads, s->pairs.n, s->wall_pairs.n, sim_memory_bytes(s));
+            (long long)s->lists.n_builds, s->threads.n, s->lists.pairs.n, s->lists.wall_pairs.n,
+            sim_memory_bytes(s));
     const int64_t inserted = sim_inlets_inserted(s);
     if (inserted > 0)
         fprintf(stderr, "jdem-inlets: inserted=%lld seconds=%.6f ns_per_particle=%.1f\n",
@@ -394,7 +395,7 @@ static int output_particles(const jd_scene *sc, const jd_sim *sim, jd_h5md_parti
     memcpy(id, sc->id, n * sizeof *id);
     memcpy(species, sc->material, n * sizeof *species);
     memcpy(radius, sc->radius, n * sizeof *radius);
-    sim_scalars_in_scene_order(sim, sim->mass, radius + n1);
+    sim_scalars_in_scene_order(&sim->particles, sim->particles.mass, radius + n1);
     return 0;
 }
 
@@ -472,7 +473,7 @@ static int run_and_close(const cli *c, jd_sim *sim, jd_h5md *h, const char *out)
     }
     if (!c->quiet)
         fprintf(stderr, "jdem: wrote %s (%lld steps, %lld neighbour builds)\n", out,
-                (long long)sim->step, (long long)sim->n_builds);
+                (long long)sim->step, (long long)sim->lists.n_builds);
     return 0;
 }
 
@@ -485,8 +486,7 @@ static int cmd_run(const cli *c) {
     jd_sim sim;
     const jd_sim_options opt = {
         .allpairs = getenv("JDEM_NEIGHBOUR") && !strcmp(getenv("JDEM_NEIGHBOUR"), "allpairs"),
-        .no_sort = c->no_sort, .all_laws = c->all_laws, .plain_loops = c->plain_loops,
-        .threads = c->threads ? c->threads : 1};
+        .no_sort = c->no_sort, .all_laws = c->all_laws, .plain_loops = c->plain_loops};
     if ((rc = check_time_step(&sc, c)) || (rc = output_path(c, &sc, out, sizeof out))) {
         scene_free(&sc);
         return rc;
@@ -494,7 +494,7 @@ static int cmd_run(const cli *c) {
     if (make_parent_dirs(out, err, sizeof err) != 0) {
         fprintf(stderr, "jdem: %s\n", err);
         rc = EXIT_IO;
-    } else if (sim_init(&sim, &sc, &opt, err, sizeof err) != 0) {
+    } else if (sim_init(&sim, &sc, &opt, c->threads ? c->threads : 1, err, sizeof err) != 0) {
         fprintf(stderr, "jdem: %s\n", err);
         rc = setup_failure(err);
     } else {

@@ -104,21 +104,21 @@ static int key_less(const jd_contact_list *a, size_t p, const jd_contact_list *b
 
 /* The dissipation accumulated by entry c (energy bookkeeping only), harvested into the run's
  * totals when the entry is dropped (jd_contact_harvest). */
-static void drop_entry(jd_sim *s, const jd_contact_list *l, size_t c) {
+static void drop_entry(jd_accounts *accounts, const jd_contact_list *l, size_t c) {
     if (l->hw < JD_CONTACT_STATE_LEN) return;
     jd_contact_state st;
     sim_hist_get(l, c, &st, NULL);
-    jd_contact_harvest(&st, 1.0, &s->e_damp_dropped, &s->e_fric_dropped);
+    jd_contact_harvest(&st, 1.0, &accounts->e_damp_dropped, &accounts->e_fric_dropped);
 }
 
 /* Give every entry of nw (one sorted run) the history of the same (i, j) in old, or a fresh
  * (zero) history: one merge with each of old's two sorted runs (jd_contact_list). */
-static void carry_over(jd_sim *s, const jd_contact_list *old, jd_contact_list *nw) {
+static void carry_over(jd_accounts *accounts, const jd_contact_list *old, jd_contact_list *nw) {
     const size_t hw = (size_t)nw->hw, rw = (size_t)nw->rw;
     size_t a = 0, a_end = old->n_touch, q = old->n_touch;
     for (size_t b = 0; b < nw->n; b++) {
-        for (; a < a_end && key_less(old, a, nw, b); a++) drop_entry(s, old, a);
-        for (; q < old->n && key_less(old, q, nw, b); q++) drop_entry(s, old, q);
+        for (; a < a_end && key_less(old, a, nw, b); a++) drop_entry(accounts, old, a);
+        for (; q < old->n && key_less(old, q, nw, b); q++) drop_entry(accounts, old, q);
         const int in_a = a < a_end && !key_less(nw, b, old, a);
         const int in_q = !in_a && q < old->n && !key_less(nw, b, old, q);
         if (in_a || in_q) {
@@ -130,8 +130,8 @@ static void carry_over(jd_sim *s, const jd_contact_list *old, jd_contact_list *n
             if (rw) memset(nw->rhist + rw * b, 0, rw * sizeof *nw->rhist);
         }
     }
-    for (; a < a_end; a++) drop_entry(s, old, a);
-    for (; q < old->n; q++) drop_entry(s, old, q);
+    for (; a < a_end; a++) drop_entry(accounts, old, a);
+    for (; q < old->n; q++) drop_entry(accounts, old, q);
 }
 
 /* Can particle i touch wall w before the next rebuild (relative motion <= skin)? */
@@ -141,9 +141,9 @@ static int wall_candidate(const jd_sim_wall *w, const double *x, double R, doubl
 }
 
 /* The kind of list the run's history needs. */
-static unsigned list_kind(const jd_sim *s) {
-    return ((s->features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) |
-           ((s->features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u);
+static unsigned list_kind(unsigned features) {
+    return ((features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) |
+           ((features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u);
 }
 
 /* Entry c of `from` into entry d of `to` (same kind of list). */
@@ -157,23 +157,26 @@ static void copy_entry(const jd_contact_list *from, size_t c, jd_contact_list *t
 
 /* The pair list `in` (one sorted run) into `out` as two sorted runs: the candidates whose
  * spheres touch now (LIGGGHTS' rsq < radsum^2), then the others (jd_contact_list). */
-static int split_touching(const jd_sim *s, const jd_contact_list *in, jd_contact_list *out) {
-    if (sim_list_reserve(out, in->n, list_kind(s)) != 0) return -1;
+static int split_touching(const jd_particles *ps, unsigned kind, const jd_contact_list *in,
+                          jd_contact_list *out) {
+    if (sim_list_reserve(out, in->n, kind) != 0) return -1;
     size_t touching = 0;
-    for (size_t c = 0; c < in->n; c++) touching += sim_pair_touching(s, in->i[c], in->j[c]);
+    for (size_t c = 0; c < in->n; c++) touching += sim_pair_touching(ps, in->i[c], in->j[c]);
     size_t t = 0, o = touching;
     for (size_t c = 0; c < in->n; c++)
-        copy_entry(in, c, out, sim_pair_touching(s, in->i[c], in->j[c]) ? t++ : o++);
+        copy_entry(in, c, out, sim_pair_touching(ps, in->i[c], in->j[c]) ? t++ : o++);
     out->n = in->n;
     out->n_touch = touching;
     return 0;
 }
 
-static int build_wall_list(jd_sim *s, jd_contact_list *l) {
-    const unsigned kind = list_kind(s);
-    for (size_t i = 0; i < s->n; i++)
-        for (size_t w = 0; w < s->n_walls; w++)
-            if ((s->allpairs || wall_candidate(&s->walls[w], s->x + 3 * i, s->radius[i], s->skin)) &&
+/* The (particle, wall) candidates within the skin into l; allpairs: every particle with every
+ * wall. */
+static int build_wall_list(const jd_particles *ps, const jd_walls *walls, double skin, int allpairs,
+                           unsigned kind, jd_contact_list *l) {
+    for (size_t i = 0; i < ps->n; i++)
+        for (size_t w = 0; w < walls->n; w++)
+            if ((allpairs || wall_candidate(&walls->wall[w], ps->x + 3 * i, ps->radius[i], skin)) &&
                 list_push(l, (int32_t)i, (int32_t)w, kind) != 0)
                 return -1;
     return 0;
@@ -212,28 +215,29 @@ static inline size_t cell_number(const int c[3], const int nc[3], const int ax[3
 }
 
 /* Sort particles into cells (counting sort, so each cell lists its particles in index order). */
-static int bin_particles(jd_sim *s, double h, const double lo[3], const int nc[3], const int ax[3]) {
+static int bin_particles(jd_neighbour_lists *lists, const jd_particles *ps, double h,
+                         const double lo[3], const int nc[3], const int ax[3]) {
     const size_t ncell = (size_t)nc[0] * (size_t)nc[1] * (size_t)nc[2];
-    if (ncell + 1 > s->cell_cap) {
-        int32_t *cs = realloc(s->cell_start, (ncell + 1) * sizeof *cs);
+    if (ncell + 1 > lists->cell_cap) {
+        int32_t *cs = realloc(lists->cell_start, (ncell + 1) * sizeof *cs);
         if (!cs) return -1;
-        s->cell_start = cs;
-        s->cell_cap = ncell + 1;
+        lists->cell_start = cs;
+        lists->cell_cap = ncell + 1;
     }
-    memset(s->cell_start, 0, (ncell + 1) * sizeof *s->cell_start);
-    for (size_t i = 0; i < s->n; i++) {
+    memset(lists->cell_start, 0, (ncell + 1) * sizeof *lists->cell_start);
+    for (size_t i = 0; i < ps->n; i++) {
         int c[3];
         for (int d = 0; d < 3; d++) {
-            c[d] = (int)((s->x[3 * i + d] - lo[d]) / h);
+            c[d] = (int)((ps->x[3 * i + d] - lo[d]) / h);
             c[d] = c[d] < 0 ? 0 : c[d] >= nc[d] ? nc[d] - 1 : c[d];
         }
-        s->cell_of[i] = (int32_t)cell_number(c, nc, ax);
-        s->cell_start[s->cell_of[i] + 1]++;
+        lists->cell_of[i] = (int32_t)cell_number(c, nc, ax);
+        lists->cell_start[lists->cell_of[i] + 1]++;
     }
-    for (size_t c = 0; c < ncell; c++) s->cell_start[c + 1] += s->cell_start[c];
-    for (size_t i = 0; i < s->n; i++) s->cell_items[s->cell_start[s->cell_of[i]]++] = (int32_t)i;
-    for (size_t c = ncell; c > 0; c--) s->cell_start[c] = s->cell_start[c - 1]; /* undo the shift */
-    s->cell_start[0] = 0;
+    for (size_t c = 0; c < ncell; c++) lists->cell_start[c + 1] += lists->cell_start[c];
+    for (size_t i = 0; i < ps->n; i++) lists->cell_items[lists->cell_start[lists->cell_of[i]]++] = (int32_t)i;
+    for (size_t c = ncell; c > 0; c--) lists->cell_start[c] = lists->cell_start[c - 1]; /* undo the shift */
+    lists->cell_start[0] = 0;
     return 0;
 }
 
@@ -246,26 +250,26 @@ static double grid_cells(const double lo[3], const double hi[3], double h) {
 /* The cell grid over the particles' bounding box: cell edge h >= the largest interaction
  * range, grown if the box would need more than about 8 cells per particle (sparse or scattered
  * systems).  Fails on a non-finite position. */
-static int cell_grid(const jd_sim *s, double *h_out, double lo[3], int nc[3], char *err,
-                     size_t errlen) {
+static int cell_grid(const jd_particles *ps, double skin, int64_t step, double *h_out, double lo[3],
+                     int nc[3], char *err, size_t errlen) {
     double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     double rmax = 0.0;
     for (int d = 0; d < 3; d++) lo[d] = INFINITY;
-    for (size_t i = 0; i < s->n; i++) {
+    for (size_t i = 0; i < ps->n; i++) {
         for (int d = 0; d < 3; d++) {
-            const double xd = s->x[3 * i + d];
+            const double xd = ps->x[3 * i + d];
             if (!isfinite(xd)) {
                 snprintf(err, errlen, "particle %lld has a non-finite position at step %lld",
-                         sim_particle_id(s, i), (long long)s->step);
+                         sim_particle_id(ps, i), (long long)step);
                 return -1;
             }
             lo[d] = fmin(lo[d], xd);
             hi[d] = fmax(hi[d], xd);
         }
-        rmax = fmax(rmax, s->radius[i]);
+        rmax = fmax(rmax, ps->radius[i]);
     }
-    double h = 2.0 * rmax + s->skin;
-    const double max_cells = 8.0 * (double)s->n + 64.0;
+    double h = 2.0 * rmax + skin;
+    const double max_cells = 8.0 * (double)ps->n + 64.0;
     const double cells = grid_cells(lo, hi, h);
     if (cells > max_cells) h *= cbrt(cells / max_cells) * 1.01;
     /* the cube root fits a box spread in three dimensions; a flat one (one particle far away
@@ -281,33 +285,35 @@ static int cell_grid(const jd_sim *s, double *h_out, double lo[3], int nc[3], ch
 static int sort_into_cells(jd_sim *s, char *err, size_t errlen) {
     double h, lo[3];
     int nc[3], ax[3];
-    if (cell_grid(s, &h, lo, nc, err, errlen) != 0) return -1;
+    if (cell_grid(&s->particles, s->lists.skin, s->step, &h, lo, nc, err, errlen) != 0) return -1;
     cell_axes(nc, ax);
-    if (bin_particles(s, h, lo, nc, ax) != 0) {
-        snprintf(err, errlen, "out of memory sorting %zu particles", s->n);
+    if (bin_particles(&s->lists, &s->particles, h, lo, nc, ax) != 0) {
+        snprintf(err, errlen, "out of memory sorting %zu particles", s->particles.n);
         return -1;
     }
     /* cell_items is the new order (new index -> old index) */
-    return sim_reorder(s, s->cell_items, err, errlen);
+    return sim_reorder(s, s->lists.cell_items, err, errlen);
 }
 
-static int build_pair_list_cells(jd_sim *s, jd_contact_list *l, char *err, size_t errlen) {
-    if (s->n < 2) return 0;
-    const unsigned kind = list_kind(s);
+/* The pairs within the skin, from the cell grid (lists' cell arrays), into l; step: for a
+ * message. */
+static int build_pair_list_cells(const jd_particles *ps, jd_neighbour_lists *lists, unsigned kind,
+                                 int64_t step, jd_contact_list *l, char *err, size_t errlen) {
+    if (ps->n < 2) return 0;
     double h, lo[3];
     int nc[3], ax[3];
-    if (cell_grid(s, &h, lo, nc, err, errlen) != 0) return -1;
+    if (cell_grid(ps, lists->skin, step, &h, lo, nc, err, errlen) != 0) return -1;
     cell_axes(nc, ax);
-    if (bin_particles(s, h, lo, nc, ax) != 0) goto oom;
+    if (bin_particles(lists, ps, h, lo, nc, ax) != 0) goto oom;
 
-    for (size_t i = 0; i < s->n; i++) {
-        const int32_t ci = s->cell_of[i];
+    for (size_t i = 0; i < ps->n; i++) {
+        const int32_t ci = lists->cell_of[i];
         int c[3];
         c[ax[2]] = ci % nc[ax[2]];
         c[ax[1]] = (ci / nc[ax[2]]) % nc[ax[1]];
         c[ax[0]] = ci / (nc[ax[2]] * nc[ax[1]]);
-        const double *xi = s->x + 3 * i;
-        const double ri = s->radius[i];
+        const double *xi = ps->x + 3 * i;
+        const double ri = ps->radius[i];
         const size_t first = l->n;
         for (int dz = -1; dz <= 1; dz++) {
             const int z = c[2] + dz;
@@ -320,12 +326,12 @@ static int build_pair_list_cells(jd_sim *s, jd_contact_list *l, char *err, size_
                     if (x < 0 || x >= nc[0]) continue;
                     const int nb[3] = {x, y, z};
                     const size_t cell = cell_number(nb, nc, ax);
-                    for (int32_t q = s->cell_start[cell]; q < s->cell_start[cell + 1]; q++) {
-                        const int32_t j = s->cell_items[q];
+                    for (int32_t q = lists->cell_start[cell]; q < lists->cell_start[cell + 1]; q++) {
+                        const int32_t j = lists->cell_items[q];
                         if ((size_t)j <= i) continue;
-                        const double *xj = s->x + 3 * (size_t)j;
+                        const double *xj = ps->x + 3 * (size_t)j;
                         const double d[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
-                        const double range = ri + s->radius[j] + s->skin;
+                        const double range = ri + ps->radius[j] + lists->skin;
                         if (jd_dot(d, d) < range * range && list_push(l, (int32_t)i, j, kind) != 0)
                             goto oom;
                     }
@@ -340,10 +346,9 @@ oom:
     return -1;
 }
 
-static int build_pair_list_all(jd_sim *s, jd_contact_list *l) {
-    const unsigned kind = list_kind(s);
-    for (size_t i = 0; i < s->n; i++)
-        for (size_t j = i + 1; j < s->n; j++)
+static int build_pair_list_all(size_t n, unsigned kind, jd_contact_list *l) {
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = i + 1; j < n; j++)
             if (list_push(l, (int32_t)i, (int32_t)j, kind) != 0) return -1;
     return 0;
 }
@@ -352,61 +357,63 @@ static int build_pair_list_all(jd_sim *s, jd_contact_list *l) {
  * between builds, and the pair spare is reserved at once for the last list and an eighth more,
  * so a build reallocates only when the list grows by more than that. */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
-    if (!s->allpairs && !s->opt.no_sort && s->n > 1 && sort_into_cells(s, err, errlen) != 0)
+    if (!s->opt.allpairs && !s->opt.no_sort && s->particles.n > 1 && sort_into_cells(s, err, errlen) != 0)
         return -1;
-    jd_contact_list *nw = &s->spare;
+    const unsigned kind = list_kind(s->run.features);
+    jd_contact_list *nw = &s->lists.spare;
     nw->n = 0;
-    if (sim_list_reserve(nw, s->pairs.n + s->pairs.n / 8 + 1, list_kind(s)) != 0) {
-        snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", s->pairs.n);
+    if (sim_list_reserve(nw, s->lists.pairs.n + s->lists.pairs.n / 8 + 1, kind) != 0) {
+        snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", s->lists.pairs.n);
         return -1;
     }
-    if (s->allpairs) {
-        if (build_pair_list_all(s, nw) != 0) {
-            snprintf(err, errlen, "out of memory building the all-pairs list (%zu particles)", s->n);
+    if (s->opt.allpairs) {
+        if (build_pair_list_all(s->particles.n, kind, nw) != 0) {
+            snprintf(err, errlen, "out of memory building the all-pairs list (%zu particles)",
+                     s->particles.n);
             return -1;
         }
-    } else if (build_pair_list_cells(s, nw, err, errlen) != 0) {
+    } else if (build_pair_list_cells(&s->particles, &s->lists, kind, s->step, nw, err, errlen) != 0) {
         return -1;
     }
     nw->n_touch = nw->n;
-    carry_over(s, &s->pairs, nw);
+    carry_over(&s->accounts, &s->lists.pairs, nw);
     /* the old list's buffers take the new list, split */
-    if (split_touching(s, nw, &s->pairs) != 0) {
+    if (split_touching(&s->particles, kind, nw, &s->lists.pairs) != 0) {
         snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", nw->n);
         return -1;
     }
-    list_fit(&s->pairs);
+    list_fit(&s->lists.pairs);
     list_fit(nw);
 
-    jd_contact_list *wn = &s->wall_spare;
+    jd_contact_list *wn = &s->lists.wall_spare;
     wn->n = 0;
-    if (build_wall_list(s, wn) != 0) {
+    if (build_wall_list(&s->particles, &s->walls, s->lists.skin, s->opt.allpairs, kind, wn) != 0) {
         snprintf(err, errlen, "out of memory building the wall candidate list");
         return -1;
     }
     wn->n_touch = wn->n;
-    carry_over(s, &s->wall_pairs, wn);
-    const jd_contact_list t = s->wall_pairs;
-    s->wall_pairs = *wn;
+    carry_over(&s->accounts, &s->lists.wall_pairs, wn);
+    const jd_contact_list t = s->lists.wall_pairs;
+    s->lists.wall_pairs = *wn;
     *wn = t;
-    list_fit(&s->wall_pairs);
+    list_fit(&s->lists.wall_pairs);
     list_fit(wn);
 
-    if (sim_forces_partition(s) != 0) {
-        snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads);
+    if (sim_forces_partition(&s->threads, &s->lists, s->particles.n) != 0) {
+        snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads.n);
         return -1;
     }
-    if (sim_walls_reserve(s, err, errlen) != 0) return -1;
-    memcpy(s->x_build, s->x, 3 * s->n * sizeof *s->x);
-    s->drift_bound = 0.0;
-    for (size_t w = 0; w < s->n_walls; w++) memset(s->walls[w].disp, 0, sizeof s->walls[w].disp);
-    s->n_builds++;
+    if (sim_walls_reserve(&s->walls, s->lists.wall_pairs.n, err, errlen) != 0) return -1;
+    memcpy(s->lists.x_build, s->particles.x, 3 * s->particles.n * sizeof *s->particles.x);
+    s->lists.drift_bound = 0.0;
+    for (size_t w = 0; w < s->walls.n; w++) memset(s->walls.wall[w].disp, 0, sizeof s->walls.wall[w].disp);
+    s->lists.n_builds++;
     return 0;
 }
 
-int sim_neighbour_walls_moved(const jd_sim *s) {
-    const double lim = 0.25 * s->skin * s->skin; /* (skin/2)^2 */
-    for (size_t w = 0; w < s->n_walls; w++)
-        if (jd_dot(s->walls[w].disp, s->walls[w].disp) > lim) return 1;
+int sim_neighbour_walls_moved(const jd_walls *walls, double skin) {
+    const double lim = 0.25 * skin * skin; /* (skin/2)^2 */
+    for (size_t w = 0; w < walls->n; w++)
+        if (jd_dot(walls->wall[w].disp, walls->wall[w].disp) > lim) return 1;
     return 0;
 }

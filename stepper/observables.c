@@ -29,39 +29,41 @@ static int carries_force(const jd_contact_state *st) {
     return st->flags != (double)JD_S_ENDED;
 }
 
-void sim_observables(const jd_sim *s, jd_observables *o) {
+void sim_observables(const jd_particles *ps, const jd_run_constants *run,
+                     const jd_neighbour_lists *lists, const jd_walls *walls,
+                     const jd_accounts *accounts, jd_observables *o) {
     *o = (jd_observables){0};
-    for (size_t i = 0; i < s->n; i++) {
-        const double *v = s->v + 3 * i, *w = s->omega + 3 * i, *x = s->x + 3 * i;
-        o->kinetic_energy += 0.5 * s->mass[i] * jd_dot(v, v);
-        o->rotational_energy += 0.5 * s->inertia[i] * jd_dot(w, w);
-        o->gravitational_energy -= s->mass[i] * jd_dot(s->g, x);
+    for (size_t i = 0; i < ps->n; i++) {
+        const double *v = ps->v + 3 * i, *w = ps->omega + 3 * i, *x = ps->x + 3 * i;
+        o->kinetic_energy += 0.5 * ps->mass[i] * jd_dot(v, v);
+        o->rotational_energy += 0.5 * ps->inertia[i] * jd_dot(w, w);
+        o->gravitational_energy -= ps->mass[i] * jd_dot(run->g, x);
     }
     /* Stored energy comes from the contact state (zero for separated and ended contacts); the
      * geometry decides which contacts count. */
-    for (size_t c = 0; c < s->pairs.n; c++) {
+    for (size_t c = 0; c < lists->pairs.n; c++) {
         jd_contact_geom g;
         jd_contact_state st;
-        sim_hist_get(&s->pairs, c, &st, NULL);
+        sim_hist_get(&lists->pairs, c, &st, NULL);
         o->elastic_energy += jd_contact_elastic_energy(&st);
-        const int32_t i = s->pairs.i[c], j = s->pairs.j[c];
+        const int32_t i = lists->pairs.i[c], j = lists->pairs.j[c];
         if (carries_force(&st) &&
-            jd_geom_spheres_contact(s->x + 3 * (size_t)i, s->radius[i], s->x + 3 * (size_t)j,
-                                    s->radius[j], &g))
+            jd_geom_spheres_contact(ps->x + 3 * (size_t)i, ps->radius[i], ps->x + 3 * (size_t)j,
+                                    ps->radius[j], &g))
             o->contacts += 1.0;
     }
-    for (size_t c = 0; c < s->wall_pairs.n; c++) {
+    for (size_t c = 0; c < lists->wall_pairs.n; c++) {
         jd_contact_geom g;
         jd_contact_state st;
-        sim_hist_get(&s->wall_pairs, c, &st, NULL);
+        sim_hist_get(&lists->wall_pairs, c, &st, NULL);
         o->elastic_energy += jd_contact_elastic_energy(&st);
-        if (carries_force(&st) && sim_wall_geom(s, s->wall_pairs.i[c], &s->walls[s->wall_pairs.j[c]], &g))
+        const jd_sim_wall *w = &walls->wall[lists->wall_pairs.j[c]];
+        if (carries_force(&st) && sim_wall_geom(ps, lists->wall_pairs.i[c], w, &g))
             o->wall_contacts += 1.0;
     }
-    o->damping_dissipation = s->e_damp_dropped;
-    o->friction_dissipation = s->e_fric_dropped;
-    list_energies(&s->pairs, &o->damping_dissipation, &o->friction_dissipation);
-    list_energies(&s->wall_pairs, &o->damping_dissipation, &o->friction_dissipation);
-    o->wall_work = s->wall_work;
-    if (s->bonds) sim_bonds_observables(s, &o->bond);
+    o->damping_dissipation = accounts->e_damp_dropped;
+    o->friction_dissipation = accounts->e_fric_dropped;
+    list_energies(&lists->pairs, &o->damping_dissipation, &o->friction_dissipation);
+    list_energies(&lists->wall_pairs, &o->damping_dissipation, &o->friction_dissipation);
+    o->wall_work = accounts->wall_work;
 }

@@ -92,12 +92,14 @@ static int rekey(jd_contact_list *l, int pairs, const int32_t *new_of_old, size_
     return 0;
 }
 
-static int reorder_list(jd_sim *s, jd_contact_list *l, int pairs, const int32_t *new_of_old) {
+/* List l of n particles re-keyed and sorted through spare, which then takes l's old buffers. */
+static int reorder_list(jd_contact_list *l, jd_contact_list *spare, int pairs,
+                        const int32_t *new_of_old, size_t n) {
     if (l->n == 0) return 0;
-    jd_contact_list *spare = pairs ? &s->spare : &s->wall_spare;
-    const unsigned kind = (l->rw ? JD_LIST_ROLLING : 0u) | (l->hw == JD_CONTACT_STATE_LEN ? JD_LIST_ENERGY : 0u);
+    const unsigned kind =
+        (l->rw ? JD_LIST_ROLLING : 0u) | (l->hw == JD_CONTACT_STATE_LEN ? JD_LIST_ENERGY : 0u);
     if (sim_list_reserve(spare, l->n, kind) != 0 ||
-        rekey(l, pairs, new_of_old, s->n, spare) != 0)
+        rekey(l, pairs, new_of_old, n, spare) != 0)
         return -1;
     const jd_contact_list t = *l;
     *l = *spare;
@@ -106,24 +108,28 @@ static int reorder_list(jd_sim *s, jd_contact_list *l, int pairs, const int32_t 
 }
 
 int sim_reorder(jd_sim *s, const int32_t *old_of_new, char *err, size_t errlen) {
-    const size_t n = s->n;
+    jd_particles *ps = &s->particles;
+    jd_neighbour_lists *lists = &s->lists;
+    const size_t n = ps->n;
     int32_t *new_of_old = malloc((n ? n : 1) * sizeof *new_of_old);
     if (!new_of_old) goto oom;
     for (size_t k = 0; k < n; k++) new_of_old[old_of_new[k]] = (int32_t)k;
     /* the lists first: they are the only step that can fail, and the arrays stay untouched */
-    if (reorder_list(s, &s->pairs, 1, new_of_old) != 0 ||
-        reorder_list(s, &s->wall_pairs, 0, new_of_old) != 0) {
+    if (reorder_list(&lists->pairs, &lists->spare, 1, new_of_old, n) != 0 ||
+        reorder_list(&lists->wall_pairs, &lists->wall_spare, 0, new_of_old, n) != 0) {
         free(new_of_old);
         goto oom;
     }
-    double *const vec[] = {s->x, s->v, s->omega, s->f, s->torque, s->x_build};
-    for (size_t k = 0; k < sizeof vec / sizeof *vec; k++) gather_doubles(vec[k], 3, old_of_new, n, s->scratch);
-    double *const per[] = {s->radius, s->mass, s->inertia, s->kp, s->kw, s->dtfm, s->dtirot};
-    for (size_t k = 0; k < sizeof per / sizeof *per; k++) gather_doubles(per[k], 1, old_of_new, n, s->scratch);
-    int32_t *iscratch = (int32_t *)s->scratch; /* 3n doubles hold n int32 */
-    gather_ints(s->species, old_of_new, n, iscratch);
-    gather_ints(s->orig, old_of_new, n, iscratch);
-    s->sorted = 1;
+    double *const vec[] = {ps->x, ps->v, ps->omega, ps->f, ps->torque, lists->x_build};
+    for (size_t k = 0; k < sizeof vec / sizeof *vec; k++)
+        gather_doubles(vec[k], 3, old_of_new, n, ps->scratch);
+    double *const per[] = {ps->radius, ps->mass, ps->inertia, ps->kp, ps->kw, ps->dtfm, ps->dtirot};
+    for (size_t k = 0; k < sizeof per / sizeof *per; k++)
+        gather_doubles(per[k], 1, old_of_new, n, ps->scratch);
+    int32_t *iscratch = (int32_t *)ps->scratch; /* 3n doubles hold n int32 */
+    gather_ints(ps->species, old_of_new, n, iscratch);
+    gather_ints(ps->orig, old_of_new, n, iscratch);
+    ps->sorted = 1;
     sim_bonds_permute(s->bonds, new_of_old, n);
     sim_loads_permute(s->loads, new_of_old);
     free(new_of_old);
@@ -139,19 +145,20 @@ static void to_scene(double *a, const int32_t *orig, size_t n, double *scratch) 
     memcpy(a, scratch, 3 * n * sizeof *a);
 }
 
-void sim_vectors_to_scene_order(jd_sim *s) {
-    if (!s->sorted) return;
-    double *const vec[] = {s->x, s->v, s->omega, s->f, s->torque};
-    for (size_t k = 0; k < sizeof vec / sizeof *vec; k++) to_scene(vec[k], s->orig, s->n, s->scratch);
+void sim_vectors_to_scene_order(jd_particles *ps) {
+    if (!ps->sorted) return;
+    double *const vec[] = {ps->x, ps->v, ps->omega, ps->f, ps->torque};
+    for (size_t k = 0; k < sizeof vec / sizeof *vec; k++) to_scene(vec[k], ps->orig, ps->n, ps->scratch);
 }
 
-void sim_vectors_to_sim_order(jd_sim *s) {
-    if (!s->sorted) return;
-    double *const vec[] = {s->x, s->v, s->omega, s->f, s->torque};
-    for (size_t k = 0; k < sizeof vec / sizeof *vec; k++) gather_doubles(vec[k], 3, s->orig, s->n, s->scratch);
+void sim_vectors_to_sim_order(jd_particles *ps) {
+    if (!ps->sorted) return;
+    double *const vec[] = {ps->x, ps->v, ps->omega, ps->f, ps->torque};
+    for (size_t k = 0; k < sizeof vec / sizeof *vec; k++)
+        gather_doubles(vec[k], 3, ps->orig, ps->n, ps->scratch);
 }
 
-void sim_scalars_in_scene_order(const jd_sim *s, const double *a, double *out) {
-    for (size_t i = 0; i < s->n; i++) out[s->orig[i]] = a[i];
+void sim_scalars_in_scene_order(const jd_particles *ps, const double *a, double *out) {
+    for (size_t i = 0; i < ps->n; i++) out[ps->orig[i]] = a[i];
 }
 

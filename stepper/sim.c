@@ -48,23 +48,23 @@ static double *interaction_tables(const jd_scene *sc, double **friction, double 
  * some interaction that can occur in this scene needs (particle materials against particle and
  * wall materials: jd_law_set_select).  --all-laws: the general loop, every law evaluated. */
 static int init_laws(jd_sim *s) {
-    const jd_scene *sc = s->scene;
+    const jd_scene *sc = s->run.scene;
     const size_t nm = sc->n_materials, nn = nm * nm;
     double *mu = NULL, *eta = NULL, *E = NULL, *nu = NULL;
     double *e = interaction_tables(sc, &mu, &eta, &E, &nu);
     unsigned char *used = calloc(2 * (nm ? nm : 1), 1), *wall_used = used + nm;
-    s->n_materials = nm;
-    s->coeffs = calloc(nn ? nn : 1, sizeof *s->coeffs);
-    const int rc = (e && used && s->coeffs) ? 0 : -1;
+    s->run.n_materials = nm;
+    s->run.coeffs = calloc(nn ? nn : 1, sizeof *s->run.coeffs);
+    const int rc = (e && used && s->run.coeffs) ? 0 : -1;
     if (rc == 0) {
         jd_pair_coeffs_table(nm, e, mu, eta, E, nu, sc->damping_map, sc->mu_r, sc->xi_limit,
-                             s->coeffs);
+                             s->run.coeffs);
         for (size_t i = 0; i < sc->n_particles; i++) used[sc->material[i]] = 1;
         for (size_t k = 0; k < sc->n_inlets; k++)
             for (size_t p = 0; p < sc->inlets[k].n; p++) used[sc->inlets[k].material[p]] = 1;
         for (size_t w = 0; w < sc->n_walls; w++) wall_used[sc->walls[w].material] = 1;
         const unsigned mindlin = sc->tangential_rule == JD_KT_MINDLIN ? JD_F_MINDLIN : 0u;
-        s->features = s->opt.all_laws
+        s->run.features = s->opt.all_laws
                           ? JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | mindlin |
                                 (sc->energy ? JD_F_ENERGY : 0u)
                           : jd_law_set_select(nm, e, mu, eta, used, wall_used, sc->mu_r,
@@ -77,21 +77,22 @@ static int init_laws(jd_sim *s) {
 
 /* How alike the particles are (sim.h: pair_row, alike), which lets the pair loop read the
  * coefficients, or also the pair constants and radii, once instead of per pair. */
-void sim_particle_kinds(jd_sim *s) {
-    s->pair_row = s->n ? s->species[0] * (int32_t)(s->n_materials + 1) : -1;
-    s->alike = s->n > 0;
-    for (size_t i = 1; i < s->n; i++) {
-        if (s->species[i] != s->species[0]) s->pair_row = -1;
-        if (s->species[i] != s->species[0] || s->radius[i] != s->radius[0]) s->alike = 0;
+void sim_particle_kinds(jd_fast_paths *fast, const jd_particles *ps, size_t n_materials,
+                        int plain) {
+    fast->pair_row = ps->n ? ps->species[0] * (int32_t)(n_materials + 1) : -1;
+    fast->alike = ps->n > 0;
+    for (size_t i = 1; i < ps->n; i++) {
+        if (ps->species[i] != ps->species[0]) fast->pair_row = -1;
+        if (ps->species[i] != ps->species[0] || ps->radius[i] != ps->radius[0]) fast->alike = 0;
     }
-    if (s->alike) { /* the constants of any pair: those of particle 0 with itself */
-        s->r_alike = s->radius[0];
-        sim_pair_constants(s, 0, 0, &s->pc_alike, &s->pcr_alike);
+    if (fast->alike) { /* the constants of any pair: those of particle 0 with itself */
+        fast->r_alike = ps->radius[0];
+        sim_pair_constants(ps, 0, 0, &fast->pc_alike, &fast->pcr_alike);
     }
-    s->uniform_mass = s->n > 0 && !s->opt.plain_loops; /* plain: the reference path */
-    for (size_t i = 1; i < s->n && s->uniform_mass; i++)
-        s->uniform_mass = s->mass[i] == s->mass[0] && s->dtfm[i] == s->dtfm[0] &&
-                          s->dtirot[i] == s->dtirot[0];
+    fast->uniform_mass = ps->n > 0 && !plain; /* plain: the reference path */
+    for (size_t i = 1; i < ps->n && fast->uniform_mass; i++)
+        fast->uniform_mass = ps->mass[i] == ps->mass[0] && ps->dtfm[i] == ps->dtfm[0] &&
+                          ps->dtirot[i] == ps->dtirot[0];
 }
 
 /* The next `bytes` of the per-particle block (alloc_particle_arrays) at offset *at: 64-byte
@@ -111,24 +112,24 @@ static void *slice(char *block, size_t *at, size_t bytes) {
  * they take.  The five arrays the pair loop reads and writes come first. */
 static size_t carve(jd_sim *s, size_t n, char *block) {
     size_t at = 0;
-    s->x = slice(block, &at, 3 * n * sizeof *s->x);
-    s->v = slice(block, &at, 3 * n * sizeof *s->v);
-    s->omega = slice(block, &at, 3 * n * sizeof *s->omega);
-    s->f = slice(block, &at, 3 * n * sizeof *s->f);
-    s->torque = slice(block, &at, 3 * n * sizeof *s->torque);
-    s->dtfm = slice(block, &at, n * sizeof *s->dtfm);
-    s->dtirot = slice(block, &at, n * sizeof *s->dtirot);
-    s->radius = slice(block, &at, n * sizeof *s->radius);
-    s->mass = slice(block, &at, n * sizeof *s->mass);
-    s->inertia = slice(block, &at, n * sizeof *s->inertia);
-    s->kp = slice(block, &at, n * sizeof *s->kp);
-    s->kw = slice(block, &at, n * sizeof *s->kw);
-    s->x_build = slice(block, &at, 3 * n * sizeof *s->x_build);
-    s->scratch = slice(block, &at, 3 * n * sizeof *s->scratch);
-    s->species = slice(block, &at, n * sizeof *s->species);
-    s->orig = slice(block, &at, n * sizeof *s->orig);
-    s->cell_of = slice(block, &at, n * sizeof *s->cell_of);
-    s->cell_items = slice(block, &at, n * sizeof *s->cell_items);
+    s->particles.x = slice(block, &at, 3 * n * sizeof *s->particles.x);
+    s->particles.v = slice(block, &at, 3 * n * sizeof *s->particles.v);
+    s->particles.omega = slice(block, &at, 3 * n * sizeof *s->particles.omega);
+    s->particles.f = slice(block, &at, 3 * n * sizeof *s->particles.f);
+    s->particles.torque = slice(block, &at, 3 * n * sizeof *s->particles.torque);
+    s->particles.dtfm = slice(block, &at, n * sizeof *s->particles.dtfm);
+    s->particles.dtirot = slice(block, &at, n * sizeof *s->particles.dtirot);
+    s->particles.radius = slice(block, &at, n * sizeof *s->particles.radius);
+    s->particles.mass = slice(block, &at, n * sizeof *s->particles.mass);
+    s->particles.inertia = slice(block, &at, n * sizeof *s->particles.inertia);
+    s->particles.kp = slice(block, &at, n * sizeof *s->particles.kp);
+    s->particles.kw = slice(block, &at, n * sizeof *s->particles.kw);
+    s->lists.x_build = slice(block, &at, 3 * n * sizeof *s->lists.x_build);
+    s->particles.scratch = slice(block, &at, 3 * n * sizeof *s->particles.scratch);
+    s->particles.species = slice(block, &at, n * sizeof *s->particles.species);
+    s->particles.orig = slice(block, &at, n * sizeof *s->particles.orig);
+    s->lists.cell_of = slice(block, &at, n * sizeof *s->lists.cell_of);
+    s->lists.cell_items = slice(block, &at, n * sizeof *s->lists.cell_items);
     return at;
 }
 
@@ -144,27 +145,28 @@ static int alloc_particle_arrays(jd_sim *s, size_t n) {
     return 0;
 }
 
-void sim_particle_constants(jd_sim *s, size_t i, int32_t material, double r) {
-    const jd_scene *sc = s->scene;
+void sim_particle_constants(jd_particles *ps, const jd_run_constants *run, size_t i,
+                            int32_t material, double r) {
+    const jd_scene *sc = run->scene;
     const jd_material *m = &sc->materials[material];
-    const double dtfrotate = 0.5 * s->dt / 0.4; /* fix nve/sphere: dtfrotate, then dtirotate */
-    s->species[i] = material;
-    s->radius[i] = r;
-    s->mass[i] = jd_sphere_mass(r, m->density);
-    s->inertia[i] = jd_sphere_inertia(s->mass[i], r);
-    s->kp[i] = jd_hertz_prefactor(m->youngs_modulus, m->poisson_ratio, r);
-    s->kw[i] = jd_kn_wall(sc->wall_rule, m->youngs_modulus, m->poisson_ratio, r);
-    s->dtfm[i] = 0.5 * s->dt / s->mass[i];
-    s->dtirot[i] = dtfrotate / (r * r * s->mass[i]);
+    const double dtfrotate = 0.5 * run->dt / 0.4; /* fix nve/sphere: dtfrotate, then dtirotate */
+    ps->species[i] = material;
+    ps->radius[i] = r;
+    ps->mass[i] = jd_sphere_mass(r, m->density);
+    ps->inertia[i] = jd_sphere_inertia(ps->mass[i], r);
+    ps->kp[i] = jd_hertz_prefactor(m->youngs_modulus, m->poisson_ratio, r);
+    ps->kw[i] = jd_kn_wall(sc->wall_rule, m->youngs_modulus, m->poisson_ratio, r);
+    ps->dtfm[i] = 0.5 * run->dt / ps->mass[i];
+    ps->dtirot[i] = dtfrotate / (r * r * ps->mass[i]);
 }
 
 static int init_particles(jd_sim *s, char *err, size_t errlen) {
-    const jd_scene *sc = s->scene;
+    const jd_scene *sc = s->run.scene;
     const size_t n = sc->n_particles, cap = sim_inlets_capacity(sc), n1 = cap ? cap : 1;
     if (alloc_particle_arrays(s, n1) != 0) goto oom;
-    memcpy(s->x, sc->position, 3 * n * sizeof(double));
-    memcpy(s->v, sc->velocity, 3 * n * sizeof(double));
-    memcpy(s->omega, sc->angular_velocity, 3 * n * sizeof(double));
+    memcpy(s->particles.x, sc->position, 3 * n * sizeof(double));
+    memcpy(s->particles.v, sc->velocity, 3 * n * sizeof(double));
+    memcpy(s->particles.omega, sc->angular_velocity, 3 * n * sizeof(double));
     double rmax = 0.0;
     for (size_t i = 0; i < n; i++) {
         const jd_material *m = &sc->materials[sc->material[i]];
@@ -173,8 +175,8 @@ static int init_particles(jd_sim *s, char *err, size_t errlen) {
                      (long long)sc->id[i], m->name);
             return -1;
         }
-        s->orig[i] = (int32_t)i;
-        sim_particle_constants(s, i, sc->material[i], sc->radius[i]);
+        s->particles.orig[i] = (int32_t)i;
+        sim_particle_constants(&s->particles, &s->run, i, sc->material[i], sc->radius[i]);
         rmax = fmax(rmax, sc->radius[i]);
     }
     for (size_t k = 0; k < sc->n_inlets; k++)
@@ -182,7 +184,7 @@ static int init_particles(jd_sim *s, char *err, size_t errlen) {
     /* Skin 0.1 x the largest diameter: the list then holds ~(1.1)^3 = 1.33x the touching pairs
      * of a dense packing, and a rebuild is due only after some particle moved 5 % of a
      * diameter (~100 steps at typical granular speeds and time steps). */
-    s->skin = 0.2 * rmax;
+    s->lists.skin = 0.2 * rmax;
     return 0;
 oom:
     snprintf(err, errlen, "out of memory for %zu particles", n1);
@@ -212,7 +214,7 @@ static void restore_history(jd_contact_list *l, const jd_contact_state *state,
  * contact counts its first spring increment and its first step of dissipation once; only the
  * energy reference of that evaluation is kept. */
 static int setup_forces(jd_sim *s, char *err, size_t errlen) {
-    jd_contact_list *lists[2] = {&s->pairs, &s->wall_pairs};
+    jd_contact_list *lists[2] = {&s->lists.pairs, &s->lists.wall_pairs};
     jd_contact_state *state[2];
     jd_rolling_state *roll[2];
     int ok = 1;
@@ -243,36 +245,36 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
         snprintf(err, errlen, "out of memory");
         return -1;
     }
-    sim_particle_kinds(s);
-    if (sim_forces_init(s) != 0) {
-        snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads);
+    sim_particle_kinds(&s->fast, &s->particles, s->run.n_materials, s->opt.plain_loops);
+    if (sim_forces_init(&s->threads) != 0) {
+        snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads.n);
         return -1;
     }
-    if (sim_walls_init(s, err, errlen) != 0) return -1;
-    if (sim_bonds_init(s, err, errlen) != 0 || sim_loads_init(s, err, errlen) != 0 ||
+    if (sim_walls_init(&s->walls, &s->run, err, errlen) != 0) return -1;
+    if (sim_bonds_init(&s->bonds, &s->particles, s->run.scene, err, errlen) != 0 ||
+        sim_loads_init(&s->loads, s->run.scene, err, errlen) != 0 ||
         sim_inlets_init(s, err, errlen) != 0)
         return -1;
-    s->weight_in_kick = !s->loads && !s->opt.plain_loops &&
-                        (s->g[0] != 0.0 || s->g[1] != 0.0 || s->g[2] != 0.0);
+    s->fast.weight_in_kick = !s->loads && !s->opt.plain_loops &&
+                             (s->run.g[0] != 0.0 || s->run.g[1] != 0.0 || s->run.g[2] != 0.0);
     if (sim_neighbour_build(s, err, errlen) != 0) return -1;
     return setup_forces(s, err, errlen);
 }
 
-int sim_init(jd_sim *s, const jd_scene *scene, const jd_sim_options *opt, char *err,
+int sim_init(jd_sim *s, const jd_scene *scene, const jd_sim_options *opt, int threads, char *err,
              size_t errlen) {
     memset(s, 0, sizeof *s);
-    s->scene = scene;
-    s->n = scene->n_particles;
-    s->ids = scene->id;
-    s->dt = scene->dt;
+    s->run.scene = scene;
+    s->particles.n = scene->n_particles;
+    s->particles.ids = scene->id;
+    s->run.dt = scene->dt;
     if (opt) s->opt = *opt;
-    s->allpairs = s->opt.allpairs;
-    s->threads = s->opt.threads > 1 ? s->opt.threads : 1;
+    s->threads.n = threads > 1 ? threads : 1;
     s->frame_step = -1;
-    memcpy(s->g, scene->gravity, sizeof s->g);
-    s->max_overlap = scene->watchdog.enabled ? scene->watchdog.max_overlap_fraction : INFINITY;
+    memcpy(s->run.g, scene->gravity, sizeof s->run.g);
+    s->run.max_overlap = scene->watchdog.enabled ? scene->watchdog.max_overlap_fraction : INFINITY;
     if (setup(s, err, errlen) == 0) {
-        memset(&s->timing, 0, sizeof s->timing); /* the time loop's parts only */
+        memset(&s->accounts.timing, 0, sizeof s->accounts.timing); /* the time loop's parts only */
         return 0;
     }
     sim_free(s);
@@ -282,16 +284,16 @@ int sim_init(jd_sim *s, const jd_scene *scene, const jd_sim_options *opt, char *
 void sim_free(jd_sim *s) {
     if (s->particle_block) ASAN_UNPOISON_MEMORY_REGION(s->particle_block, s->particle_block_bytes);
     jd_huge_free(s->particle_block, s->particle_block_bytes);
-    sim_forces_free(s);
-    free(s->coeffs);
-    sim_walls_free(s);
-    free(s->cell_start);
-    sim_contact_list_free(&s->pairs);
-    sim_contact_list_free(&s->wall_pairs);
-    sim_contact_list_free(&s->spare);
-    sim_contact_list_free(&s->wall_spare);
-    sim_bonds_free(s);
-    sim_loads_free(s);
+    sim_forces_free(&s->threads);
+    free(s->run.coeffs);
+    sim_walls_free(&s->walls);
+    free(s->lists.cell_start);
+    sim_contact_list_free(&s->lists.pairs);
+    sim_contact_list_free(&s->lists.wall_pairs);
+    sim_contact_list_free(&s->lists.spare);
+    sim_contact_list_free(&s->lists.wall_spare);
+    sim_bonds_free(&s->bonds);
+    sim_loads_free(&s->loads);
     sim_inlets_free(s);
     memset(s, 0, sizeof *s);
 }
@@ -305,19 +307,21 @@ size_t sim_memory_bytes(const jd_sim *s) {
     const size_t per_particle = 6 * 3 * sizeof(double) /* x v omega f torque x_build */ +
                                 3 * sizeof(double) /* scratch */ + 7 * sizeof(double) /* constants */ +
                                 4 * sizeof(int32_t) /* species orig cell_of cell_items */;
+    const jd_thread_layout *th = &s->threads;
+    const jd_neighbour_lists *l = &s->lists;
     size_t overflow = 0;
-    for (int t = 0; s->shares && t < s->threads; t++) overflow += 6 * s->shares[t].cap * sizeof(double);
-    return s->n * per_particle + overflow + sim_bonds_memory_bytes(s->bonds, s->n) +
-           s->cell_cap * sizeof(int32_t) + list_bytes(&s->pairs) + list_bytes(&s->wall_pairs) +
-           list_bytes(&s->spare) + list_bytes(&s->wall_spare) + s->n_walls * sizeof *s->walls +
-           s->n_materials * s->n_materials * sizeof *s->coeffs;
+    for (int t = 0; th->shares && t < th->n; t++) overflow += 6 * th->shares[t].cap * sizeof(double);
+    return s->particles.n * per_particle + overflow + sim_bonds_memory_bytes(s->bonds, s->particles.n) +
+           l->cell_cap * sizeof(int32_t) + list_bytes(&l->pairs) + list_bytes(&l->wall_pairs) +
+           list_bytes(&l->spare) + list_bytes(&l->wall_spare) + s->walls.n * sizeof *s->walls.wall +
+           s->run.n_materials * s->run.n_materials * sizeof *s->run.coeffs;
 }
 
-static int check_finite(const jd_sim *s, char *err, size_t errlen) {
-    for (size_t k = 0; k < 3 * s->n; k++) {
-        if (!isfinite(s->x[k]) || !isfinite(s->v[k]) || !isfinite(s->omega[k])) {
+static int check_finite(const jd_particles *ps, int64_t step, char *err, size_t errlen) {
+    for (size_t k = 0; k < 3 * ps->n; k++) {
+        if (!isfinite(ps->x[k]) || !isfinite(ps->v[k]) || !isfinite(ps->omega[k])) {
             snprintf(err, errlen, "particle %lld has a non-finite state at step %lld (diverged)",
-                     sim_particle_id(s, k / 3), (long long)s->step);
+                     sim_particle_id(ps, k / 3), (long long)step);
             return -1;
         }
     }
@@ -326,15 +330,16 @@ static int check_finite(const jd_sim *s, char *err, size_t errlen) {
 
 /* Frames are in scene order: the vectors are put into it for the write and back after. */
 static int write_frame(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
-    if (check_finite(s, err, errlen) != 0) return -1;
+    if (check_finite(&s->particles, s->step, err, errlen) != 0) return -1;
     if (!h) return 0;
-    sim_vectors_to_scene_order(s);
-    jd_h5md_frame fr = {.step = s->step, .time = (double)s->step * s->dt, .position = s->x,
-                        .velocity = s->v, .angular_velocity = s->omega, .force = s->f,
-                        .torque = s->torque};
+    jd_particles *ps = &s->particles;
+    sim_vectors_to_scene_order(ps);
+    jd_h5md_frame fr = {.step = s->step, .time = (double)s->step * s->run.dt, .position = ps->x,
+                        .velocity = ps->v, .angular_velocity = ps->omega, .force = ps->f,
+                        .torque = ps->torque};
     jd_h5md_particles rows = {0};
     if (s->inlets) { /* the rows of every particle the run can hold, id -1 until inserted */
-        const double *const vec[JD_INLET_FRAME_VECTORS] = {s->x, s->v, s->omega, s->f, s->torque};
+        const double *const vec[JD_INLET_FRAME_VECTORS] = {ps->x, ps->v, ps->omega, ps->f, ps->torque};
         const double **dst[JD_INLET_FRAME_VECTORS] = {&fr.position, &fr.velocity,
                                                       &fr.angular_velocity, &fr.force, &fr.torque};
         for (int k = 0; k < JD_INLET_FRAME_VECTORS; k++) *dst[k] = sim_inlets_frame_rows(s, k, vec[k]);
@@ -342,7 +347,7 @@ static int write_frame(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
         fr.rows = &rows;
     }
     const int rc = jd_h5md_write_frame(h, &fr, err, errlen);
-    sim_vectors_to_sim_order(s);
+    sim_vectors_to_sim_order(ps);
     return rc ? JD_RUN_OUTPUT : 0;
 }
 
@@ -350,29 +355,31 @@ static int write_frame(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
 static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     jd_observables o;
     double val[JD_N_OBSERVABLES];
-    sim_observables(s, &o);
+    sim_observables(&s->particles, &s->run, &s->lists, &s->walls, &s->accounts, &o);
+    if (s->bonds) sim_bonds_observables(s->bonds, s->particles.n, &o.bond);
     sim_observables_values(&o, val);
     for (int k = 0; h && k < JD_N_OBSERVABLES; k++)
-        if ((s->scene->energy || !jd_observable_is_energy[k]) &&
-            jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->dt,
+        if ((s->run.scene->energy || !jd_observable_is_energy[k]) &&
+            jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->run.dt,
                                      val[k], err, errlen) != 0)
             return JD_RUN_OUTPUT;
     if (h && s->inlets && jd_h5md_write_observable(h, "inlet_energy", s->step,
-                                                   (double)s->step * s->dt,
+                                                   (double)s->step * s->run.dt,
                                                    sim_inlets_energy(s), err, errlen) != 0)
         return JD_RUN_OUTPUT;
-    if (h && s->wall_forces && sim_walls_write_observables(s, h, err, errlen) != 0)
+    if (h && s->walls.forces && sim_walls_write_observables(&s->walls, &s->run, s->step, h, err, errlen) != 0)
         return JD_RUN_OUTPUT;
     if (s->bonds) {
         double bv[JD_N_BOND_OBSERVABLES];
         sim_bond_observables_values(&o.bond, bv);
         for (int k = 0; h && k < JD_N_BOND_OBSERVABLES; k++)
-            if ((s->scene->energy || !jd_bond_observable_is_energy[k]) &&
+            if ((s->run.scene->energy || !jd_bond_observable_is_energy[k]) &&
                 jd_h5md_write_observable(h, jd_bond_observable_names[k], s->step,
-                                         (double)s->step * s->dt, bv[k], err, errlen) != 0)
+                                         (double)s->step * s->run.dt, bv[k], err, errlen) != 0)
                 return JD_RUN_OUTPUT;
     }
-    return sim_watchdog_energy(s, &o, err, errlen);
+    return sim_watchdog_energy(&s->watch, &s->particles, &s->run, s->step, sim_inlets_energy(s), &o,
+                               err, errlen);
 }
 
 static int due(int64_t step, int64_t every, int64_t last) {
@@ -389,7 +396,7 @@ static void write_stop_frame(jd_sim *s, jd_h5md *h) {
 }
 
 int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) {
-    const jd_scene *sc = s->scene;
+    const jd_scene *sc = s->run.scene;
     const int64_t last = sc->steps;
     jd_progress p;
     progress_start(&p, show_progress, last);
@@ -397,8 +404,9 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
     int rc = 0;
     for (;;) {
         /* the bonds formed and broken by the last step, also when the watchdog stops here */
-        if (s->bonds && (rc = sim_bonds_output(s, h, err, errlen)) != 0) break;
-        if ((rc = sim_watchdog_step(s, err, errlen)) != 0) break;
+        if (s->bonds && (rc = sim_bonds_output(s->bonds, s->step, h, err, errlen)) != 0) break;
+        if ((rc = sim_watchdog_step(&s->watch, &s->particles, &s->run, s->step, err, errlen)) != 0)
+            break;
         if (s->inlets && (rc = sim_inlets_step(s, err, errlen)) != 0) break;
         const double t0 = sim_clock();
         if (due(s->step, sc->output_every, last)) {
@@ -408,7 +416,7 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
         if (due(s->step, sc->observables_every, last) &&
             (rc = sample_observables(s, h, err, errlen)) != 0)
             break;
-        s->timing.output += sim_clock() - t0;
+        s->accounts.timing.output += sim_clock() - t0;
         if (s->step >= last) break;
         if (s->stop && *s->stop) {
             snprintf(err, errlen, "stopped at step %lld", (long long)s->step);
@@ -418,10 +426,10 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
         const int seen = due(s->step + 1, sc->output_every, last) ||
                          due(s->step + 1, sc->observables_every, last);
         if ((rc = sim_step(s, seen, err, errlen)) != 0) break;
-        progress_update(&p, s->step, (double)s->step * s->dt, s->n);
+        progress_update(&p, s->step, (double)s->step * s->run.dt, s->particles.n);
     }
     sim_finish_step(s); /* a run stopped between samples: its stop frame, and the caller */
-    s->timing.loop += sim_clock() - t_loop;
+    s->accounts.timing.loop += sim_clock() - t_loop;
     progress_finish(&p);
     if (rc == JD_RUN_TRIPPED || rc == JD_RUN_STOPPED) write_stop_frame(s, h);
     return rc;

@@ -23,6 +23,16 @@
  * constants are separate arrays (structure of arrays) so that each loop streams only what it
  * uses.  Pairs are always i < j.
  *
+ * Parts.  A run (jd_sim) is a set of parts that each hold one kind of thing: the particles
+ * (jd_particles), the run's constants (jd_run_constants), the options of the reference paths
+ * (jd_sim_options), what the fast paths may assume (jd_fast_paths), the threads' shares of the
+ * loops (jd_thread_layout), the contact lists and their neighbour search (jd_neighbour_lists),
+ * the walls (jd_walls), the accounts of time and energy (jd_accounts), what the watchdog has
+ * seen (jd_watch), and the optional modules (bonds, loads, inlets).  A pass takes pointers to
+ * the parts it reads (const) and writes; only the passes that drive others (sim_run, sim_step,
+ * sim_compute_forces, sim_neighbour_build with its renumbering, the inlets) take the whole run.
+ * docs/architecture.md lists which pass touches which part.
+ *
  * Particle order.  At every neighbour rebuild the particles are renumbered in the order of
  * their neighbour cells (reorder.c), so that the particles of one cell, and the neighbours a
  * contact loop visits, lie close in memory.  orig[i] is the scene index (position in the scene,
@@ -63,7 +73,7 @@
 
 /* Material constants of a particle pair (sim_pair_constants).  The force loops compute them per
  * contact from the particles' constants, or, when all particles are alike, take the scene's
- * single set (jd_sim.pc_alike); the lists store none, which keeps an entry at 40 bytes (56
+ * single set (jd_fast_paths.pc_alike); the lists store none, which keeps an entry at 40 bytes (56
  * with rolling) instead of 56 (88). */
 typedef struct jd_pair_const {
     double k_n;       /* Hertz prefactor of the pair (eq. 5) [N/m^1.5] */
@@ -76,7 +86,7 @@ typedef struct jd_pair_const_roll {
     double r_roll;    /* rolling radius R_a R_b/(R_a + R_b) [m] */
 } jd_pair_const_roll;
 
-/* Run options that are not part of the scene (command line). */
+/* Run options that are not part of the scene (command line): the reference paths. */
 typedef struct jd_sim_options {
     int allpairs;     /* debugging reference: every pair listed, never sorted; the list is built
                          again whenever the default one would be, so that its entries are split
@@ -87,7 +97,6 @@ typedef struct jd_sim_options {
     int plain_loops;  /* the reference for the fast paths: one contact at a time instead of
                        * SIMD batches, gravity in a pass of its own, the integration constants
                        * read per particle, the rebuild check against x_build at every step */
-    int threads;      /* OpenMP threads of the force and integration loops; <= 0: 1 */
 } jd_sim_options;
 
 /* Wall-clock seconds spent in each part of the time loop (CLOCK_MONOTONIC). */
@@ -182,32 +191,48 @@ typedef struct jd_overlap_trip {
     int32_t i, j;      /* particle indices; j < 0: wall -j - 1 */
 } jd_overlap_trip;
 
-typedef struct jd_sim {
-    const jd_scene *scene;
+/* The particles: their state and per-particle constants.  The arrays (and the neighbour
+ * search's x_build, cell_of, cell_items) are slices of one block (sim.c, hugepages.h); with
+ * conveyor inlets they have room for every particle the run can hold, and n counts the active
+ * prefix. */
+typedef struct jd_particles {
     size_t n;          /* particles */
-    double dt;         /* [s] */
-    int64_t step;      /* steps done */
-    int64_t frame_step; /* step of the last frame written by sim_run, -1 before the first */
-    unsigned features; /* JD_F_* bits of the force loops, fixed for the run */
-
-    /* The per-particle arrays below (x ... torque, the constants, scratch, x_build, orig,
-     * species, cell_of, cell_items) are slices of one block (sim.c, hugepages.h). */
-    void *particle_block;
-    size_t particle_block_bytes;
-    /* particle state, 3n each */
-    double *x, *v, *omega, *f, *torque;
-    /* per-particle constants */
+    /* state, 3n each */
+    double *x;         /* position [m] */
+    double *v;         /* velocity [m/s] */
+    double *omega;     /* angular velocity [rad/s] */
+    double *f;         /* force [N] */
+    double *torque;    /* [N m] */
+    /* constants, n each */
     int32_t *orig;     /* scene index of the particle at each index (see "Particle order") */
     int sorted;        /* 1 once the particles have been renumbered (orig is not the identity) */
-    int32_t *species;
-    double *radius, *mass, *inertia;
-    double *kp;        /* Hertz prefactor jd_hertz_prefactor(E, nu, R) */
-    double *kw;        /* wall prefactor jd_kn_wall(rule, E, nu, R) */
-    double *dtfm;      /* 0.5 dt / m, as fix nve/sphere */
-    double *dtirot;    /* (0.5 dt / 0.4) / (r r m), as fix nve/sphere */
+    int32_t *species;  /* material index */
+    double *radius;    /* [m] */
+    double *mass;      /* [kg] */
+    double *inertia;   /* moment of inertia [kg m^2] */
+    double *kp;        /* Hertz prefactor jd_hertz_prefactor(E, nu, R) [N/m^1.5] */
+    double *kw;        /* wall prefactor jd_kn_wall(rule, E, nu, R) [N/m^1.5] */
+    double *dtfm;      /* 0.5 dt / m, as fix nve/sphere [s/kg] */
+    double *dtirot;    /* (0.5 dt / 0.4) / (r r m), as fix nve/sphere [s/(kg m^2)] */
+    const int64_t *ids; /* id of each scene index: scene->id, or the inlets' table */
+    double *scratch;   /* 3n doubles: reordering and frames in scene order */
+} jd_particles;
 
+/* The run's constants, fixed at set-up (sim_init). */
+typedef struct jd_run_constants {
+    const jd_scene *scene;
+    double dt;         /* [s] (the scene's) */
+    double g[3];       /* gravity [m/s^2] (the scene's) */
+    unsigned features; /* JD_F_* bits of the force loops (the law set) */
     size_t n_materials;
     jd_pair_coeffs *coeffs; /* n_materials^2, row-major: coefficients of (material a, material b) */
+    double max_overlap; /* the scene's max_overlap_fraction [-]; INFINITY with the watchdog off,
+                           so that the force loops test it without a branch on it */
+} jd_run_constants;
+
+/* What the fast paths may assume of the particles (sim_particle_kinds, after the set changed)
+ * and of the forces (set-up). */
+typedef struct jd_fast_paths {
     int32_t pair_row;  /* the row of coeffs every particle pair uses when all particles share one
                         * material (the pair loop then reads no species), else -1 */
     int alike;         /* 1 when all particles also share one radius: every pair then has the
@@ -216,72 +241,98 @@ typedef struct jd_sim {
     double r_alike;            /* [m] */
     jd_pair_const pc_alike;
     jd_pair_const_roll pcr_alike;
-    double g[3];
+    int uniform_mass;  /* every particle has particle 0's mass, dtfm and dtirot, bit for bit: the
+                          integration passes read them once */
+    int weight_in_kick; /* gravity acts and no post-force load comes after it: the weight m g is
+                           added by the half kick that follows each force evaluation
+                           (integrate.c) rather than by a pass of its own; the step-0 evaluation
+                           still adds it (sim_gravity) */
+} jd_fast_paths;
 
-    size_t n_walls;
-    jd_sim_wall *walls;
-    /* Wall forces, for a scene with a servo wall (walls.c): per wall-list entry the force on the
-     * wall [N] and the contact point [m] (3 each, zero unless it carries force), written by the
-     * wall loops and summed in list order after them, so the sums are the same bits whatever
-     * the threads; the boundary stress of those contacts [Pa] (jd_stress_tensor). */
-    int wall_forces;
-    double *wall_f, *wall_x;
-    size_t wall_cap;
-    double stress_tensor[9];
+/* How the force loops are split between the threads (see "Threads"). */
+typedef struct jd_thread_layout {
+    int n;                   /* threads used (the requested count, at least 1) */
+    jd_thread_share *shares; /* one per thread, set at every neighbour build */
+    jd_overlap_trip *trips;  /* one per thread, merged into jd_watch.overlap_trip */
+} jd_thread_layout;
 
-    jd_sim_options opt;
-    int threads;       /* threads actually used (opt.threads clamped to >= 1) */
-    jd_thread_share *shares; /* one per thread (see "Threads"), set at every neighbour build */
-    jd_overlap_trip *trips; /* one per thread, merged into overlap_trip */
-    double *scratch;   /* 3n doubles: reordering and frames in scene order */
-    jd_timing timing;
-
-    /* neighbour search */
-    int allpairs;      /* opt.allpairs */
-    double skin;       /* [m] */
-    double *x_build;   /* positions at the last build, 3n */
+/* The contact lists and the neighbour search that builds them (neighbour.c). */
+typedef struct jd_neighbour_lists {
     jd_contact_list pairs, wall_pairs;
     /* the buffers each build fills before its swap (and sim_reorder uses), kept from one build to
      * the next: a fresh list would grow from empty, copying and faulting in its pages every build */
     jd_contact_list spare, wall_spare;
+    double skin;       /* [m] */
+    double *x_build;   /* positions at the last build, 3n [m] */
+    double drift_bound; /* [m] the sum, over the steps since the last neighbour build, of dt
+                           times the largest speed: no particle has moved further (integrate.c,
+                           the rebuild check) */
     int64_t n_builds;
-    int32_t *cell_of, *cell_items, *cell_start;
+    int32_t *cell_of, *cell_items, *cell_start; /* cell of each particle, particles by cell, and
+                                                   each cell's first item (cell_cap + 1) */
     size_t cell_cap;   /* capacity of cell_start */
+} jd_neighbour_lists;
 
-    jd_bonds *bonds;   /* parallel bonds (bonds.h); NULL when the scene has no bond types */
-    struct jd_loads *loads; /* held particles and external forces (loads.c); NULL if none */
-    int in_setup;      /* the step-0 force evaluation (LIGGGHTS `setup`) is running */
+/* The walls (walls.c). */
+typedef struct jd_walls {
+    size_t n;
+    jd_sim_wall *wall;
+    /* Wall forces, for a scene with a servo wall: per wall-list entry the force on the wall [N]
+     * and the contact point [m] (3 each, zero unless it carries force), written by the wall
+     * loops and summed in list order after them, so the sums are the same bits whatever the
+     * threads; the boundary stress of those contacts [Pa] (jd_stress_tensor). */
+    int forces;
+    double *f, *x;
+    size_t cap;        /* entries f and x have room for */
+    double stress_tensor[9];
+} jd_walls;
 
-    /* energy bookkeeping */
-    double e_damp_dropped, e_fric_dropped; /* accumulators of contacts dropped from the lists */
+/* What the run has spent and dissipated outside the contact lists. */
+typedef struct jd_accounts {
+    jd_timing timing;
+    double e_damp_dropped, e_fric_dropped; /* damping and friction dissipation of contacts
+                                              dropped from the lists [J] */
     double wall_work;  /* work done on the particles by the walls [J] */
+} jd_accounts;
 
-    /* run-time watchdog (watchdog.c) */
-    double max_overlap;         /* the scene's max_overlap_fraction; INFINITY with the watchdog
-                                   off, so that the force loops test it without a branch on it */
+/* What the run-time watchdog (watchdog.c) has seen. */
+typedef struct jd_watch {
     jd_overlap_trip overlap_trip; /* of the last force evaluation */
     int nonfinite;              /* the last step left a non-finite x (it then stopped before
                                    the neighbour search), v or omega (a non-finite force or
                                    torque shows up in v or omega) */
-    int kick_pending;           /* the last step's final half kick is not applied yet: v and
-                                   omega are at the half step (sim_step, sim_finish_step) */
-    int weight_in_kick;         /* gravity acts and no post-force load comes after it: the
-                                   weight m g is added by the half kick that follows each force
-                                   evaluation (integrate.c) rather than by a pass of its own;
-                                   the step-0 evaluation still adds it (sim_gravity) */
-    double drift_bound;         /* [m] the sum, over the steps since the last neighbour build,
-                                   of dt times the largest speed: no particle has moved further
-                                   (integrate.c, the rebuild check) */
-    int uniform_mass;           /* every particle has particle 0's mass, dtfm and dtirot, bit
-                                   for bit: the integration passes read them once */
     int has_energy_ref;         /* energy_ref holds the previous observable sample */
     jd_energy_terms energy_ref;
     int64_t energy_ref_step;
+} jd_watch;
 
-    /* conveyor inlets (inlet.c); NULL without.  The per-particle arrays then have room for
-     * every particle the run can hold, and n counts the active prefix */
-    struct jd_sim_inlets *inlets;
-    const int64_t *ids;         /* id of each scene index: scene->id, or the inlets' table */
+/* One run: its parts, and where it stands.  Each pass takes the parts it reads (const) and
+ * writes (docs/architecture.md, "The stepper's parts"). */
+typedef struct jd_sim {
+    jd_particles particles;
+    jd_run_constants run;
+    jd_sim_options opt;
+    jd_fast_paths fast;
+    jd_thread_layout threads;
+    jd_neighbour_lists lists;
+    jd_walls walls;
+    jd_accounts accounts;
+    jd_watch watch;
+
+    int64_t step;      /* steps done */
+    int64_t frame_step; /* step of the last frame written by sim_run, -1 before the first */
+    int in_setup;      /* the step-0 force evaluation (LIGGGHTS `setup`) is running */
+    int kick_pending;  /* the last step's final half kick is not applied yet: v and omega are at
+                          the half step (sim_step, sim_finish_step) */
+
+    /* the block the per-particle arrays are slices of */
+    void *particle_block;
+    size_t particle_block_bytes;
+
+    /* the optional modules; NULL when the scene has none */
+    jd_bonds *bonds;   /* parallel bonds (bonds.h) */
+    struct jd_loads *loads; /* held particles and external forces (loads.c) */
+    struct jd_sim_inlets *inlets; /* conveyor inlets (inlet.c) */
 
     /* set by the caller (e.g. a signal handler) to stop the run at the next step; NULL: never */
     const volatile sig_atomic_t *stop;
@@ -292,8 +343,9 @@ enum { JD_RUN_ERROR = -1, JD_RUN_TRIPPED = -2, JD_RUN_STOPPED = -3, JD_RUN_OUTPU
 
 /* sim.c */
 /* Set up from a loaded scene (kept by pointer; it must outlive the sim) and compute the forces
- * of step 0 (LIGGGHTS `setup`).  Returns 0, or -1 with a reason in err. */
-int sim_init(jd_sim *s, const jd_scene *scene, const jd_sim_options *opt, char *err,
+ * of step 0 (LIGGGHTS `setup`).  opt may be NULL (no reference path); threads: OpenMP threads
+ * of the force and integration loops (<= 0: 1).  Returns 0, or -1 with a reason in err. */
+int sim_init(jd_sim *s, const jd_scene *scene, const jd_sim_options *opt, int threads, char *err,
              size_t errlen);
 void sim_free(jd_sim *s);
 
@@ -311,10 +363,13 @@ int sim_run(jd_sim *s, struct jd_h5md *h, int show_progress, char *err, size_t e
 size_t sim_memory_bytes(const jd_sim *s);
 
 /* Per-particle constants of particle i (mass, inertia, Hertz and wall prefactors, the
- * integration factors) from its material and radius. */
-void sim_particle_constants(jd_sim *s, size_t i, int32_t material, double radius);
-/* How alike the particles are (pair_row, alike, uniform_mass), after the set changed. */
-void sim_particle_kinds(jd_sim *s);
+ * integration factors) from its material and radius [m]. */
+void sim_particle_constants(jd_particles *ps, const jd_run_constants *run, size_t i,
+                            int32_t material, double radius);
+/* How alike the particles are (pair_row, alike, uniform_mass), after the set changed; plain:
+ * the reference path (--plain-loops), which reads the integration constants per particle. */
+void sim_particle_kinds(jd_fast_paths *fast, const jd_particles *ps, size_t n_materials,
+                        int plain);
 
 /* inlet.c: the conveyor inlets (docs/mixing.md 2.1). */
 typedef struct jd_sim_inlets jd_sim_inlets;
@@ -344,9 +399,9 @@ const int64_t *sim_inlets_frame_ids(const jd_sim *s);
 
 /* neighbour.c */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
-/* 1 when some wall moved more than skin/2 since the last build (the particles' part of the
+/* 1 when some wall moved more than skin/2 [m] since the last build (the particles' part of the
  * rebuild criterion rides in the drift, integrate.c) */
-int sim_neighbour_walls_moved(const jd_sim *s);
+int sim_neighbour_walls_moved(const jd_walls *walls, double skin);
 /* Capacity for `need` entries of a list of this kind (JD_LIST_* bits).  Returns 0 or -1. */
 enum { JD_LIST_ROLLING = 1, JD_LIST_ENERGY = 2 };
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind);
@@ -359,48 +414,55 @@ void sim_contact_list_free(jd_contact_list *l);
  * -1 (out of memory; nothing changed). */
 int sim_reorder(jd_sim *s, const int32_t *old_of_new, char *err, size_t errlen);
 /* Put x, v, omega, f and torque into scene order (for a frame), and back. */
-void sim_vectors_to_scene_order(jd_sim *s);
-void sim_vectors_to_sim_order(jd_sim *s);
+void sim_vectors_to_scene_order(jd_particles *ps);
+void sim_vectors_to_sim_order(jd_particles *ps);
 /* A per-particle array in scene order: out[orig[i]] = a[i]. */
-void sim_scalars_in_scene_order(const jd_sim *s, const double *a, double *out);
+void sim_scalars_in_scene_order(const jd_particles *ps, const double *a, double *out);
 /* Scene id of the particle at index i. */
-static inline long long sim_particle_id(const jd_sim *s, size_t i) {
-    return (long long)s->ids[s->orig[i]];
+static inline long long sim_particle_id(const jd_particles *ps, size_t i) {
+    return (long long)ps->ids[ps->orig[i]];
 }
 
 /* walls.c */
-int sim_walls_init(jd_sim *s, char *err, size_t errlen);
-void sim_walls_move(jd_sim *s);
-void sim_walls_free(jd_sim *s);
-/* With wall_forces: room for an entry record per wall-list entry (after every list build). */
-int sim_walls_reserve(jd_sim *s, char *err, size_t errlen);
+int sim_walls_init(jd_walls *walls, const jd_run_constants *run, char *err, size_t errlen);
+/* Translate every wall by its velocity times dt [s]. */
+void sim_walls_move(jd_walls *walls, double dt);
+void sim_walls_free(jd_walls *walls);
+/* With walls->forces: room for an entry record per wall-list entry (n of them; after every
+ * list build). */
+int sim_walls_reserve(jd_walls *walls, size_t n, char *err, size_t errlen);
 /* With wall_forces, after the wall loops: each wall's force, the boundary stress, and each
  * servo wall's measured stress and speed for the next step (kernel/jdem_servo.h); the records
  * are zeroed for the next evaluation. */
-void sim_walls_sum(jd_sim *s);
-/* With wall_forces: the wall observables of jdem_observable_names.h at this step (sim.c). */
+void sim_walls_sum(jd_walls *walls, const jd_contact_list *wall_pairs);
+/* With walls->forces: the wall observables of jdem_observable_names.h at this step (sim.c). */
 struct jd_h5md;
-int sim_walls_write_observables(const jd_sim *s, struct jd_h5md *h, char *err, size_t errlen);
+int sim_walls_write_observables(const jd_walls *walls, const jd_run_constants *run, int64_t step,
+                                struct jd_h5md *h, char *err, size_t errlen);
 
 /* forces.c: zero f and torque, then pair forces, wall forces, bonds, gravity (unless
- * s->weight_in_kick), loads. */
+ * s->fast.weight_in_kick), loads. */
 void sim_compute_forces(jd_sim *s);
 /* Add every particle's weight m g to its force. */
-void sim_gravity(jd_sim *s);
-/* The force loops' per-thread state for s->threads threads (sim_init), and its release. */
-int sim_forces_init(jd_sim *s);
-void sim_forces_free(jd_sim *s);
-/* Split the current lists between the threads (jd_thread_share); after every neighbour
- * build.  Returns 0, or -1 when out of memory. */
-int sim_forces_partition(jd_sim *s);
+void sim_gravity(jd_particles *ps, const jd_run_constants *run, const jd_thread_layout *threads);
+/* The force loops' per-thread state for threads->n threads (sim_init), and its release. */
+int sim_forces_init(jd_thread_layout *threads);
+void sim_forces_free(jd_thread_layout *threads);
+/* Split the current lists of n particles between the threads (jd_thread_share); after every
+ * neighbour build.  Returns 0, or -1 when out of memory. */
+int sim_forces_partition(jd_thread_layout *threads, const jd_neighbour_lists *lists, size_t n);
 /* Monotonic wall clock [s]. */
 double sim_clock(void);
 
 /* loads.c: set up (0 or -1 with err), free, and apply after every other force (forces.c). */
 typedef struct jd_loads jd_loads;
-int sim_loads_init(jd_sim *s, char *err, size_t errlen);
-void sim_loads_free(jd_sim *s);
-void sim_loads_apply(jd_sim *s);
+/* *loads stays NULL when the scene has none. */
+int sim_loads_init(jd_loads **loads, const jd_scene *scene, char *err, size_t errlen);
+void sim_loads_free(jd_loads **loads);
+/* The loads' forces on the particles, and their work booked in accounts (not at step 0,
+ * in_setup: LIGGGHTS `setup`). */
+void sim_loads_apply(jd_loads *l, jd_particles *ps, const jd_run_constants *run,
+                     jd_accounts *accounts, int in_setup);
 /* Remap the loaded particles after a re-sort (reorder.c): particle k is now new_index[k]. */
 void sim_loads_permute(jd_loads *l, const int32_t *new_index);
 
@@ -416,9 +478,12 @@ typedef struct jd_observables {
     double kinetic_energy, rotational_energy, elastic_energy, gravitational_energy;
     double damping_dissipation, friction_dissipation, wall_work;
     double contacts, wall_contacts;
-    jd_bond_observables bond;  /* scenes with bond types only (s->bonds) */
+    jd_bond_observables bond;  /* scenes with bond types only (sim_bonds_observables) */
 } jd_observables;
-void sim_observables(const jd_sim *s, jd_observables *o);
+/* Every field but bond. */
+void sim_observables(const jd_particles *ps, const jd_run_constants *run,
+                     const jd_neighbour_lists *lists, const jd_walls *walls,
+                     const jd_accounts *accounts, jd_observables *o);
 void sim_observables_values(const jd_observables *o, double out[JD_N_OBSERVABLES]);
 
 /* guard.c: the kernel's time-step guard (kernel/jdem_guard.h) applied to a scene.  Fills *in
@@ -436,8 +501,13 @@ int sim_guard(const jd_scene *scene, jd_guard_input *in, jd_guard_species **spec
  * JD_RUN_TRIPPED with "watchdog: step N: QUANTITY VALUE for particle(s) IDS exceeds LIMIT ..."
  * in msg. */
 void sim_watchdog_overlap(jd_overlap_trip *t, int32_t i, int32_t j, double delta, double rmin);
-int sim_watchdog_step(const jd_sim *s, char *msg, size_t len);       /* every step */
-int sim_watchdog_energy(jd_sim *s, const jd_observables *o, char *msg, size_t len); /* samples */
+/* every step (step: steps done) */
+int sim_watchdog_step(const jd_watch *watch, const jd_particles *ps, const jd_run_constants *run,
+                      int64_t step, char *msg, size_t len);
+/* at every observable sample; inlet_energy: what the inlets brought in so far [J] */
+int sim_watchdog_energy(jd_watch *watch, const jd_particles *ps, const jd_run_constants *run,
+                        int64_t step, double inlet_energy, const jd_observables *o, char *msg,
+                        size_t len);
 
 /* progress.c */
 typedef struct jd_progress {

@@ -20,56 +20,56 @@ void sim_watchdog_overlap(jd_overlap_trip *t, int32_t i, int32_t j, double delta
     if (fraction > t->fraction) *t = (jd_overlap_trip){.fraction = fraction, .i = i, .j = j};
 }
 
-static long long id_of(const jd_sim *s, size_t i) { return sim_particle_id(s, i); }
-
-static int overlap_message(const jd_sim *s, char *msg, size_t len) {
-    const jd_overlap_trip *t = &s->overlap_trip;
-    jd_watchdog_overlap_message(msg, len, (long long)s->step, t->fraction, id_of(s, (size_t)t->i),
-                                t->j >= 0 ? id_of(s, (size_t)t->j) : -1,
-                                t->j >= 0 ? "" : s->scene->walls[-t->j - 1].name, s->max_overlap);
+static int overlap_message(const jd_overlap_trip *t, const jd_particles *ps,
+                           const jd_run_constants *run, int64_t step, char *msg, size_t len) {
+    jd_watchdog_overlap_message(msg, len, (long long)step, t->fraction, sim_particle_id(ps, (size_t)t->i),
+                                t->j >= 0 ? sim_particle_id(ps, (size_t)t->j) : -1,
+                                t->j >= 0 ? "" : run->scene->walls[-t->j - 1].name, run->max_overlap);
     return JD_RUN_TRIPPED;
 }
 
 /* Name the first non-finite quantity, in the kernel's order (jd_watchdog_quantities). */
-static int nonfinite_message(const jd_sim *s, char *msg, size_t len) {
-    const double *q[JD_N_WATCHDOG_QUANTITIES] = {s->f, s->torque, s->x, s->v, s->omega};
+static int nonfinite_message(const jd_particles *ps, int64_t step, char *msg, size_t len) {
+    const double *q[JD_N_WATCHDOG_QUANTITIES] = {ps->f, ps->torque, ps->x, ps->v, ps->omega};
     for (int k = 0; k < JD_N_WATCHDOG_QUANTITIES; k++)
-        for (size_t c = 0; c < 3 * s->n; c++)
+        for (size_t c = 0; c < 3 * ps->n; c++)
             if (!isfinite(q[k][c])) {
-                jd_watchdog_nonfinite_message(msg, len, (long long)s->step, k, q[k][c],
-                                              id_of(s, c / 3));
+                jd_watchdog_nonfinite_message(msg, len, (long long)step, k, q[k][c],
+                                              sim_particle_id(ps, c / 3));
                 return JD_RUN_TRIPPED;
             }
     /* the probe saw a NaN that is gone from the state: cannot happen, but never pass silently */
-    snprintf(msg, len, "watchdog: step %lld: non-finite state", (long long)s->step);
+    snprintf(msg, len, "watchdog: step %lld: non-finite state", (long long)step);
     return JD_RUN_TRIPPED;
 }
 
-int sim_watchdog_step(const jd_sim *s, char *msg, size_t len) {
+int sim_watchdog_step(const jd_watch *watch, const jd_particles *ps, const jd_run_constants *run,
+                      int64_t step, char *msg, size_t len) {
     /* a non-finite state stops the run even with the watchdog off: the writer could not write
      * it, and the next step could not bin it (the overlap limit is INFINITY when off) */
-    if (s->nonfinite) return nonfinite_message(s, msg, len);
-    if (s->overlap_trip.fraction > 0.0) return overlap_message(s, msg, len);
+    if (watch->nonfinite) return nonfinite_message(ps, step, msg, len);
+    if (watch->overlap_trip.fraction > 0.0)
+        return overlap_message(&watch->overlap_trip, ps, run, step, msg, len);
     return 0;
 }
 
 /* The balance's terms by the kernel's rule (jd_energy_terms_of). */
 /* The energy the inlets brought in is booked as work done on the particles, so the balance
  * closes while the set grows. */
-static void energy_terms(const jd_sim *s, const jd_observables *o, jd_energy_terms *e) {
+static void energy_terms(double inlet_energy, const jd_observables *o, jd_energy_terms *e) {
     double v[JD_N_OBSERVABLES], b[JD_N_BOND_OBSERVABLES];
     sim_observables_values(o, v);
     sim_bond_observables_values(&o->bond, b);
     *e = jd_energy_terms_of(v, b);
-    e->wall_work += sim_inlets_energy(s);
+    e->wall_work += inlet_energy;
 }
 
 /* The particle with the largest kinetic energy: where a spurious energy gain usually sits. */
-static size_t most_energetic(const jd_sim *s) {
+static size_t most_energetic(const jd_particles *ps) {
     size_t best = 0;
     double e_best = -1.0;
-    for (size_t i = 0; i < s->n; i++) {
-        const double *v = s->v + 3 * i, e = s->mass[i] * jd_dot(v, v);
+    for (size_t i = 0; i < ps->n; i++) {
+        const double *v = ps->v + 3 * i, e = ps->mass[i] * jd_dot(v, v);
         if (e > e_best) {
             e_best = e;
             best = i;
@@ -78,20 +78,22 @@ static size_t most_energetic(const jd_sim *s) {
     return best;
 }
 
-int sim_watchdog_energy(jd_sim *s, const jd_observables *o, char *msg, size_t len) {
-    if (!s->scene->watchdog.enabled || !s->scene->energy) return 0; /* no energies to check */
+int sim_watchdog_energy(jd_watch *watch, const jd_particles *ps, const jd_run_constants *run,
+                        int64_t step, double inlet_energy, const jd_observables *o, char *msg,
+                        size_t len) {
+    if (!run->scene->watchdog.enabled || !run->scene->energy) return 0; /* no energies to check */
     jd_energy_terms now;
-    energy_terms(s, o, &now);
-    const double limit = s->scene->watchdog.max_energy_jump;
-    const double jump = s->has_energy_ref ? jd_energy_jump(&s->energy_ref, &now) : 0.0;
+    energy_terms(inlet_energy, o, &now);
+    const double limit = run->scene->watchdog.max_energy_jump;
+    const double jump = watch->has_energy_ref ? jd_energy_jump(&watch->energy_ref, &now) : 0.0;
     if (!(jump <= limit)) { /* NaN trips too */
-        jd_watchdog_energy_message(msg, len, (long long)s->step, jump, id_of(s, most_energetic(s)),
-                                   limit, jd_energy_total(&s->energy_ref),
-                                   (long long)s->energy_ref_step, jd_energy_total(&now));
+        jd_watchdog_energy_message(msg, len, (long long)step, jump, sim_particle_id(ps, most_energetic(ps)),
+                                   limit, jd_energy_total(&watch->energy_ref),
+                                   (long long)watch->energy_ref_step, jd_energy_total(&now));
         return JD_RUN_TRIPPED;
     }
-    s->energy_ref = now;
-    s->energy_ref_step = s->step;
-    s->has_energy_ref = 1;
+    watch->energy_ref = now;
+    watch->energy_ref_step = step;
+    watch->has_energy_ref = 1;
     return 0;
 }
