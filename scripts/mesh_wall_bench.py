@@ -17,8 +17,7 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-sys.path.insert(0, os.path.join(ROOT, "tests", "mesh"))
-from test_mesh_liggghts import floor_triangles, write_stl  # noqa: E402
+from tests.mesh.test_mesh_liggghts import floor_triangles, write_stl
 
 LIG = os.path.join(ROOT, "build", "liggghts-jdem")
 DECK = """atom_style granular

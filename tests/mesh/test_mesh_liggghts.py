@@ -35,8 +35,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(ROOT, "tests", "engine"))
-from engine_common import Checks  # noqa: E402
+from tests.engine.engine_common import Checks
 
 LIG = os.path.join(ROOT, "build", "liggghts-jdem")
 H = 2.0 ** -7   # grid spacing [m]
