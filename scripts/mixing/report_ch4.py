@@ -162,6 +162,13 @@ def claims(found):
     out = []
     phi = {(e, m, p): found[e][m]["fill%d" % p]["summary"]["phi_v"]
            for e in ENGINES for m in MODELS for p in PASSES if found[e][m].get("fill%d" % p)}
+    for (e, m, p), _ in sorted(phi.items()):
+        if m in ("model1", "model2"):
+            values = [q["phi_v"] for q in found[e][m]["fill%d" % p]["points"]]
+            small = sum(v < 0.1 * params.IDEAL_PHI_V for v in values)
+            out.append("- %s %s pass %d: \"many zero or very small φv values\" (below a tenth of the "
+                       "ideal %.4f) at %d of the 9 points: %s" % (e, m, p, params.IDEAL_PHI_V, small,
+                                                             "held" if small >= 5 else "not held"))
     for e in ENGINES:
         low = [phi[(e, m, 1)]["mean"] for m in ("model1", "model2") if (e, m, 1) in phi]
         high = [phi[(e, m, 1)]["mean"] for m in MODELS[2:] if (e, m, 1) in phi]
@@ -176,7 +183,7 @@ def claims(found):
             held = all(b < a for a, b in pairs)
             out.append("- %s: the second pass reduces the spread of φv: std %s: %s" % (
                 e, "; ".join("%.4f → %.4f" % ab for ab in pairs), "held" if held else "not held"))
-    return "\n".join(out) + "\n" if out else "No claim can be checked yet: no fill has finished.\n"
+    return "\n".join(out) + "\n" if out else "No claim can be checked with the fills finished so far.\n"
 
 
 def commit():
