@@ -169,6 +169,7 @@ void FixWallJiangMesh::mesh_loop(bool commit) {
   const int nlocal = atom->nlocal;
   touched.assign((size_t)nlocal, 0);
   double sums[5] = {0.0, 0.0, 0.0, 0.0, 0.0}; /* e_damp, e_fric, e_el, contacts, work */
+  const unsigned laws = jd_law_set_of_loop(F, pair->features()); /* with the run-time laws */
   for (size_t im = 0; im < meshes.size(); im++) {
     rebuild_topology(meshes[im]);
     cand.clear();
@@ -177,7 +178,7 @@ void FixWallJiangMesh::mesh_loop(bool commit) {
     for (size_t a = 0; a < cand.size();) {
       size_t b = a;
       while (b < cand.size() && cand[b].i == cand[a].i) b++;
-      sphere_contacts<F>((int)im, cand[a].i, a, b, commit, sums);
+      sphere_contacts<F>((int)im, cand[a].i, a, b, commit, laws, sums);
       a = b;
     }
   }
@@ -196,10 +197,10 @@ void FixWallJiangMesh::mesh_loop(bool commit) {
 
 /* Atom i's contacts with mesh im (candidates cand[first, last)): the kernel's rule picks the
  * contacts; each takes the history slot its normal continues; the slots are rewritten in the
- * contacts' order (ascending triangle). */
+ * contacts' order (ascending triangle); laws: the loop's law set with the run's run-time laws. */
 template <unsigned F>
 void FixWallJiangMesh::sphere_contacts(int im, int i, size_t first, size_t last, bool commit,
-                                       double *sums) {
+                                       unsigned laws, double *sums) {
   Mesh &m = meshes[(size_t)im];
   double **x = atom->x, **v = atom->v, **f = atom->f;
   double **omega = atom->omega, **torque = atom->torque;
@@ -265,7 +266,6 @@ void FixWallJiangMesh::sphere_contacts(int im, int i, size_t first, size_t last,
     double f_prev[3] = {0.0, 0.0, 0.0};
     if (F & JD_F_ENERGY) jd_copy3(f_prev, hs.st->f_prev);
     jd_contact_result out;
-    const unsigned laws = jd_law_set_of_loop(F, pair->features()); /* with the run-time laws */
     const int carries = jd_contact(laws, &co, &g[c], &k, update->dt, hs.st, hs.rs, &out);
     if (F & JD_F_ENERGY) {
       sums[4] += jd_wall_work(f_prev, out.f, k.vb, update->dt);

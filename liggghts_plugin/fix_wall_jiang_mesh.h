@@ -62,7 +62,7 @@ class FixWallJiangMesh : public FixWallJiang {
   void gather_candidates(Mesh &m, bool every_pair);
   template <unsigned F> JD_SPECIALISED void mesh_loop(bool commit);
   template <unsigned F> void sphere_contacts(int im, int i, size_t first, size_t last, bool commit,
-                                             double *sums);
+                                             unsigned laws, double *sums);
   void compute_mesh(bool commit);
 
   std::vector<Mesh> meshes;

@@ -17,24 +17,11 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
+from tests.liggghts.liggghts_common import granular_deck_head
 from tests.mesh.test_mesh_liggghts import floor_triangles, write_stl
 
 LIG = os.path.join(ROOT, "build", "liggghts-jdem")
-DECK = """atom_style granular
-atom_modify map array
-boundary f f f
-newton off
-communicate single vel yes
-units si
-region box block -0.3 0.3 -0.3 0.3 -0.01 0.1 units box
-create_box 2 box
-neighbor 0.002 bin
-neigh_modify delay 0
-fix m1 all property/global youngsModulus peratomtype 5.e6 5.e6
-fix m2 all property/global poissonsRatio peratomtype 0.45 0.45
-fix m3 all property/global coefficientRestitution peratomtypepair 2 0.5 0.5 0.5 0.5
-fix m4 all property/global coefficientFriction peratomtypepair 2 0.5 0.5 0.5 0.5
-{pair}
+DECK = granular_deck_head("-0.3 0.3 -0.3 0.3 -0.01 0.1") + """{pair}
 timestep 1.0e-5
 lattice sc 0.0125
 region bed block -16 16 -16 16 0 0.5 units lattice

@@ -15,23 +15,9 @@ import re
 import sys
 import tempfile
 
-from tests.liggghts.liggghts_common import Checks, run_deck
+from tests.liggghts.liggghts_common import Checks, granular_deck_head, run_deck
 
-DECK = """atom_style granular
-atom_modify map array
-boundary f f f
-newton off
-communicate single vel yes
-units si
-region box block -0.1 0.1 -0.1 0.1 -0.01 0.2 units box
-create_box 2 box
-neighbor 0.002 bin
-neigh_modify delay 0
-fix m1 all property/global youngsModulus peratomtype 5.e6 5.e6
-fix m2 all property/global poissonsRatio peratomtype {nu} 0.45
-fix m3 all property/global coefficientRestitution peratomtypepair 2 0.5 0.5 0.5 0.5
-fix m4 all property/global coefficientFriction peratomtypepair 2 0.5 0.5 0.5 0.5
-{extra}
+DECK = granular_deck_head("-0.1 0.1 -0.1 0.1 -0.01 0.2", "{nu}") + """{extra}
 pair_style gran/jiang
 pair_coeff * *
 timestep 1.0e-5

@@ -21,6 +21,30 @@ LIGGGHTS_JDEM = engines.LIGGGHTS_JDEM
 STATE = ("position", "velocity", "angular_velocity", "force", "torque")
 
 
+GRANULAR_DECK_HEAD = """atom_style granular
+atom_modify map array
+boundary f f f
+newton off
+communicate single vel yes
+units si
+region box block %s units box
+create_box 2 box
+neighbor 0.002 bin
+neigh_modify delay 0
+fix m1 all property/global youngsModulus peratomtype 5.e6 5.e6
+fix m2 all property/global poissonsRatio peratomtype %s 0.45
+fix m3 all property/global coefficientRestitution peratomtypepair 2 0.5 0.5 0.5 0.5
+fix m4 all property/global coefficientFriction peratomtypepair 2 0.5 0.5 0.5 0.5
+"""
+
+
+def granular_deck_head(box, poisson="0.45"):
+    """The opening of the hand-written decks of the LIGGGHTS checks: two atom types (1 the
+    particles, 2 the walls) with their material properties, in the box "xlo xhi ylo yhi zlo zhi";
+    poisson is type 1's Poisson ratio (a str.format field such as "{nu}" passes through)."""
+    return GRANULAR_DECK_HEAD % (box, poisson)
+
+
 def run(cmd, cwd=None):
     """(exit status, stdout + stderr) of CMD."""
     r = engines.run(cmd, cwd=cwd)

@@ -36,26 +36,13 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 from tests.engine.engine_common import Checks
+from tests.liggghts.liggghts_common import granular_deck_head
 
 LIG = os.path.join(ROOT, "build", "liggghts-jdem")
 H = 2.0 ** -7   # grid spacing [m]
 R = 0.005       # sphere radius [m]
 
-DECK = """atom_style granular
-atom_modify map array
-boundary f f f
-newton off
-communicate single vel yes
-units si
-region box block -0.1 0.1 -0.1 0.1 -0.01 0.2 units box
-create_box 2 box
-neighbor 0.002 bin
-neigh_modify delay 0
-fix m1 all property/global youngsModulus peratomtype 5.e6 5.e6
-fix m2 all property/global poissonsRatio peratomtype 0.45 0.45
-fix m3 all property/global coefficientRestitution peratomtypepair 2 0.5 0.5 0.5 0.5
-fix m4 all property/global coefficientFriction peratomtypepair 2 0.5 0.5 0.5 0.5
-pair_style gran/jiang
+DECK = granular_deck_head("-0.1 0.1 -0.1 0.1 -0.01 0.2") + """pair_style gran/jiang
 pair_coeff * *
 timestep 1.0e-5
 {atoms}
