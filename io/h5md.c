@@ -84,6 +84,12 @@ struct jd_h5md {
 
 /* ------------------------------------------------------------------------------------------ */
 
+int jd_h5md_flush(jd_h5md *h) {
+    if (!h || h->broken || H5Fflush(h->file, H5F_SCOPE_LOCAL) < 0) return -1;
+    h->obs_dirty = 0;
+    return 0;
+}
+
 h5md_view h5md_view_of(jd_h5md *h) {
     return (h5md_view){h->file, h->part, h->h5detail, &h->broken};
 }

@@ -43,6 +43,10 @@ hid_t h5md_dset_extendible(hid_t loc, const char *name, hid_t ftype, int rank,
 int h5md_append_row(hid_t d, hsize_t at, int rank, const hsize_t *rest, hid_t mtype,
                     const void *buf);
 
+/* h5md.c: hand everything written so far to the OS (a checkpoint then matches the file on
+ * disk: stepper/checkpoint.h).  0 or -1. */
+int jd_h5md_flush(jd_h5md *h);
+
 /* h5md.c: what io/h5md_bonds.c needs of a writer.  A write that fails part-way sets *broken. */
 typedef struct h5md_view {
     hid_t file;

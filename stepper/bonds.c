@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "bonds.h"
+#include "checkpoint.h"
 #include "sim.h"
 
 /* The pragmas are guarded: the scene checker and the fuzzer link this file (for the guard's
@@ -61,6 +62,8 @@ static int reserve(jd_bonds *b, size_t need) {
     while (c < need) c *= 2;
     return resize(b, c);
 }
+
+int sim_bonds_reserve(jd_bonds *b, size_t need) { return reserve(b, need); }
 
 /* Bonds form only at step 0 and when a rule applies, and afterwards only break: give back the
  * room the doubling left once they have formed.  Every array then holds at least cap bonds:

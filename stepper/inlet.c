@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "checkpoint.h"
 #include "jdem_inlet.h"
 #include "sim.h"
 
@@ -285,4 +286,17 @@ const int64_t *sim_inlets_frame_ids(const jd_sim *s) {
     for (size_t r = 0; r < in->cap; r++) in->frame_id[r] = -1;
     for (size_t j = 0; j < s->particles.n; j++) in->frame_id[in->slot[j]] = in->id[j];
     return in->frame_id;
+}
+
+void sim_inlets_state(jd_sim *s, jd_inlet_state_view *v) {
+    jd_sim_inlets *in = s->inlets;
+    *v = (jd_inlet_state_view){.n_inlets = in->n_inlets, .next_step = &in->next_step,
+                               .energy_in = &in->energy_in, .seconds = &in->seconds,
+                               .id = in->id, .slot = in->slot};
+}
+
+jd_inlet_stream *sim_inlets_stream(jd_sim *s, size_t k, size_t *n) {
+    inlet_run *r = &s->inlets->run[k];
+    *n = r->spec.n;
+    return &r->st;
 }

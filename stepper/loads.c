@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "checkpoint.h"
 #include "sim.h"
 
 struct jd_loads {
@@ -84,4 +85,10 @@ void sim_loads_apply(jd_loads *l, jd_particles *ps, const jd_run_constants *run,
         memcpy(prev, applied, sizeof applied);
     }
     if (!in_setup) accounts->wall_work += work;
+}
+
+size_t sim_loads_state(jd_loads *l, int32_t **index, double **f_prev) {
+    *index = l->index;
+    *f_prev = l->f_prev;
+    return l->n;
 }

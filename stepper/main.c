@@ -8,12 +8,15 @@
  * successful close; a stopped run closes OUT.part properly, so it stays readable.
  */
 #include <errno.h>
+#include <math.h>
+#include <unistd.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
+#include "checkpoint.h"
 #include "h5md.h"
 #include "scene.h"
 #include "sim.h"
@@ -66,6 +69,15 @@ static const char usage_text[] =
     "                           gravity in a pass of its own, the integration constants per\n"
     "                           particle and the rebuild check at every step (run; the\n"
     "                           reference for the fast paths: same trajectory)\n"
+    "  --checkpoint FILE        write checkpoints to FILE (run; default OUT with .h5 replaced\n"
+    "                           by .ckpt.h5); with this option or the two below a checkpoint\n"
+    "                           is also written when SIGINT or SIGTERM stops the run\n"
+    "  --checkpoint-every N     a checkpoint every N steps (run)\n"
+    "  --checkpoint-seconds T   a checkpoint every T seconds of wall time (run)\n"
+    "  --resume FILE            continue the run from checkpoint FILE (run; the same scene,\n"
+    "                           case, -o, --threads and reference options): the result equals\n"
+    "                           the uninterrupted run's bit for bit, and OUT.h5.part of the\n"
+    "                           stopped run is continued (docs/output.md \"Resumed runs\")\n"
     "\n"
     "time-step guard (run): dt must not exceed 20 % of the Rayleigh time step of the smallest\n"
     "sphere, nor 1/50 of the shortest Hertz contact time at time.max_impact_speed, nor the\n"
@@ -84,7 +96,8 @@ static const char usage_text[] =
     "max_energy_jump between observable samples stops the run (exit status 4).\n"
     "\n"
     "signals (run): SIGINT or SIGTERM stops the run at the next step (a second one at once);\n"
-    "the frame of that step is written and the trajectory closed, as OUT.h5.part.  A signal\n"
+    "the frame of that step is written and the trajectory closed, as OUT.h5.part; with\n"
+    "checkpoints a checkpoint of that step is written first.  A signal\n"
     "during set-up stops the run before anything is written; one during the final write lets\n"
     "the complete run finish (exit status 0).\n"
     "\n"
@@ -101,7 +114,26 @@ static const char usage_text[] =
 typedef struct cli {
     const char *command, *scene, *case_name, *output, *inlet_record;
     int force, quiet, timing, no_sort, all_laws, plain_loops, threads;
+    const char *checkpoint, *resume; /* --checkpoint FILE, --resume FILE */
+    long long checkpoint_every;      /* steps, 0: none */
+    double checkpoint_seconds;       /* wall seconds, 0: none */
 } cli;
+
+/* A whole number of steps >= 1 (0: not one). */
+static long long step_count(const char *s) {
+    char *end;
+    errno = 0;
+    const long long v = strtoll(s, &end, 10);
+    return *s && !*end && errno == 0 && v >= 1 ? v : 0;
+}
+
+/* A positive finite number of seconds (0: not one). */
+static double seconds_value(const char *s) {
+    char *end;
+    errno = 0;
+    const double v = strtod(s, &end);
+    return *s && !*end && errno == 0 && isfinite(v) && v > 0.0 ? v : 0.0;
+}
 
 /* A positive thread count from s (option or environment), or 0. */
 static int thread_count(const char *s) {
@@ -132,6 +164,18 @@ static int parse(int argc, char **argv, cli *c) {
         } else if (!strcmp(a, "--inlet-record")) {
             if (!has_value) return usage_error("--inlet-record needs a value", NULL);
             c->inlet_record = argv[++k];
+        } else if (!strcmp(a, "--checkpoint") || !strcmp(a, "--resume")) {
+            if (!has_value) return usage_error(a[2] == 'c' ? "--checkpoint needs a value"
+                                                           : "--resume needs a value", NULL);
+            *(a[2] == 'c' ? &c->checkpoint : &c->resume) = argv[++k];
+        } else if (!strcmp(a, "--checkpoint-every")) {
+            if (!has_value) return usage_error("--checkpoint-every needs a value", NULL);
+            if (!(c->checkpoint_every = step_count(argv[++k])))
+                return usage_error("--checkpoint-every needs a whole number of steps >= 1", argv[k]);
+        } else if (!strcmp(a, "--checkpoint-seconds")) {
+            if (!has_value) return usage_error("--checkpoint-seconds needs a value", NULL);
+            if (!(c->checkpoint_seconds = seconds_value(argv[++k])))
+                return usage_error("--checkpoint-seconds needs a number of seconds > 0", argv[k]);
         } else if (!strcmp(a, "--force")) {
             c->force = 1;
         } else if (!strcmp(a, "--quiet")) {
@@ -164,9 +208,11 @@ static int parse(int argc, char **argv, cli *c) {
     if (!c->scene) return usage_error("missing SCENE", NULL);
     if (strcmp(c->command, "run") &&
         (c->output || c->force || c->quiet || c->timing || c->no_sort || c->all_laws ||
-         c->plain_loops || c->threads || c->inlet_record))
+         c->plain_loops || c->threads || c->inlet_record || c->checkpoint || c->resume ||
+         c->checkpoint_every || c->checkpoint_seconds))
         return usage_error("-o, --force, --quiet, --threads, --timing, --no-sort, --all-laws, "
-                           "--plain-loops and --inlet-record apply to 'run' only", NULL);
+                           "--plain-loops, --inlet-record, --checkpoint, --checkpoint-every, "
+                           "--checkpoint-seconds and --resume apply to 'run' only", NULL);
     if (!c->threads && getenv("OMP_NUM_THREADS")) {
         if (!(c->threads = thread_count(getenv("OMP_NUM_THREADS"))))
             return usage_error("OMP_NUM_THREADS must be a whole number from 1 to 1024",
@@ -293,6 +339,9 @@ static void catch_stop_signals(void) {
     sa.sa_flags = SA_RESETHAND | SA_RESTART;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    /* a file-size limit (ulimit -f) fails the write (EFBIG), reported like a full disk,
+     * instead of killing the run before it can report */
+    signal(SIGXFSZ, SIG_IGN);
 }
 
 static const char *stop_signal_text(void) {
@@ -452,11 +501,66 @@ static jd_h5md *create_output(const jd_scene *sc, const jd_sim *sim, const char 
     return h;
 }
 
+/* The checkpointer of the run: where and when it writes (path NULL: never), and the state of
+ * --resume restored into sim.  Returns 0 or an exit status. */
+static int setup_checkpoints(const cli *c, const jd_scene *sc, jd_sim *sim, const char *out,
+                             jd_checkpointer *ck, char *path, size_t len) {
+    char *yaml = scene_yaml_string(sc);
+    if (!yaml) {
+        fprintf(stderr, "jdem: out of memory for the scene's identity\n");
+        return EXIT_NO_MEMORY;
+    }
+    const uint64_t hash = jd_checkpoint_scene_hash(yaml);
+    free(yaml);
+    const int writes = c->checkpoint || c->checkpoint_every || c->checkpoint_seconds;
+    const size_t stem = strlen(out) > 3 && !strcmp(out + strlen(out) - 3, ".h5") ? strlen(out) - 3
+                                                                                 : strlen(out);
+    const int k = c->checkpoint ? snprintf(path, len, "%s", c->checkpoint)
+                                : snprintf(path, len, "%.*s.ckpt.h5", (int)stem, out);
+    if (k < 0 || (size_t)k >= len - sizeof ".tmp") {
+        fprintf(stderr, "jdem: the checkpoint path is too long\n");
+        return EXIT_INPUT;
+    }
+    jd_checkpointer_init(ck, writes ? path : NULL, c->checkpoint_every, c->checkpoint_seconds,
+                         hash, sc->name, sc->case_name);
+    if (!c->resume) return 0;
+    char err[1024];
+    const int rc = jd_checkpoint_read(sim, ck, c->resume, err, sizeof err);
+    if (rc != 0) {
+        fprintf(stderr, "jdem: %s\n", err);
+        return rc == JD_CHECKPOINT_NO_MEMORY ? EXIT_NO_MEMORY : EXIT_INPUT;
+    }
+    if (!c->quiet)
+        fprintf(stderr, "jdem: resuming from %s at step %lld\n", c->resume, (long long)sim->step);
+    return 0;
+}
+
+/* The trajectory of a resumed run: the stopped run's prefix moved aside, a fresh OUT.part
+ * with that prefix copied in (checkpoint_trajectory.c).  NULL after reporting, with *rc. */
+static jd_h5md *resume_output(const jd_scene *sc, const jd_sim *sim, const char *out, int *rc) {
+    char src[4200], err[1024] = "";
+    if (jd_checkpoint_trajectory_source(out, sim->frame_step, src, sizeof src, err, sizeof err)) {
+        fprintf(stderr, "jdem: %s\n", err);
+        *rc = EXIT_INPUT;
+        return NULL;
+    }
+    jd_h5md *h = create_output(sc, sim, out, rc);
+    if (h && jd_checkpoint_trajectory_copy(src, h, sim->frame_step, sim->step, err, sizeof err)) {
+        fprintf(stderr, "jdem: %s\n", err);
+        jd_h5md_close(h, 0, err, sizeof err);
+        *rc = EXIT_IO;
+        return NULL;
+    }
+    if (h) unlink(src); /* its prefix is in OUT.part now, flushed */
+    return h;
+}
+
 /* Run the set-up sim into h and close it; returns the exit status. */
-static int run_and_close(const cli *c, jd_sim *sim, jd_h5md *h, const char *out) {
+static int run_and_close(const cli *c, jd_sim *sim, jd_h5md *h, const char *out,
+                         jd_checkpointer *ck) {
     char err[1024] = "";
     sim->stop = &stop_signal;
-    const int run_rc = sim_run(sim, h, !c->quiet, err, sizeof err);
+    const int run_rc = sim_run_checkpointed(sim, h, !c->quiet, ck, err, sizeof err);
     if (c->timing) print_timing(sim);
     if (run_rc != 0) {
         char err2[1024];
@@ -465,7 +569,11 @@ static int run_and_close(const cli *c, jd_sim *sim, jd_h5md *h, const char *out)
             fprintf(stderr, "jdem: closing %s.part failed: %s\n", out, err2);
             kept = strstr(err2, "nothing could be kept") == NULL; /* the writer removed it */
         }
-        return report_unfinished(run_rc, sim, err, out, kept);
+        const int status = report_unfinished(run_rc, sim, err, out, kept);
+        if (run_rc == JD_RUN_STOPPED && ck->path && ck->last_step == sim->step)
+            fprintf(stderr, "jdem: checkpoint of step %lld written to %s; continue with --resume "
+                    "%s\n", (long long)sim->step, ck->path, ck->path);
+        return status;
     }
     if (jd_h5md_close(h, 1, err, sizeof err) != 0) {
         fprintf(stderr, "jdem: %s\n", err);
@@ -474,6 +582,7 @@ static int run_and_close(const cli *c, jd_sim *sim, jd_h5md *h, const char *out)
     if (!c->quiet)
         fprintf(stderr, "jdem: wrote %s (%lld steps, %lld neighbour builds)\n", out,
                 (long long)sim->step, (long long)sim->lists.n_builds);
+    if (ck->path) unlink(ck->path); /* a complete run has nothing to resume */
     return 0;
 }
 
@@ -499,16 +608,22 @@ static int cmd_run(const cli *c) {
         rc = setup_failure(err);
     } else {
         jd_h5md *h = NULL;
+        jd_checkpointer ck;
+        char ck_path[4200];
+        rc = setup_checkpoints(c, &sc, &sim, out, &ck, ck_path, sizeof ck_path);
         FILE *record = c->inlet_record ? fopen(c->inlet_record, "w") : NULL;
-        if (c->inlet_record && !record) {
+        if (rc) {
+            /* reported */
+        } else if (c->inlet_record && !record) {
             fprintf(stderr, "jdem: %s: %s\n", c->inlet_record, strerror(errno));
             rc = EXIT_IO;
         } else if (stop_signal) {
             rc = stopped_in_setup();
-        } else if ((h = create_output(&sc, &sim, out, &rc))) {
+        } else if ((h = c->resume ? resume_output(&sc, &sim, out, &rc)
+                                  : create_output(&sc, &sim, out, &rc))) {
             if (record) fprintf(record, "id,step,x,y,z,vx,vy,vz\n");
             sim_inlets_log(&sim, record);
-            rc = run_and_close(c, &sim, h, out);
+            rc = run_and_close(c, &sim, h, out, &ck);
         }
         if (record && fclose(record) != 0 && rc == 0) {
             fprintf(stderr, "jdem: %s: %s\n", c->inlet_record, strerror(errno));

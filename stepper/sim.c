@@ -7,8 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "checkpoint.h"
 #include "geometry.h"
 #include "h5md.h"
+#include "h5md_internal.h"
 #include "hugepages.h"
 #include "jdem_laws.h"
 #include "sim.h"
@@ -395,11 +397,45 @@ static void write_stop_frame(jd_sim *s, jd_h5md *h) {
         s->frame_step = s->step;
 }
 
+/* A checkpoint when one is due: at every_steps, after every_seconds, or before a stop (the
+ * signal's flag is set).  Never twice at one step; 0 or JD_RUN_OUTPUT with err. */
+static int checkpoint_if_due(jd_sim *s, jd_h5md *h, jd_checkpointer *ck, const jd_progress *p,
+                             char *err, size_t errlen) {
+    if (!ck || s->step == ck->last_step) return 0;
+    const double now = sim_clock();
+    const int due = (s->stop && *s->stop) ||
+                    (s->step > 0 && ck->every_steps > 0 && s->step % ck->every_steps == 0) ||
+                    (ck->every_seconds > 0.0 && now - ck->t_last >= ck->every_seconds);
+    if (!due) return 0;
+    /* the trajectory on disk holds everything up to the checkpoint: a resume reads it back */
+    if (h && jd_h5md_flush(h) != 0) {
+        snprintf(err, errlen, "cannot flush the trajectory before the checkpoint of step %lld",
+                 (long long)s->step);
+        return JD_RUN_OUTPUT;
+    }
+    if (jd_checkpoint_write(s, ck, now - p->t_start, p->particle_steps, err, errlen) != 0)
+        return JD_RUN_OUTPUT;
+    ck->last_step = s->step;
+    ck->t_last = sim_clock();
+    return 0;
+}
+
 int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) {
+    return sim_run_checkpointed(s, h, show_progress, NULL, err, errlen);
+}
+
+int sim_run_checkpointed(jd_sim *s, jd_h5md *h, int show_progress, jd_checkpointer *ck,
+                         char *err, size_t errlen) {
     const jd_scene *sc = s->run.scene;
     const int64_t last = sc->steps;
+    /* a resumed run: the output of its first step is in the trajectory already */
+    const int64_t written = ck ? ck->resumed_step : -1;
     jd_progress p;
     progress_start(&p, show_progress, last);
+    if (written >= 0) { /* the rate and ETA count the time before the resume */
+        p.t_start -= ck->elapsed;
+        p.particle_steps = ck->particle_steps;
+    }
     const double t_loop = sim_clock();
     int rc = 0;
     for (;;) {
@@ -409,15 +445,16 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
             break;
         if (s->inlets && (rc = sim_inlets_step(s, err, errlen)) != 0) break;
         const double t0 = sim_clock();
-        if (due(s->step, sc->output_every, last)) {
+        if (s->step != written && due(s->step, sc->output_every, last)) {
             if ((rc = write_frame(s, h, err, errlen)) != 0) break;
             s->frame_step = s->step;
         }
-        if (due(s->step, sc->observables_every, last) &&
+        if (s->step != written && due(s->step, sc->observables_every, last) &&
             (rc = sample_observables(s, h, err, errlen)) != 0)
             break;
         s->accounts.timing.output += sim_clock() - t0;
         if (s->step >= last) break;
+        if ((rc = checkpoint_if_due(s, h, ck, &p, err, errlen)) != 0) break;
         if (s->stop && *s->stop) {
             snprintf(err, errlen, "stopped at step %lld", (long long)s->step);
             rc = JD_RUN_STOPPED;

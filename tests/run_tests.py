@@ -57,6 +57,9 @@ SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "line
 # Restart files in LIGGGHTS: continued runs == the uninterrupted run bit for bit on 1 and 2 ranks
 # (history, bonds, servo, kill -9), and restart files across stock and our pair styles.
 SUITES += [("liggghts-restart", [PY, "tests/liggghts/check_restart.py"], "lines", {})]
+# jdem checkpoints: kill -9 after a checkpoint, resume, == the uninterrupted run bit for bit on
+# 1 and 2 threads (bed, servo, inlet, bonds); SIGTERM; refused checkpoints; a failed write.
+SUITES += [("checkpoint", [PY, "tests/checkpoint/test_checkpoint.py"], "lines", {})]
 # SIGINT/SIGTERM stop liggghts-jdem cleanly (exit 130/143, OUT.part kept), on 1 and 2 ranks.
 SUITES += [("liggghts-signals", [PY, "tests/liggghts/check_signals.py"], "lines", {})]
 # Parallel bonds in LIGGGHTS (fix bond/jiang): 1 vs 2 MPI ranks, the ghost-cutoff guard, bad input.

@@ -1,0 +1,184 @@
+"""jdem checkpoints (docs/scenes.md "Checkpoints"): a run killed with SIGKILL after a checkpoint
+and resumed from it equals the uninterrupted run bit for bit (every dataset of the trajectory,
+tests/checkpoint/compare_h5.py), on 1 and 2 threads, for a settling bed with walls, friction
+and rolling, a servo compression, an inlet stream and a bonded beam; SIGTERM writes a
+checkpoint and exits 143; bad checkpoints are refused with their messages; a failed
+checkpoint write keeps the previous checkpoint and stops the run (exit 3)."""
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+import h5py
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, ROOT)
+from tests.checkpoint.compare_h5 import differences  # noqa: E402
+
+JDEM = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
+FAILED = []
+
+CASES = [  # scene, case, checkpoint every N steps
+    ("tests/engine/scenes/lattice_floor.yaml", None, 15000),
+    ("tests/engine/scenes/servo_columns.yaml", None, 1500),
+    ("tests/inlet/fill_small.yaml", None, None),
+    ("reference_runs/stability/bonded_beam.yaml", "tip_load", 20000),
+]
+
+
+def check(name, ok, detail=""):
+    print(f"{'PASS' if ok else 'FAIL'} {name}{'' if ok else ': ' + detail}", flush=True)
+    if not ok:
+        FAILED.append(name)
+
+
+def jdem(scene, out, *extra, case=None, threads=1):
+    cmd = [JDEM, "run", os.path.join(ROOT, scene), "-o", out, "--quiet", "--threads", str(threads)]
+    return cmd + (["--case", case] if case else []) + list(extra)
+
+
+def steps_of(scene, case):
+    text = subprocess.run([JDEM, "resolve", os.path.join(ROOT, scene)] + (["--case", case] if case else []),
+                          capture_output=True, text=True, check=True).stdout
+    for line in text.splitlines():
+        if line.strip().startswith("steps:"):
+            return int(line.split(":")[1])
+    raise RuntimeError("no steps")
+
+
+def wait_for(path, proc, limit=600):
+    t0 = time.time()
+    while not os.path.exists(path):
+        if proc.poll() is not None or time.time() - t0 > limit:
+            return False
+        time.sleep(0.05)
+    return True
+
+
+def killed_and_resumed(d, scene, case, every, threads):
+    tag = f"{os.path.basename(scene)[:-5]} {threads} thread(s)"
+    a, b = os.path.join(d, "a.h5"), os.path.join(d, "b.h5")
+    ck = os.path.join(d, "b.ckpt.h5")
+    every = every or steps_of(scene, case) // 2
+    subprocess.run(jdem(scene, a, case=case, threads=threads), check=True)
+    p = subprocess.Popen(jdem(scene, b, "--checkpoint-every", str(every), case=case, threads=threads))
+    got = wait_for(ck, p)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    check(f"{tag}: a checkpoint was written before the kill", got and p.returncode == -9,
+          f"exit {p.returncode}")
+    r = subprocess.run(jdem(scene, b, "--checkpoint-every", str(every), "--resume", ck, case=case,
+                            threads=threads), capture_output=True, text=True)
+    check(f"{tag}: the resumed run completes", r.returncode == 0, r.stderr[-400:])
+    if r.returncode == 0:
+        diffs, n = differences(a, b)
+        check(f"{tag}: resumed == uninterrupted, bit for bit ({n} datasets)", not diffs and n > 10,
+              "; ".join(diffs[:5]))
+        check(f"{tag}: the complete run removed its checkpoint", not os.path.exists(ck))
+
+
+def sigterm(d):
+    scene, out = CASES[0][0], os.path.join(d, "t.h5")
+    ck = os.path.join(d, "t.ckpt.h5")
+    p = subprocess.Popen(jdem(scene, out, "--checkpoint", ck), stderr=subprocess.PIPE, text=True)
+    while not os.path.exists(out + ".part"):
+        time.sleep(0.05)
+    time.sleep(1.0)
+    p.send_signal(signal.SIGTERM)
+    err = p.communicate()[1]
+    check("SIGTERM: exit status 143", p.returncode == 143, f"exit {p.returncode}: {err[-300:]}")
+    check("SIGTERM: a checkpoint is written and named", os.path.exists(ck) and
+          f"written to {ck}; continue with --resume {ck}" in err, err[-300:])
+    r = subprocess.run(jdem(scene, out, "--resume", ck), capture_output=True, text=True)
+    a = os.path.join(d, "ref.h5")
+    subprocess.run(jdem(scene, a), check=True)
+    diffs, _ = differences(a, out) if r.returncode == 0 else (["resume failed " + r.stderr], 0)
+    check("SIGTERM: the resumed run equals the uninterrupted one", not diffs, "; ".join(diffs[:3]))
+    return ck
+
+
+def refused(name, cmd, message, status=2):
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    check(f"{name}: exit {status}", r.returncode == status, f"exit {r.returncode}")
+    check(f"{name}: message", message in r.stderr, f"want {message!r}, got {r.stderr[-400:]!r}")
+
+
+def bad_checkpoints(d):
+    scene, out = CASES[0][0], os.path.join(d, "bad.h5")
+    ck = os.path.join(d, "good.ckpt.h5")
+    subprocess.run(jdem(scene, out, "--checkpoint-every", "10000") + ["--quiet"], check=True)
+    p = subprocess.Popen(jdem(scene, out, "--checkpoint", ck, "--checkpoint-every", "10000"))
+    wait_for(ck, p)
+    p.kill()
+    p.wait()
+    missing = os.path.join(d, "none.ckpt.h5")
+    refused("missing checkpoint", jdem(scene, out, "--resume", missing),
+            f"jdem: cannot resume: checkpoint '{missing}': No such file or directory; valid: a "
+            "checkpoint written by 'jdem run --checkpoint' for this scene")
+    half = os.path.join(d, "half.ckpt.h5")
+    with open(ck, "rb") as f, open(half, "wb") as g:
+        g.write(f.read()[: os.path.getsize(ck) // 2])
+    refused("truncated checkpoint", jdem(scene, out, "--resume", half),
+            f"jdem: cannot resume: '{half}' is not a readable HDF5 file (truncated or corrupt); "
+            "valid: a checkpoint written by 'jdem run --checkpoint' for this scene")
+    changed = os.path.join(d, "changed.ckpt.h5")
+    shutil.copy(ck, changed)
+    with h5py.File(changed, "r+") as f:
+        f["particles/x"][0] += 1e-9
+    refused("corrupt checkpoint", jdem(scene, out, "--resume", changed),
+            f"jdem: cannot resume: checkpoint '{changed}' is corrupt (its values do not match "
+            "their digest)")
+    other = CASES[1][0]
+    refused("checkpoint of another scene", jdem(other, out, "--resume", ck),
+            f"jdem: cannot resume: checkpoint '{ck}' is of another scene (scene 'lattice_floor', "
+            "case 'lattice_floor'")
+    refused("checkpoint of another thread count", jdem(scene, out, "--resume", ck, threads=2),
+            f"jdem: cannot resume: checkpoint '{ck}' was written with --threads 1, this run has 2; "
+            "valid: --threads 1")
+
+
+def failed_write(d):
+    scene = CASES[0][0]
+    sub = os.path.join(d, "ro")
+    os.mkdir(sub)
+    ck = os.path.join(sub, "run.ckpt.h5")
+    out = os.path.join(d, "w.h5")
+    p = subprocess.Popen(jdem(scene, out, "--checkpoint", ck, "--checkpoint-every", "10000"),
+                         stderr=subprocess.PIPE, text=True)
+    wait_for(ck, p)
+    before = open(ck, "rb").read() if os.path.exists(ck) else b""
+    os.chmod(sub, 0o555)
+    err = p.communicate()[1]
+    os.chmod(sub, 0o755)
+    if os.geteuid() == 0:  # root writes into a read-only directory: use a file-size limit
+        os.remove(ck)
+        p = subprocess.Popen(["sh", "-c", "ulimit -f 64; exec \"$@\"", "sh"] +
+                             jdem(scene, out, "--checkpoint", ck, "--checkpoint-every", "10000"),
+                             stderr=subprocess.PIPE, text=True)
+        err = p.communicate()[1]
+        before = b""
+    check("failed checkpoint write: exit 3", p.returncode == 3, f"exit {p.returncode}: {err[-300:]}")
+    check("failed checkpoint write: message", "checkpoint at step" in err and
+          "failed:" in err and f"the previous checkpoint '{ck}' is unchanged" in err, err[-400:])
+    after = open(ck, "rb").read() if os.path.exists(ck) else b""
+    check("failed checkpoint write: the previous checkpoint is intact", after == before)
+    check("failed checkpoint write: no temporary file left", not os.path.exists(ck + ".tmp"))
+
+
+def main():
+    with tempfile.TemporaryDirectory() as d:
+        for scene, case, every in CASES:
+            for threads in (1, 2):
+                sub = tempfile.mkdtemp(dir=d)
+                killed_and_resumed(sub, scene, case, every, threads)
+        sigterm(tempfile.mkdtemp(dir=d))
+        bad_checkpoints(tempfile.mkdtemp(dir=d))
+        failed_write(tempfile.mkdtemp(dir=d))
+    sys.exit(1 if FAILED else 0)
+
+
+if __name__ == "__main__":
+    main()
