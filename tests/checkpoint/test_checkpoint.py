@@ -23,7 +23,7 @@ FAILED = []
 
 CASES = [  # scene, case, checkpoint every N steps
     ("tests/engine/scenes/lattice_floor.yaml", None, 15000),
-    ("tests/engine/scenes/servo_columns.yaml", None, 1500),
+    ("tests/engine/scenes/servo_columns.yaml", None, 500),
     ("tests/inlet/fill_small.yaml", None, None),
     ("reference_runs/stability/bonded_beam.yaml", "tip_load", 20000),
 ]
