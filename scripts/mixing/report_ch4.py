@@ -75,6 +75,42 @@ def cube_result(path):
             "particles": r["particles"]}
 
 
+def jitter_fills(d):
+    """The finished realisations fill1_jitterK.h5 of a model's first fill, K = 1, 2, ..."""
+    found, k = [], 1
+    while os.path.exists(os.path.join(d, "fill1_jitter%d.h5" % k)):
+        found.append(os.path.join(d, "fill1_jitter%d.h5" % k))
+        k += 1
+    return found
+
+
+def spread_table(found):
+    """The run-to-run spread: the first fill and its jittered realisations (generate.py
+    --jitter), their trimmed means, and the sample std of those means."""
+    lines = ["### Run-to-run spread (the first fill and its realisations with the stream shifted by "
+             "K micrometres in y)", "",
+             "| engine | model | realisation | height [m] | φv | e | ρb [kg/m³] | Z |",
+             "|---|---|---|---|---|---|---|---|"]
+    keys = (("phi_v", "%.4f"), ("e", "%.3f"), ("rho_b", "%.0f"), ("Z", "%.2f"))
+    any_row = False
+    for engine in ENGINES:
+        for model in MODELS:
+            entry = found[engine][model]
+            runs = ([entry["fill1"]] if entry.get("fill1") else []) + entry.get("jitter", [])
+            if len(runs) < 2:
+                continue
+            any_row = True
+            for k, r in enumerate(runs):
+                lines.append("| %s | %s | %s | %.3f | %s |" % (
+                    engine, model, "K = %d" % k, r["deposit_height"],
+                    " | ".join(fmt % r["summary"][key]["mean"] for key, fmt in keys)))
+            std = lambda vals: float(np.std(vals, ddof=1))
+            lines.append("| %s | %s | std of the %d | %.3f | %s |" % (
+                engine, model, len(runs), std([r["deposit_height"] for r in runs]),
+                " | ".join(fmt % std([r["summary"][key]["mean"] for r in runs]) for key, fmt in keys)))
+    return "\n".join(lines) + "\n" if any_row else ""
+
+
 def collect(out):
     """{engine: {model: {"fillP": ..., "passP_cubes": [...], "times": ...}}} of the finished units."""
     found, missing = {}, []
@@ -88,6 +124,8 @@ def collect(out):
                     entry["fill%d" % p] = fill_result(fill)
                 else:
                     missing.append("%s/%s/fill%d" % (engine, model, p))
+                if p == 1:
+                    entry["jitter"] = [fill_result(j) for j in jitter_fills(d)]
                 cubes = [os.path.join(d, "pass%d_cube%d.h5" % (p, k)) for k in range(1, 10)]
                 done = [c for c in cubes if os.path.exists(c)]
                 if len(done) == 9:
@@ -192,7 +230,7 @@ def report(found, missing, rev):
              "(commit %s). Every reconstruction the seed leaves open is a scene parameter "
              "(docs/mixing.md §1).\n" % rev, mixing_table(found)]
     parts += [elastic_table(found, k, t, f) for k, t, f in TABLES]
-    parts += [constants_table(found), "### The seed's claims\n", claims_ch4.claims(found, ENGINES), times_table(found),
+    parts += [spread_table(found), constants_table(found), "### The seed's claims\n", claims_ch4.claims(found, ENGINES), times_table(found),
               "### Not run\n", "\n".join("- " + m for m in missing) + "\n" if missing else "nothing\n"]
     return "\n".join(parts)
 
