@@ -111,9 +111,10 @@ def phi_discriminates(found, engine):
     if d["phi_v"] is None:
         return []
     ok = d["phi_v"] > 1 and d["rho_b"] < 1 and d["Z"] < 1
-    return ["%s pass 1: φv discriminates, ρb and Z do not (range of the model means over the mean "
-            "std within a model: φv %.2f, ρb %.2f, Z %.2f; above 1 discriminates): %s"
-            % (engine, d["phi_v"], d["rho_b"], d["Z"], verdict(ok))]
+    n = sum(1 for m in MODELS if found[engine][m].get("fill1"))
+    return ["%s pass 1, %d of 6 models: φv discriminates, ρb and Z do not (range of the model means "
+            "over the mean std within a model: φv %.2f, ρb %.2f, Z %.2f; above 1 discriminates): %s"
+            % (engine, n, d["phi_v"], d["rho_b"], d["Z"], verdict(ok))]
 
 
 def poisson_anisotropy(found, engine):
