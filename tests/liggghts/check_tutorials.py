@@ -377,6 +377,26 @@ def wound_plane(c, tmp):
     c.check("plane: wound towards the particles it runs", rc == 0 and "for 10 steps with 50 atoms" in log, log[-300:])
 
 
+def pair_swapped_only(c, tmp):
+    """The issue's new user: insert_stream's stock deck with only its pair_style line replaced.
+    Its characteristicVelocity and cohesionEnergyDensity (without cohesion) have no effect on
+    gran/jiang: each is named once, in a warning."""
+    deck = open(os.path.join(TUTORIALS, "insert_stream", "in.insert_stream.stock.short")).read()
+    deck = re.sub(r"^pair_style gran model.*$", "pair_style gran/jiang", deck, flags=re.M)
+    deck = deck.replace("run\t\t20000", "run\t\t100")
+    d = os.path.join(tmp, "pair_only")
+    os.makedirs(d)
+    os.symlink(os.path.join(STOCK_TUTORIALS, "insert_stream", "meshes"), os.path.join(d, "meshes"))
+    open(os.path.join(d, "in.deck"), "w").write(deck)
+    r = subprocess.run([LIGGGHTS_JDEM, "-in", "in.deck", "-log", "log.lammps", "-screen", "screen.txt"],
+                       cwd=d, capture_output=True, text=True)
+    log = open(os.path.join(d, "log.lammps"), errors="replace").read()
+    for fix, name in (("m5", "characteristicVelocity"), ("m6", "cohesionEnergyDensity")):
+        want = "WARNING: fix %s (property/global %s) is not used by pair_style gran/jiang" % (fix, name)
+        n = sum(1 for l in log.splitlines() if l.startswith(want))
+        c.check("pair swapped only: %s named once in a warning (%d)" % (name, n), r.returncode == 0 and n == 1)
+
+
 # name, deck stem, folder of the stock tutorial, checks
 CASES = [
     ("packing", "in.packing", "packing", packing),
@@ -414,6 +434,7 @@ def main():
         guard_templates(c, tmp)
         watchdog_insertion(c, tmp)
         wound_plane(c, tmp)
+        pair_swapped_only(c, tmp)
     return finish(c, tmp, args.keep)
 
 
