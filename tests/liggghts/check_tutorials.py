@@ -322,6 +322,23 @@ def guard_templates(c, tmp):
             rc == 0 and "for 100 steps with 50 atoms" in log, log[-300:])
 
 
+def guard_cannot_check(c, tmp):
+    """A template the guard cannot read (a multisphere) is named, and a run with nothing to judge
+    says so (LIGGGHTS then stops this deck itself: multispheres need fix multisphere)."""
+    deck = POUR.format(E=5e6, dt=2e-6, floor=FLOOR_UP, extra="fix g all jdem/guard vmax 0", steps=10).replace(
+        "fix pts1 all particletemplate/sphere 15485863 atom_type 1 density constant 2500 radius constant 0.0015",
+        "fix pts1 all particletemplate/multisphere 15485863 atom_type 1 density constant 2500 nspheres 2 "
+        "ntry 1000000 spheres 0 0 0 0.0015 0.001 0 0 0.0015 type 1")
+    rc, log, _ = run_text(tmp, "guard_multisphere", deck)
+    lines = log.splitlines()
+    for want in ("WARNING: fix jdem/guard cannot check the particles that fix ins (insert/pack) will insert: "
+                 "its template pts1 (particletemplate/multisphere) is not one sphere of absolute radius; "
+                 "it checks the atoms present and the other insertions",
+                 "WARNING: fix jdem/guard: no particles and no insertion template to check at this run's "
+                 "set-up: the time step is not checked until a run starts with some"):
+        c.check("guard: says %r" % want[9:60], any(l.startswith(want) for l in lines), log[-300:])
+
+
 def watchdog_insertion(c, tmp):
     """insert/stream into free space with the watchdog's energy check every 100 steps: the
     booked inflow equals the energy of the inserted atoms (conserved in free flight by velocity
@@ -432,6 +449,7 @@ def main():
             checks(c, fr, logs)
     if not only or "fixes" in only:
         guard_templates(c, tmp)
+        guard_cannot_check(c, tmp)
         watchdog_insertion(c, tmp)
         wound_plane(c, tmp)
         pair_swapped_only(c, tmp)
