@@ -22,7 +22,7 @@ CC    := gcc
 CXX   := mpicxx
 
 DEB_PACKAGES := gcc g++ make pkg-config clang libclang-rt-14-dev libyaml-dev libhdf5-dev libcmocka-dev \
-                python3-numpy python3-h5py python3-matplotlib python3-yaml \
+                python3-numpy python3-scipy python3-h5py python3-matplotlib python3-yaml liggghts-doc \
                 liggghts libliggghts-dev mpi-default-dev mpi-default-bin
 
 VERSION  := 0.1.0
