@@ -22,7 +22,7 @@ CC    := gcc
 CXX   := mpicxx
 
 DEB_PACKAGES := gcc g++ make pkg-config clang libclang-rt-14-dev libyaml-dev libhdf5-dev libcmocka-dev \
-                python3-numpy python3-h5py python3-matplotlib python3-yaml \
+                python3-numpy python3-scipy python3-h5py python3-matplotlib python3-yaml liggghts-doc \
                 liggghts libliggghts-dev mpi-default-dev mpi-default-bin
 
 VERSION  := 0.1.0
@@ -228,6 +228,12 @@ mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),bu
 # The tables of the finished units, seed | jdem | liggghts-jdem (Tables 4-3...4-5, the mixing
 # parameters, run times): out/mixing/ch4/report.md and summary.json, and the committed copy in
 # reference_runs/mixing/ch4/results/ (stamped with the commit).
+# The fill's speed in jdem, liggghts-jdem and stock LIGGGHTS (1 and 2 cores each), measured in
+# one run: out/mixing/speed/report.md and summary.json (docs/mixing.md §10).
+.PHONY: mixing-speed
+mixing-speed: all
+	$(PY) -m scripts.mixing.speed_ch4 $(if $(SPEED_TIME),--end-time $(SPEED_TIME))
+
 .PHONY: mixing-report
 mixing-report:
 	$(PY) scripts/mixing/report_ch4.py --results reference_runs/mixing/ch4/results

@@ -60,15 +60,15 @@ int64_t jd_inlet_section_start(const jd_inlet_spec *s, int64_t copy) {
     return first;
 }
 
-void jd_inlet_particle_at_crossing(const jd_inlet_spec *s, int64_t copy, size_t p,
-                                   jd_inlet_particle *out) {
+void jd_inlet_particle_at_step(const jd_inlet_spec *s, int64_t copy, size_t p, int64_t step,
+                               jd_inlet_particle *out) {
     double u[3];
     belt_direction(s, u);
     out->id = s->first_id + copy * (int64_t)s->n + (int64_t)p;
     out->copy = copy;
     out->index = p;
-    out->step = jd_inlet_crossing_step(s, copy, p);
-    const double t = (double)out->step * s->dt;
+    out->step = step;
+    const double t = (double)step * s->dt;
     const double back = setback(s, copy);
     for (int i = 0; i < 3; i++) {
         const double b = (s->origin[i] + s->rel[3 * p + i]) - back * u[i];
@@ -77,6 +77,29 @@ void jd_inlet_particle_at_crossing(const jd_inlet_spec *s, int64_t copy, size_t 
     }
     out->radius = s->radius[p];
     out->species = s->species[p];
+}
+
+void jd_inlet_particle_at_crossing(const jd_inlet_spec *s, int64_t copy, size_t p,
+                                   jd_inlet_particle *out) {
+    jd_inlet_particle_at_step(s, copy, p, jd_inlet_crossing_step(s, copy, p), out);
+}
+
+int64_t jd_inlet_group_start(const jd_inlet_spec *s, int64_t copy, const size_t *members,
+                             size_t n_members) {
+    int64_t first = JD_INLET_NEVER;
+    for (size_t m = 0; m < n_members; m++) {
+        const int64_t k = jd_inlet_crossing_step(s, copy, members[m]);
+        if (k < first)
+            first = k;
+    }
+    return first;
+}
+
+void jd_inlet_bond_ids(const jd_inlet_spec *s, int64_t copy, size_t i, size_t j, int64_t ids[2]) {
+    const int64_t base = s->first_id + copy * (int64_t)s->n;
+    const size_t lo = i < j ? i : j, hi = i < j ? j : i;
+    ids[0] = base + (int64_t)lo;
+    ids[1] = base + (int64_t)hi;
 }
 
 /* ---------------------------------------------------------------------------------------- */

@@ -125,6 +125,30 @@ typedef struct jd_inlet_particle {
 void jd_inlet_particle_at_crossing(const jd_inlet_spec *s, int64_t copy, size_t p,
                                    jd_inlet_particle *out);
 
+/* Particle p of copy c at an arbitrary step k (>= 0): id, copy and index as at its crossing,
+ * step = k, position x(c, p, k) of the rigid belt motion (the same sums, in the same order, as
+ * at its crossing) [m], velocity v [m/s]. */
+void jd_inlet_particle_at_step(const jd_inlet_spec *s, int64_t copy, size_t p, int64_t step,
+                               jd_inlet_particle *out);
+
+/* ---- Bonded groups of a section (Jiang (2021) Ch. 5: the 2 x 2 x 8 blocks) ----
+ *
+ * A group is a set of section particles bonded to one another.  Rule: in every copy a group is
+ * inserted whole at its start step, the smallest crossing step k* of its members: every member
+ * is placed at x(c, p, start) (the members not yet across the plane still at their rigid belt
+ * positions), so no bond ever joins an inserted particle to one not yet inserted.  The copy's
+ * bonds are formed at that step, unstressed (the belt is rigid: every bond has its section
+ * length), between the ids the stream's id rule gives. */
+
+/* Start step of a group of copy c: the smallest k*(c, p) over members[0 .. n_members) (indices
+ * in the section); JD_INLET_NEVER when n_members = 0.  O(n_members). */
+int64_t jd_inlet_group_start(const jd_inlet_spec *s, int64_t copy, const size_t *members,
+                             size_t n_members);
+
+/* The ids of the bond joining section particles i and j (i != j) in copy c, the smaller first
+ * (the order of the resolved `bonds:` entries): first_id + c n + min(i, j), then the larger. */
+void jd_inlet_bond_ids(const jd_inlet_spec *s, int64_t copy, size_t i, size_t j, int64_t ids[2]);
+
 /* The state of a stream during a run: one cursor per section particle (an array of n that the
  * engine allocates), the next copy of that particle due and its step.  The engine compares the
  * current step with next_step only, so particles not yet inserted cost nothing per step. */

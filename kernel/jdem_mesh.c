@@ -306,6 +306,41 @@ void jd_mesh_match_history(size_t nold, const double (*old_n)[3], size_t nnew,
     }
 }
 
+static void copy3(double to[3], const double from[3]) {
+    for (int d = 0; d < 3; d++) to[d] = from[d];
+}
+
+int jd_mesh_sphere_contacts(const jd_mesh *m, size_t n, const int32_t *tri, const double x[3],
+                            double R, const double *slots, size_t stride, jd_mesh_closest *closest,
+                            unsigned char *is_contact, jd_mesh_sphere *out) {
+    out->n = 0;
+    for (size_t k = 0; k < n; k++) jd_mesh_closest_feature(m, tri[k], x, &closest[k]);
+    jd_mesh_contacts(m, n, closest, R, is_contact);
+    for (size_t k = 0; k < n; k++) {
+        if (!is_contact[k]) continue;
+        if (out->n == JD_MESH_SLOTS) return JD_MESH_TOO_MANY;
+        if (!jd_geom_mesh(&closest[k], x, R, &out->geom[out->n])) continue;
+        out->feature[out->n++] = &closest[k];
+    }
+    double old_n[JD_MESH_SLOTS][3], new_n[JD_MESH_SLOTS][3];
+    for (size_t s = 0; s < JD_MESH_SLOTS; s++) copy3(old_n[s], slots + s * stride);
+    for (size_t c = 0; c < out->n; c++) copy3(new_n[c], out->geom[c].n);
+    jd_mesh_match_history(JD_MESH_SLOTS, (const double(*)[3])old_n, out->n,
+                          (const double(*)[3])new_n, out->from);
+    return JD_MESH_OK;
+}
+
+void jd_mesh_history_next(const double *slots, size_t stride, const jd_mesh_sphere *s, double *next) {
+    for (size_t k = 0; k < JD_MESH_SLOTS * stride; k++) next[k] = 0.0;
+    for (size_t c = 0; c < s->n; c++) {
+        double *to = next + c * stride;
+        copy3(to, s->geom[c].n);
+        if (s->from[c] < 0) continue;
+        const double *was = slots + (size_t)s->from[c] * stride;
+        for (size_t k = 3; k < stride; k++) to[k] = was[k];
+    }
+}
+
 void jd_mesh_point_velocity(const jd_mesh *m, const jd_mesh_closest *c, const double vnode[3][3],
                             double v[3]) {
     const int32_t *tv = m->tri_vertex[c->tri];

@@ -114,6 +114,37 @@ size_t jd_mesh_contacts(const jd_mesh *m, size_t n, const jd_mesh_closest *c, do
 void jd_mesh_match_history(size_t nold, const double (*old_n)[3], size_t nnew,
                            const double (*new_n)[3], int *from);
 
+/* One sphere's contacts with one mesh, the procedure both engines run per sphere and mesh:
+ * each candidate triangle's closest feature (jd_mesh_closest_feature), the contacts among them
+ * (jd_mesh_contacts), their geometry (jd_geom_mesh; contacts whose centre lies on the surface
+ * are dropped), and the history slot each continues (jd_mesh_match_history).
+ *
+ * History slots.  A sphere's history with one mesh is JD_MESH_SLOTS slots of `stride` doubles
+ * each: the contact's unit normal at its last evaluation (3 doubles; (0, 0, 0): empty slot),
+ * then the engine's record of the law's state (stride - 3 doubles). */
+typedef struct jd_mesh_sphere {
+    size_t n;                                      /* contacts found (<= JD_MESH_SLOTS)     */
+    const jd_mesh_closest *feature[JD_MESH_SLOTS]; /* contact c's feature (in closest[])     */
+    jd_contact_geom geom[JD_MESH_SLOTS];           /* its geometry; no material fields yet  */
+    int from[JD_MESH_SLOTS];                       /* the old slot it continues, or -1      */
+} jd_mesh_sphere;
+
+/* The sphere of centre x [m] and radius R [m] against the n candidate triangles tri[] of m
+ * (every triangle within R of x, any order), with its history slots `slots` (JD_MESH_SLOTS x
+ * stride doubles, layout above).  closest[n] and is_contact[n] are the caller's scratch.
+ * Contacts are numbered in the candidates' order.  Returns JD_MESH_OK, or JD_MESH_TOO_MANY when
+ * the sphere has more than JD_MESH_SLOTS contacts (out->n then JD_MESH_SLOTS). */
+enum { JD_MESH_TOO_MANY = 3 };
+int jd_mesh_sphere_contacts(const jd_mesh *m, size_t n, const int32_t *tri, const double x[3],
+                            double R, const double *slots, size_t stride, jd_mesh_closest *closest,
+                            unsigned char *is_contact, jd_mesh_sphere *out);
+
+/* The sphere's slots after this evaluation, into next (JD_MESH_SLOTS x stride doubles): slot c
+ * (c < s->n) holds contact c's normal and the record of the slot it continues (zero for a new
+ * contact); the other slots are empty (zero).  The engine then evaluates contact c's law on the
+ * record of slot c of next. */
+void jd_mesh_history_next(const double *slots, size_t stride, const jd_mesh_sphere *s, double *next);
+
 /* The wall's velocity [m/s] at c's point: the velocities vnode[k] [m/s] of the corners k of
  * triangle c->tri (the order of its corners given to jd_mesh_build) interpolated linearly,
  * v = v0 + b1 (v1 - v0) + b2 (v2 - v0) with (b1, b2) the point's barycentric coordinates, so a

@@ -15,6 +15,11 @@
 #include "modify.h"
 #include "update.h"
 
+#include "fix_insert.h"
+#include "fix_particledistribution_discrete.h"
+#include "fix_template_sphere.h"
+#include "probability_distribution.h"
+
 #include "fix_bond_jiang.h"
 #include "fix_jdem_inlet.h"
 #include "fix_wall_jiang.h"
@@ -23,6 +28,87 @@
 #include "pair_gran_jiang.h"
 
 using namespace LAMMPS_NS;
+
+bool JdemGuardTally::any() const {
+  for (size_t t = 0; t < count.size(); t++)
+    if (count[t] > 0.0) return true;
+  return false;
+}
+
+void JdemGuardTally::add(int t, double r, double density, double n) {
+  count[t] += n;
+  if (r < rmin[t]) {
+    rmin[t] = r;
+    rho[t] = density;
+  }
+}
+
+/* LIGGGHTS keeps a template's density distribution and an insertion's velocity protected, with
+ * no accessor.  A class derived from the owner may name them ([class.protected]): these read
+ * them through such member pointers, without changing LIGGGHTS. */
+namespace {
+struct TemplatePeek : FixTemplateSphere {
+  static double min_density(FixTemplateSphere *t) {
+    return LMP_PROBABILITY_NS::pdf_min(t->*(&TemplatePeek::pdf_density));
+  }
+};
+struct InsertPeek : FixInsert {
+  /* the fastest insertion speed |v| + |fluctuation| [m/s] */
+  static double max_speed(FixInsert *f) {
+    const double *v = f->*(&InsertPeek::v_insert), *dv = f->*(&InsertPeek::v_insertFluct);
+    const bool fluct = f->*(&InsertPeek::v_randomSetting) != RANDOM_CONSTANT;
+    return std::sqrt(jd_dot(v, v)) + (fluct ? std::sqrt(jd_dot(dv, dv)) : 0.0);
+  }
+};
+}  // namespace
+
+/* the inlets' section particles, once each (as the stepper's guard: they take part once inserted) */
+void FixJdemGuard::add_inlets(JdemGuardTally &tally) {
+  for (int k = 0; k < modify->nfix; k++) {
+    const FixJdemInlet *in = dynamic_cast<const FixJdemInlet *>(modify->fix[k]);
+    for (size_t p = 0; in && p < in->section_types().size(); p++)
+      tally.add(in->section_types()[p], in->section_radii()[p], in->section_densities()[p], 1.0);
+  }
+}
+
+/* The particles that LIGGGHTS' own insertion fixes (insert/pack, insert/stream,
+ * insert/rate/region) will insert: each template of their particledistribution/discrete, with
+ * its smallest radius and its smallest density (the shortest contact: t_c grows with R and
+ * rho^(2/5)).  Returns the fastest insertion speed; what cannot be checked is named in a
+ * warning. */
+double FixJdemGuard::add_templates(JdemGuardTally &tally) {
+  double speed = 0.0;
+  for (int k = 0; k < modify->nfix; k++) {
+    Fix *f = modify->fix[k];
+    FixInsert *ins = dynamic_cast<FixInsert *>(f);
+    if (!ins) {
+      if (std::strncmp(f->style, "pour", 4) == 0 || std::strncmp(f->style, "insert", 6) == 0)
+        cannot_check(f, "its particles are not described by particle templates the guard can read");
+      continue;
+    }
+    FixParticledistributionDiscrete *dist = ins->get_distribution();
+    if (!dist) continue;
+    const double v = InsertPeek::max_speed(ins);
+    speed = v > speed ? v : speed;
+    for (int j = 0; j < dist->n_particletemplates(); j++) {
+      FixTemplateSphere *t = dist->get_template(j);
+      if (std::strcmp(t->style, "particletemplate/sphere") != 0 || t->is_relative()) {
+        cannot_check(f, (std::string("its template ") + t->id + " (" + t->style + ") is not one "
+                         "sphere of absolute radius").c_str());
+        continue;
+      }
+      tally.add(t->mintype() - 1, t->min_rad(), TemplatePeek::min_density(t), 1.0);
+    }
+  }
+  return speed;
+}
+
+void FixJdemGuard::cannot_check(const Fix *f, const char *why) {
+  if (comm->me != 0) return;
+  error->warning(FLERR, (std::string("fix jdem/guard cannot check the particles that fix ") + f->id +
+                         " (" + f->style + ") will insert: " + why +
+                         "; it checks the atoms present and the other insertions").c_str());
+}
 
 FixJdemGuard::FixJdemGuard(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), vmax(0.0), coordination(JD_GUARD_DEFAULT_COORDINATION), force_run(false) {
@@ -73,18 +159,12 @@ void FixJdemGuard::setup(int) {
   for (int t = 0; t < nt; t++) rho[t] = rmin[t] == g_rmin[t] ? rho[t] : 0.0; /* the owner's */
   MPI_Allreduce(rho.data(), g_rho.data(), nt, MPI_DOUBLE, MPI_MAX, world);
 
-  /* the inlets' section particles, once each (as the stepper's guard: they take part once inserted) */
-  for (int k = 0; k < modify->nfix; k++) {
-    const FixJdemInlet *in = dynamic_cast<const FixJdemInlet *>(modify->fix[k]);
-    for (size_t p = 0; in && p < in->section_types().size(); p++) {
-      const int t = in->section_types()[p];
-      g_count[t] += 1.0;
-      if (in->section_radii()[p] < g_rmin[t]) {
-        g_rmin[t] = in->section_radii()[p];
-        g_rho[t] = in->section_densities()[p];
-      }
-    }
-  }
+  JdemGuardTally tally = {g_rmin, g_rho, g_count};
+  add_inlets(tally);
+  const double insertion_speed = add_templates(tally);
+  if (comm->me == 0 && !tally.any())
+    error->warning(FLERR, "fix jdem/guard: no particles and no insertion template to check at this "
+                          "run's set-up: the time step is not checked until a run starts with some");
   std::vector<jd_guard_species> sp(nt);
   for (int t = 0; t < nt; t++) {
     sp[t].count = (size_t)g_count[t];
@@ -102,7 +182,7 @@ void FixJdemGuard::setup(int) {
   in.has_walls = walls;
   in.wall_rule = pair->wall_rule;
   in.tangential_rule = pair->tangential_rule;
-  in.max_impact_speed = vmax;
+  in.max_impact_speed = vmax > insertion_speed ? vmax : insertion_speed;
   in.coordination = coordination;
   in.damping_ratio = jd_guard_damping_ratio(sp.data(), (size_t)nt, pair->restitution_table(),
                                             pair->damping_map);

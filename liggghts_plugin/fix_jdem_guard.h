@@ -9,13 +9,26 @@
  * coordination number (default 12); with fix bond/jiang, the bonds' frequency bound
  * (FixBondJiang::omega2_max, summed over the bond fixes).  An unsafe `timestep` stops the run before anything is
  * written, with the stepper's message (error->all); `force` runs it anyway with a warning.
+ * The particles still to come count too: fix jdem/inlet's sections, and the templates
+ * (particletemplate/sphere) of LIGGGHTS' insert/pack, insert/stream and insert/rate/region,
+ * whose fastest insertion speed raises V; an insertion it cannot read is named in a warning.
  * scripts/scene_to_liggghts.py writes this fix from the resolved scene. */
 #ifndef JDEM_FIX_JDEM_GUARD_H
 #define JDEM_FIX_JDEM_GUARD_H
 
 #include "fix.h"
 
+#include <vector>
+
 namespace LAMMPS_NS {
+
+/* Per atom type (index type - 1): the smallest radius [m], its density [kg/m^3] and how many
+ * particles (present, or one per template / inlet section particle) the guard evaluates. */
+struct JdemGuardTally {
+  std::vector<double> &rmin, &rho, &count;
+  void add(int t, double r, double density, double n);
+  bool any() const;
+};
 
 class FixJdemGuard : public Fix {
  public:
@@ -25,6 +38,9 @@ class FixJdemGuard : public Fix {
   void setup(int);
 
  private:
+  void add_inlets(JdemGuardTally &tally);
+  double add_templates(JdemGuardTally &tally);
+  void cannot_check(const Fix *f, const char *why);
   double vmax, coordination;
   bool force_run;
 };

@@ -19,6 +19,8 @@
 #include "output.h"
 #include "update.h"
 
+#include "fix_insert.h"
+
 #include "dump_h5md_jdem.h"
 #include "fix_jdem_inlet.h"
 #include "fix_wall_jiang.h"
@@ -29,9 +31,19 @@
 
 using namespace LAMMPS_NS;
 
+static std::string format(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
+/* LIGGGHTS keeps fix insert's compress_tags flag protected, with no accessor; a class derived
+ * from it may name it ([class.protected]). */
+namespace {
+struct InsertPeek : FixInsert {
+  using FixInsert::compress_flag;
+};
+}  // namespace
+
 FixJdemWatchdog::FixJdemWatchdog(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), energy_every(1), max_overlap(0.5), max_energy_jump(0.05),
-      has_ref(false), ref(), ref_step(0) {
+      has_ref(false), ref(), ref_step(0), last_tag(0), inserted_energy(0.0), inserted_atoms(0.0) {
   if (narg < 4) error->all(FLERR, "Illegal fix jdem/watchdog command: fix ID group jdem/watchdog N [overlap F] [energy J|off]");
   energy_every = force->inumeric(FLERR, arg[3]);
   if (energy_every < 1) error->all(FLERR, "fix jdem/watchdog: N must be >= 1");
@@ -49,6 +61,9 @@ FixJdemWatchdog::FixJdemWatchdog(LAMMPS *lmp, int narg, char **arg)
   }
   nevery = 1; /* the cheap checks run every step; the energy check every energy_every */
   restart_global = 1; /* the energy account continues (jdem_restart.h) */
+  scalar_flag = 1;    /* f_ID: the energy booked for fix insert/...'s atoms */
+  global_freq = 1;
+  extscalar = 0;
 }
 
 int FixJdemWatchdog::setmask() { return FixConst::END_OF_STEP; }
@@ -58,17 +73,34 @@ void FixJdemWatchdog::init() {
   PairGranJiang *pair = dynamic_cast<PairGranJiang *>(force->pair);
   if (!pair) error->all(FLERR, "fix jdem/watchdog requires pair_style gran/jiang");
   pair->overlap_limit = max_overlap;
+  inserts.clear();
+  bool inlet = false;
+  for (int k = 0; k < modify->nfix; k++) {
+    FixInsert *ins = dynamic_cast<FixInsert *>(modify->fix[k]);
+    if (ins && ins->*(&InsertPeek::compress_flag))
+      error->all(FLERR, (std::string("fix jdem/watchdog cannot tell the atoms that fix ") + ins->id +
+                         " inserts from the others: compress_tags yes renumbers every atom; use "
+                         "compress_tags no, or energy off").c_str());
+    if (ins) inserts.push_back(ins);
+    inlet = inlet || dynamic_cast<FixJdemInlet *>(modify->fix[k]);
+  }
+  if (inlet && !inserts.empty())
+    error->all(FLERR, "fix jdem/watchdog books the energy of fix jdem/inlet or of LIGGGHTS' fix "
+                      "insert/..., not of both in one run: their new atoms' ids overlap");
   for (int k = 0; k < modify->nfix; k++) {
     FixWallJiang *w = dynamic_cast<FixWallJiang *>(modify->fix[k]);
     if (w) w->overlap_limit = max_overlap;
   }
 }
 
-void FixJdemWatchdog::setup(int) { check(); }
+void FixJdemWatchdog::setup(int) {
+  note_last_tag();
+  check();
+}
 
 /* Restart files: the energy account of the last check (the reference of the next one). */
 namespace {
-enum { WATCHDOG_SHARED = 9 };
+enum { WATCHDOG_SHARED = 11 };
 }
 
 void FixJdemWatchdog::write_restart(FILE *fp) {
@@ -78,6 +110,8 @@ void FixJdemWatchdog::write_restart(FILE *fp) {
   st.shared.push_back(has_ref ? 1.0 : 0.0);
   st.shared.insert(st.shared.end(), terms, terms + 7);
   st.shared.push_back(jdem_restart_pack_i64(ref_step));
+  st.shared.push_back(inserted_energy);
+  st.shared.push_back(inserted_atoms);
   jdem_restart_write_state(lmp, fp, st);
 }
 
@@ -94,9 +128,62 @@ void FixJdemWatchdog::restart(char *buf) {
   ref.friction = s[6];
   ref.wall_work = s[7];
   ref_step = jdem_restart_unpack_i64(s[8]);
+  inserted_energy = s[9];
+  inserted_atoms = s[10];
 }
 
-void FixJdemWatchdog::end_of_step() { check(); }
+void FixJdemWatchdog::end_of_step() {
+  book_insertions();
+  if (inserting_at(update->ntimestep + 1)) note_last_tag();
+  check();
+}
+
+void FixJdemWatchdog::post_run() {
+  if (comm->me != 0 || inserts.empty()) return;
+  const std::string line = format("fix %s jdem/watchdog: booked the energy of %.0f atoms inserted by "
+                                  "fix insert: %.17g J\n", id, inserted_atoms, inserted_energy);
+  if (screen) std::fputs(line.c_str(), screen);
+  if (logfile) std::fputs(line.c_str(), logfile);
+}
+
+/* Does a fix insert/... insert at STEP (at the run's first step: it was scheduled before)? */
+bool FixJdemWatchdog::inserting_at(bigint step) const {
+  for (size_t k = 0; k < inserts.size(); k++)
+    if (inserts[k]->next_reneighbor == step) return true;
+  return false;
+}
+
+/* The largest atom id present (all ranks), when an insertion is due next step: the atoms of
+ * that insertion get larger ids (Atom::tag_extend). */
+void FixJdemWatchdog::note_last_tag() {
+  if (inserts.empty()) return;
+  int mine = 0;
+  for (int i = 0; i < atom->nlocal; i++) mine = atom->tag[i] > mine ? atom->tag[i] : mine;
+  MPI_Allreduce(&mine, &last_tag, 1, MPI_INT, MPI_MAX, world);
+}
+
+/* After a step on which a fix insert/... inserted: book the energy of its atoms, in the state the
+ * energy account sees them first (the end of this step: the insertion's position, its velocity
+ * after the step's last half kick), as input. */
+void FixJdemWatchdog::book_insertions() {
+  bool inserted = false;
+  for (size_t k = 0; k < inserts.size(); k++) inserted = inserted || inserts[k]->has_inserted();
+  if (!inserted) return;
+  double g[3];
+  jdem_gravity(lmp, g);
+  double mine[2] = {0.0, 0.0}, all[2];
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (atom->tag[i] <= last_tag || !(atom->mask[i] & groupbit)) continue;
+    const double m = atom->rmass[i];
+    mine[0] += 0.5 * m * jd_dot(atom->v[i], atom->v[i]) +
+               0.5 * jd_sphere_inertia(m, atom->radius[i]) * jd_dot(atom->omega[i], atom->omega[i]) -
+               m * jd_dot(g, atom->x[i]);
+    mine[1] += 1.0;
+  }
+  MPI_Allreduce(mine, all, 2, MPI_DOUBLE, MPI_SUM, world);
+  inserted_energy += all[0];
+  inserted_atoms += all[1];
+}
 
 /* Is every component of x, v, omega, f and torque of this rank's atoms finite?  x - x is +0
  * (all bits zero) for every finite x and NaN for an infinity or a NaN (IEEE 754; GCC does not
@@ -152,7 +239,6 @@ void FixJdemWatchdog::check() {
     trip(msg, true);
 }
 
-static std::string format(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 static std::string format(const char *fmt, ...) {
   char buf[1024];
   va_list ap;
@@ -236,6 +322,7 @@ bool FixJdemWatchdog::energy(std::string &msg) {
     const FixJdemInlet *in = dynamic_cast<const FixJdemInlet *>(modify->fix[k]);
     if (in) now.wall_work += in->inflow_energy();
   }
+  now.wall_work += inserted_energy;
   const double jump = has_ref ? jd_energy_jump(&ref, &now) : 0.0;
   if (!(jump <= max_energy_jump)) { /* NaN trips too */
     const int id = most_energetic();

@@ -12,6 +12,13 @@
  * "jdem: watchdog: step S: QUANTITY VALUE for particle(s) IDS exceeds LIMIT ...": dump
  * h5md/jdem then keeps its file, closed, as FILE.part.
  *
+ * Energy that enters the run counts as input (wall_work), as in the stepper: fix jdem/inlet's
+ * inflow, and the kinetic, rotational and gravitational energy of each atom that LIGGGHTS' fix
+ * insert/... inserts (booked in the state it has at the end of its insertion step, the state the
+ * energy account first sees).  A new atom is one whose id exceeds the largest id present at the
+ * end of the step before the insertion (fix insert gives new atoms ids above every present one).
+ * f_ID is that booked insertion energy [J]; every run's end prints it.
+ *
  * Requires pair_style gran/jiang.  scripts/scene_to_liggghts.py writes this fix from the scene's
  * watchdog: section. */
 #ifndef JDEM_FIX_JDEM_WATCHDOG_H
@@ -19,6 +26,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "fix.h"
 
@@ -35,10 +43,15 @@ class FixJdemWatchdog : public Fix {
   void end_of_step();
   void write_restart(FILE *);
   void restart(char *);
+  void post_run();
+  double compute_scalar() { return inserted_energy; }
   bool checks_energy() const { return max_energy_jump > 0.0; }
 
  private:
   void check();
+  bool inserting_at(bigint step) const;
+  void note_last_tag();
+  void book_insertions();
   bool nonfinite(std::string &msg);
   bool overlap(std::string &msg);
   bool energy(std::string &msg);
@@ -50,6 +63,11 @@ class FixJdemWatchdog : public Fix {
   bool has_ref;
   jd_energy_terms ref;
   bigint ref_step;
+  /* LIGGGHTS' fix insert/... of the run (init), the largest atom id present before the next
+   * insertion, the energy [J] and the number of the atoms they inserted */
+  std::vector<class FixInsert *> inserts;
+  int last_tag;
+  double inserted_energy, inserted_atoms;
 };
 
 }  // namespace LAMMPS_NS

@@ -3,6 +3,7 @@
 #include "fix_wall_jiang.h"
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <mpi.h>
 #include <string>
@@ -10,6 +11,7 @@
 #include "atom.h"
 #include "error.h"
 #include "force.h"
+#include "group.h"
 #include "memory.h"
 #include "neighbor.h"
 #include "update.h"
@@ -175,9 +177,52 @@ void FixWallJiang::init() {
  * tests every particle; the first step of the run builds the candidate list. */
 void FixWallJiang::setup(int vflag) {
   cand_ncalls = -1;
+  if (shape == 0) check_winding();
   if (jdem_restart_resuming(lmp)) return; /* the state read from the file stands */
   compute(false);
   sum_force_and_servo();
+}
+
+/* A plane acts on its active side only: a plane wound the wrong way lets every particle pass.
+ * Of the group's particles whose centre projects onto the quadrilateral, count those in front
+ * of it and those behind it (over all ranks); when some are behind and none in front, the
+ * winding is wrong (a plane with no particle over it has nothing to say yet: a later run's
+ * set-up, after an insertion, checks again). */
+static void difference(double out[3], const double a[3], const double b[3]) {
+  for (int k = 0; k < 3; k++) out[k] = a[k] - b[k];
+}
+
+void FixWallJiang::check_winding() {
+  double side[2] = {0.0, 0.0}, all[2]; /* in front, behind */
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!(atom->mask[i] & groupbit)) continue;
+    double d[3];
+    difference(d, atom->x[i], plane.p[0]);
+    const double s = jd_dot(plane.n, d);
+    double xc[3];
+    for (int k = 0; k < 3; k++) xc[k] = atom->x[i][k] - s * plane.n[k];
+    bool over = true;
+    for (int e = 0; e < 4 && over; e++) {
+      double edge[3], to[3], c[3];
+      difference(edge, plane.p[(e + 1) % 4], plane.p[e]);
+      difference(to, xc, plane.p[e]);
+      jd_cross(edge, to, c);
+      over = jd_dot(c, plane.n) >= 0.0;
+    }
+    if (over && s != 0.0) side[s > 0.0 ? 0 : 1] += 1.0;
+  }
+  MPI_Allreduce(side, all, 2, MPI_DOUBLE, MPI_SUM, world);
+  if (!(all[0] == 0.0 && all[1] > 0.0)) return;
+  char msg[768];
+  std::snprintf(msg, sizeof msg,
+                "fix %s wall/jiang plane: its active side, normal (%g, %g, %g) = (P2-P1) x (P3-P1), "
+                "faces away from the particles: all %.0f particles of group %s over the plane are "
+                "behind it, so they would pass through it. List the corners counter-clockwise as "
+                "seen from the particles: reverse their order (P4 P3 P2 P1), which turns the normal "
+                "to (%g, %g, %g)",
+                id, plane.n[0], plane.n[1], plane.n[2], all[1], group->names[igroup], -plane.n[0],
+                -plane.n[1], -plane.n[2]);
+  error->all(FLERR, msg);
 }
 
 void FixWallJiang::post_force(int vflag) {

@@ -103,6 +103,7 @@ class FixWallJiang : public Fix {
   void compute(bool commit);
   void refresh_candidates();
   void sum_force_and_servo();
+  void check_winding();
   void parse_servo(int narg, char **arg, int &iarg);
 
   int shape; /* 0 plane, 1 cylinder, 2 mesh (FixWallJiangMesh) */

@@ -195,9 +195,10 @@ void FixWallJiangMesh::mesh_loop(bool commit) {
   contacts_now = sums[3];
 }
 
-/* Atom i's contacts with mesh im (candidates cand[first, last)): the kernel's rule picks the
- * contacts; each takes the history slot its normal continues; the slots are rewritten in the
- * contacts' order (ascending triangle); laws: the loop's law set with the run's run-time laws. */
+/* Atom i's contacts with mesh im (candidates cand[first, last)): the kernel's procedure
+ * (jd_mesh_sphere_contacts) picks the contacts and the history slot each continues, and
+ * rewrites the slots in the contacts' order (ascending triangle); laws: the loop's law set with
+ * the run's run-time laws. */
 template <unsigned F>
 void FixWallJiangMesh::sphere_contacts(int im, int i, size_t first, size_t last, bool commit,
                                        unsigned laws, double *sums) {
@@ -208,34 +209,22 @@ void FixWallJiangMesh::sphere_contacts(int im, int i, size_t first, size_t last,
   const size_t n = last - first;
   closest.resize(n);
   is_contact.resize(n);
-  for (size_t k = 0; k < n; k++) jd_mesh_closest_feature(&m.topo, cand[first + k].t, x[i], &closest[k]);
-  jd_mesh_contacts(&m.topo, n, closest.data(), R, is_contact.data());
-
-  jd_contact_geom g[JD_MESH_SLOTS];
-  const jd_mesh_closest *which[JD_MESH_SLOTS];
-  size_t nc = 0;
-  for (size_t k = 0; k < n; k++) {
-    if (!is_contact[k]) continue;
-    if (nc == JD_MESH_SLOTS)
-      error->one(FLERR, "fix wall/jiang mesh: a sphere touches more than 6 faces of one mesh at once");
-    if (!jd_geom_mesh(&closest[k], x[i], R, &g[nc])) continue;
-    which[nc++] = &closest[k];
-  }
-  if (nc == 0) return;
+  tri.resize(n);
+  for (size_t k = 0; k < n; k++) tri[k] = cand[first + k].t;
+  const int stride = 3 + state_len;
+  double *h = hist[i];
+  jd_mesh_sphere sc;
+  if (jd_mesh_sphere_contacts(&m.topo, n, tri.data(), x[i], R, h, (size_t)stride, closest.data(),
+                              is_contact.data(), &sc) == JD_MESH_TOO_MANY)
+    error->one(FLERR, "fix wall/jiang mesh: a sphere touches more than 6 faces of one mesh at once");
+  if (sc.n == 0) return;
   if (meshes.size() > 1 && touched[i])
     error->one(FLERR, "fix wall/jiang mesh: a sphere touches two meshes of one fix at once; use one fix per mesh");
   touched[i] = 1;
-
-  const int stride = 3 + state_len;
-  double *h = hist[i];
-  double old_n[JD_MESH_SLOTS][3], new_n[JD_MESH_SLOTS][3];
-  for (int s = 0; s < JD_MESH_SLOTS; s++) jd_copy3(old_n[s], h + s * stride);
-  for (size_t c = 0; c < nc; c++) jd_copy3(new_n[c], g[c].n);
-  int from[JD_MESH_SLOTS];
-  jd_mesh_match_history(JD_MESH_SLOTS, old_n, nc, new_n, from);
-  next.assign((size_t)JD_MESH_SLOTS * stride, 0.0);
-  for (size_t c = 0; c < nc; c++)
-    if (from[c] >= 0) std::memcpy(&next[c * stride + 3], h + from[c] * stride + 3, state_len * sizeof(double));
+  next.resize((size_t)JD_MESH_SLOTS * stride);
+  jd_mesh_history_next(h, (size_t)stride, &sc, next.data());
+  jd_contact_geom *g = sc.geom;
+  const size_t nc = sc.n;
 
   TriMesh *tm = m.fix->triMesh();
   MultiVectorContainer<double, 3, 3> *vprop =
@@ -253,16 +242,14 @@ void FixWallJiangMesh::sphere_contacts(int im, int i, size_t first, size_t last,
     jd_copy3(k.wa, omega[i]);
     k.vb[0] = k.vb[1] = k.vb[2] = 0.0;
     if (vnode) {
-      const int lt = m.lig_of[which[c]->tri];
+      const int lt = m.lig_of[sc.feature[c]->tri];
       const double vt[3][3] = {{vnode[lt][0][0], vnode[lt][0][1], vnode[lt][0][2]},
                                {vnode[lt][1][0], vnode[lt][1][1], vnode[lt][1][2]},
                                {vnode[lt][2][0], vnode[lt][2][1], vnode[lt][2][2]}};
-      jd_mesh_point_velocity(&m.topo, which[c], vt, k.vb);
+      jd_mesh_point_velocity(&m.topo, sc.feature[c], vt, k.vb);
     }
     k.wb[0] = k.wb[1] = k.wb[2] = 0.0;
-    double *slot = &next[c * stride];
-    jd_copy3(slot, g[c].n);
-    JdHistory<F> hs(slot + 3, roll_at, commit);
+    JdHistory<F> hs(&next[c * stride + 3], roll_at, commit);
     double f_prev[3] = {0.0, 0.0, 0.0};
     if (F & JD_F_ENERGY) jd_copy3(f_prev, hs.st->f_prev);
     jd_contact_result out;

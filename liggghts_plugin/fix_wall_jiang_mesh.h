@@ -67,7 +67,8 @@ class FixWallJiangMesh : public FixWallJiang {
 
   std::vector<Mesh> meshes;
   std::vector<Candidate> cand;
-  std::vector<jd_mesh_closest> closest; /* per candidate of the sphere in hand: its feature, */
+  std::vector<int32_t> tri;             /* per candidate of the sphere in hand: its triangle, */
+  std::vector<jd_mesh_closest> closest; /* its feature, */
   std::vector<unsigned char> is_contact; /* whether it is a contact                        */
   std::vector<double> next;              /* the sphere's history slots being rewritten     */
   std::vector<unsigned char> touched; /* per local atom: had contacts on this mesh */

@@ -52,6 +52,9 @@ SUITES += [("law-sets", [PY, "tests/liggghts/check_law_sets.py"], "lines", {})]
 SUITES += [("liggghts-pair-local", [PY, "tests/liggghts/check_pair_local.py"], "lines", {})]
 # A hand-written script: warnings for a stock wall/gran and foreign material properties.
 SUITES += [("liggghts-script-warnings", [PY, "tests/liggghts/check_script_warnings.py"], "lines", {})]
+# LIGGGHTS' public tutorials converted to gran/jiang and wall/jiang, shortened, against stock's
+# (reference_runs/liggghts_tutorials/); the guard, the watchdog and the plane walls with insertion.
+SUITES += [("liggghts-tutorials", [PY, "tests/liggghts/check_tutorials.py"], "lines", {})]
 # The watchdog in LIGGGHTS (fix jdem/watchdog): the same trips as the stepper's.
 SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "lines", {})]
 # Restart files in LIGGGHTS: continued runs == the uninterrupted run bit for bit on 1 and 2 ranks
@@ -118,11 +121,12 @@ SUITES += [
      "lines", {}),
 ]
 
-# The Ch. 4 mixing analysis (scripts/mixing) on synthetic deposits, its pictures, and the
-# generator of the second pass and the cubes (reference_runs/mixing/ch4/generate.py).
+# The Ch. 4 mixing analysis (scripts/mixing) on synthetic deposits, the seed's claims on
+# hand-made results, its pictures, and the generator of the second pass and the cubes (reference_runs/mixing/ch4/generate.py).
 SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py; a=$?; "
                                 f"{PY} tests/mixing/test_pictures.py; b=$?; "
-                                f"{PY} tests/mixing/test_generate.py; c=$?; exit $((a | b | c))"],
+                                f"{PY} tests/mixing/test_generate.py; c=$?; "
+                                f"{PY} tests/mixing/test_claims.py; d=$?; exit $((a | b | c | d))"],
             "lines", {})]
 # The campaign driver (scripts/campaign.py) with dummy units, a killed run resumed.
 SUITES += [("campaign", [PY, "tests/mixing/test_campaign.py"], "lines", {})]

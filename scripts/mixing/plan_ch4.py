@@ -4,7 +4,9 @@
                         [-- --dt seed|guard|half]
 
 Per engine (jdem, liggghts-jdem) and model 1-6: the first fill, the second-pass scene cut from
-it, the second fill, and per pass the 9 cube scenes and their 9 compressions.  --dt picks the
+it, the second fill, and per pass the 9 cube scenes and their 9 compressions; for Model 3 also
+two realisations of the first fill with the stream shifted by 1 and 2 micrometres (the run-to-run
+spread).  --dt picks the
 time-step variant of the error-against-run-time study: `seed` (default) the seed's dt = 1e-4 s
 under out/mixing/ch4/, run with --force because the guard refuses it (docs/mixing.md §6);
 `guard` the guard's dt (what `time.dt: auto` resolves to) under out/mixing/ch4_dt_guard/; `half` half of it under
@@ -38,6 +40,7 @@ SEED_DT = 1.0e-4
 FILL_PARTICLES, FILL_TIME = 41280, 25.0   # 80 sections of 516 spheres over 25 s
 CUBE_PARTICLES, CUBE_TIME = 400, 10.0     # about 400 spheres in a 0.2 m cube, up to 10 s
 SCENE_COST = 1e6                          # cutting: a read of the deposit
+SPREAD_MODEL, SPREAD_REALISATIONS = "model3", 2   # the run-to-run spread's fills (obstacles: phi_v > 0)
 
 
 def jdem():
@@ -156,12 +159,29 @@ def run_command(engine, scene, out, force):
     return [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out, *extra]
 
 
-def fill1_command(engine, model, dt_arg, force):
-    """Write the case's scene with the variant's dt into the unit's directory, then run it."""
+def fill1_command(engine, model, dt_arg, force, jitter=0):
+    """Write the case's scene with the variant's dt (and the stream's jitter) into the unit's
+    directory, then run it."""
     run = run_command(engine, '"$1"', '"$2"', force)
     words = [a if a in ('"$1"', '"$2"') else shlex.quote(a) for a in run]
+    name = f"fill1_jitter{jitter}" if jitter else "fill1"
     return ["sh", "-c", f'{shlex.quote(PY)} {shlex.quote(GENERATE)} fill --case {model} '
-            f'--dt {dt_arg} -o "$1" && ' + " ".join(words), "fill1", "{dir}/fill1.yaml", "{out0}"]
+            f'--dt {dt_arg} --jitter {jitter} -o "$1" && ' + " ".join(words), name,
+            "{dir}/%s.yaml" % name, "{out0}"]
+
+
+def spread_units(engine, model, variant):
+    """The run-to-run spread: the first fill again with the stream shifted by K micrometres
+    (generate.py --jitter), K = 1..SPREAD_REALISATIONS, for SPREAD_MODEL only."""
+    if model != SPREAD_MODEL or variant != "seed":
+        return []
+    base = os.path.join(OUT[variant], engine, model)
+    dt_arg, dt = variant_dt(variant, model)
+    return [Unit(f"{engine}/{model}/fill1_jitter{k}", [os.path.join(base, f"fill1_jitter{k}.h5")],
+                 fill1_command(engine, model, dt_arg, True, k), model, engine,
+                 validate=valid_trajectory, cost=FILL_PARTICLES * FILL_TIME / dt,
+                 blocked=gate(engine, "conveyor inlet"))
+            for k in range(1, SPREAD_REALISATIONS + 1)]
 
 
 def pass_units(engine, model, p, deposit, base, dt_arg, dt, force):
@@ -201,7 +221,8 @@ def model_units(engine, model, variant):
              blocked=gate(engine, "conveyor inlet", "inlet section from a deposit")),
     ]
     return units + pass_units(engine, model, 1, fill1, base, dt_arg, dt, force) \
-        + pass_units(engine, model, 2, fill2, base, dt_arg, dt, force)
+        + pass_units(engine, model, 2, fill2, base, dt_arg, dt, force) \
+        + spread_units(engine, model, variant)
 
 
 def units(argv):

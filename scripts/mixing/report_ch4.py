@@ -20,7 +20,7 @@ import subprocess
 
 import numpy as np
 
-from scripts.mixing import compression, deposit, params, stats
+from scripts.mixing import claims_ch4, compression, deposit, params, stats
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -57,7 +57,11 @@ def unit_times(out, engine, model):
 def fill_result(path):
     dep = deposit.read_frame(path)
     points = params.at_points(dep)
+    big = params.big_mask(dep.radius)
+    x = dep.position[:, 0]
+    sides = {"big_right": float(np.mean(x[big] > 0.5)), "small_left": float(np.mean(x[~big] < 0.5))}
     return {"particles": int(len(dep.radius)), "deposit_height": deposit.deposit_height(dep),
+            "sides": sides,
             "points": [{k: float(p[k]) for k in PARAMS} for p in points],
             "summary": {k: stats.summary([p[k] for p in points]) for k in PARAMS}}
 
@@ -69,6 +73,42 @@ def cube_result(path):
             "nu_xz": fit.get("nu_xz", float("nan")), "cond": fit.get("cond", float("nan")),
             "M_wall": r["M_wall"], "M_best_fit": r["M_best_fit"], "K0": r["K0"],
             "particles": r["particles"]}
+
+
+def jitter_fills(d):
+    """The finished realisations fill1_jitterK.h5 of a model's first fill, K = 1, 2, ..."""
+    found, k = [], 1
+    while os.path.exists(os.path.join(d, "fill1_jitter%d.h5" % k)):
+        found.append(os.path.join(d, "fill1_jitter%d.h5" % k))
+        k += 1
+    return found
+
+
+def spread_table(found):
+    """The run-to-run spread: the first fill and its jittered realisations (generate.py
+    --jitter), their trimmed means, and the sample std of those means."""
+    lines = ["### Run-to-run spread (the first fill and its realisations with the stream shifted by "
+             "K micrometres in y)", "",
+             "| engine | model | realisation | height [m] | φv | e | ρb [kg/m³] | Z |",
+             "|---|---|---|---|---|---|---|---|"]
+    keys = (("phi_v", "%.4f"), ("e", "%.3f"), ("rho_b", "%.0f"), ("Z", "%.2f"))
+    any_row = False
+    for engine in ENGINES:
+        for model in MODELS:
+            entry = found[engine][model]
+            runs = ([entry["fill1"]] if entry.get("fill1") else []) + entry.get("jitter", [])
+            if len(runs) < 2:
+                continue
+            any_row = True
+            for k, r in enumerate(runs):
+                lines.append("| %s | %s | %s | %.3f | %s |" % (
+                    engine, model, "K = %d" % k, r["deposit_height"],
+                    " | ".join(fmt % r["summary"][key]["mean"] for key, fmt in keys)))
+            std = lambda vals: float(np.std(vals, ddof=1))
+            lines.append("| %s | %s | std of the %d | %.3f | %s |" % (
+                engine, model, len(runs), std([r["deposit_height"] for r in runs]),
+                " | ".join(fmt % std([r["summary"][key]["mean"] for r in runs]) for key, fmt in keys)))
+    return "\n".join(lines) + "\n" if any_row else ""
 
 
 def collect(out):
@@ -84,6 +124,8 @@ def collect(out):
                     entry["fill%d" % p] = fill_result(fill)
                 else:
                     missing.append("%s/%s/fill%d" % (engine, model, p))
+                if p == 1:
+                    entry["jitter"] = [fill_result(j) for j in jitter_fills(d)]
                 cubes = [os.path.join(d, "pass%d_cube%d.h5" % (p, k)) for k in range(1, 10)]
                 done = [c for c in cubes if os.path.exists(c)]
                 if len(done) == 9:
@@ -126,6 +168,26 @@ def elastic_table(found, key, title, fmt):
         title, head, "\n".join(rows))
 
 
+def constants_table(found):
+    """M (wall strain and best-fit strain) and K0 of every finished deposit: the unambiguous
+    constants of a laterally confined cube (docs/model.md §10); the seed gives neither."""
+    lines = ["### Constrained modulus M = σzz/εzz and K0 = (σxx+σyy)/(2σzz)", "",
+             "mean ± std over the 9 cubes, the highest and lowest dropped; the seed reports neither", "",
+             "| engine | model | pass | M, wall strain [Pa] | M, best-fit strain [Pa] | K0 | condition number of the fit |",
+             "|---|---|---|---|---|---|---|"]
+    for engine in ENGINES:
+        for model in MODELS:
+            for p in PASSES:
+                cubes = found[engine][model].get("pass%d_cubes" % p)
+                if not cubes:
+                    continue
+                col = lambda k, fmt: cell(*ours(found, engine, model, p, k), fmt)
+                lines.append("| %s | %s | %d | %s | %s | %s | %s |" % (
+                    engine, model, p, col("M_wall", "%.0f"), col("M_best_fit", "%.0f"),
+                    col("K0", "%.3f"), col("cond", "%.0f")))
+    return "\n".join(lines) + "\n"
+
+
 def mixing_table(found):
     lines = ["### Mixing parameters at the 9 points of Table 4-2 (the seed gives plots only, Figs 4-11/4-12)",
              "", "trimmed mean ± std (ideal φv = %.4f)" % params.IDEAL_PHI_V, "",
@@ -157,35 +219,6 @@ def times_table(found):
     return "\n".join(lines) + "\n"
 
 
-def claims(found):
-    """The seed's qualitative Chapter 4 claims on phi_v that the finished fills can test."""
-    out = []
-    phi = {(e, m, p): found[e][m]["fill%d" % p]["summary"]["phi_v"]
-           for e in ENGINES for m in MODELS for p in PASSES if found[e][m].get("fill%d" % p)}
-    for (e, m, p), _ in sorted(phi.items()):
-        if m in ("model1", "model2"):
-            values = [q["phi_v"] for q in found[e][m]["fill%d" % p]["points"]]
-            small = sum(v < 0.1 * params.IDEAL_PHI_V for v in values)
-            out.append("- %s %s pass %d: \"many zero or very small φv values\" (below a tenth of the "
-                       "ideal %.4f) at %d of the 9 points: %s" % (e, m, p, params.IDEAL_PHI_V, small,
-                                                             "held" if small >= 5 else "not held"))
-    for e in ENGINES:
-        low = [phi[(e, m, 1)]["mean"] for m in ("model1", "model2") if (e, m, 1) in phi]
-        high = [phi[(e, m, 1)]["mean"] for m in MODELS[2:] if (e, m, 1) in phi]
-        if low and high:
-            held = max(low) < min(high)
-            out.append("- %s: Models 1 and 2 mix worst (trimmed mean φv %s against %s for Models 3–6): %s"
-                       % (e, ", ".join("%.4f" % v for v in low), ", ".join("%.4f" % v for v in high),
-                          "held" if held else "not held"))
-        pairs = [(phi[(e, m, 1)]["std"], phi[(e, m, 2)]["std"]) for m in MODELS
-                 if (e, m, 1) in phi and (e, m, 2) in phi]
-        if pairs:
-            held = all(b < a for a, b in pairs)
-            out.append("- %s: the second pass reduces the spread of φv: std %s: %s" % (
-                e, "; ".join("%.4f → %.4f" % ab for ab in pairs), "held" if held else "not held"))
-    return "\n".join(out) + "\n" if out else "No claim can be checked with the fills finished so far.\n"
-
-
 def commit():
     r = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
     return r.stdout.strip() or "unknown"
@@ -197,7 +230,7 @@ def report(found, missing, rev):
              "(commit %s). Every reconstruction the seed leaves open is a scene parameter "
              "(docs/mixing.md §1).\n" % rev, mixing_table(found)]
     parts += [elastic_table(found, k, t, f) for k, t, f in TABLES]
-    parts += ["### The seed's claims\n", claims(found), times_table(found),
+    parts += [spread_table(found), constants_table(found), "### The seed's claims\n", claims_ch4.claims(found, ENGINES), times_table(found),
               "### Not run\n", "\n".join("- " + m for m in missing) + "\n" if missing else "nothing\n"]
     return "\n".join(parts)
 

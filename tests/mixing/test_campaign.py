@@ -155,8 +155,9 @@ def test_not_yet_runnable():
 
 def test_ch4_plan():
     """The plan of make mixing (docs/mixing.md §4): 2 engines x 6 models x (2 fills, 1 second-
-    pass scene, 2 x (1 cube-scene unit + 9 compressions)) = 276 units, unique names, and every
-    need an earlier unit."""
+    pass scene, 2 x (1 cube-scene unit + 9 compressions)) = 276 units, plus per engine the
+    spread model's realisations (2 x SPREAD_REALISATIONS), unique names, and every need an
+    earlier unit."""
     from scripts.mixing import plan_ch4
     units = plan_ch4.units([])
     seen = set()
@@ -164,10 +165,14 @@ def test_ch4_plan():
     for u in units:
         order_ok &= all(n in seen for n in u.needs)
         seen.add(u.name)
-    check("ch4_plan_units", len(units) == 276 and len(seen) == 276, f"{len(units)} units")
+    want = 276 + 2 * plan_ch4.SPREAD_REALISATIONS
+    check("ch4_plan_units", len(units) == want and len(seen) == want, f"{len(units)} units")
     check("ch4_plan_needs_come_first", order_ok, "a need after its unit")
     m3 = [u.name for u in units if u.model == "model3" and u.engine == "liggghts-jdem"]
-    check("ch4_plan_model_engine", len(m3) == 23 and m3[0] == "liggghts-jdem/model3/fill1", f"{m3[:3]}")
+    check("ch4_plan_model_engine", len(m3) == 23 + plan_ch4.SPREAD_REALISATIONS
+          and m3[0] == "liggghts-jdem/model3/fill1"
+          and m3[-1] == "liggghts-jdem/model3/fill1_jitter%d" % plan_ch4.SPREAD_REALISATIONS,
+          f"{len(m3)}: {m3[:3]} ... {m3[-1:]}")
 
 
 test_killed_run_resumes()

@@ -369,6 +369,53 @@ static void record_line_round_trip(void **state) {
     assert_true(jd_inlet_record_line(&big, line, sizeof line) < JD_INLET_RECORD_LINE_MAX);
 }
 
+/* A 2 x 2 x 8 block (r = 0.01 m, spacing 0.02 m, long axis z) on the belt of one_sphere with
+ * L = 0.3 m: its leading column (rel_x = 0) crosses first, at k* = ceil((0.0505 + 0.3 c)/0.001)
+ * = 51 + 300 c; the trailing column (rel_x = -0.02) would cross 20 steps later.  The whole block
+ * starts at the leading column's step, the trailing spheres at their rigid belt positions, so
+ * every face-neighbour distance is still 2 r. */
+static void bonded_block_starts_with_its_first_sphere(void **state) {
+    (void)state;
+    double rel[3 * 32], radius[32];
+    int32_t species[32];
+    size_t members[32];
+    for (size_t p = 0; p < 32; p++) {
+        rel[3 * p] = -0.02 * (double)(p % 2);
+        rel[3 * p + 1] = 0.02 * (double)(p / 2 % 2);
+        rel[3 * p + 2] = 0.02 * (double)(p / 4);
+        radius[p] = 0.01;
+        species[p] = 1;
+        members[p] = p;
+    }
+    jd_inlet_spec s = one_sphere(rel, radius, species);
+    s.n = 32;
+    s.period = 0.3;
+    char msg[256];
+    assert_int_equal(jd_inlet_check(&s, 1, msg, sizeof msg), JD_INLET_OK);
+    for (int64_t c = 0; c < 4; c++) {
+        const int64_t start = jd_inlet_group_start(&s, c, members, 32);
+        assert_int_equal(start, 51 + 300 * c);
+        assert_int_equal(jd_inlet_crossing_step(&s, c, 1), 71 + 300 * c);
+        jd_inlet_particle lead, trail;
+        jd_inlet_particle_at_step(&s, c, 0, start, &lead);
+        jd_inlet_particle_at_step(&s, c, 1, start, &trail);
+        assert_int_equal(trail.step, start);
+        assert_int_equal(trail.id, 7 + 32 * c + 1);
+        assert_rel(lead.position[0], 0.0005, 1e-9);
+        assert_rel(trail.position[0], -0.0195, 1e-9); /* still behind the plane, on the belt */
+        assert_rel(lead.position[0] - trail.position[0], 0.02, 1e-12);
+        assert_rel(trail.velocity[0], 1.0, 0.0);
+        jd_inlet_particle at_crossing;
+        jd_inlet_particle_at_crossing(&s, c, 0, &at_crossing);
+        assert_memory_equal(at_crossing.position, lead.position, sizeof lead.position);
+    }
+    assert_int_equal(jd_inlet_group_start(&s, 0, members, 0), JD_INLET_NEVER);
+    int64_t ids[2];
+    jd_inlet_bond_ids(&s, 2, 5, 3, ids);
+    assert_int_equal(ids[0], 7 + 64 + 3);
+    assert_int_equal(ids[1], 7 + 64 + 5);
+}
+
 int run_inlet_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(crossing_step_of_each_copy),
@@ -383,6 +430,7 @@ int run_inlet_tests(void) {
         cmocka_unit_test(time_stop_is_the_ceiling),
         cmocka_unit_test(height_rule),
         cmocka_unit_test(record_line_round_trip),
+        cmocka_unit_test(bonded_block_starts_with_its_first_sphere),
     };
     return cmocka_run_group_tests_name("inlet", tests, NULL, NULL);
 }

@@ -317,6 +317,71 @@ static void degenerate_triangles_are_named(void **state) {
     free(b);
 }
 
+/* jd_mesh_sphere_contacts over a flat grid: one contact at the foot (delta = R - h, the normal
+ * straight down), continuing the old slot whose normal it shares, whatever slot that was; and
+ * jd_mesh_history_next moves that slot's record to slot 0 and empties the rest. */
+static void sphere_contacts_continue_the_matching_slot(void **state) {
+    (void)state;
+    double (*tri)[3][3] = malloc(32 * sizeof *tri);
+    const size_t n = grid(4, tri);
+    built *b = build(n, (const double(*)[3][3])tri);
+    int32_t cand[32];
+    for (size_t k = 0; k < n; k++) cand[k] = (int32_t)(n - 1 - k);
+    enum { STRIDE = 4 };
+    double slots[JD_MESH_SLOTS * STRIDE] = {0}, next[JD_MESH_SLOTS * STRIDE];
+    slots[2 * STRIDE + 2] = -1.0; /* slot 2: normal (0, 0, -1), record 7 */
+    slots[2 * STRIDE + 3] = 7.0;
+    slots[4 * STRIDE + 0] = 1.0;  /* slot 4: normal (1, 0, 0), record 5 */
+    slots[4 * STRIDE + 3] = 5.0;
+    jd_mesh_closest c[32];
+    unsigned char contact[32];
+    jd_mesh_sphere sc;
+    const double p[3] = {1.5, 1.0, 0.1}; /* over an interior edge */
+    assert_int_equal(jd_mesh_sphere_contacts(&b->m, n, cand, p, 0.3, slots, STRIDE, c, contact, &sc),
+                     JD_MESH_OK);
+    assert_int_equal(sc.n, 1);
+    assert_rel(sc.geom[0].delta, 0.2, 1e-15);
+    assert_rel(sc.geom[0].n[2], -1.0, 1e-15);
+    assert_int_equal(sc.from[0], 2);
+    jd_mesh_history_next(slots, STRIDE, &sc, next);
+    const double want[STRIDE] = {0.0, 0.0, -1.0, 7.0};
+    assert_memory_equal(next, want, sizeof want);
+    for (size_t k = STRIDE; k < JD_MESH_SLOTS * STRIDE; k++) assert_true(next[k] == 0.0);
+    free(b);
+    free(tri);
+}
+
+/* A concave corner (a floor face and a wall face at 90 degrees): two contacts, each with its own
+ * distance (R - h), each continuing the slot of its own normal. */
+static void corner_contacts_keep_separate_slots(void **state) {
+    (void)state;
+    const double tri[2][3][3] = {{{0, 0, 0}, {2, 0, 0}, {0, 2, 0}}, {{0, 0, 0}, {0, 2, 0}, {0, 0, 2}}};
+    built *b = build(2, tri);
+    const int32_t cand[2] = {0, 1};
+    enum { STRIDE = 4 };
+    double slots[JD_MESH_SLOTS * STRIDE] = {0};
+    slots[0 * STRIDE + 0] = -1.0; /* slot 0: the wall's normal (-1, 0, 0), record 5 */
+    slots[0 * STRIDE + 3] = 5.0;
+    slots[1 * STRIDE + 2] = -1.0; /* slot 1: the floor's normal (0, 0, -1), record 6 */
+    slots[1 * STRIDE + 3] = 6.0;
+    jd_mesh_closest c[2];
+    unsigned char contact[2];
+    jd_mesh_sphere sc;
+    const double p[3] = {0.25, 0.5, 0.2};
+    assert_int_equal(jd_mesh_sphere_contacts(&b->m, 2, cand, p, 0.3, slots, STRIDE, c, contact, &sc),
+                     JD_MESH_OK);
+    assert_int_equal(sc.n, 2);
+    assert_int_equal(sc.feature[0]->tri, 0);
+    assert_rel(sc.geom[0].delta, 0.3 - 0.2, 1e-15);
+    assert_rel(sc.geom[1].delta, 0.3 - 0.25, 1e-15);
+    assert_int_equal(sc.from[0], 1);
+    assert_int_equal(sc.from[1], 0);
+    double next[JD_MESH_SLOTS * STRIDE];
+    jd_mesh_history_next(slots, STRIDE, &sc, next);
+    assert_true(next[3] == 6.0 && next[STRIDE + 3] == 5.0 && next[STRIDE] == -1.0);
+    free(b);
+}
+
 /* jd_geom_mesh: the normal towards the wall, the overlap, the lever arm. */
 static void geometry_of_a_face_contact(void **state) {
     (void)state;
@@ -421,6 +486,8 @@ int run_mesh_tests(void) {
         cmocka_unit_test(closest_feature_matches_brute_force),
         cmocka_unit_test(contacts_do_not_depend_on_candidate_order),
         cmocka_unit_test(degenerate_triangles_are_named),
+        cmocka_unit_test(sphere_contacts_continue_the_matching_slot),
+        cmocka_unit_test(corner_contacts_keep_separate_slots),
         cmocka_unit_test(geometry_of_a_face_contact),
         cmocka_unit_test(history_follows_the_normal),
         cmocka_unit_test(near_vertex_the_contact_is_the_exact_foot),

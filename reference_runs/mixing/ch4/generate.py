@@ -4,11 +4,15 @@ first- or second-pass deposit, and the first-pass cases as scenes of their own (
 §1, §2, §4); every scene runs in both engines.
 
     generate.py fill --case modelM -o FILL1.yaml [--dt DT] [--sections N] [--end-time T]
+                     [--jitter K]
     generate.py second-pass DEPOSIT.h5 --case modelM -o PASS2.yaml [--gap 0.06] [--dt DT]
     generate.py cubes DEPOSIT.h5 --case modelM -o DIR [--dt DT]  (writes DIR/cubeK.yaml, K = 1..9)
 
 fill: the first-pass case of models.yaml as a scene of its own, optionally with another time
 step (a number in s, or auto: the guard's) or a reduced stream (the first N sections, T s).
+--jitter K shifts the whole stream by K micrometres in y (the inlet's origin), a realisation of
+the same fill for the run-to-run spread: the fill is chaotic, so 1e-6 m grows into another
+deposit with the same statistics.
 --dt sets the time step of every scene written (default: the seed's, models.yaml's time.dt); a
 number rescales the output cadence so that the frames stay at the same times (auto keeps the
 cadence in steps).
@@ -35,6 +39,7 @@ from scripts.mixing import deposit, params
 from scripts.stability_scenes import set_path  # the sweep's dotted-path override
 
 MODELS = os.path.join(HERE, "models.yaml")
+JITTER = 1.0e-6           # [m] one step of --jitter: far below every length of the scene
 CELL = (1.0, 0.5, 0.25)   # [RECON] orientation, spec §1.7
 DEPTH = 1.0               # [TEXT] L1539
 CUBE = 0.2                # [TEXT] spec §2.4
@@ -75,9 +80,13 @@ def fill(args):
         doc["inlets"][0]["stop"] = {"sections": args.sections}
     if args.end_time is not None:
         doc["time"]["end_time"] = args.end_time
+    jitter = ""
+    if args.jitter:
+        doc["inlets"][0]["origin"][1] += JITTER * args.jitter
+        jitter = f", stream shifted by {args.jitter} x {JITTER} m in y (run-to-run spread)"
     write(args.out, doc, f"first pass, {args.case}, dt {doc['time']['dt']}, "
                          f"{doc['inlets'][0]['stop']['sections']} sections, "
-                         f"{doc['time']['end_time']} s")
+                         f"{doc['time']['end_time']} s{jitter}")
 
 
 def cells(dep, deposit_path, gap):
@@ -192,6 +201,8 @@ def main():
         if name == "fill":
             p.add_argument("--sections", type=int, help="sections of the stream (default 80)")
             p.add_argument("--end-time", type=float, help="simulated time [s] (default 25)")
+            p.add_argument("--jitter", type=int, default=0,
+                           help="shift the stream by K micrometres in y (a realisation for the spread)")
         if name == "second-pass":
             p.add_argument("--gap", type=float, default=0.06,
                            help="[RECON] gap between queued cells [m], default 2 R_big")

@@ -1,0 +1,123 @@
+"""speed_ch4.py — the Chapter 4 fill's speed in the three engines, measured in one run
+(`make mixing-speed`; docs/mixing.md §9).
+
+    python3 -m scripts.mixing.speed_ch4 [--case model1] [--end-time 5] [--out out/mixing/speed]
+
+The first END_TIME seconds of the case's fill at the seed's dt (--force: the guard refuses it),
+run by jdem on 1 and 2 threads, by liggghts-jdem (our law and walls, fix jdem/inlet) on 1 and 2
+ranks, and by LIGGGHTS' own hertz/history pair and primitive walls (the deck generator's
+--builtin mode) with our inlet on 1 and 2 ranks.  The engines are run in turn, so they see the
+same spell of the shared machine.  Each engine's time is its time loop without output (jdem's
+`loop - output` of --timing, LIGGGHTS' Loop time less its Outpt share): every engine writes the
+same H5MD frames.  The work is the particle-steps of the growing set, the sum over the inserted
+particles of the steps after their insertion step (jdem's --inlet-record; the stream is the same
+in every engine by construction).  Writes OUT/summary.json and OUT/report.md.
+"""
+import argparse
+import csv
+import json
+import os
+import re
+import subprocess
+
+from scripts import engines
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "generate.py")
+RUNS = (("jdem", 1), ("jdem", 2), ("liggghts-jdem", 1), ("liggghts-jdem", 2),
+        ("liggghts", 1), ("liggghts", 2))
+OUTPT_RE = re.compile(r"(?m)^Outpt\s+time \(%\) = \S+ \(([0-9.eE+-]+)\)")
+
+
+def particle_steps(record, steps):
+    """Sum over the inserted particles of the steps they take part in."""
+    with open(record) as f:
+        return sum(steps - int(row["step"]) for row in csv.DictReader(f))
+
+
+def run_jdem(resolved, d, threads):
+    out = os.path.join(d, f"jdem_t{threads}.h5")
+    rec = os.path.join(d, "inlet_record.csv")
+    r = engines.jdem("run", resolved, "-o", out, "--force", "--quiet", "--timing",
+                     "--threads", str(threads), "--inlet-record", rec, check=True)
+    t = engines.jdem_timing(r.stderr)
+    return {"loop_s": t["loop"] - t["output"], "steps": int(t["steps"]), "record": rec}
+
+
+def run_liggghts(resolved, d, engine, ranks):
+    deck_dir = os.path.join(d, f"{engine}_deck")
+    deck = os.path.join(deck_dir, "in.jdem")
+    if not os.path.exists(deck):
+        engines.write_deck(resolved, deck, "--force", "--trajectory",
+                           os.path.join(d, f"{engine}.h5"),
+                           *(["--builtin"] if engine == "liggghts" else []), check=True)
+    log = f"log.{ranks}"
+    engines.run_deck(deck_dir, ranks=ranks, log=log, mpi_flags=("--bind-to", "none"), check=True)
+    text = open(os.path.join(deck_dir, log), errors="replace").read()
+    loop, _, steps, _ = engines.liggghts_loops(text)[-1]
+    tail = text[text.rfind("Loop time of"):]
+    outpt = OUTPT_RE.search(tail)
+    share = float(outpt.group(1)) / 100.0 if outpt else 0.0
+    return {"loop_s": float(loop) * (1.0 - share), "steps": int(steps)}
+
+
+def report(summary):
+    rows = ["| engine | cores | loop without output [s] | particle-steps/s | jdem (same cores) is faster by |",
+            "|---|---:|---:|---:|---:|"]
+    for r in summary["runs"]:
+        ref = next(q for q in summary["runs"] if q["engine"] == "jdem" and q["cores"] == r["cores"])
+        rows.append(f"| {r['engine']} | {r['cores']} | {r['loop_s']:.1f} | {r['rate']:.3g} | "
+                    f"{r['loop_s'] / ref['loop_s']:.2f}x |")
+    return (f"# Chapter 4 fill: speed of the three engines\n\n"
+            f"Case {summary['case']}, the first {summary['end_time']} s of the fill at dt = "
+            f"{summary['dt']} s ({summary['steps']} steps, {summary['inserted']} spheres inserted, "
+            f"{summary['particle_steps']:.4g} particle-steps); load average before the runs "
+            f"{summary['load_before']:.2f}, after {summary['load_after']:.2f}.  `liggghts` is "
+            f"LIGGGHTS' own hertz/history pair and primitive walls with our inlet.\n\n"
+            + "\n".join(rows) + "\n")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--case", default="model1")
+    ap.add_argument("--end-time", type=float, default=5.0, help="simulated time [s]")
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "mixing", "speed"))
+    a = ap.parse_args()
+    d = os.path.abspath(a.out)
+    os.makedirs(d, exist_ok=True)
+    scene, resolved = os.path.join(d, "fill.yaml"), os.path.join(d, "resolved.yaml")
+    subprocess.run([engines.PY, GENERATE, "fill", "--case", a.case, "--dt", "1e-4",
+                    "--end-time", repr(a.end_time), "-o", scene], check=True, env=engines.python_env())
+    with open(resolved, "w") as f:
+        f.write(engines.resolve(scene, check=True).stdout)
+    load_before = os.getloadavg()[0]
+    runs = []
+    for engine, cores in RUNS:
+        r = run_jdem(resolved, d, cores) if engine == "jdem" else run_liggghts(resolved, d, engine, cores)
+        r.update(engine=engine, cores=cores)
+        runs.append(r)
+        print(f"speed_ch4: {engine} on {cores}: {r['loop_s']:.1f} s", flush=True)
+    steps = runs[0]["steps"]
+    if any(r["steps"] != steps for r in runs):
+        raise SystemExit("speed_ch4: the engines ran different numbers of steps: "
+                         + ", ".join(f"{r['engine']}/{r['cores']}={r['steps']}" for r in runs))
+    work = particle_steps(runs[0]["record"], steps)
+    with open(runs[0]["record"]) as f:
+        inserted = sum(1 for _ in f) - 1
+    for r in runs:
+        r.pop("record", None)
+        r["rate"] = work / r["loop_s"]
+    summary = {"case": a.case, "end_time": a.end_time, "dt": 1e-4, "steps": steps,
+               "inserted": inserted, "particle_steps": work, "load_before": load_before,
+               "load_after": os.getloadavg()[0], "runs": runs,
+               "commit": subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                                        capture_output=True, text=True).stdout.strip()}
+    with open(os.path.join(d, "summary.json"), "w") as f:
+        json.dump(summary, f, indent=1)
+    with open(os.path.join(d, "report.md"), "w") as f:
+        f.write(report(summary))
+    print(report(summary))
+
+
+if __name__ == "__main__":
+    main()

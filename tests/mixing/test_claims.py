@@ -1,0 +1,87 @@
+#!/usr/bin/python3
+"""The seed's Chapter 4 claims (scripts/mixing/claims_ch4.py) on hand-made results whose verdicts
+follow from the claims' definitions: each check must say "held" on a case built to hold, and
+"not held" on the same case with one number moved across its boundary."""
+import copy
+
+from tests.mixing.common import check, finish
+from scripts.mixing import claims_ch4, stats
+
+MODELS = claims_ch4.MODELS
+
+
+def fill(phi_values, rho=2600.0, z=5.0, big_right=0.9, small_left=0.6):
+    """A fill result: nine points with these phi_v values, rho_b and Z varying by +-1 %."""
+    wobble = [1 + 0.01 * ((k % 3) - 1) for k in range(9)]
+    points = [{"phi_v": v, "rho_b": rho * w, "Z": z * w} for v, w in zip(phi_values, wobble)]
+    return {"points": points, "sides": {"big_right": big_right, "small_left": small_left},
+            "summary": {k: stats.summary([q[k] for q in points]) for k in ("phi_v", "rho_b", "Z")}}
+
+
+def spread(mean, half):
+    return [mean - half, mean, mean + half] * 3
+
+
+def campaign():
+    """Model 2 worst and split, 3 and 4 above 1 and 2, 5 above 3; the second pass converges."""
+    first = {"model1": 0.010, "model2": 0.002, "model3": 0.040, "model4": 0.045,
+             "model5": 0.050, "model6": 0.030}
+    found = {"jdem": {}}
+    for m in MODELS:
+        found["jdem"][m] = {"fill1": fill(spread(first[m], 0.004)),
+                            "fill2": fill(spread(0.06, 0.002))}
+    return found
+
+
+def verdicts(found, check_fn):
+    return [line.endswith(": held") for line in check_fn(found, "jdem")]
+
+
+def test_all_hold():
+    f = campaign()
+    for fn in (claims_ch4.model2_split, claims_ch4.obstacles_left, claims_ch4.second_pass,
+               claims_ch4.phi_discriminates):
+        v = verdicts(f, fn)
+        check("holds_" + fn.__name__, v and all(v), f"{fn(f, 'jdem')}")
+
+
+def test_each_fails():
+    f = campaign()
+    g = copy.deepcopy(f)
+    g["jdem"]["model2"]["fill1"]["sides"]["small_left"] = 0.4   # small spheres not left
+    check("split_not_held", verdicts(g, claims_ch4.model2_split)[0] is False)
+    g = copy.deepcopy(f)
+    g["jdem"]["model2"]["fill1"] = fill(spread(0.09, 0.004))     # model 2 no longer the worst
+    check("worst_not_held", verdicts(g, claims_ch4.model2_split)[1] is False)
+    g = copy.deepcopy(f)
+    g["jdem"]["model5"]["fill1"] = fill(spread(0.035, 0.004))    # 5 below 3
+    check("model5_not_held", verdicts(g, claims_ch4.obstacles_left) == [True, False])
+    g = copy.deepcopy(f)
+    g["jdem"]["model3"]["fill2"] = fill(spread(0.06, 0.02))      # wider after the second pass
+    check("second_pass_spread_not_held", verdicts(g, claims_ch4.second_pass) == [True, False])
+    g = copy.deepcopy(f)
+    for m in MODELS:                                             # rho_b differs between models
+        g["jdem"][m]["fill1"] = fill(spread(g["jdem"][m]["fill1"]["summary"]["phi_v"]["mean"], 0.004),
+                                     rho=2000.0 + 100.0 * MODELS.index(m))
+    check("rho_discriminates_not_held", verdicts(g, claims_ch4.phi_discriminates) == [False])
+
+
+def test_discrimination_index():
+    """Range of the model means over the mean within-model std, by hand for phi_v."""
+    f = campaign()
+    within = stats.summary(spread(0.01, 0.004))["std"]   # every model has the same spread
+    want = (0.050 - 0.002) / within
+    got = claims_ch4.discrimination(f, "jdem", "phi_v", 1)
+    check("discrimination_index", abs(got - want) < 1e-12 * want, f"got {got}, expected {want}")
+
+
+def test_incomplete_is_silent():
+    f = campaign()
+    del f["jdem"]["model4"]["fill1"]
+    check("worst_needs_all_models", len(claims_ch4.model2_split(f, "jdem")) == 1)
+    check("left_needs_models_1_to_4", len(claims_ch4.obstacles_left(f, "jdem")) == 1)
+
+
+for t in (test_all_hold, test_each_fails, test_discrimination_index, test_incomplete_is_silent):
+    t()
+finish()
