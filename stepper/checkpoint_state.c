@@ -148,6 +148,9 @@ static void ck_bonds(ck_io *io, jd_bonds *b, size_t n_particles) {
             return;
         }
         b->n = n;
+        /* the set-up's records of its bonds were written before the checkpoint was: the
+         * prefix copied from the stopped run holds them */
+        b->n_formed = b->n_events = 0;
     }
     ck_int32s(io, "bonds/i", n, b->i);
     ck_int32s(io, "bonds/j", n, b->j);
