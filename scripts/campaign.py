@@ -41,6 +41,8 @@ class Unit:
     cost: float = 1.0           # relative cost, for the ETA (e.g. particle-steps)
     blocked: object = None      # f() -> None if the engines can run the unit, else why not
                                 # (a feature still missing); such a unit is reported, not run
+    resumes: bool = False       # the command continues from what an interrupted run of it left
+                                # in "{dir}" (a checkpoint), so that directory is kept
 
 
 def non_empty(path):
@@ -117,11 +119,17 @@ class Times:
         return sum(u.cost for u in remaining) * sum(d["seconds"] for d in done) / cost
 
 
+def resuming(unit):
+    """True when the unit continues an interrupted run of itself (see Unit.resumes)."""
+    return unit.resumes and os.path.isdir(partial_dir(unit))
+
+
 def run_unit(unit):
     """Run one unit into its partial directory; returns None or the reason it failed."""
     tmp = partial_dir(unit)
-    shutil.rmtree(tmp, ignore_errors=True)
-    os.makedirs(tmp)
+    if not resuming(unit):
+        shutil.rmtree(tmp, ignore_errors=True)
+    os.makedirs(tmp, exist_ok=True)
     staged = [os.path.join(tmp, os.path.basename(p)) for p in unit.outputs]
     subs = {f"out{i}": p for i, p in enumerate(staged)}
     subs["dir"] = tmp
@@ -168,7 +176,8 @@ def run(units, times, everything=None, log=sys.stderr):
     failed = 0
     for i, u in enumerate(todo):
         eta = times.eta(todo[i:])
-        print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: running"
+        print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: "
+              + ("continuing its interrupted run" if resuming(u) else "running")
               + (f"; ETA {fmt_seconds(eta)}" if eta is not None else ""), file=log, flush=True)
         start, cpu0 = time.monotonic(), children_cpu()
         reason = run_unit(u)

@@ -39,6 +39,7 @@ ENGINES = ("jdem", "liggghts-jdem")
 SEED_DT = 1.0e-4
 FILL_PARTICLES, FILL_TIME = 41280, 25.0   # 80 sections of 516 spheres over 25 s
 CUBE_PARTICLES, CUBE_TIME = 400, 10.0     # about 400 spheres in a 0.2 m cube, up to 10 s
+CHECKPOINT_SECONDS = 300                  # a killed fill loses at most this much of its work
 SCENE_COST = 1e6                          # cutting: a read of the deposit
 SPREAD_MODEL, SPREAD_REALISATIONS = "model3", 2   # the run-to-run spread's fills (obstacles: phi_v > 0)
 
@@ -159,15 +160,31 @@ def run_command(engine, scene, out, force):
     return [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out, *extra]
 
 
+def resumable(engine):
+    """Whether the engine's fills checkpoint and continue after an interruption (jdem only:
+    the LIGGGHTS runner does not restart yet)."""
+    return engine == "jdem"
+
+
+def fill_command(engine, scene, force, generate=None, checkpoint_seconds=CHECKPOINT_SECONDS):
+    """sh argv running `scene` into "{out0}" (after the shell line `generate`, which writes it).
+    jdem checkpoints every checkpoint_seconds of wall time and, when an interrupted run left
+    its checkpoint in the unit's directory, continues from it (docs/mixing.md §4)."""
+    run = " ".join(a if a in ('"$1"', '"$2"') else shlex.quote(a)
+                   for a in run_command(engine, '"$1"', '"$2"', force))
+    if resumable(engine):
+        run += f" --checkpoint-seconds {checkpoint_seconds}"
+        run = f'ck="${{2%.h5}}.ckpt.h5"; if [ -f "$ck" ]; then {run} --resume "$ck"; else {run}; fi'
+    return ["sh", "-c", (generate + " && " if generate else "") + run, "fill", scene, "{out0}"]
+
+
 def fill1_command(engine, model, dt_arg, force, jitter=0):
     """Write the case's scene with the variant's dt (and the stream's jitter) into the unit's
     directory, then run it."""
-    run = run_command(engine, '"$1"', '"$2"', force)
-    words = [a if a in ('"$1"', '"$2"') else shlex.quote(a) for a in run]
     name = f"fill1_jitter{jitter}" if jitter else "fill1"
-    return ["sh", "-c", f'{shlex.quote(PY)} {shlex.quote(GENERATE)} fill --case {model} '
-            f'--dt {dt_arg} --jitter {jitter} -o "$1" && ' + " ".join(words), name,
-            "{dir}/%s.yaml" % name, "{out0}"]
+    return fill_command(engine, "{dir}/%s.yaml" % name, force,
+                        f'{shlex.quote(PY)} {shlex.quote(GENERATE)} fill --case {model} '
+                        f'--dt {dt_arg} --jitter {jitter} -o "$1"')
 
 
 def spread_units(engine, model, variant):
@@ -180,7 +197,7 @@ def spread_units(engine, model, variant):
     return [Unit(f"{engine}/{model}/fill1_jitter{k}", [os.path.join(base, f"fill1_jitter{k}.h5")],
                  fill1_command(engine, model, dt_arg, True, k), model, engine,
                  validate=valid_trajectory, cost=FILL_PARTICLES * FILL_TIME / dt,
-                 blocked=gate(engine, "conveyor inlet"))
+                 blocked=gate(engine, "conveyor inlet"), resumes=resumable(engine))
             for k in range(1, SPREAD_REALISATIONS + 1)]
 
 
@@ -212,12 +229,14 @@ def model_units(engine, model, variant):
     fill_cost = FILL_PARTICLES * FILL_TIME / dt
     units = [
         Unit(f"{pre}/fill1", [fill1], fill1_command(engine, model, dt_arg, force), model, engine,
-             validate=valid_trajectory, cost=fill_cost, blocked=gate(engine, "conveyor inlet")),
+             validate=valid_trajectory, cost=fill_cost, blocked=gate(engine, "conveyor inlet"),
+             resumes=resumable(engine)),
         Unit(f"{pre}/pass2_scene", [pass2], [PY, GENERATE, "second-pass", fill1, "--case", model,
                                              "--dt", dt_arg, "-o", "{out0}"],
              model, engine, needs=[f"{pre}/fill1"], validate=valid_scene, cost=SCENE_COST),
-        Unit(f"{pre}/fill2", [fill2], run_command(engine, pass2, "{out0}", force), model, engine,
+        Unit(f"{pre}/fill2", [fill2], fill_command(engine, pass2, force), model, engine,
              needs=[f"{pre}/pass2_scene"], validate=valid_trajectory, cost=fill_cost,
+             resumes=resumable(engine),
              blocked=gate(engine, "conveyor inlet", "inlet section from a deposit")),
     ]
     return units + pass_units(engine, model, 1, fill1, base, dt_arg, dt, force) \

@@ -22,7 +22,8 @@ HERE = {here!r}
 WORKER = [sys.executable, "-c", """
 import os, sys, time
 name, out = sys.argv[1], sys.argv[2]
-open(os.path.join({here!r}, "runs.log"), "a").write(name + "\\\\n")
+again = os.path.exists(out + ".started")  # left by an interrupted run of this unit
+open(os.path.join({here!r}, "runs.log"), "a").write(name + ("-again" if again else "") + "\\\\n")
 open(out + ".started", "w").close()
 time.sleep(float(os.environ.get("SLEEP_" + name, "0.1")))
 open(out, "w").write(os.environ.get("CONTENT_" + name, "ok"))
@@ -43,6 +44,9 @@ def units(argv):
         Unit("c", [out("c")], WORKER + ["c", "{{out0}}"], model="m2", engine="e1", validate=valid,
              cost=2.0),
     ]
+    if os.environ.get("WITH_R"):  # r: the resumable unit's test only
+        return plan + [Unit("r", [out("r")], WORKER + ["r", "{{out0}}"], model="m4", engine="e1",
+                            validate=valid, resumes=True)]
     if not os.environ.get("WITH_D"):  # d and e: the not-yet-runnable test's only
         return plan
     return plan + [
@@ -112,6 +116,27 @@ def test_killed_run_resumes():
     check("rerun_runs_nothing", r.returncode == 0 and runs(here) == [], f"ran {runs(here)}")
 
 
+def test_resumable_unit_continues():
+    """A unit that resumes (a checkpointing run) finds what its killed run left in its partial
+    directory, and the driver says it continues; an ordinary unit (b above) starts afresh."""
+    here = setup()
+    env = {"WITH_R": "1", "SLEEP_r": "30"}
+    proc = campaign(here, "--unit", "r", env=env, wait=False)
+    started = os.path.join(here, "out", ".partial", "r", "r.txt.started")
+    deadline = time.monotonic() + 20
+    while not os.path.exists(started) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    reset_log(here)
+    r = campaign(here, "--unit", "r", env={"WITH_R": "1"})
+    check("resumable_unit_sees_its_partial_run", r.returncode == 0 and runs(here) == ["r-again"],
+          f"ran {runs(here)}: {r.stderr}")
+    check("resumable_unit_says_it_continues",
+          "[1/1] r: continuing its interrupted run" in r.stderr, r.stderr)
+    check("resumable_unit_final_output", open(final(here, "r")).read() == "ok", "r.txt")
+
+
 def test_validation_and_selection():
     here = setup()
     r = campaign(here, "--unit", "a", env={"CONTENT_a": "garbage"})
@@ -175,7 +200,34 @@ def test_ch4_plan():
           f"{len(m3)}: {m3[:3]} ... {m3[-1:]}")
 
 
+def test_ch4_fill_resumes():
+    """The plan's jdem fill command, killed after its first checkpoint and run again as the
+    campaign would, continues from the checkpoint and gives the uninterrupted trajectory bit for
+    bit (a small conveyor fill, a checkpoint every 0.2 s of wall time)."""
+    from scripts.mixing import plan_ch4
+    from tests.checkpoint.compare_h5 import differences
+    scene = os.path.join(ROOT, "tests", "checkpoint", "scenes", "inlet_stream.yaml")
+    d = tempfile.mkdtemp()
+    ref, out = os.path.join(d, "ref.h5"), os.path.join(d, "fill.h5")
+    subprocess.run([plan_ch4.jdem(), "run", scene, "-o", ref, "--quiet"], check=True)
+    argv = [a.replace("{out0}", out) for a in
+            plan_ch4.fill_command("jdem", scene, False, checkpoint_seconds=0.2)]
+    proc = subprocess.Popen(argv, stderr=subprocess.DEVNULL, start_new_session=True)
+    ck = os.path.join(d, "fill.ckpt.h5")
+    while not os.path.exists(ck) and proc.poll() is None:
+        time.sleep(0.01)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    check("ch4_fill_killed_after_a_checkpoint", os.path.exists(ck) and not os.path.exists(out),
+          "the run ended before its first checkpoint")
+    r = subprocess.run(argv, capture_output=True, text=True)
+    check("ch4_fill_resumed", r.returncode == 0 and "resuming from" in r.stderr, r.stderr[-300:])
+    diffs, n = differences(ref, out) if r.returncode == 0 else (["no output"], 0)
+    check("ch4_fill_resumed_equals_uninterrupted", not diffs and n > 10, "; ".join(diffs[:3]))
+
+
 test_killed_run_resumes()
+test_resumable_unit_continues()
 def test_ch4_dt_variants():
     """The plan's time-step variants: the seed's 1e-4 s forced, the guard's dt as jdem states it
     when it refuses the seed's, and half of it, each in its own output tree."""
@@ -201,4 +253,5 @@ test_validation_and_selection()
 test_not_yet_runnable()
 test_ch4_dt_variants()
 test_ch4_plan()
+test_ch4_fill_resumes()
 finish()
