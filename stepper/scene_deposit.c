@@ -15,8 +15,11 @@
 #include "scene_deposit.h"
 #include "scene_internal.h"
 
-static const char *const ENTRY_KEYS[] = {"file", "frame", "region", "translate", "velocities",
-                                         "ids", NULL};
+static const char *const ENTRY_KEYS[] = {"file", "frame", "region", "dilate", "translate",
+                                         "velocities", "ids", NULL};
+/* A dilation spreads a cut that was under the deposit's pressure until its overlaps are gone;
+ * past 2 the cut is no longer the packing it was taken from. */
+static const sd_range DILATION = {1.0, 2.0, 0, 0};
 static const char *const REGION_KEYS[] = {"lo", "hi", NULL};
 static const char *const VELOCITIES[] = {"zero", "keep", NULL};
 static const char *const IDS[] = {"keep", "renumber", NULL};
@@ -83,6 +86,7 @@ typedef struct deposit_entry {
     int64_t frame;
     int has_region;
     double lo[3], hi[3], shift[3];
+    double dilate; /* positions scaled by this about the region's centre, before the shift */
     int velocities, renumber;
 } deposit_entry;
 
@@ -100,13 +104,27 @@ static int read_region(loader *L, deposit_entry *d) {
     return 0;
 }
 
+/* dilate: about the region's centre, so a region is needed. */
+static int read_dilation(loader *L, deposit_entry *d) {
+    const yaml_node_t *n = sd_get(&L->c, d->map, "dilate");
+    if (!n) return 0;
+    char sub[SD_PATH_MAX];
+    sd_join(sub, d->path, "dilate");
+    if (!d->has_region)
+        return sd_fail(&L->c, n, sub, "a dilation needs a region (it scales the kept positions "
+                       "about the region's centre); valid: add region: {lo: [x, y, z], hi: [x, y, z]}");
+    return sd_num(&L->c, n, sub, DILATION, &d->dilate);
+}
+
 static int read_entry(loader *L, const yaml_node_t *map, const char *list_path, size_t k,
                       deposit_entry *d) {
     memset(d, 0, sizeof *d);
     d->map = map;
     d->frame = -1;
+    d->dilate = 1.0;
     sd_join_index(d->path, list_path, k);
-    if (sd_mapping(&L->c, map, d->path, "{file, frame, region, translate, velocities, ids}") ||
+    if (sd_mapping(&L->c, map, d->path,
+                   "{file, frame, region, dilate, translate, velocities, ids}") ||
         sd_keys(&L->c, map, d->path, ENTRY_KEYS))
         return -1;
     d->file_node = sd_get(&L->c, map, "file");
@@ -120,7 +138,8 @@ static int read_entry(loader *L, const yaml_node_t *map, const char *list_path, 
                        "of an H5MD trajectory", sd_kind(d->file_node));
     d->frame_node = sd_get(&L->c, map, "frame");
     return scene_opt_int(L, map, d->path, "frame", INT64_MIN + 1, &d->frame) ||
-                   read_region(L, d) || sd_opt_vec3(&L->c, map, d->path, "translate", d->shift) ||
+                   read_region(L, d) || read_dilation(L, d) ||
+                   sd_opt_vec3(&L->c, map, d->path, "translate", d->shift) ||
                    sd_opt_enum(&L->c, map, d->path, "velocities", VELOCITIES, &d->velocities) ||
                    sd_opt_enum(&L->c, map, d->path, "ids", IDS, &d->renumber)
                ? -1
@@ -208,7 +227,9 @@ static int add_kept(loader *L, const deposit_entry *d, const dep_frame *fr, int3
         s->radius[i] = fr->radius[j];
         s->settled[i] = 1;
         for (int a = 0; a < 3; a++) {
-            s->position[3 * i + a] = fr->position[3 * j + a] + d->shift[a];
+            const double centre = 0.5 * (d->lo[a] + d->hi[a]), x = fr->position[3 * j + a];
+            s->position[3 * i + a] =
+                (d->dilate == 1.0 ? x : centre + d->dilate * (x - centre)) + d->shift[a];
             if (d->velocities) {
                 s->velocity[3 * i + a] = fr->velocity[3 * j + a];
                 s->angular_velocity[3 * i + a] = fr->angular_velocity[3 * j + a];

@@ -174,7 +174,9 @@ def fill_command(engine, scene, force, generate=None, checkpoint_seconds=CHECKPO
                    for a in run_command(engine, '"$1"', '"$2"', force))
     if resumable(engine):
         run += f" --checkpoint-seconds {checkpoint_seconds}"
-        run = f'ck="${{2%.h5}}.ckpt.h5"; if [ -f "$ck" ]; then {run} --resume "$ck"; else {run}; fi'
+        # no braces: the campaign driver fills the "{...}" placeholders of every word
+        run = (f'ck="$(dirname "$2")/$(basename "$2" .h5).ckpt.h5"; '
+               f'if [ -f "$ck" ]; then {run} --resume "$ck"; else {run}; fi')
     return ["sh", "-c", (generate + " && " if generate else "") + run, "fill", scene, "{out0}"]
 
 

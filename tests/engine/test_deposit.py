@@ -106,6 +106,23 @@ def check_round_trip(c, work, src):
     return path, out_h5
 
 
+def check_dilation(c, work, src):
+    """dilate: s scales the kept positions about the region's centre, then translate adds:
+    c + s (x - c) + shift, in that order of double operations (numpy's are the same)."""
+    s, shift = 1.25, [0.1, 0.0, 0.01]   # lifted: the spread bed's bottom layer would cut the floor
+    entry = "{file: %s, region: {lo: %s, hi: %s}, dilate: %r, translate: %s}" % (src, LO, HI, s, shift)
+    rc, out, err = resolve(write_scene(work, "dilated", entry))
+    if not c.check("deposit_dilated_resolve", rc == 0, err):
+        return
+    got = np.array([p["position"] for p in resolved_particles(out)])
+    _, _, _, pos, _, _ = source_frame(src)
+    kept = pos[np.all((pos >= LO) & (pos < HI), axis=1)]
+    centre = 0.5 * (np.array(LO) + np.array(HI))
+    want = (centre + s * (kept - centre)) + np.array(shift)
+    c.check("deposit_dilated_positions_bitwise", got.shape == want.shape and np.array_equal(got, want),
+            "positions differ from c + s (x - c) + shift")
+
+
 def check_renumber(c, work, src):
     extra = "particles:\n  - {id: 7, material: glass, radius: 0.002, position: [0.13, 0.03, 0.01]}\n"
     entry = "{file: %s, region: {lo: %s, hi: %s}, translate: %s, ids: renumber}" % (src, LO, HI, SHIFT)
@@ -199,6 +216,11 @@ def bad_cases(work, src):
         ("region_keeps_nothing", "{file: %s, region: {lo: %s, hi: %s}}" % (src, ext_lo.tolist(), corner_hi),
          k % "region" + "region %s..%s keeps no particle of the deposit; valid: a region holding at "
          "least one particle centre" % (ext_lo.tolist(), corner_hi)),
+        ("dilate_without_region", "{file: %s, dilate: 1.2}" % src,
+         k % "dilate" + "a dilation needs a region (it scales the kept positions about the "
+         "region's centre); valid: add region: {lo: [x, y, z], hi: [x, y, z]}"),
+        ("dilate_too_large", "{file: %s, region: {lo: %s, hi: %s}, dilate: 2.5}" % (src, LO, HI),
+         k % "dilate" + "2.5 is out of range; valid: a number in [1, 2]"),
         ("bad_velocities", "{file: %s, velocities: fast}" % src,
          k % "velocities" + "unknown value 'fast'; valid: zero, keep"),
     ]
@@ -230,6 +252,7 @@ def main():
         c.exit()
     done = check_round_trip(c, work, src)
     check_renumber(c, work, src)
+    check_dilation(c, work, src)
     check_empty_slots(c, work, src)
     check_bad(c, work, src)
     if done:

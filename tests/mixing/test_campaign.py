@@ -210,7 +210,7 @@ def test_ch4_fill_resumes():
     d = tempfile.mkdtemp()
     ref, out = os.path.join(d, "ref.h5"), os.path.join(d, "fill.h5")
     subprocess.run([plan_ch4.jdem(), "run", scene, "-o", ref, "--quiet"], check=True)
-    argv = [a.replace("{out0}", out) for a in
+    argv = [a.format(out0=out, dir=d) for a in  # as the driver's run_unit fills them
             plan_ch4.fill_command("jdem", scene, False, checkpoint_seconds=0.2)]
     proc = subprocess.Popen(argv, stderr=subprocess.DEVNULL, start_new_session=True)
     ck = os.path.join(d, "fill.ckpt.h5")

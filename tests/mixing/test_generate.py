@@ -48,12 +48,17 @@ cells = doc["inlets"][0]["section"]["from_deposit"]
 los = [tuple(c["region"]["lo"]) for c in cells]
 want = [(0.0, 0.5 * (q % 2), 0.25 * (q // 2)) for q in range(8)]
 check("second_pass_cells_bottom_to_top", los == want, f"{los}")
-# queued end to end with the 0.06 m gap, the first front 0.005 m behind the plane x = 0.05,
-# every cell's bottom at z = 1.8 and centred at y = 0.5
-tx = [c["translate"][0] for c in cells]
-ok = all(abs(tx[q] - (0.05 - 0.005 - 1.0 - 1.06 * q)) < 1e-12 for q in range(8))
-ok &= all(abs(c["translate"][2] + c["region"]["lo"][2] - 1.8) < 1e-12 for c in cells)
-ok &= all(abs(c["translate"][1] + c["region"]["lo"][1] + 0.25 - 0.5) < 1e-12 for c in cells)
+# each cell dilated about its centre until its closest pair is 1.1 times the sum of the radii
+# apart (the simple-cubic bed's neighbours touch: 1.1 exactly), then queued end to end with the
+# 0.06 m gap, the first front 0.005 m behind the plane x = 0.05, every cell's bottom at z = 1.8
+# and centred at y = 0.5 (dilated lengths 1.1, 0.55, 0.275 m)
+check("second_pass_dilation", all(c["dilate"] == 1.1 for c in cells), f"{[c.get('dilate') for c in cells]}")
+front = [0.045 - q * (1.1 + 0.06) for q in range(8)]
+centre = [[0.5, 0.25 + 0.5 * (q % 2), 0.125 + 0.25 * (q // 2)] for q in range(8)]
+t = [c["translate"] for c in cells]
+ok = all(abs(t[q][0] + centre[q][0] + 0.55 - front[q]) < 1e-12 for q in range(8))
+ok &= all(abs(t[q][2] + centre[q][2] - 0.1375 - 1.8) < 1e-12 for q in range(8))
+ok &= all(abs(t[q][1] + centre[q][1] - 0.5) < 1e-12 for q in range(8))
 check("second_pass_queue", ok, f"{[c['translate'] for c in cells]}")
 check("second_pass_inserted_once", doc["inlets"][0]["stop"] == {"sections": 1}, f"{doc['inlets'][0]}")
 check("second_pass_keeps_model", doc["walls"][5]["present"] and doc["walls"][6]["axis"][0][0] == 0.7,

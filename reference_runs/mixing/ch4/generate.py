@@ -19,9 +19,14 @@ cadence in steps).
 
 second-pass: the bottom 1 m of the deposit's last frame (centres with 0 <= z < 1) is cut into
 1 x 2 x 4 cells of 1 (x) x 0.5 (y) x 0.25 (z) m; cell q = 2 layer + half (bottom to top, y < 0.5
-first) is queued on the belt q (1 + gap) m behind the first, each keeping its orientation, its
-bottom at z = 1.8 and centred at y = 0.5; one section inserted once.  The cells are
-`from_deposit` entries (region + translation), so the scene names the deposit, not its particles.
+first) is queued on the belt, gap m behind the one before, each keeping its orientation, its
+bottom at z = 1.8 and centred at y = 0.5; one section inserted once.  Each cell is dilated about
+its centre until its closest pair is as far apart as the first pass's lattice neighbours
+(1.1 times the sum of their radii) [RECON]: the inlet inserts each sphere as it crosses the
+plane, so spheres that touch (or overlap, as a cut from under the deposit's pressure does) are
+rammed by their neighbours still on the belt (the undilated fill stops on the watchdog's
+overlap limit within 0.1 s, a fill dilated only to touching within 0.3 s).  The cells are `from_deposit`
+entries (region + dilation + translation), so the scene names the deposit, not its particles.
 cubes: a 0.2 m cube at each Table 4-2 point keeps the particles whose centres lie inside; five
 fixed walls and a servo top wall (1000 Pa +- 10 Pa) at the outline of the kept particles, so
 that none starts inside a wall.  The kept particles are `settled`: their contact overlaps are
@@ -32,6 +37,7 @@ import argparse
 import os
 import sys
 
+import numpy as np
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -42,6 +48,7 @@ MODELS = os.path.join(HERE, "models.yaml")
 JITTER = 1.0e-6           # [m] one step of --jitter: far below every length of the scene
 CELL = (1.0, 0.5, 0.25)   # [RECON] orientation, spec §1.7
 DEPTH = 1.0               # [TEXT] L1539
+FEED_PITCH = 1.1          # [RECON] the first pass's lattice pitch over the sphere diameter
 CUBE = 0.2                # [TEXT] spec §2.4
 SEED_DT = 1.0e-4          # [TEXT] Table 4-1
 SERVO = {"target": 1000.0, "gain": 1.0e-4, "tolerance": 10.0, "max_speed": 0.02, "hold": 0.05}
@@ -89,10 +96,24 @@ def fill(args):
                          f"{doc['time']['end_time']} s{jitter}")
 
 
+def unloading_dilation(cut):
+    """The factor s that spreads the cut until its closest pair is FEED_PITCH times the sum of
+    its radii apart, the first pass's pitch (models.yaml: 0.033 m for 0.030 m spheres):
+    FEED_PITCH times the largest (R_a + R_b) / d over its pairs, to 9 digits."""
+    from scipy.spatial import cKDTree
+    pairs = cKDTree(cut.position).query_pairs(2 * cut.radius.max(), output_type="ndarray")
+    if len(pairs) == 0:
+        return 1.0
+    d = np.linalg.norm(cut.position[pairs[:, 0]] - cut.position[pairs[:, 1]], axis=1)
+    s = FEED_PITCH * ((cut.radius[pairs[:, 0]] + cut.radius[pairs[:, 1]]) / d).max()
+    return max(1.0, round(float(s), 9))
+
+
 def cells(dep, deposit_path, gap):
-    """The from_deposit entries of the second pass, in queue order."""
+    """The from_deposit entries of the second pass, in queue order: each cell dilated
+    (unloading_dilation) about its centre, its front gap m behind the previous cell's back."""
     belt = []
-    plane_x = 0.05
+    front = 0.05 - 0.005   # the first cell's front, 5 mm behind the inlet plane x = 0.05
     for q in range(8):
         layer, half = divmod(q, 2)
         lo = [0.0, CELL[1] * half, CELL[2] * layer]
@@ -100,9 +121,13 @@ def cells(dep, deposit_path, gap):
         cut = deposit.keep_box(dep, lo, hi, source=deposit_path)
         if len(cut.id) == 0:
             sys.exit(f"generate.py: {deposit_path}: cell {q} {lo}..{hi} holds no particle")
-        shift = [plane_x - 0.005 - CELL[0] - q * (CELL[0] + gap), 0.25 - lo[1], 1.8 - lo[2]]
+        s = unloading_dilation(cut)
+        centre = [(a + b) / 2 for a, b in zip(lo, hi)]
+        half_len = [s * c / 2 for c in CELL]
+        shift = [front - half_len[0] - centre[0], 0.5 - centre[1], 1.8 + half_len[2] - centre[2]]
+        front -= 2 * half_len[0] + gap
         belt.append({"file": os.path.abspath(deposit_path), "frame": -1,
-                     "region": {"lo": lo, "hi": hi}, "translate": shift})
+                     "region": {"lo": lo, "hi": hi}, "dilate": s, "translate": shift})
     return belt
 
 
