@@ -108,6 +108,17 @@ static int sync_path(const char *path, int flags) {
     return rc;
 }
 
+/* A checkpoint file, created (truncated) or opened read-only, without HDF5's file locks: the
+ * file is this run's alone, and locking fails on some network file systems. */
+static hid_t open_unlocked(const char *path, int create) {
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    if (fapl >= 0) H5Pset_file_locking(fapl, 0, 1);
+    const hid_t f = create ? H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl)
+                           : H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    if (fapl >= 0) H5Pclose(fapl);
+    return f;
+}
+
 static void directory_of(const char *path, char *dir, size_t len) {
     const char *slash = strrchr(path, '/');
     if (!slash) snprintf(dir, len, ".");
@@ -123,11 +134,8 @@ int jd_checkpoint_write(const jd_sim *s, const jd_checkpointer *ck, double elaps
     void *data;
     H5Eget_auto2(H5E_DEFAULT, &fn, &data);
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    if (fapl >= 0) H5Pset_file_locking(fapl, 0, 1);
     ck_io io = {.reading = 0, .path = tmp, .err = why, .errlen = sizeof why};
-    io.file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-    if (fapl >= 0) H5Pclose(fapl);
+    io.file = open_unlocked(tmp, 1);
     int rc = -1;
     if (io.file < 0) {
         snprintf(why, sizeof why, "cannot create '%s': %s", tmp, errno ? strerror(errno) : "HDF5 error");
@@ -243,11 +251,8 @@ int jd_checkpoint_read(jd_sim *s, jd_checkpointer *ck, const char *path, char *e
     void *data;
     H5Eget_auto2(H5E_DEFAULT, &fn, &data);
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    if (fapl >= 0) H5Pset_file_locking(fapl, 0, 1);
     ck_io io = {.reading = 1, .path = path, .err = err, .errlen = errlen};
-    io.file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
-    if (fapl >= 0) H5Pclose(fapl);
+    io.file = open_unlocked(path, 0);
     int rc = 0;
     if (io.file < 0) {
         snprintf(err, errlen, "cannot resume: '%s' is not a readable HDF5 file (truncated or "
