@@ -99,15 +99,86 @@ def particles(case, path):
         write_data(path, [(-0.05, 0.05), (-0.05, 0.05), (-0.01, 0.02)], atoms, velocity=(1.5, 0.5, -4.0))
     elif case == "inlet":
         return  # the box starts empty: fix jdem/inlet brings the particles
+    elif case in MESHES:
+        origin, counts, box = MESH_BEDS[case]
+        pts = lattice(origin, 0.021, counts, 0.05, rng)
+        atoms = [(1, 2 * (0.0095 + 0.0005 * (n % 2)), 2500.0, p) for n, p in enumerate(pts)]
+        write_data(path, box, atoms)
+        for name, tris in MESHES[case]().items():
+            write_stl(os.path.join(os.path.dirname(path), name + ".stl"), tris)
     else:
         pts = lattice([0.0295, 0.0295, 0.0145], 0.0282, [6, 6, 6], 0.05, rng)
         atoms = [(1, 2 * (0.013 if rng.uniform() < 0.5 else 0.014), 2500.0, p) for p in pts]
         write_data(path, [(-0.3, 0.5), (-0.3, 0.5), (-0.3, 0.6)], atoms)
 
 
+# ---- the meshes of the mesh-wall cases (STL files written next to the data file) -------------
+
+def grid(corner, du, dv, nu, nv, lift=None):
+    """An nu x nv grid of quadrilaterals from `corner` along du and dv, two triangles each
+    (diagonals alternating, so that the contacts meet edges of both directions); lift(p)
+    moves each grid point (e.g. onto a funnel's slope)."""
+    lift = lift or (lambda p: p)
+    at = lambda i, j: tuple(lift(np.asarray(corner) + i * np.asarray(du) + j * np.asarray(dv)))
+    tris = []
+    for i in range(nu):
+        for j in range(nv):
+            a, b, c, d = at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)
+            tris += [(a, b, c), (a, c, d)] if (i + j) % 2 == 0 else [(a, b, d), (b, c, d)]
+    return tris
+
+
+def box_mesh():
+    """A box of half width 0.05 m whose floor is a funnel: z = 0.02 max(|x|, |y|) / 0.05."""
+    w, h = 0.05, 0.15
+    funnel = lambda p: p + np.array([0.0, 0.0, 0.02 * max(abs(p[0]), abs(p[1])) / w])
+    tris = grid((-w, -w, 0.0), (w / 2, 0, 0), (0, w / 2, 0), 4, 4, funnel)
+    for s in (-w, w):
+        tris += grid((s, -w, 0.0), (0, w / 2, 0), (0, 0, h / 6), 4, 6)
+        tris += grid((-w, s, 0.0), (w / 2, 0, 0), (0, 0, h / 6), 4, 6)
+    return {"box": tris}
+
+
+def drum_mesh(radius=0.08, half_length=0.03, n=24):
+    """A drum about the y axis: n lateral strips and two end caps as fans."""
+    ring = [(radius * np.cos(2 * np.pi * k / n), radius * np.sin(2 * np.pi * k / n)) for k in range(n + 1)]
+    tris = []
+    for k in range(n):
+        (x0, z0), (x1, z1) = ring[k], ring[k + 1]
+        tris += [((x0, -half_length, z0), (x1, -half_length, z1), (x1, half_length, z1)),
+                 ((x0, -half_length, z0), (x1, half_length, z1), (x0, half_length, z0))]
+        for y in (-half_length, half_length):
+            tris.append(((0.0, y, 0.0), (x0, y, z0), (x1, y, z1)))
+    return {"drum": tris}
+
+
+def belt_mesh():
+    """The belt z = 0 and an end wall across it at x = 0.008 (the bed reaches it)."""
+    return {"belt": grid((-0.12, -0.06, 0.0), (0.03, 0, 0), (0, 0.03, 0), 8, 4),
+            "stop": grid((0.008, -0.06, -0.02), (0, 0.03, 0), (0, 0, 0.02), 4, 4)}
+
+
+def write_stl(path, tris):
+    with open(path, "w") as f:
+        f.write("solid wall\n")
+        for t in tris:
+            f.write(" facet normal 0 0 0\n  outer loop\n")
+            for p in t:
+                f.write("   vertex %r %r %r\n" % tuple(float(c) for c in p))
+            f.write("  endloop\n endfacet\n")
+        f.write("endsolid wall\n")
+
+
+MESHES = {"mesh_box": box_mesh, "mesh_drum": drum_mesh, "mesh_belt": belt_mesh}
+# the bed's lattice (origin, counts; spacing 0.021 m) and the simulation box of each mesh case
+MESH_BEDS = {"mesh_box": ([-0.0315, -0.0315, 0.035], [4, 4, 4], [(-0.1, 0.1), (-0.1, 0.1), (-0.05, 0.3)]),
+             "mesh_drum": ([-0.0315, -0.0105, -0.05], [4, 2, 3], [(-0.1, 0.1), (-0.1, 0.1), (-0.1, 0.1)]),
+             "mesh_belt": ([-0.07, -0.0315, 0.012], [4, 4, 2], [(-0.15, 0.15), (-0.1, 0.1), (-0.05, 0.2)])}
+
 # steps, restart cadence (half way), dump cadence of each case
 CASES = {"bed": (3000, 1500, 100), "block": (1200, 300, 100), "servo": (3000, 1500, 100),
-         "inlet": (6000, 3000, 500)}
+         "inlet": (6000, 3000, 500), "mesh_box": (3000, 1500, 100), "mesh_drum": (3000, 1500, 100),
+         "mesh_belt": (3000, 1500, 100)}
 
 
 # ---- running -------------------------------------------------------------------------------
@@ -115,7 +186,9 @@ CASES = {"bed": (3000, 1500, 100), "block": (1200, 300, 100), "servo": (3000, 15
 def command(np_, deck, variables):
     mpi = [] if np_ == 1 else ["mpirun"] + (["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []) + \
         ["-np", str(np_)]
-    args = mpi + [LIGGGHTS, "-in", deck, "-log", "log.lammps", "-screen", "none", "-var", "decks", DECKS]
+    # LIGGGHTS' STL reader writes to the screen: with -screen none it would crash
+    screen = "screen.txt" if "stl" in variables else "none"
+    args = mpi + [LIGGGHTS, "-in", deck, "-log", "log.lammps", "-screen", screen, "-var", "decks", DECKS]
     for k, v in variables.items():
         args += ["-var", k, str(v)]
     return args
@@ -128,10 +201,15 @@ def run_dir(tmp, name):
     return d
 
 
-def variables(d, data, n, restart_every, dump_every, resume="none"):
-    return {"data": data, "out": os.path.join(d, "out.h5"), "rdir": os.path.join(d, "restarts"),
-            "n": n, "restart_every": restart_every, "dump_every": dump_every, "resume": resume,
-            "resuming": 0 if resume == "none" else 1}
+def variables(d, data, n, restart_every, dump_every, resume="none", case=None):
+    var = {"data": data, "out": os.path.join(d, "out.h5"), "rdir": os.path.join(d, "restarts"),
+           "n": n, "restart_every": restart_every, "dump_every": dump_every, "resume": resume,
+           "resuming": 0 if resume == "none" else 1}
+    if case in MESHES:  # the STL files next to the data file: stl, and stl_<name> for the others
+        names = list(MESHES[case]().keys())
+        for k, name in enumerate(names):
+            var["stl" if k == 0 else "stl_end"] = os.path.join(os.path.dirname(data), name + ".stl")
+    return var
 
 
 def run(d, np_, deck, var):
@@ -201,12 +279,12 @@ def half_way(tmp, case, np_):
     ref = run_dir(tmp, "%s_np%d_ref" % (case, np_))
     data = os.path.join(ref, "particles.data")
     particles(case, data)
-    rc, log = run(ref, np_, deck, variables(ref, data, n, every, dump_every))
+    rc, log = run(ref, np_, deck, variables(ref, data, n, every, dump_every, case=case))
     if not check("%s_np%d_reference_runs" % (case, np_), rc == 0, log[-1500:]):
         return
     cont = run_dir(tmp, "%s_np%d_cont" % (case, np_))
     resume = os.path.join(ref, "restarts", "r.%d" % every)
-    rc, log = run(cont, np_, deck, variables(cont, data, n - every, every, dump_every, resume))
+    rc, log = run(cont, np_, deck, variables(cont, data, n - every, every, dump_every, resume, case))
     if check("%s_np%d_continued_runs" % (case, np_), rc == 0, log[-1500:]):
         same_final_frame("%s_np%d" % (case, np_), os.path.join(ref, "out.h5"), os.path.join(cont, "out.h5"))
 
