@@ -400,6 +400,32 @@ def option_mismatch(tmp):
           "non-printable bytes in the log: %r" % [c for c in log if not (c.isprintable() or c in "\n\t")][:8])
 
 
+def mesh_shape_mismatch(tmp):
+    """The meshed box's file continued by a deck whose fix of the mesh wall's ID is a plane
+    wall: an error that names both kinds (never a plane continuing from a mesh's history)."""
+    w = run_dir(tmp, "mesh_mismatch_writer")
+    data = os.path.join(w, "particles.data")
+    particles("mesh_box", data)
+    box = os.path.join(DECKS, "mesh_box.in")
+    rc, log = run(w, 1, box, variables(w, data, 200, 200, 100, case="mesh_box"))
+    if not check("mesh_mismatch_writer_runs", rc == 0, log[-1500:]):
+        return
+    with open(box) as f:
+        text = f.read().replace("fix walls all wall/jiang mesh n_meshes 1 meshes box",
+                                "fix walls all wall/jiang plane corners -0.1 -0.1 0.0 0.1 -0.1 0.0 "
+                                "0.1 0.1 0.0 -0.1 0.1 0.0 type 2")
+    deck = os.path.join(tmp, "mesh_box_plane.in")
+    with open(deck, "w") as f:
+        f.write(text)
+    r = run_dir(tmp, "mesh_mismatch_reader")
+    rc, log = run(r, 1, deck, variables(r, data, 100, 100, 100, os.path.join(w, "restarts", "r.200"), "mesh_box"))
+    want = "ERROR: fix walls (wall/jiang): the restart file's wall of this ID is a mesh, not a plane ("
+    check("mesh_mismatch_fails", rc != 0, "exit status 0")
+    lines = [l for l in log.splitlines() if l.startswith("ERROR")]
+    check("mesh_mismatch_message", any(l.startswith(want) and re.search(r"\([\w./]+:\d+\)$", l) for l in lines),
+          "expected %r in %r" % (want, lines))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", help="keep the runs under DIR")
@@ -421,6 +447,7 @@ def main():
         across(tmp, "stock_to_jiang", stock, bed, DROPPED % (STOCK, OURS))
         across(tmp, "jiang_to_stock", bed, stock, DROPPED % (OURS, STOCK))
         option_mismatch(tmp)
+        mesh_shape_mismatch(tmp)
     finally:
         if not args.out and not args.keep:
             shutil.rmtree(tmp, ignore_errors=True)
