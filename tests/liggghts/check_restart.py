@@ -18,6 +18,12 @@ stress tensor, bond energies) -- on 1 and 2 MPI ranks:
          position, speed and hold count);
   inlet  a conveyor inlet (fix jdem/inlet) written with sections still to come (the stream's
          position; the continued run inserts the same particles at the same steps);
+  mesh_box   64 spheres settle in a static meshed box with a funnel floor (fix mesh/surface +
+         fix wall/jiang mesh: the mesh history slots, face, edge and corner contacts);
+  mesh_drum  48 spheres in a meshed drum turned by fix move/mesh rotate (the mesh's position
+         and the wall velocity at the contacts);
+  mesh_belt  32 spheres on a surface_vel belt carried against a meshed end wall that fix
+         move/mesh linear lifts (two mesh fixes; their energy sums, which the watchdog reads);
 each written by `restart N` (half way; the block at a quarter) and continued with read_restart; and the bed killed with
 SIGKILL while it writes a restart file every 400 steps, continued from the last complete one.
 The continued deck is the same deck: LIGGGHTS' `restart N` rebuilds the neighbour lists at the
@@ -28,7 +34,8 @@ Across pair styles: LIGGGHTS' own pair_style gran read into the bed with gran/ji
 file read into LIGGGHTS' own pair_style and walls, continue with a warning that the contact
 history is dropped (its exact text), from the file's positions (== the writer's last frame);
 the bed's file read with `rolling off` stops with the message naming the file's options, a
-clean line of printable text.
+clean line of printable text; the meshed box's file read by a deck whose wall of that ID is a
+plane stops with the message naming both kinds.
 Prints one PASS/FAIL line per check; exit 1 if any fails.
 """
 import argparse
