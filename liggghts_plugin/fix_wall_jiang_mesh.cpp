@@ -74,9 +74,9 @@ void FixWallJiangMesh::init() {
 }
 
 /* As FixWallJiang::setup: while a run resumes from a restart file, the history, energy sums
- * and contact count read from it stand (the set-up evaluation would set the energy reference
- * of every contact from this evaluation, which sees fix move/mesh's node velocities zeroed by
- * its own set-up). */
+ * and contact count read from it stand (the set-up evaluation sees the full-step velocities,
+ * and would set every contact's energy reference from them: the continued run's dissipation
+ * would then differ from the uninterrupted one's in its last digits). */
 void FixWallJiangMesh::setup(int vflag) {
   if (jdem_restart_resuming(lmp)) return;
   compute_mesh(false);

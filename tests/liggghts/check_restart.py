@@ -107,10 +107,10 @@ def particles(case, path):
     elif case == "inlet":
         return  # the box starts empty: fix jdem/inlet brings the particles
     elif case in MESHES:
-        origin, counts, box = MESH_BEDS[case]
+        origin, counts, box, velocity = MESH_BEDS[case]
         pts = lattice(origin, 0.021, counts, 0.05, rng)
         atoms = [(1, 2 * (0.0095 + 0.0005 * (n % 2)), 2500.0, p) for n, p in enumerate(pts)]
-        write_data(path, box, atoms)
+        write_data(path, box, atoms, velocity)
         for name, tris in MESHES[case]().items():
             write_stl(os.path.join(os.path.dirname(path), name + ".stl"), tris)
     else:
@@ -177,10 +177,15 @@ def write_stl(path, tris):
 
 
 MESHES = {"mesh_box": box_mesh, "mesh_drum": drum_mesh, "mesh_belt": belt_mesh}
-# the bed's lattice (origin, counts; spacing 0.021 m) and the simulation box of each mesh case
-MESH_BEDS = {"mesh_box": ([-0.0315, -0.0315, 0.035], [4, 4, 4], [(-0.1, 0.1), (-0.1, 0.1), (-0.05, 0.3)]),
-             "mesh_drum": ([-0.0315, -0.0105, -0.05], [4, 2, 3], [(-0.1, 0.1), (-0.1, 0.1), (-0.1, 0.1)]),
-             "mesh_belt": ([-0.07, -0.0315, 0.012], [4, 4, 2], [(-0.15, 0.15), (-0.1, 0.1), (-0.05, 0.2)])}
+# the bed's lattice (origin, counts; spacing 0.021 m), the simulation box and the initial
+# velocity of each mesh case: thrown at the walls, so that the beds slide on the mesh with
+# friction well before the restart file is written
+MESH_BEDS = {"mesh_box": ([-0.0315, -0.0315, 0.025], [4, 4, 4], [(-0.1, 0.1), (-0.1, 0.1), (-0.05, 0.3)],
+                          (0.3, 0.15, -0.6)),
+             "mesh_drum": ([-0.0315, -0.0105, -0.059], [4, 2, 3], [(-0.1, 0.1), (-0.1, 0.1), (-0.1, 0.1)],
+                           (0.2, 0.1, -0.4)),
+             "mesh_belt": ([-0.07, -0.0315, 0.012], [4, 4, 2], [(-0.15, 0.15), (-0.1, 0.1), (-0.05, 0.2)],
+                           (0.0, 0.0, 0.0))}
 
 # steps, restart cadence (half way), dump cadence of each case
 CASES = {"bed": (3000, 1500, 100), "block": (1200, 300, 100), "servo": (3000, 1500, 100),
@@ -257,6 +262,14 @@ def frame(path, index=-1):
     return step, q, obs
 
 
+def observable_at(path, name, step):
+    """Observable `name` of a dump h5md/jdem file at `step` (None if not recorded then)."""
+    with h5py.File(path, "r") as f:
+        node = f["observables"][name]
+        hit = np.nonzero(node["step"][()] == step)[0]
+        return node["value"][hit[0]] if len(hit) else None
+
+
 def same_bits(a, b):
     """== to the bit (a NaN of the reference, e.g. a stress tensor without a box, matches only
     the same NaN)."""
@@ -289,6 +302,10 @@ def half_way(tmp, case, np_):
     rc, log = run(ref, np_, deck, variables(ref, data, n, every, dump_every, case=case))
     if not check("%s_np%d_reference_runs" % (case, np_), rc == 0, log[-1500:]):
         return
+    if case in MESHES:
+        touching = observable_at(os.path.join(ref, "out.h5"), "wall_contacts", every)
+        check("%s_np%d_mesh_contacts_at_restart" % (case, np_), touching > 0,
+              "%s mesh wall contacts when the file is written: the case tests no mesh history" % touching)
     cont = run_dir(tmp, "%s_np%d_cont" % (case, np_))
     resume = os.path.join(ref, "restarts", "r.%d" % every)
     rc, log = run(cont, np_, deck, variables(cont, data, n - every, every, dump_every, resume, case))
