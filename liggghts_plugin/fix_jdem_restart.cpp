@@ -33,6 +33,7 @@ FixJdemRestart::~FixJdemRestart() {
 
 void FixJdemRestart::define(LAMMPS *lmp) {
   if (lmp->modify->find_fix("jdem_restart") >= 0) return;
+  jdem_restart_warn_unclaimed_motion(lmp);
   char *args[3] = {(char *)"jdem_restart", (char *)"all", (char *)"jdem/restart"};
   lmp->modify->add_fix(3, args);
 }

@@ -460,10 +460,12 @@ void FixWallJiang::restart(char *buf) {
   const std::string who = std::string("fix ") + id + " (wall/jiang)";
   const JdemRestartState st = jdem_restart_read_state(lmp, buf, who, WALL_SHARED, WALL_SUMS);
   const double *s = st.shared.data();
-  if ((int)s[0] != shape)
+  static const char *const shapes[3] = {"plane", "cylinder", "mesh"};
+  const int written = (int)s[0];
+  if (written != shape)
     error->all(FLERR, (who + ": the restart file's wall of this ID is a " +
-                       (s[0] == 0 ? "plane" : "cylinder") + ", not a " +
-                       (shape == 0 ? "plane" : "cylinder")).c_str());
+                       (written >= 0 && written <= 2 ? shapes[written] : "wall of another kind") +
+                       ", not a " + shapes[shape]).c_str());
   if ((int)s[1] != slen)
     error->all(FLERR, (who + ": the restart file's wall history has another length: give "
                              "pair_style gran/jiang the rolling and energy options of the run "

@@ -19,6 +19,7 @@
 
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
+#include "jdem_restart.h"
 #include "jdem_watchdog.h"
 #include "pair_gran_jiang.h"
 
@@ -72,7 +73,14 @@ void FixWallJiangMesh::init() {
   for (size_t k = 0; k < meshes.size(); k++) meshes[k].built = false;
 }
 
-void FixWallJiangMesh::setup(int vflag) { compute_mesh(false); }
+/* As FixWallJiang::setup: while a run resumes from a restart file, the history, energy sums
+ * and contact count read from it stand (the set-up evaluation sees the full-step velocities,
+ * and would set every contact's energy reference from them: the continued run's dissipation
+ * would then differ from the uninterrupted one's in its last digits). */
+void FixWallJiangMesh::setup(int vflag) {
+  if (jdem_restart_resuming(lmp)) return;
+  compute_mesh(false);
+}
 
 void FixWallJiangMesh::post_force(int vflag) { compute_mesh(true); }
 

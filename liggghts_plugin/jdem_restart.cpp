@@ -176,6 +176,20 @@ static void drop_stored(Modify *modify, const char *style) {
     }
 }
 
+void jdem_restart_warn_unclaimed_motion(LAMMPS *lmp) {
+  Modify *modify = lmp->modify;
+  char **ids = modify->*get(StoredGlobalId());
+  char **styles = modify->*get(StoredGlobalStyle());
+  for (int i = 0; i < modify->nfix_restart_global; i++) {
+    if (std::strcmp(styles[i], "move/mesh") != 0) continue;
+    const int k = modify->find_fix(ids[i]);
+    if (k >= 0 && std::strcmp(modify->fix[k]->style, "move/mesh") == 0) continue;
+    lmp->error->warning(FLERR, (std::string("read_restart: the restart file holds the motion of fix ") +
+                                ids[i] + " (move/mesh), which this script does not define before "
+                                "its first run: that mesh stays where the file put it").c_str());
+  }
+}
+
 void jdem_restart_check_pair_style(LAMMPS *lmp, const char *style, int history_len) {
   const bool gran_jiang = std::strcmp(style, "gran/jiang") == 0;
   Modify *modify = lmp->modify;

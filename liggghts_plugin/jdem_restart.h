@@ -76,6 +76,11 @@ void jdem_unpack_restart(LAMMPS *lmp, Fix *fix, int nlocal, int nth);
  * first set-up that follows (see fix_jdem_restart.h). */
 bool jdem_restart_resuming(LAMMPS *lmp);
 
+/* At the first run's set-up (before LIGGGHTS drops the states read from a file): a warning for
+ * each fix move/mesh of the file that the script does not define again with its ID, whose
+ * mesh would otherwise stop moving without a word. */
+void jdem_restart_warn_unclaimed_motion(LAMMPS *lmp);
+
 /* The restart file that was read (if any) against the pair style the script now defines,
  * called when pair_style is given (`style`; for gran/jiang with `history_len` doubles per
  * contact).  A file whose contact history belongs to the

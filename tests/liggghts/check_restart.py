@@ -18,6 +18,12 @@ stress tensor, bond energies) -- on 1 and 2 MPI ranks:
          position, speed and hold count);
   inlet  a conveyor inlet (fix jdem/inlet) written with sections still to come (the stream's
          position; the continued run inserts the same particles at the same steps);
+  mesh_box   64 spheres settle in a static meshed box with a funnel floor (fix mesh/surface +
+         fix wall/jiang mesh: the mesh history slots, face, edge and corner contacts);
+  mesh_drum  48 spheres in a meshed drum turned by fix move/mesh rotate (the mesh's position
+         and the wall velocity at the contacts);
+  mesh_belt  32 spheres on a surface_vel belt carried against a meshed end wall that fix
+         move/mesh linear lifts (two mesh fixes; their energy sums, which the watchdog reads);
 each written by `restart N` (half way; the block at a quarter) and continued with read_restart; and the bed killed with
 SIGKILL while it writes a restart file every 400 steps, continued from the last complete one.
 The continued deck is the same deck: LIGGGHTS' `restart N` rebuilds the neighbour lists at the
@@ -28,7 +34,9 @@ Across pair styles: LIGGGHTS' own pair_style gran read into the bed with gran/ji
 file read into LIGGGHTS' own pair_style and walls, continue with a warning that the contact
 history is dropped (its exact text), from the file's positions (== the writer's last frame);
 the bed's file read with `rolling off` stops with the message naming the file's options, a
-clean line of printable text.
+clean line of printable text; the meshed box's file read by a deck whose wall of that ID is a
+plane stops with the message naming both kinds; the drum's file continued without its fix
+move/mesh warns that the mesh stays where the file put it.
 Prints one PASS/FAIL line per check; exit 1 if any fails.
 """
 import argparse
@@ -99,15 +107,91 @@ def particles(case, path):
         write_data(path, [(-0.05, 0.05), (-0.05, 0.05), (-0.01, 0.02)], atoms, velocity=(1.5, 0.5, -4.0))
     elif case == "inlet":
         return  # the box starts empty: fix jdem/inlet brings the particles
+    elif case in MESHES:
+        origin, counts, box, velocity = MESH_BEDS[case]
+        pts = lattice(origin, 0.021, counts, 0.05, rng)
+        atoms = [(1, 2 * (0.0095 + 0.0005 * (n % 2)), 2500.0, p) for n, p in enumerate(pts)]
+        write_data(path, box, atoms, velocity)
+        for name, tris in MESHES[case]().items():
+            write_stl(os.path.join(os.path.dirname(path), name + ".stl"), tris)
     else:
         pts = lattice([0.0295, 0.0295, 0.0145], 0.0282, [6, 6, 6], 0.05, rng)
         atoms = [(1, 2 * (0.013 if rng.uniform() < 0.5 else 0.014), 2500.0, p) for p in pts]
         write_data(path, [(-0.3, 0.5), (-0.3, 0.5), (-0.3, 0.6)], atoms)
 
 
+# ---- the meshes of the mesh-wall cases (STL files written next to the data file) -------------
+
+def grid(corner, du, dv, nu, nv, lift=None):
+    """An nu x nv grid of quadrilaterals from `corner` along du and dv, two triangles each
+    (diagonals alternating, so that the contacts meet edges of both directions); lift(p)
+    moves each grid point (e.g. onto a funnel's slope)."""
+    lift = lift or (lambda p: p)
+    at = lambda i, j: tuple(lift(np.asarray(corner) + i * np.asarray(du) + j * np.asarray(dv)))
+    tris = []
+    for i in range(nu):
+        for j in range(nv):
+            a, b, c, d = at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)
+            tris += [(a, b, c), (a, c, d)] if (i + j) % 2 == 0 else [(a, b, d), (b, c, d)]
+    return tris
+
+
+def box_mesh():
+    """A box of half width 0.05 m whose floor is a funnel: z = 0.02 max(|x|, |y|) / 0.05."""
+    w, h = 0.05, 0.15
+    funnel = lambda p: p + np.array([0.0, 0.0, 0.02 * max(abs(p[0]), abs(p[1])) / w])
+    tris = grid((-w, -w, 0.0), (w / 2, 0, 0), (0, w / 2, 0), 4, 4, funnel)
+    for s in (-w, w):
+        tris += grid((s, -w, 0.0), (0, w / 2, 0), (0, 0, h / 6), 4, 6)
+        tris += grid((-w, s, 0.0), (w / 2, 0, 0), (0, 0, h / 6), 4, 6)
+    return {"box": tris}
+
+
+def drum_mesh(radius=0.08, half_length=0.03, n=24):
+    """A drum about the y axis: n lateral strips and two end caps as fans."""
+    ring = [(radius * np.cos(2 * np.pi * k / n), radius * np.sin(2 * np.pi * k / n)) for k in range(n + 1)]
+    tris = []
+    for k in range(n):
+        (x0, z0), (x1, z1) = ring[k], ring[k + 1]
+        tris += [((x0, -half_length, z0), (x1, -half_length, z1), (x1, half_length, z1)),
+                 ((x0, -half_length, z0), (x1, half_length, z1), (x0, half_length, z0))]
+        for y in (-half_length, half_length):
+            tris.append(((0.0, y, 0.0), (x0, y, z0), (x1, y, z1)))
+    return {"drum": tris}
+
+
+def belt_mesh():
+    """The belt z = 0 and an end wall across it at x = 0.006 (the bed reaches it)."""
+    return {"belt": grid((-0.12, -0.06, 0.0), (0.03, 0, 0), (0, 0.03, 0), 8, 4),
+            "stop": grid((0.006, -0.06, -0.02), (0, 0.03, 0), (0, 0, 0.02), 4, 4)}
+
+
+def write_stl(path, tris):
+    with open(path, "w") as f:
+        f.write("solid wall\n")
+        for t in tris:
+            f.write(" facet normal 0 0 0\n  outer loop\n")
+            for p in t:
+                f.write("   vertex %r %r %r\n" % tuple(float(c) for c in p))
+            f.write("  endloop\n endfacet\n")
+        f.write("endsolid wall\n")
+
+
+MESHES = {"mesh_box": box_mesh, "mesh_drum": drum_mesh, "mesh_belt": belt_mesh}
+# the bed's lattice (origin, counts; spacing 0.021 m), the simulation box and the initial
+# velocity of each mesh case: thrown at the walls, so that the beds slide on the mesh with
+# friction well before the restart file is written
+MESH_BEDS = {"mesh_box": ([-0.0315, -0.0315, 0.025], [4, 4, 4], [(-0.1, 0.1), (-0.1, 0.1), (-0.05, 0.3)],
+                          (0.3, 0.15, -0.6)),
+             "mesh_drum": ([-0.0315, -0.0105, -0.059], [4, 2, 3], [(-0.1, 0.1), (-0.1, 0.1), (-0.1, 0.1)],
+                           (0.2, 0.1, -0.4)),
+             "mesh_belt": ([-0.07, -0.0315, 0.012], [4, 4, 2], [(-0.15, 0.15), (-0.1, 0.1), (-0.05, 0.2)],
+                           (0.15, 0.0, 0.0))}
+
 # steps, restart cadence (half way), dump cadence of each case
 CASES = {"bed": (3000, 1500, 100), "block": (1200, 300, 100), "servo": (3000, 1500, 100),
-         "inlet": (6000, 3000, 500)}
+         "inlet": (6000, 3000, 500), "mesh_box": (3000, 1500, 100), "mesh_drum": (3000, 1500, 100),
+         "mesh_belt": (3000, 1500, 100)}
 
 
 # ---- running -------------------------------------------------------------------------------
@@ -115,7 +199,9 @@ CASES = {"bed": (3000, 1500, 100), "block": (1200, 300, 100), "servo": (3000, 15
 def command(np_, deck, variables):
     mpi = [] if np_ == 1 else ["mpirun"] + (["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else []) + \
         ["-np", str(np_)]
-    args = mpi + [LIGGGHTS, "-in", deck, "-log", "log.lammps", "-screen", "none", "-var", "decks", DECKS]
+    # LIGGGHTS' STL reader writes to the screen: with -screen none it would crash
+    screen = "screen.txt" if "stl" in variables else "none"
+    args = mpi + [LIGGGHTS, "-in", deck, "-log", "log.lammps", "-screen", screen, "-var", "decks", DECKS]
     for k, v in variables.items():
         args += ["-var", k, str(v)]
     return args
@@ -128,10 +214,15 @@ def run_dir(tmp, name):
     return d
 
 
-def variables(d, data, n, restart_every, dump_every, resume="none"):
-    return {"data": data, "out": os.path.join(d, "out.h5"), "rdir": os.path.join(d, "restarts"),
-            "n": n, "restart_every": restart_every, "dump_every": dump_every, "resume": resume,
-            "resuming": 0 if resume == "none" else 1}
+def variables(d, data, n, restart_every, dump_every, resume="none", case=None):
+    var = {"data": data, "out": os.path.join(d, "out.h5"), "rdir": os.path.join(d, "restarts"),
+           "n": n, "restart_every": restart_every, "dump_every": dump_every, "resume": resume,
+           "resuming": 0 if resume == "none" else 1}
+    if case in MESHES:  # the STL files next to the data file: stl, and stl_<name> for the others
+        names = list(MESHES[case]().keys())
+        for k, name in enumerate(names):
+            var["stl" if k == 0 else "stl_end"] = os.path.join(os.path.dirname(data), name + ".stl")
+    return var
 
 
 def run(d, np_, deck, var):
@@ -172,6 +263,14 @@ def frame(path, index=-1):
     return step, q, obs
 
 
+def observable_at(path, name, step):
+    """Observable `name` of a dump h5md/jdem file at `step` (None if not recorded then)."""
+    with h5py.File(path, "r") as f:
+        node = f["observables"][name]
+        hit = np.nonzero(node["step"][()] == step)[0]
+        return node["value"][hit[0]] if len(hit) else None
+
+
 def same_bits(a, b):
     """== to the bit (a NaN of the reference, e.g. a stress tensor without a box, matches only
     the same NaN)."""
@@ -201,12 +300,16 @@ def half_way(tmp, case, np_):
     ref = run_dir(tmp, "%s_np%d_ref" % (case, np_))
     data = os.path.join(ref, "particles.data")
     particles(case, data)
-    rc, log = run(ref, np_, deck, variables(ref, data, n, every, dump_every))
+    rc, log = run(ref, np_, deck, variables(ref, data, n, every, dump_every, case=case))
     if not check("%s_np%d_reference_runs" % (case, np_), rc == 0, log[-1500:]):
         return
+    if case in MESHES:
+        touching = observable_at(os.path.join(ref, "out.h5"), "wall_contacts", every)
+        check("%s_np%d_mesh_contacts_at_restart" % (case, np_), touching > 0,
+              "%s mesh wall contacts when the file is written: the case tests no mesh history" % touching)
     cont = run_dir(tmp, "%s_np%d_cont" % (case, np_))
     resume = os.path.join(ref, "restarts", "r.%d" % every)
-    rc, log = run(cont, np_, deck, variables(cont, data, n - every, every, dump_every, resume))
+    rc, log = run(cont, np_, deck, variables(cont, data, n - every, every, dump_every, resume, case))
     if check("%s_np%d_continued_runs" % (case, np_), rc == 0, log[-1500:]):
         same_final_frame("%s_np%d" % (case, np_), os.path.join(ref, "out.h5"), os.path.join(cont, "out.h5"))
 
@@ -322,6 +425,61 @@ def option_mismatch(tmp):
           "non-printable bytes in the log: %r" % [c for c in log if not (c.isprintable() or c in "\n\t")][:8])
 
 
+def mesh_shape_mismatch(tmp):
+    """The meshed box's file continued by a deck whose fix of the mesh wall's ID is a plane
+    wall: an error that names both kinds (never a plane continuing from a mesh's history)."""
+    w = run_dir(tmp, "mesh_mismatch_writer")
+    data = os.path.join(w, "particles.data")
+    particles("mesh_box", data)
+    box = os.path.join(DECKS, "mesh_box.in")
+    rc, log = run(w, 1, box, variables(w, data, 200, 200, 100, case="mesh_box"))
+    if not check("mesh_mismatch_writer_runs", rc == 0, log[-1500:]):
+        return
+    with open(box) as f:
+        text = f.read().replace("fix walls all wall/jiang mesh n_meshes 1 meshes box",
+                                "fix walls all wall/jiang plane corners -0.1 -0.1 0.0 0.1 -0.1 0.0 "
+                                "0.1 0.1 0.0 -0.1 0.1 0.0 type 2")
+    deck = os.path.join(tmp, "mesh_box_plane.in")
+    with open(deck, "w") as f:
+        f.write(text)
+    r = run_dir(tmp, "mesh_mismatch_reader")
+    rc, log = run(r, 1, deck, variables(r, data, 100, 100, 100, os.path.join(w, "restarts", "r.200"), "mesh_box"))
+    want = "ERROR: fix walls (wall/jiang): the restart file's wall of this ID is a mesh, not a plane ("
+    check("mesh_mismatch_fails", rc != 0, "exit status 0")
+    lines = [l for l in log.splitlines() if l.startswith("ERROR")]
+    check("mesh_mismatch_message", any(l.startswith(want) and re.search(r"\([\w./]+:\d+\)$", l) for l in lines),
+          "expected %r in %r" % (want, lines))
+
+
+UNCLAIMED_MOTION = ("read_restart: the restart file holds the motion of fix turn (move/mesh), which "
+                    "this script does not define before its first run: that mesh stays where the file put it")
+
+
+def drum_without_motion(tmp):
+    """The drum's file continued by the drum's deck without its fix move/mesh: the warning
+    that names the motion left behind, once (the full deck, in the half-way cases, has none)."""
+    w = run_dir(tmp, "drum_motion_writer")
+    data = os.path.join(w, "particles.data")
+    particles("mesh_drum", data)
+    drum = os.path.join(DECKS, "mesh_drum.in")
+    rc, log = run(w, 1, drum, variables(w, data, 200, 200, 100, case="mesh_drum"))
+    if not check("drum_motion_writer_runs", rc == 0, log[-1500:]):
+        return
+    resume = os.path.join(w, "restarts", "r.200")
+    r = run_dir(tmp, "drum_motion_kept")
+    rc, log = run(r, 1, drum, variables(r, data, 100, 200, 100, resume, "mesh_drum"))
+    check("drum_motion_kept_no_warning", rc == 0 and "(move/mesh), which" not in log, log[-1500:])
+    with open(drum) as f:
+        text = re.sub(r"(?m)^fix turn .*\n", "", f.read())
+    deck = os.path.join(tmp, "mesh_drum_still.in")
+    with open(deck, "w") as f:
+        f.write(text)
+    r = run_dir(tmp, "drum_motion_left")
+    rc, log = run(r, 1, deck, variables(r, data, 100, 200, 100, resume, "mesh_drum"))
+    check("drum_motion_left_warning", rc == 0 and log.count("WARNING: " + UNCLAIMED_MOTION) == 1,
+          "expected once %r in %r" % (UNCLAIMED_MOTION, log[-2500:]))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", help="keep the runs under DIR")
@@ -343,6 +501,8 @@ def main():
         across(tmp, "stock_to_jiang", stock, bed, DROPPED % (STOCK, OURS))
         across(tmp, "jiang_to_stock", bed, stock, DROPPED % (OURS, STOCK))
         option_mismatch(tmp)
+        mesh_shape_mismatch(tmp)
+        drum_without_motion(tmp)
     finally:
         if not args.out and not args.keep:
             shutil.rmtree(tmp, ignore_errors=True)
