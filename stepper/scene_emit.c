@@ -216,6 +216,13 @@ static int emit_wall(yaml_emitter_t *e, const jd_scene *s, const jd_wall *w) {
            key_num(e, "hold", w->servo_hold) || map_end(e) || map_end(e);
 }
 
+/* A mesh wall: its STL file as resolved (so the resolved scene reads from anywhere). */
+static int emit_mesh_wall(yaml_emitter_t *e, const jd_scene *s, const jd_mesh_wall *w) {
+    return map_start(e, 1) || key_str(e, "name", w->name) || key_str(e, "type", "mesh") ||
+           key_str(e, "file", w->file) || key_num(e, "scale", w->scale) ||
+           key_str(e, "material", s->materials[w->material].name) || map_end(e);
+}
+
 static const char *const BENDINGS[] = {"potyondy_cundall", "jiang2021_literal"};
 
 /* Bonds (docs/scenes.md "Bonds"): the types, every step-0 bond, the rules of later steps; only
@@ -308,6 +315,8 @@ static int emit_scene(yaml_emitter_t *e, const jd_scene *s) {
         return 1;
     for (size_t i = 0; i < s->n_walls; i++)
         if (emit_wall(e, s, &s->walls[i])) return 1;
+    for (size_t i = 0; i < s->n_mesh_walls; i++)
+        if (emit_mesh_wall(e, s, &s->mesh_walls[i])) return 1;
     return seq_end(e) || emit_bonds(e, s) || emit_inlets(e, s) || map_end(e) ||
            emit(e, &ev, yaml_document_end_event_initialize(&ev, 1)) ||
            emit(e, &ev, yaml_stream_end_event_initialize(&ev)) || !yaml_emitter_flush(e);
