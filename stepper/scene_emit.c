@@ -7,10 +7,12 @@
  * sweep case loads back under its own name.
  */
 #include <inttypes.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 #include <yaml.h>
 
 #include "scene.h"
@@ -216,10 +218,17 @@ static int emit_wall(yaml_emitter_t *e, const jd_scene *s, const jd_wall *w) {
            key_num(e, "hold", w->servo_hold) || map_end(e) || map_end(e);
 }
 
-/* A mesh wall: its STL file as resolved (so the resolved scene reads from anywhere). */
+/* A mesh wall: its STL file as an absolute path, so that the resolved scene reads the same file
+ * from any folder. */
 static int emit_mesh_wall(yaml_emitter_t *e, const jd_scene *s, const jd_mesh_wall *w) {
-    return map_start(e, 1) || key_str(e, "name", w->name) || key_str(e, "type", "mesh") ||
-           key_str(e, "file", w->file) || key_num(e, "scale", w->scale) ||
+    char cwd[PATH_MAX], absolute[2 * PATH_MAX + 2];
+    const char *file = w->file;
+    if (file[0] != '/' && getcwd(cwd, sizeof cwd)) {
+        snprintf(absolute, sizeof absolute, "%s/%s", cwd, w->file);
+        file = absolute;
+    }
+    return map_start(e, 0) || key_str(e, "name", w->name) || key_str(e, "type", "mesh") ||
+           key_str(e, "file", file) || key_num(e, "scale", w->scale) ||
            key_str(e, "material", s->materials[w->material].name) || map_end(e);
 }
 

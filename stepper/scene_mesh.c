@@ -44,7 +44,7 @@ static int read_stl(loader *L, const yaml_node_t *at, const char *sub, jd_mesh_w
     if (size < STL_MIN_BYTES)
         return sd_fail(&L->c, at, sub, "the STL file '%s' has %ld bytes, fewer than the %d that "
                        "admesh reads; valid: an STL file of at least %d bytes (at least four "
-                       "triangles)", mw->file, size, STL_MIN_BYTES, STL_MIN_BYTES);
+                       "triangles in binary)", mw->file, size, STL_MIN_BYTES, STL_MIN_BYTES);
     stl_file stl;
     memset(&stl, 0, sizeof stl);
     stl_open(&stl, mw->file);

@@ -158,10 +158,15 @@ static int read_servo(loader *L, const yaml_node_t *w, const char *path, jd_wall
 /* A name used by an earlier wall of either kind: "duplicate" message, else 0. */
 static int unique_name(loader *L, const yaml_node_t *name, const char *sub, const char *s,
                        size_t index) {
-    int dup = 0;
-    for (size_t k = 0; k < index; k++) dup |= strcmp(L->s->walls[k].name, s) == 0;
-    for (size_t k = 0; k < L->s->n_mesh_walls; k++) dup |= strcmp(L->s->mesh_walls[k].name, s) == 0;
-    return dup ? sd_fail(&L->c, name, sub, "duplicate wall name '%s'; valid: unique names", s) : 0;
+    for (size_t k = 0; k < index; k++)
+        if (strcmp(L->s->walls[k].name, s) == 0)
+            return sd_fail(&L->c, name, sub, "duplicate wall name '%s' (also walls.%zu); valid: "
+                           "unique names", s, k);
+    for (size_t k = 0; k < L->s->n_mesh_walls; k++)
+        if (strcmp(L->s->mesh_walls[k].name, s) == 0)
+            return sd_fail(&L->c, name, sub, "duplicate wall name '%s' (also the mesh wall of that "
+                           "name); valid: unique names", s);
+    return 0;
 }
 
 /* A wall of type mesh at PATH, appended to mesh_walls (name already read into wall). */
