@@ -18,6 +18,8 @@ binary STL as float32 too), so both engines see the same triangles:
   sliding across the edges of a triangulated floor, a sphere rolling over the apex of a shallow
   pyramid (a vertex contact), a few spheres dropped into a meshed funnel;
 - jdem on 1 and 2 threads on the funnel: the same bits.
+- the watchdog's overlap trip names the mesh wall; --checkpoint-every is refused with a mesh
+  wall (checkpoints do not carry its history yet).
 One PASS/FAIL line per check.
 """
 import math
@@ -127,7 +129,7 @@ def particle(x, v=(0.0, 0.0, 0.0), r=0.005):
         r, *x, *v)
 
 
-def write_case(tmp, name, particles, walls, tris=None, steps=3000, e=0.5, mu=0.3, ascii=False):
+def write_case(tmp, name, particles, walls, tris=None, steps=3000, e=0.5, mu=0.3, ascii=False, extra=""):
     d = os.path.join(tmp, name)
     os.makedirs(d, exist_ok=True)
     if tris is not None:
@@ -135,7 +137,7 @@ def write_case(tmp, name, particles, walls, tris=None, steps=3000, e=0.5, mu=0.3
     path = os.path.join(d, "scene.yaml")
     with open(path, "w") as f:
         f.write(HEAD.format(name=name, steps=steps, e=e, mu=mu, particles="\n".join(particles),
-                            walls="\n".join(walls)))
+                            walls="\n".join(walls)) + extra)
     return path
 
 
@@ -234,6 +236,23 @@ def check_funnel_path(c, jd, R):
             np.all(x[:, :, 2].min(axis=0) < 2 * R), "lowest centres %s" % x[:, :, 2].min(axis=0))
 
 
+def check_refusals(c, tmp):
+    """The watchdog's overlap trip names the mesh wall (a sphere of radius R placed 0.2 R into the
+    floor: the fraction is 0.2 at step 0); checkpoints are refused with a mesh wall."""
+    scene = write_case(tmp, "overlap", [particle((0.001, 0.001, 0.004))], [MESH_WALL],
+                       floor_grid(4, 2.0 ** -6), steps=10,
+                       extra="watchdog: {enabled: true, max_overlap_fraction: 0.1}\n")
+    out = os.path.join(os.path.dirname(scene), "jdem.h5")
+    rc, err = run_jdem(scene, out)
+    want = "overlap fraction 0.2 for particle(s) 1 against wall 'cad' exceeds 0.1"
+    c.check("watchdog: an overlap with a mesh wall trips naming the wall (%r)" % want,
+            rc != 0 and want in err, "exit %d: %s" % (rc, err))
+    rc, err = run_jdem(scene, out + "2", "--checkpoint-every", "5")
+    want = "checkpoints do not carry the contact history of mesh walls (wall 'cad') yet"
+    c.check("checkpoints with a mesh wall: refused with a message (%r)" % want,
+            rc != 0 and want in err, "exit %d: %s" % (rc, err))
+
+
 def cross_engine(c, tmp, name, particles, tris, steps, what, threads=False):
     scene = write_case(tmp, name, particles, [MESH_WALL], tris, steps=steps)
     d = os.path.dirname(scene)
@@ -261,6 +280,7 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         check_square_vs_plane(c, tmp)
         check_rest(c, tmp)
+        check_refusals(c, tmp)
         cross_engine(c, tmp, "slide_edges", [particle((-0.012, -0.01, 0.005001), (0.4, 0.3, 0.0))],
                      floor_grid(8, 2.0 ** -6), 3000, "a sphere sliding across triangle edges")
         jd = cross_engine(c, tmp, "roll_vertex", [particle((-0.01, 0.0, 0.005001 + 0.0007), (0.4, 0.0, 0.0))],
