@@ -17,7 +17,8 @@ binary STL as float32 too), so both engines see the same triangles:
 - jdem against liggghts-jdem (deck from scripts/scene_to_liggghts.py), bit for bit: a sphere
   sliding across the edges of a triangulated floor, a sphere rolling over the apex of a shallow
   pyramid (a vertex contact), a few spheres dropped into a meshed funnel;
-- jdem on 1 and 2 threads on the funnel: the same bits.
+- jdem on 1 and 2 threads on the funnel: the same bits; its energy balance closes to 1e-3 (the
+  plane walls' standard, tests/engine/test_energy_balance.py) with the mesh's dissipation;
 - the watchdog's overlap trip names the mesh wall; --checkpoint-every is refused with a mesh
   wall (checkpoints do not carry its history yet).
 One PASS/FAIL line per check.
@@ -35,7 +36,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 from scripts import engines
-from tests.engine.engine_common import Checks
+from tests.engine.engine_common import Checks, energy_total
 
 JDEM = engines.JDEM
 LIG = engines.LIGGGHTS_JDEM
@@ -213,7 +214,7 @@ def check_rest(c, tmp):
     kn = 4.0 / 3.0 * E / (1.0 - NU * NU) * math.sqrt(R)
     delta = (m * g / kn) ** (2.0 / 3.0)
     scene = write_case(tmp, "rest", [particle((0.003, 0.002, R - delta * 0.5))], [MESH_WALL],
-                       floor_grid(4, 2.0 ** -6), steps=40000, e=0.1, mu=0.0)
+                       floor_grid(4, 2.0 ** -6), steps=20000, e=0.1, mu=0.0)
     out = os.path.join(os.path.dirname(scene), "jdem.h5")
     rc, err = run_jdem(scene, out)
     if not c.check("rest on a face: the run succeeds", rc == 0, err):
@@ -234,6 +235,17 @@ def check_funnel_path(c, jd, R):
     c.check("funnel: the spheres never touch each other (closest centres %.4g m > 2 R)" % gap, gap > 2 * R)
     c.check("funnel: every sphere reaches the bottom (its centre within R of the floor)",
             np.all(x[:, :, 2].min(axis=0) < 2 * R), "lowest centres %s" % x[:, :, 2].min(axis=0))
+    # the mesh contacts' energy accounts close the balance as the plane walls' do
+    # (tests/engine/test_energy_balance.py: 1e-3 of the initial total)
+    with h5py.File(jd, "r") as f:
+        obs = {k: f["observables"][k]["value"][()] for k in f["observables"] if "value" in f["observables"][k]}
+    total = energy_total(obs)
+    drift = np.abs(total - total[0]).max() / abs(total[0])
+    c.check("funnel: energy balance with mesh contacts, max |E - E0| / E0 = %.3g <= 1e-3" % drift,
+            drift <= 1e-3)
+    c.check("funnel: the mesh contacts dissipate (damping and friction > 1e-2 of E0)",
+            min(obs["damping_dissipation"][-1], obs["friction_dissipation"][-1]) > 1e-2 * abs(total[0]),
+            "damping %.3g J, friction %.3g J" % (obs["damping_dissipation"][-1], obs["friction_dissipation"][-1]))
 
 
 def check_refusals(c, tmp):
