@@ -99,9 +99,11 @@ def mpirun(ranks, *flags):
     return [shutil.which("mpirun") or "mpirun", *root, *flags, "-np", str(ranks)]
 
 
-def liggghts_command(deck, ranks=1, binary=LIGGGHTS_JDEM, log="log.lammps", mpi_flags=()):
-    """LIGGGHTS on DECK (a path relative to the deck's directory, where it runs), its log in LOG."""
-    return mpirun(ranks, *mpi_flags) + [binary, "-in", deck, "-log", log, "-screen", "none"]
+def liggghts_command(deck, ranks=1, binary=LIGGGHTS_JDEM, log="log.lammps", mpi_flags=(), screen=False):
+    """LIGGGHTS on DECK (a path relative to the deck's directory, where it runs), its log in LOG;
+    screen: keep the screen output (LIGGGHTS 3.8's STL reader crashes under -screen none, so a
+    deck with fix mesh/surface needs it)."""
+    return mpirun(ranks, *mpi_flags) + [binary, "-in", deck, "-log", log] + ([] if screen else ["-screen", "none"])
 
 
 def run_deck(deck_dir, deck="in.jdem", ranks=1, binary=LIGGGHTS_JDEM, log="log.lammps", mpi_flags=(), **kw):

@@ -14,7 +14,7 @@ binary STL as float32 too), so both engines see the same triangles:
 - a frictionless sphere at rest on a face: Hertz's overlap (m g / k_n)^(2/3), k_n = (4/3)
   E / (1 - nu^2) sqrt(R) (the default wall rule), to 1e-9 of the overlap as the servo wall's rest
   test (tests/engine/test_servo.py);
-- jdem against liggghts-jdem (deck from scripts/scene_to_liggghts.py), bit for bit: a sphere
+- jdem against liggghts-jdem (scripts/liggghts_run.py: the deck from scene_to_liggghts.py), bit for bit: a sphere
   sliding across the edges of a triangulated floor, a sphere rolling over the apex of a shallow
   pyramid (a vertex contact), a few spheres dropped into a meshed funnel;
 - jdem on 1 and 2 threads on the funnel: the same bits; its energy balance closes to 1e-3 (the
@@ -151,20 +151,10 @@ def run_jdem(scene, out, *args):
 
 
 def run_liggghts(scene, out):
-    """The scene's deck (scene_to_liggghts.py) in liggghts-jdem.  LIGGGHTS' STL reader prints to
-    the screen: with -screen none it crashes, so the screen goes to a pipe."""
-    d = os.path.dirname(out)
-    res = subprocess.run([JDEM, "resolve", scene], capture_output=True, text=True)
-    if res.returncode:
-        return res.returncode, res.stderr
-    resolved = os.path.join(d, "resolved.yaml")
-    with open(resolved, "w") as f:
-        f.write(res.stdout)
-    deck = subprocess.run([PY, os.path.join(ROOT, "scripts", "scene_to_liggghts.py"), resolved, "-o",
-                           os.path.join(d, "in.jdem"), "--trajectory", out], capture_output=True, text=True)
-    if deck.returncode:
-        return deck.returncode, deck.stderr
-    r = subprocess.run([LIG, "-in", "in.jdem", "-log", "log.lammps"], cwd=d, capture_output=True, text=True)
+    """The scene in liggghts-jdem through scripts/liggghts_run.py (jdem resolve, the deck from
+    scene_to_liggghts.py, the run; with the screen kept, as LIGGGHTS' STL reader needs)."""
+    r = subprocess.run([PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out],
+                       capture_output=True, text=True)
     return r.returncode, (r.stdout + r.stderr)[-1500:]
 
 
