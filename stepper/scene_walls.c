@@ -169,14 +169,14 @@ static int unique_name(loader *L, const yaml_node_t *name, const char *sub, cons
     return 0;
 }
 
-/* A wall of type mesh at PATH, appended to mesh_walls (name already read into wall). */
+/* A wall of type mesh at PATH, appended to mesh_walls (name already read into wall); counted
+ * before it is read, so that scene_free frees its triangles also when a check fails. */
 static int read_mesh(loader *L, const yaml_node_t *w, const char *path, const jd_wall *wall) {
-    jd_mesh_wall *mw = &L->s->mesh_walls[L->s->n_mesh_walls];
+    jd_mesh_wall *mw = &L->s->mesh_walls[L->s->n_mesh_walls++];
     memcpy(mw->name, wall->name, sizeof mw->name);
     if (scene_req_material(L, w, path, &mw->material) || scene_read_mesh_wall(L, w, path, mw))
         return -1;
     L->by_wall[mw->material] = 1;
-    L->s->n_mesh_walls++;
     return 0;
 }
 
