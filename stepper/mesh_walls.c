@@ -134,9 +134,12 @@ static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
     free(mw->cand_start);
     mw->cand_start = malloc((mw->n * (np + 1)) * sizeof *mw->cand_start);
     if (!mw->cand_start) return -1;
-    size_t at = 0, widest = 1;
+    size_t at = 0, widest = 1, n_orig = 0;
+    for (size_t i = 0; i < np; i++)
+        if ((size_t)ps->orig[i] + 1 > n_orig) n_orig = (size_t)ps->orig[i] + 1;
     for (size_t k = 0; k < mw->n; k++) {
         jd_sim_mesh *m = &mw->mesh[k];
+        if (history_reserve(&m->hist, n_orig) != 0) return -1;
         size_t *start = mw->cand_start + k * (np + 1);
         for (size_t i = 0; i < np; i++) {
             start[i] = at;
@@ -146,9 +149,7 @@ static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
                 jd_mesh_closest_feature(&m->topo, (int32_t)t, x, &c);
                 if (c.dist2 < reach * reach && push_candidate(mw, at++, (int32_t)t) != 0) return -1;
             }
-            const size_t o = (size_t)ps->orig[i];
-            if (history_reserve(&m->hist, o + 1) != 0) return -1;
-            if (at == start[i]) history_drop(mw, &m->hist, o, s->run.features);
+            if (at == start[i]) history_drop(mw, &m->hist, (size_t)ps->orig[i], s->run.features);
             if (at - start[i] > widest) widest = at - start[i];
         }
         start[np] = at;
