@@ -143,9 +143,8 @@ def write_deck(a, text, deck_dir, out):
 
 def liggghts_command(a, deck_dir):
     """The run of DECK_DIR/in.jdem; with the screen kept for a deck that reads an STL mesh."""
-    with open(os.path.join(deck_dir, "in.jdem")) as f:
-        meshes = any(line.split()[3:4] == ["mesh/surface"] for line in f if line.startswith("fix "))
-    return engines.liggghts_command("in.jdem", a.np, binary=os.path.abspath(a.liggghts), screen=meshes)
+    screen = engines.deck_reads_stl(os.path.join(deck_dir, "in.jdem"))
+    return engines.liggghts_command("in.jdem", a.np, binary=os.path.abspath(a.liggghts), screen=screen)
 
 
 def main():
