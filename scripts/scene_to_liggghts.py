@@ -125,7 +125,11 @@ def bounding_box(scene, particles):
     g = [float(c) for c in scene.get("gravity", [0, 0, 0])]
     for w in scene.get("walls") or []:
         if w["type"] == "mesh":  # static: its extent, scaled
-            for p in stl_extent(w["file"]):
+            try:
+                extent = stl_extent(str(w["file"]))
+            except ValueError as e:
+                fail("wall %s: %s" % (w["name"], e))
+            for p in extent:
                 grow([c * float(w["scale"]) for c in p])
             continue
         pts = w["corners"] if w["type"] == "plane" else w["axis"]
