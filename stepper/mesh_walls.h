@@ -22,8 +22,9 @@
 
 /* The contact history of one mesh wall: per particle, keyed by its scene index (orig[i], which
  * survives the renumbering), JD_MESH_SLOTS slots of `stride` doubles in the kernel's layout
- * (jdem_mesh.h: the contact's normal, then the law's record, jd_record_load/store).  A
- * checkpoint carries `slots` as it is (sim_mesh_history_block). */
+ * (jdem_mesh.h: the contact's normal, then the law's record, jd_record_load/store).  The
+ * whole state is the flat array `slots` (n x JD_MESH_SLOTS x stride doubles), so a checkpoint
+ * can carry it as one block; checkpoints do not do so yet and are refused with mesh walls. */
 typedef struct jd_mesh_history {
     size_t stride;  /* 3 + the law set's contact and rolling records [doubles]     */
     size_t n;       /* scene indices with room, 0 .. n - 1 (grows with the inlets) */
