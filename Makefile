@@ -23,12 +23,12 @@ CXX   := mpicxx
 
 DEB_PACKAGES := gcc g++ make pkg-config clang libclang-rt-14-dev libyaml-dev libhdf5-dev libcmocka-dev \
                 python3-numpy python3-scipy python3-h5py python3-matplotlib python3-yaml liggghts-doc \
-                liggghts libliggghts-dev mpi-default-dev mpi-default-bin
+                liggghts libliggghts-dev mpi-default-dev mpi-default-bin libadmesh-dev
 
 VERSION  := 0.1.0
 WARN     := -Wall -Wextra -Werror
-PKG_CFLAGS := $(shell pkg-config --cflags yaml-0.1 hdf5 2>/dev/null)
-PKG_LIBS   := $(shell pkg-config --libs yaml-0.1 hdf5 2>/dev/null) -lm
+PKG_CFLAGS := $(shell pkg-config --cflags yaml-0.1 hdf5 libadmesh 2>/dev/null)
+PKG_LIBS   := $(shell pkg-config --libs yaml-0.1 hdf5 libadmesh 2>/dev/null) -lm
 # Code generation, the same for both engines.  -O3 with the host's vector units: the pair loop
 # evaluates the contact law in SIMD lanes (stepper/forces.c).  -fno-trapping-math lets the
 # vectoriser compute both sides of the law's selects (e.g. a division in a lane whose result is

@@ -99,14 +99,24 @@ def mpirun(ranks, *flags):
     return [shutil.which("mpirun") or "mpirun", *root, *flags, "-np", str(ranks)]
 
 
-def liggghts_command(deck, ranks=1, binary=LIGGGHTS_JDEM, log="log.lammps", mpi_flags=()):
-    """LIGGGHTS on DECK (a path relative to the deck's directory, where it runs), its log in LOG."""
-    return mpirun(ranks, *mpi_flags) + [binary, "-in", deck, "-log", log, "-screen", "none"]
+def liggghts_command(deck, ranks=1, binary=LIGGGHTS_JDEM, log="log.lammps", mpi_flags=(), screen=False):
+    """LIGGGHTS on DECK (a path relative to the deck's directory, where it runs), its log in LOG;
+    screen: keep the screen output (LIGGGHTS 3.8's STL reader crashes under -screen none, so a
+    deck with fix mesh/surface needs it)."""
+    return mpirun(ranks, *mpi_flags) + [binary, "-in", deck, "-log", log] + ([] if screen else ["-screen", "none"])
+
+
+def deck_reads_stl(deck_path):
+    """1 when the deck has a `fix ID group mesh/surface` line (it reads an STL file)."""
+    with open(deck_path, errors="replace") as f:
+        return any(line.split()[:1] == ["fix"] and line.split()[3:4] == ["mesh/surface"] for line in f)
 
 
 def run_deck(deck_dir, deck="in.jdem", ranks=1, binary=LIGGGHTS_JDEM, log="log.lammps", mpi_flags=(), **kw):
-    """Run LIGGGHTS on DECK_DIR/DECK in DECK_DIR (run()'s keywords)."""
-    return run(liggghts_command(deck, ranks, binary, log, mpi_flags), cwd=deck_dir, **kw)
+    """Run LIGGGHTS on DECK_DIR/DECK in DECK_DIR (run()'s keywords); the screen kept for a deck
+    that reads an STL file."""
+    screen = deck_reads_stl(os.path.join(deck_dir, deck))
+    return run(liggghts_command(deck, ranks, binary, log, mpi_flags, screen), cwd=deck_dir, **kw)
 
 
 def write_deck(resolved, deck, *args, **kw):

@@ -141,8 +141,10 @@ def write_deck(a, text, deck_dir, out):
     return EXIT_OK
 
 
-def liggghts_command(a):
-    return engines.liggghts_command("in.jdem", a.np, binary=os.path.abspath(a.liggghts))
+def liggghts_command(a, deck_dir):
+    """The run of DECK_DIR/in.jdem; with the screen kept for a deck that reads an STL mesh."""
+    screen = engines.deck_reads_stl(os.path.join(deck_dir, "in.jdem"))
+    return engines.liggghts_command("in.jdem", a.np, binary=os.path.abspath(a.liggghts), screen=screen)
 
 
 def main():
@@ -183,7 +185,7 @@ def main():
     if child.signal:
         return 128 + child.signal
 
-    run = liggghts_command(a)
+    run = liggghts_command(a, deck_dir)
     rc, stdout, stderr = child.run(run, deck_dir, lock)
     log = os.path.join(deck_dir, "log.lammps")
     if rc < 0:

@@ -4,7 +4,7 @@
  * (JD_LAW_LOOPS) with the bits as a constant, so that jd_contact() compiles away every law the
  * scene does not use (a scene pays only for what it uses); the run-time laws (JD_F_RUN_TIME)
  * are a branch inside.  The sets with energy bookkeeping are compiled in forces_energy.c.  Order as LIGGGHTS: pair forces in list order (the candidates that
- * touched at the build, then the others: sim.h, jd_contact_list), wall forces, gravity.
+ * touched at the build, then the others: sim.h, jd_contact_list), wall forces, mesh walls, gravity.
  *
  * Threads (sim.h, "Threads"): each thread zeroes the forces of the particles it owns, evaluates
  * their entries and adds into f and torque, and into its overflow buffer for partners beyond its
@@ -855,6 +855,7 @@ void sim_compute_forces(jd_sim *s) {
      * post-force loads (loads.c); without loads, the weight is added by the half kick that
      * follows (integrate.c), which reads f anyway: the same sums, one pass less (sim.h,
      * weight_in_kick) */
+    if (s->meshes) sim_mesh_walls_forces(s); /* serial: the same bits for any thread count */
     if (s->walls.forces) sim_walls_sum(&s->walls, &s->lists.wall_pairs);
     if (s->bonds)
         sim_bonds_forces(s->bonds, &s->particles, &s->run, &s->threads, s->step, s->in_setup);

@@ -16,8 +16,10 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
+#include "mesh_walls.h"
 #include "sim.h"
 
 /* Whether a double is not finite, as arithmetic (x - x is 0 for every finite x, NaN for inf
@@ -313,6 +315,10 @@ int sim_step(jd_sim *s, int seen, char *err, size_t errlen) {
         return -1;
     const double t2 = sim_clock();
     sim_compute_forces(s);
+    if (s->meshes && s->meshes->error[0]) {
+        snprintf(err, errlen, "%s", s->meshes->error);
+        return -1;
+    }
     const double t3 = sim_clock();
     if (seen)
         s->watch.nonfinite = final_integrate(&s->particles, &s->run, &s->fast, &s->threads);

@@ -465,6 +465,8 @@ void scene_free(jd_scene *scene) {
     free(scene->settled);
     free(scene->force);
     free(scene->walls);
+    for (size_t k = 0; k < scene->n_mesh_walls; k++) free(scene->mesh_walls[k].corner);
+    free(scene->mesh_walls);
     free(scene->bond_types);
     free(scene->bond_ids);
     free(scene->bond_type);

@@ -32,7 +32,7 @@ typedef struct jd_interaction {
     double restitution, friction, rolling_friction;
 } jd_interaction;
 
-typedef enum { JD_WALL_PLANE = 0, JD_WALL_CYLINDER = 1 } jd_wall_type;
+typedef enum { JD_WALL_PLANE = 0, JD_WALL_CYLINDER = 1, JD_WALL_MESH = 2 } jd_wall_type;
 
 typedef struct jd_wall {
     char name[JD_NAME_MAX];
@@ -52,6 +52,17 @@ typedef struct jd_wall {
                                  engine from servo_hold once dt is known (jd_servo_hold_steps) */
     double servo_hold;        /* [s] within tolerance this long completes the test */
 } jd_wall;
+
+/* A static triangle-mesh wall: a walls entry of type mesh, read from an STL file (docs/scenes.md
+ * "Mesh walls").  Kept apart from the plane and cylinder walls, whose shapes the engine moves. */
+typedef struct jd_mesh_wall {
+    char name[JD_NAME_MAX];
+    int material;             /* index into materials */
+    char file[1024];          /* the STL file, relative paths resolved against the scene's folder */
+    double scale;             /* the STL coordinates times scale are metres [m per STL unit] */
+    size_t ntri;              /* triangles, in the STL's order */
+    double (*corner)[3][3];   /* [ntri] the triangles' corners, scaled [m] */
+} jd_mesh_wall;
 
 /* Run-time watchdog (docs/scenes.md "Watchdog"): limits that stop a run that goes wrong. */
 typedef struct jd_watchdog_limits {
@@ -164,6 +175,8 @@ typedef struct jd_scene {
 
     size_t n_walls;
     jd_wall *walls;
+    size_t n_mesh_walls;      /* walls of type mesh, in file order */
+    jd_mesh_wall *mesh_walls;
 
     /* bonds (docs/scenes.md "Bonds") */
     size_t n_bond_types;

@@ -7,10 +7,12 @@
  * sweep case loads back under its own name.
  */
 #include <inttypes.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 #include <yaml.h>
 
 #include "scene.h"
@@ -216,6 +218,20 @@ static int emit_wall(yaml_emitter_t *e, const jd_scene *s, const jd_wall *w) {
            key_num(e, "hold", w->servo_hold) || map_end(e) || map_end(e);
 }
 
+/* A mesh wall: its STL file as an absolute path, so that the resolved scene reads the same file
+ * from any folder. */
+static int emit_mesh_wall(yaml_emitter_t *e, const jd_scene *s, const jd_mesh_wall *w) {
+    char cwd[PATH_MAX], absolute[2 * PATH_MAX + 2];
+    const char *file = w->file;
+    if (file[0] != '/' && getcwd(cwd, sizeof cwd)) {
+        snprintf(absolute, sizeof absolute, "%s/%s", cwd, w->file);
+        file = absolute;
+    }
+    return map_start(e, 0) || key_str(e, "name", w->name) || key_str(e, "type", "mesh") ||
+           key_str(e, "file", file) || key_num(e, "scale", w->scale) ||
+           key_str(e, "material", s->materials[w->material].name) || map_end(e);
+}
+
 static const char *const BENDINGS[] = {"potyondy_cundall", "jiang2021_literal"};
 
 /* Bonds (docs/scenes.md "Bonds"): the types, every step-0 bond, the rules of later steps; only
@@ -308,6 +324,8 @@ static int emit_scene(yaml_emitter_t *e, const jd_scene *s) {
         return 1;
     for (size_t i = 0; i < s->n_walls; i++)
         if (emit_wall(e, s, &s->walls[i])) return 1;
+    for (size_t i = 0; i < s->n_mesh_walls; i++)
+        if (emit_mesh_wall(e, s, &s->mesh_walls[i])) return 1;
     return seq_end(e) || emit_bonds(e, s) || emit_inlets(e, s) || map_end(e) ||
            emit(e, &ev, yaml_document_end_event_initialize(&ev, 1)) ||
            emit(e, &ev, yaml_stream_end_event_initialize(&ev)) || !yaml_emitter_flush(e);

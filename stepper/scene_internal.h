@@ -64,6 +64,8 @@ int scene_opt_int(loader *L, const yaml_node_t *map, const char *path, const cha
 int scene_read_materials(loader *L);
 /* The required map.material, as an index into the scene's materials. */
 int scene_req_material(loader *L, const yaml_node_t *map, const char *path, int *out);
+/* scene_mesh.c: walls.K of type mesh (file, scale) into mw: the STL read and checked. */
+int scene_read_mesh_wall(loader *L, const yaml_node_t *w, const char *path, jd_mesh_wall *mw);
 /* Last: the defaults of a pair depend on whether particles and walls make it meet. */
 int scene_read_interactions(loader *L);
 

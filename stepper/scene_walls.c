@@ -1,6 +1,6 @@
 /*
  * scene_walls.c — the walls section: planar quadrilaterals and cylinders, with their geometry
- * checks.
+ * checks, and STL meshes (scene_mesh.c).
  */
 #include <stdlib.h>
 #include <string.h>
@@ -16,12 +16,13 @@ static const char *const PLANE_KEYS[] = {"name",     "type",    "corners", "mate
 static const char *const SERVO_KEYS[] = {"target", "gain", "tolerance", "max_speed", "hold", NULL};
 static const char *const CYLINDER_KEYS[] = {"name",     "type",     "axis",    "radius", "side",
                                             "material", "velocity", "present", NULL};
+static const char *const MESH_KEYS[] = {"name", "type", "file", "material", "scale", NULL};
 static const char *const BOOLEANS[] = {"false", "true", NULL};
 
 /* Enum spellings, indexed by the kernel's enum values. */
-static const char *const WALL_TYPES[] = {"plane", "cylinder", NULL};
+static const char *const WALL_TYPES[] = {"plane", "cylinder", "mesh", NULL};
 static const char *const CYLINDER_SIDES[] = {"outside", "inside", NULL};
-_Static_assert(JD_WALL_PLANE == 0 && JD_WALL_CYLINDER == 1, "WALL_TYPES order");
+_Static_assert(JD_WALL_PLANE == 0 && JD_WALL_CYLINDER == 1 && JD_WALL_MESH == 2, "WALL_TYPES order");
 
 /* Size of a point set: its largest pairwise distance. */
 static double extent(const double (*p)[3], int n) {
@@ -154,9 +155,35 @@ static int read_servo(loader *L, const yaml_node_t *w, const char *path, jd_wall
     return sd_fail(&L->c, sd_get(&L->c, m, servo_key(st)), key, "%s", msg);
 }
 
+/* A name used by an earlier wall of either kind: "duplicate" message, else 0. */
+static int unique_name(loader *L, const yaml_node_t *name, const char *sub, const char *s,
+                       size_t index) {
+    for (size_t k = 0; k < index; k++)
+        if (strcmp(L->s->walls[k].name, s) == 0)
+            return sd_fail(&L->c, name, sub, "duplicate wall name '%s' (also walls.%zu); valid: "
+                           "unique names", s, k);
+    for (size_t k = 0; k < L->s->n_mesh_walls; k++)
+        if (strcmp(L->s->mesh_walls[k].name, s) == 0)
+            return sd_fail(&L->c, name, sub, "duplicate wall name '%s' (also the mesh wall of that "
+                           "name); valid: unique names", s);
+    return 0;
+}
+
+/* A wall of type mesh at PATH, appended to mesh_walls (name already read into wall); counted
+ * before it is read, so that scene_free frees its triangles also when a check fails. */
+static int read_mesh(loader *L, const yaml_node_t *w, const char *path, const jd_wall *wall) {
+    jd_mesh_wall *mw = &L->s->mesh_walls[L->s->n_mesh_walls++];
+    memcpy(mw->name, wall->name, sizeof mw->name);
+    if (scene_req_material(L, w, path, &mw->material) || scene_read_mesh_wall(L, w, path, mw))
+        return -1;
+    L->by_wall[mw->material] = 1;
+    return 0;
+}
+
 /* Reads the wall at PATH into walls[index]; *present = 0 for a wall that the case leaves out
  * (present: false, so that one swept scene can hold the obstacles of every model): it is checked
- * like the others but takes no slot and marks no material as in use. */
+ * like the others but takes no slot and marks no material as in use.  A mesh wall goes to
+ * mesh_walls instead (*present = 0: no slot in walls). */
 static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t index,
                      int *present) {
     jd_wall *wall = &L->s->walls[index];
@@ -164,23 +191,25 @@ static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t i
     if (sd_mapping(&L->c, w, path, "{name, type, material, ...}")) return -1;
     const yaml_node_t *type = sd_get(&L->c, w, "type"), *name = sd_get(&L->c, w, "name");
     sd_join(sub, path, "type");
-    if (!type) return sd_missing(&L->c, w, path, "type", "plane, cylinder");
+    if (!type) return sd_missing(&L->c, w, path, "type", "plane, cylinder, mesh");
     if (sd_enum(&L->c, type, sub, WALL_TYPES, &wall->type)) return -1;
-    const int plane = wall->type == JD_WALL_PLANE;
+    const int plane = wall->type == JD_WALL_PLANE, mesh = wall->type == JD_WALL_MESH;
     sd_join(sub, path, "servo");
     if (!plane && sd_get(&L->c, w, "servo"))
         return sd_fail(&L->c, sd_get(&L->c, w, "servo"), sub, "a servo moves a plane wall along "
                        "its normal; valid: servo on a wall of type plane");
-    if (sd_keys(&L->c, w, path, plane ? PLANE_KEYS : CYLINDER_KEYS)) return -1;
+    if (sd_keys(&L->c, w, path, plane ? PLANE_KEYS : mesh ? MESH_KEYS : CYLINDER_KEYS)) return -1;
     *present = 1;
     if (sd_opt_enum(&L->c, w, path, "present", BOOLEANS, present)) return -1;
     sd_join(sub, path, "name");
     if (!name) return sd_missing(&L->c, w, path, "name", "a unique name");
-    if (sd_name(&L->c, name, sub, wall->name, sizeof wall->name)) return -1;
-    for (size_t k = 0; k < index; k++)
-        if (strcmp(L->s->walls[k].name, wall->name) == 0)
-            return sd_fail(&L->c, name, sub, "duplicate wall name '%s' (also walls.%zu); valid: "
-                           "unique names", wall->name, k);
+    if (sd_name(&L->c, name, sub, wall->name, sizeof wall->name) ||
+        unique_name(L, name, sub, wall->name, index))
+        return -1;
+    if (mesh) {
+        *present = 0;
+        return read_mesh(L, w, path, wall);
+    }
     if (scene_req_material(L, w, path, &wall->material) ||
         sd_opt_vec3(&L->c, w, path, "velocity", wall->velocity))
         return -1;
@@ -198,7 +227,8 @@ int scene_read_walls(loader *L) {
     if (!list) return 0;
     if (sd_sequence(&L->c, list, "walls", "a list of {name, type, material, ...}")) return -1;
     L->s->walls = calloc(sd_len(list) ? sd_len(list) : 1, sizeof *L->s->walls);
-    if (!L->s->walls) return sd_no_memory(&L->c, list, "walls");
+    L->s->mesh_walls = calloc(sd_len(list) ? sd_len(list) : 1, sizeof *L->s->mesh_walls);
+    if (!L->s->walls || !L->s->mesh_walls) return sd_no_memory(&L->c, list, "walls");
     for (size_t i = 0; i < sd_len(list); i++) {
         char path[SD_PATH_MAX];
         int present;

@@ -13,6 +13,7 @@
 #include "h5md_internal.h"
 #include "hugepages.h"
 #include "jdem_laws.h"
+#include "mesh_walls.h"
 #include "sim.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -231,6 +232,10 @@ static int setup_forces(jd_sim *s, char *err, size_t errlen) {
         sim_compute_forces(s);
         s->in_setup = 0;
         for (int k = 0; k < 2; k++) restore_history(lists[k], state[k], roll[k]);
+        if (s->meshes && s->meshes->error[0]) {
+            snprintf(err, errlen, "%s", s->meshes->error);
+            ok = 0;
+        }
     } else {
         snprintf(err, errlen, "out of memory");
     }
@@ -252,7 +257,9 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
         snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads.n);
         return -1;
     }
-    if (sim_walls_init(&s->walls, &s->run, err, errlen) != 0) return -1;
+    if (sim_walls_init(&s->walls, &s->run, err, errlen) != 0 ||
+        sim_mesh_walls_init(&s->meshes, &s->run, err, errlen) != 0)
+        return -1;
     if (sim_bonds_init(&s->bonds, &s->particles, s->run.scene, err, errlen) != 0 ||
         sim_loads_init(&s->loads, s->run.scene, err, errlen) != 0 ||
         sim_inlets_init(s, err, errlen) != 0)
@@ -289,6 +296,7 @@ void sim_free(jd_sim *s) {
     sim_forces_free(&s->threads);
     free(s->run.coeffs);
     sim_walls_free(&s->walls);
+    sim_mesh_walls_free(s->meshes);
     free(s->lists.cell_start);
     sim_contact_list_free(&s->lists.pairs);
     sim_contact_list_free(&s->lists.wall_pairs);
@@ -359,6 +367,7 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     double val[JD_N_OBSERVABLES];
     sim_observables(&s->particles, &s->run, &s->lists, &s->walls, &s->accounts, &o);
     if (s->bonds) sim_bonds_observables(s->bonds, s->particles.n, &o.bond);
+    if (s->meshes) sim_mesh_walls_observables(s->meshes, &o);
     sim_observables_values(&o, val);
     for (int k = 0; h && k < JD_N_OBSERVABLES; k++)
         if ((s->run.scene->energy || !jd_observable_is_energy[k]) &&
@@ -370,6 +379,9 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
                                                    sim_inlets_energy(s), err, errlen) != 0)
         return JD_RUN_OUTPUT;
     if (h && s->walls.forces && sim_walls_write_observables(&s->walls, &s->run, s->step, h, err, errlen) != 0)
+        return JD_RUN_OUTPUT;
+    if (h && s->meshes &&
+        sim_mesh_walls_write_observables(s->meshes, &s->run, s->step, h, err, errlen) != 0)
         return JD_RUN_OUTPUT;
     if (s->bonds) {
         double bv[JD_N_BOND_OBSERVABLES];

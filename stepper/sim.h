@@ -333,6 +333,7 @@ typedef struct jd_sim {
     jd_bonds *bonds;   /* parallel bonds (bonds.h) */
     struct jd_loads *loads; /* held particles and external forces (loads.c) */
     struct jd_sim_inlets *inlets; /* conveyor inlets (inlet.c) */
+    struct jd_mesh_walls *meshes; /* STL mesh walls (mesh_walls.c) */
 
     /* set by the caller (e.g. a signal handler) to stop the run at the next step; NULL: never */
     const volatile sig_atomic_t *stop;
@@ -443,6 +444,8 @@ int sim_walls_write_observables(const jd_walls *walls, const jd_run_constants *r
 /* forces.c: zero f and torque, then pair forces, wall forces, bonds, gravity (unless
  * s->fast.weight_in_kick), loads. */
 void sim_compute_forces(jd_sim *s);
+/* mesh_walls.c: the STL mesh walls' forces, serially after the contact loops (mesh_walls.h). */
+void sim_mesh_walls_forces(jd_sim *s);
 /* Add every particle's weight m g to its force. */
 void sim_gravity(jd_particles *ps, const jd_run_constants *run, const jd_thread_layout *threads);
 /* The force loops' per-thread state for threads->n threads (sim_init), and its release. */

@@ -20,11 +20,17 @@ void sim_watchdog_overlap(jd_overlap_trip *t, int32_t i, int32_t j, double delta
     if (fraction > t->fraction) *t = (jd_overlap_trip){.fraction = fraction, .i = i, .j = j};
 }
 
+/* The name of wall -j - 1 of a trip: the plane and cylinder walls, then the mesh walls. */
+static const char *trip_wall_name(const jd_scene *sc, int32_t j) {
+    const size_t w = (size_t)(-(int64_t)j - 1);
+    return w < sc->n_walls ? sc->walls[w].name : sc->mesh_walls[w - sc->n_walls].name;
+}
+
 static int overlap_message(const jd_overlap_trip *t, const jd_particles *ps,
                            const jd_run_constants *run, int64_t step, char *msg, size_t len) {
     jd_watchdog_overlap_message(msg, len, (long long)step, t->fraction, sim_particle_id(ps, (size_t)t->i),
                                 t->j >= 0 ? sim_particle_id(ps, (size_t)t->j) : -1,
-                                t->j >= 0 ? "" : run->scene->walls[-t->j - 1].name, run->max_overlap);
+                                t->j >= 0 ? "" : trip_wall_name(run->scene, t->j), run->max_overlap);
     return JD_RUN_TRIPPED;
 }
 

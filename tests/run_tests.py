@@ -45,6 +45,10 @@ SUITES += [("observables-cadence", [PY, "tests/liggghts/check_observables_cadenc
 # STL mesh walls in LIGGGHTS (fix wall/jiang mesh) against our plane primitive, bit for bit:
 # resting, sliding across edges, a concave corner, a conveyor; move/mesh motion; bad input.
 SUITES += [("mesh-liggghts", [PY, "tests/mesh/test_mesh_liggghts.py"], "lines", {})]
+# STL mesh walls in build/jdem: against the plane primitive and Hertz at rest, against
+# liggghts-jdem bit for bit (edges, a vertex, a funnel), 1 vs 2 threads.
+SUITES += [("mesh-engines", [PY, "tests/mesh/test_mesh_engines.py"], "lines", {}),
+           ("mesh-engines-sanitized", [PY, "tests/mesh/test_mesh_engines.py"], "lines", SANITIZED)]
 # The law set (kernel/jdem_laws.h) each engine selects, for every scene of reference_runs/ and
 # tests/, and hand-written decks that leave out `rolling on`.
 SUITES += [("law-sets", [PY, "tests/liggghts/check_law_sets.py"], "lines", {})]

@@ -1,0 +1,288 @@
+/*
+ * mesh_walls.c — static STL mesh walls in the stepper (mesh_walls.h): set-up, candidates,
+ * the serial force loop, the observables.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "h5md.h"
+#include "mesh_walls.h"
+
+/* The topology of scene wall `in` into m (the scene reader has run the same build). */
+static int mesh_init(jd_sim_mesh *m, const jd_mesh_wall *in, size_t stride, char *err, size_t errlen) {
+    const size_t n = in->ntri;
+    jd_mesh_storage *st = &m->storage;
+    st->vertex = malloc(3 * n * sizeof *st->vertex);
+    st->tri_vertex = malloc(n * sizeof *st->tri_vertex);
+    st->tri_edge = malloc(n * sizeof *st->tri_edge);
+    st->edge_vertex = malloc(3 * n * sizeof *st->edge_vertex);
+    st->edge_valence = malloc(3 * n * sizeof *st->edge_valence);
+    st->vertex_valence = malloc(3 * n * sizeof *st->vertex_valence);
+    st->scratch = malloc(3 * n * sizeof *st->scratch);
+    m->material = in->material;
+    m->hist.stride = stride;
+    size_t bad = 0;
+    if (!st->vertex || !st->tri_vertex || !st->tri_edge || !st->edge_vertex || !st->edge_valence ||
+        !st->vertex_valence || !st->scratch) {
+        snprintf(err, errlen, "out of memory for the topology of mesh wall '%s'", in->name);
+        return -1;
+    }
+    if (jd_mesh_build(n, (const double(*)[3][3])in->corner, st, &m->topo, &bad) != JD_MESH_OK) {
+        snprintf(err, errlen, "mesh wall '%s': triangle %zu is degenerate", in->name, bad);
+        return -1;
+    }
+    return 0;
+}
+
+int sim_mesh_walls_init(jd_mesh_walls **out, const jd_run_constants *run, char *err, size_t errlen) {
+    const jd_scene *sc = run->scene;
+    *out = NULL;
+    if (!sc->n_mesh_walls) return 0;
+    jd_mesh_walls *mw = calloc(1, sizeof *mw);
+    const unsigned F = run->features;
+    const size_t stride = 3 + (size_t)jd_contact_record_len(F) + (size_t)jd_rolling_record_len(F);
+    if (mw) {
+        mw->mesh = calloc(sc->n_mesh_walls, sizeof *mw->mesh);
+        mw->next = calloc(JD_MESH_SLOTS * stride, sizeof *mw->next);
+    }
+    if (!mw || !mw->mesh || !mw->next) {
+        snprintf(err, errlen, "out of memory for the mesh walls");
+        sim_mesh_walls_free(mw);
+        return -1;
+    }
+    mw->built_at = -1;
+    mw->features = F;
+    for (size_t k = 0; k < sc->n_mesh_walls; k++) {
+        mw->n = k + 1;
+        if (mesh_init(&mw->mesh[k], &sc->mesh_walls[k], stride, err, errlen) != 0) {
+            sim_mesh_walls_free(mw);
+            return -1;
+        }
+    }
+    *out = mw;
+    return 0;
+}
+
+void sim_mesh_walls_free(jd_mesh_walls *mw) {
+    if (!mw) return;
+    for (size_t k = 0; k < mw->n; k++) {
+        jd_mesh_storage *st = &mw->mesh[k].storage;
+        free(st->vertex);
+        free(st->tri_vertex);
+        free(st->tri_edge);
+        free(st->edge_vertex);
+        free(st->edge_valence);
+        free(st->vertex_valence);
+        free(st->scratch);
+        free(mw->mesh[k].hist.slots);
+    }
+    free(mw->mesh);
+    free(mw->next);
+    free(mw->cand_start);
+    free(mw->cand_tri);
+    free(mw->closest);
+    free(mw->is_contact);
+    free(mw);
+}
+
+/* Room in h for scene indices below n (new ones empty). */
+static int history_reserve(jd_mesh_history *h, size_t n) {
+    if (n <= h->n) return 0;
+    const size_t per = JD_MESH_SLOTS * h->stride;
+    double *p = realloc(h->slots, n * per * sizeof *p);
+    if (!p) return -1;
+    memset(p + h->n * per, 0, (n - h->n) * per * sizeof *p);
+    h->slots = p;
+    h->n = n;
+    return 0;
+}
+
+/* Particle with scene index o loses its history with a mesh: the dissipation is booked. */
+static void history_drop(jd_mesh_walls *mw, jd_mesh_history *h, size_t o, unsigned F) {
+    double *slot = h->slots + o * JD_MESH_SLOTS * h->stride;
+    const int hw = jd_contact_record_len(F), rw = jd_rolling_record_len(F);
+    for (int c = 0; c < JD_MESH_SLOTS; c++) {
+        jd_contact_state st;
+        const double *r = slot + (size_t)c * h->stride + 3;
+        jd_record_load(r, hw, r + hw, rw, &st, NULL);
+        jd_contact_harvest(&st, 1.0, &mw->e_damp_dropped, &mw->e_fric_dropped);
+    }
+    memset(slot, 0, JD_MESH_SLOTS * h->stride * sizeof *slot);
+}
+
+static int push_candidate(jd_mesh_walls *mw, size_t at, int32_t t) {
+    if (at == mw->cand_cap) {
+        const size_t cap = mw->cand_cap ? 2 * mw->cand_cap : 1024;
+        int32_t *p = realloc(mw->cand_tri, cap * sizeof *p);
+        if (!p) return -1;
+        mw->cand_tri = p;
+        mw->cand_cap = cap;
+    }
+    mw->cand_tri[at] = t;
+    return 0;
+}
+
+/* Every triangle within R + skin of each particle's position now (the build's), ascending per
+ * particle and mesh; particles left without candidates lose their history (they cannot touch
+ * the mesh before the next build).  Brute force over the triangles: meshes here are small
+ * (docs/model.md section 11). */
+static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
+    const jd_particles *ps = &s->particles;
+    const size_t np = ps->n;
+    free(mw->cand_start);
+    mw->cand_start = malloc((mw->n * (np + 1)) * sizeof *mw->cand_start);
+    if (!mw->cand_start) return -1;
+    size_t at = 0, widest = 1, n_orig = 0;
+    for (size_t i = 0; i < np; i++)
+        if ((size_t)ps->orig[i] + 1 > n_orig) n_orig = (size_t)ps->orig[i] + 1;
+    for (size_t k = 0; k < mw->n; k++) {
+        jd_sim_mesh *m = &mw->mesh[k];
+        if (history_reserve(&m->hist, n_orig) != 0) return -1;
+        size_t *start = mw->cand_start + k * (np + 1);
+        for (size_t i = 0; i < np; i++) {
+            start[i] = at;
+            const double *x = ps->x + 3 * i, reach = ps->radius[i] + s->lists.skin;
+            for (size_t t = 0; t < m->topo.ntri; t++) {
+                jd_mesh_closest c;
+                jd_mesh_closest_feature(&m->topo, (int32_t)t, x, &c);
+                if (c.dist2 < reach * reach && push_candidate(mw, at++, (int32_t)t) != 0) return -1;
+            }
+            if (at == start[i]) history_drop(mw, &m->hist, (size_t)ps->orig[i], s->run.features);
+            if (at - start[i] > widest) widest = at - start[i];
+        }
+        start[np] = at;
+    }
+    if (widest > mw->scratch_cap) {
+        free(mw->closest);
+        free(mw->is_contact);
+        mw->closest = malloc(widest * sizeof *mw->closest);
+        mw->is_contact = malloc(widest);
+        if (!mw->closest || !mw->is_contact) return -1;
+        mw->scratch_cap = widest;
+    }
+    mw->built_at = s->lists.n_builds;
+    mw->n_particles = np;
+    return 0;
+}
+
+/* The old slots no contact continues: their dissipation is booked before they are cleared. */
+static void drop_ended(jd_mesh_walls *mw, const double *slots, size_t stride, const jd_mesh_sphere *sc,
+                       unsigned F) {
+    const int hw = jd_contact_record_len(F), rw = jd_rolling_record_len(F);
+    for (int j = 0; j < JD_MESH_SLOTS; j++) {
+        int kept = 0;
+        for (size_t c = 0; c < sc->n; c++) kept |= sc->from[c] == j;
+        if (kept) continue;
+        jd_contact_state st;
+        const double *r = slots + (size_t)j * stride + 3;
+        jd_record_load(r, hw, r + hw, rw, &st, NULL);
+        jd_contact_harvest(&st, 1.0, &mw->e_damp_dropped, &mw->e_fric_dropped);
+    }
+}
+
+/* Particle i against mesh k (candidates tri[0, n)): the kernel's contacts, the wall law on
+ * each (in the contacts' order, as fix wall/jiang mesh), the history kept unless in set-up
+ * (then only the normals and the energy reference, as the plugin's set-up evaluation). */
+static void sphere_forces(jd_sim *s, jd_mesh_walls *mw, size_t k, size_t i, size_t n,
+                          const int32_t *tri, double *work) {
+    jd_sim_mesh *m = &mw->mesh[k];
+    jd_particles *ps = &s->particles;
+    const jd_run_constants *run = &s->run;
+    const unsigned F = run->features;
+    const size_t stride = m->hist.stride;
+    const int hw = jd_contact_record_len(F), rw = jd_rolling_record_len(F);
+    double *slots = m->hist.slots + (size_t)ps->orig[i] * JD_MESH_SLOTS * stride;
+    const double *x = ps->x + 3 * i, R = ps->radius[i];
+    jd_mesh_sphere sc;
+    if (jd_mesh_sphere_contacts(&m->topo, n, tri, x, R, slots, stride, mw->closest, mw->is_contact,
+                                &sc) == JD_MESH_TOO_MANY && !mw->error[0])
+        snprintf(mw->error, sizeof mw->error, "particle %lld touches more than %d faces of mesh "
+                 "wall '%s' at once at step %lld", sim_particle_id(ps, i), JD_MESH_SLOTS,
+                 run->scene->mesh_walls[k].name, (long long)s->step);
+    if (!s->in_setup) drop_ended(mw, slots, stride, &sc, F);
+    jd_mesh_history_next(slots, stride, &sc, mw->next);
+    const jd_pair_coeffs co =
+        jd_wall_coeffs(&run->coeffs[(size_t)ps->species[i] * run->n_materials + (size_t)m->material]);
+    for (size_t c = 0; c < sc.n; c++) {
+        jd_contact_geom *g = &sc.geom[c];
+        if (jd_overlap_excessive(g->delta, R, INFINITY, run->max_overlap))
+            sim_watchdog_overlap(&s->watch.overlap_trip, (int32_t)i,
+                                 -1 - (int32_t)(s->walls.n + k), g->delta, R);
+        jd_geom_wall_material(F, g, ps->kw[i], ps->mass[i], ps->inertia[i]);
+        jd_kinematics kin;
+        memset(&kin, 0, sizeof kin); /* a static wall: vb = wb = 0 */
+        for (int d = 0; d < 3; d++) {
+            kin.va[d] = ps->v[3 * i + d];
+            kin.wa[d] = ps->omega[3 * i + d];
+        }
+        double *rec = mw->next + c * stride + 3;
+        jd_contact_state st, kept;
+        jd_rolling_state rs, rs_kept;
+        jd_record_load(rec, hw, rec + hw, rw, &st, &rs);
+        kept = st;
+        rs_kept = rs;
+        jd_contact_result out;
+        const int carries = jd_contact(F, &co, g, &kin, run->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
+        if (s->in_setup) jd_contact_keep_reference(&kept, &st, &rs_kept, &rs);
+        jd_record_store(rec, hw, rec + hw, rw, s->in_setup ? &kept : &st, s->in_setup ? &rs_kept : &rs);
+        if ((F & JD_F_ENERGY) && !s->in_setup) *work += jd_wall_work(kept.f_prev, out.f, kin.vb, run->dt);
+        if (!carries) continue;
+        for (int d = 0; d < 3; d++) {
+            ps->f[3 * i + d] -= out.f[d];
+            ps->torque[3 * i + d] += out.ta[d];
+            m->force[d] += out.f[d];
+        }
+    }
+    memcpy(slots, mw->next, JD_MESH_SLOTS * stride * sizeof *slots);
+}
+
+void sim_mesh_walls_forces(jd_sim *s) {
+    jd_mesh_walls *mw = s->meshes;
+    if (mw->built_at != s->lists.n_builds && build_candidates(mw, s) != 0) {
+        snprintf(mw->error, sizeof mw->error, "out of memory for the mesh walls' candidates");
+        return;
+    }
+    double work = 0.0;
+    const size_t np = mw->n_particles;
+    for (size_t k = 0; k < mw->n; k++) {
+        memset(mw->mesh[k].force, 0, sizeof mw->mesh[k].force);
+        const size_t *start = mw->cand_start + k * (np + 1);
+        for (size_t i = 0; i < np; i++)
+            if (start[i + 1] > start[i])
+                sphere_forces(s, mw, k, i, start[i + 1] - start[i], mw->cand_tri + start[i], &work);
+    }
+    s->accounts.wall_work += work;
+}
+
+void sim_mesh_walls_observables(const jd_mesh_walls *mw, jd_observables *o) {
+    o->damping_dissipation += mw->e_damp_dropped;
+    o->friction_dissipation += mw->e_fric_dropped;
+    for (size_t k = 0; k < mw->n; k++) {
+        const jd_mesh_history *h = &mw->mesh[k].hist;
+        for (size_t s = 0; s < h->n * JD_MESH_SLOTS; s++) {
+            const double *slot = h->slots + s * h->stride;
+            if (slot[0] == 0.0 && slot[1] == 0.0 && slot[2] == 0.0) continue;
+            jd_contact_state st;
+            jd_record_load(slot + 3, jd_contact_record_len(mw->features), NULL, 0, &st, NULL);
+            o->elastic_energy += jd_contact_elastic_energy(&st);
+            jd_contact_harvest(&st, 1.0, &o->damping_dissipation, &o->friction_dissipation);
+            if (st.flags != (double)JD_S_ENDED) o->wall_contacts += 1.0;
+        }
+    }
+}
+
+int sim_mesh_walls_write_observables(const jd_mesh_walls *mw, const jd_run_constants *run,
+                                     int64_t step, struct jd_h5md *h, char *err, size_t errlen) {
+    for (size_t k = 0; k < mw->n; k++)
+        for (int d = 0; d < 3; d++) {
+            char name[2 * JD_NAME_MAX + 32];
+            snprintf(name, sizeof name, "%s/%s/%s", jd_obs_wall_force, run->scene->mesh_walls[k].name,
+                     jd_obs_axes[d]);
+            if (jd_h5md_write_observable(h, name, step, (double)step * run->dt, mw->mesh[k].force[d],
+                                         err, errlen))
+                return -1;
+        }
+    return 0;
+}

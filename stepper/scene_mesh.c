@@ -1,0 +1,121 @@
+/*
+ * scene_mesh.c — walls of type mesh: a static triangle mesh read from an STL file with
+ * libadmesh (Debian's libadmesh-dev), scaled, and checked by the kernel's topology builder
+ * (jd_mesh_build), so that a degenerate triangle is reported at load time by its index.
+ */
+#include <errno.h>
+#include <libgen.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <admesh/stl.h>
+
+#include "jdem_mesh.h"
+#include "scene_internal.h"
+
+/* admesh 0.98 refuses a file shorter than the 84-byte binary header plus four facets. */
+#define STL_MIN_BYTES 284
+
+/* file relative to the scene file's folder (absolute paths as they are) into out. */
+static int resolve_path(const char *scene_path, const char *file, char *out, size_t size) {
+    if (file[0] == '/') return snprintf(out, size, "%s", file) >= (int)size;
+    char dir[sizeof ((jd_scene *)0)->path];
+    snprintf(dir, sizeof dir, "%s", scene_path);
+    return snprintf(out, size, "%s/%s", dirname(dir), file) >= (int)size;
+}
+
+/* The file's size in bytes, or -1 with errno when it cannot be opened for reading. */
+static long readable_size(const char *file) {
+    FILE *f = fopen(file, "rb");
+    if (!f) return -1;
+    long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    fclose(f);
+    return size;
+}
+
+/* The STL's triangles, times scale, into mw (admesh stores float32 coordinates: each is
+ * widened exactly to double before the scaling). */
+static int read_stl(loader *L, const yaml_node_t *at, const char *sub, jd_mesh_wall *mw) {
+    const long size = readable_size(mw->file);
+    if (size < 0)
+        return sd_fail(&L->c, at, sub, "cannot read the STL file '%s' (%s); valid: the path of an "
+                       "STL file, relative to the scene file's folder", mw->file, strerror(errno));
+    if (size < STL_MIN_BYTES)
+        return sd_fail(&L->c, at, sub, "the STL file '%s' has %ld bytes, fewer than the %d that "
+                       "admesh reads; valid: an STL file of at least %d bytes (at least four "
+                       "triangles in binary)", mw->file, size, STL_MIN_BYTES, STL_MIN_BYTES);
+    stl_file stl;
+    memset(&stl, 0, sizeof stl);
+    stl_open(&stl, mw->file);
+    if (stl_get_error(&stl) || stl.stats.number_of_facets <= 0) {
+        stl_close(&stl);
+        return sd_fail(&L->c, at, sub, "admesh cannot read the STL file '%s'; valid: an ASCII or "
+                       "binary STL file with at least one triangle", mw->file);
+    }
+    mw->ntri = (size_t)stl.stats.number_of_facets;
+    mw->corner = malloc(mw->ntri * sizeof *mw->corner);
+    if (!mw->corner) {
+        stl_close(&stl);
+        return sd_no_memory(&L->c, at, sub);
+    }
+    for (size_t t = 0; t < mw->ntri; t++)
+        for (int k = 0; k < 3; k++) {
+            const stl_vertex *v = &stl.facet_start[t].vertex[k];
+            mw->corner[t][k][0] = (double)v->x * mw->scale;
+            mw->corner[t][k][1] = (double)v->y * mw->scale;
+            mw->corner[t][k][2] = (double)v->z * mw->scale;
+        }
+    stl_close(&stl);
+    return 0;
+}
+
+/* The kernel's topology builder on the scaled triangles: the first degenerate one by index. */
+static int check_topology(loader *L, const yaml_node_t *at, const char *sub, const jd_mesh_wall *mw) {
+    const size_t n = mw->ntri;
+    jd_mesh_storage st = {malloc(3 * n * sizeof *st.vertex), malloc(n * sizeof *st.tri_vertex),
+                          malloc(n * sizeof *st.tri_edge), malloc(3 * n * sizeof *st.edge_vertex),
+                          malloc(3 * n * sizeof *st.edge_valence),
+                          malloc(3 * n * sizeof *st.vertex_valence), malloc(3 * n * sizeof *st.scratch)};
+    jd_mesh m;
+    size_t bad = 0;
+    int rc = -2;
+    if (st.vertex && st.tri_vertex && st.tri_edge && st.edge_vertex && st.edge_valence &&
+        st.vertex_valence && st.scratch)
+        rc = jd_mesh_build(n, (const double(*)[3][3])mw->corner, &st, &m, &bad);
+    free(st.vertex);
+    free(st.tri_vertex);
+    free(st.tri_edge);
+    free(st.edge_vertex);
+    free(st.edge_valence);
+    free(st.vertex_valence);
+    free(st.scratch);
+    if (rc == -2) return sd_no_memory(&L->c, at, sub);
+    if (rc == JD_MESH_DEGENERATE)
+        return sd_fail(&L->c, at, sub, "triangle %zu (0-based, in the file's order) of the STL "
+                       "file '%s' has zero area or two equal corners (after scaling); valid: "
+                       "triangles with three distinct corners and a non-zero area", bad, mw->file);
+    if (rc == JD_MESH_TOO_LARGE)
+        return sd_fail(&L->c, at, sub, "the STL file '%s' has %zu triangles; valid: at most %d",
+                       mw->file, n, INT32_MAX / 3);
+    return 0;
+}
+
+int scene_read_mesh_wall(loader *L, const yaml_node_t *w, const char *path, jd_mesh_wall *mw) {
+    char sub[SD_PATH_MAX];
+    sd_join(sub, path, "file");
+    const yaml_node_t *file = sd_get(&L->c, w, "file");
+    if (!file) return sd_missing(&L->c, w, path, "file", "the path of an STL file");
+    const char *text = sd_scalar(file);
+    if (!text || !*text)
+        return sd_fail(&L->c, file, sub, "expected a file name, got %s; valid: the path of an STL "
+                       "file", sd_kind(file));
+    if (resolve_path(L->s->path, text, mw->file, sizeof mw->file))
+        return sd_fail(&L->c, file, sub, "the path is too long; valid: at most %zu characters",
+                       sizeof mw->file - 1);
+    mw->scale = 1.0;
+    if (sd_opt_num(&L->c, w, path, "scale", SD_POSITIVE, &mw->scale) ||
+        read_stl(L, file, sub, mw))
+        return -1;
+    return check_topology(L, file, sub, mw);
+}
