@@ -413,7 +413,7 @@ static void write_stop_frame(jd_sim *s, jd_h5md *h) {
  * signal's flag is set).  Never twice at one step; 0 or JD_RUN_OUTPUT with err. */
 static int checkpoint_if_due(jd_sim *s, jd_h5md *h, jd_checkpointer *ck, const jd_progress *p,
                              char *err, size_t errlen) {
-    if (!ck || s->step == ck->last_step) return 0;
+    if (!ck || !ck->path || s->step == ck->last_step) return 0; /* no checkpoint asked for */
     const double now = sim_clock();
     const int due = (s->stop && *s->stop) ||
                     (s->step > 0 && ck->every_steps > 0 && s->step % ck->every_steps == 0) ||

@@ -51,6 +51,7 @@ import time
 
 import h5py
 import numpy as np
+from tests.mesh.stl_files import write_ascii_stl_double
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -113,7 +114,7 @@ def particles(case, path):
         atoms = [(1, 2 * (0.0095 + 0.0005 * (n % 2)), 2500.0, p) for n, p in enumerate(pts)]
         write_data(path, box, atoms, velocity)
         for name, tris in MESHES[case]().items():
-            write_stl(os.path.join(os.path.dirname(path), name + ".stl"), tris)
+            write_ascii_stl_double(os.path.join(os.path.dirname(path), name + ".stl"), tris)
     else:
         pts = lattice([0.0295, 0.0295, 0.0145], 0.0282, [6, 6, 6], 0.05, rng)
         atoms = [(1, 2 * (0.013 if rng.uniform() < 0.5 else 0.014), 2500.0, p) for p in pts]
@@ -164,17 +165,6 @@ def belt_mesh():
     """The belt z = 0 and an end wall across it at x = 0.006 (the bed reaches it)."""
     return {"belt": grid((-0.12, -0.06, 0.0), (0.03, 0, 0), (0, 0.03, 0), 8, 4),
             "stop": grid((0.006, -0.06, -0.02), (0, 0.03, 0), (0, 0, 0.02), 4, 4)}
-
-
-def write_stl(path, tris):
-    with open(path, "w") as f:
-        f.write("solid wall\n")
-        for t in tris:
-            f.write(" facet normal 0 0 0\n  outer loop\n")
-            for p in t:
-                f.write("   vertex %r %r %r\n" % tuple(float(c) for c in p))
-            f.write("  endloop\n endfacet\n")
-        f.write("endsolid wall\n")
 
 
 MESHES = {"mesh_box": box_mesh, "mesh_drum": drum_mesh, "mesh_belt": belt_mesh}

@@ -25,7 +25,6 @@ One PASS/FAIL line per check.
 """
 import math
 import os
-import struct
 import subprocess
 import sys
 import tempfile
@@ -37,6 +36,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 from scripts import engines
 from tests.engine.engine_common import Checks, energy_total
+from tests.mesh.stl_files import f32, write_ascii_stl_float32, write_binary_stl
 
 JDEM = engines.JDEM
 LIG = engines.LIGGGHTS_JDEM
@@ -55,35 +55,6 @@ particles:
 walls:
 {walls}
 """
-
-
-def f32(v):
-    return float(np.float32(v))
-
-
-def write_binary_stl(path, tris):
-    """Binary STL (float32 corners; the normal left zero, as both readers ignore it)."""
-    with open(path, "wb") as f:
-        f.write(b"jdem test mesh".ljust(80, b" "))
-        f.write(struct.pack("<I", len(tris)))
-        for t in tris:
-            f.write(struct.pack("<3f", 0.0, 0.0, 0.0))
-            for p in t:
-                f.write(struct.pack("<3f", *p))
-            f.write(b"\0\0")
-
-
-def write_ascii_stl(path, tris):
-    """ASCII STL; each coordinate a float32 value written with enough digits to be read back
-    exactly by admesh (float32) and by LIGGGHTS (atof, double)."""
-    with open(path, "w") as f:
-        f.write("solid wall\n")
-        for t in tris:
-            f.write(" facet normal 0 0 0\n  outer loop\n")
-            for p in t:
-                f.write("   vertex %.17g %.17g %.17g\n" % tuple(f32(c) for c in p))
-            f.write("  endloop\n endfacet\n")
-        f.write("endsolid wall\n")
 
 
 def square(h):
@@ -134,7 +105,7 @@ def write_case(tmp, name, particles, walls, tris=None, steps=3000, e=0.5, mu=0.3
     d = os.path.join(tmp, name)
     os.makedirs(d, exist_ok=True)
     if tris is not None:
-        (write_ascii_stl if ascii else write_binary_stl)(os.path.join(d, "mesh.stl"), tris)
+        (write_ascii_stl_float32 if ascii else write_binary_stl)(os.path.join(d, "mesh.stl"), tris)
     path = os.path.join(d, "scene.yaml")
     with open(path, "w") as f:
         f.write(HEAD.format(name=name, steps=steps, e=e, mu=mu, particles="\n".join(particles),

@@ -37,6 +37,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 from tests.engine.engine_common import Checks
 from tests.liggghts.liggghts_common import granular_deck_head
+from tests.mesh.stl_files import write_ascii_stl_double
 
 LIG = os.path.join(ROOT, "build", "liggghts-jdem")
 H = 2.0 ** -7   # grid spacing [m]
@@ -85,22 +86,11 @@ def wall_triangles(xw, n=16, y0=-0.0625, nz=4):
     return tris
 
 
-def write_stl(path, tris):
-    with open(path, "w") as f:
-        f.write("solid wall\n")
-        for t in tris:
-            f.write(" facet normal 0 0 0\n  outer loop\n")
-            for p in t:
-                f.write("   vertex %.17g %.17g %.17g\n" % p)
-            f.write("  endloop\n endfacet\n")
-        f.write("endsolid wall\n")
-
-
 def run(tmp, name, tris=None, ranks=1, **fields):
     d = os.path.join(tmp, name)
     os.mkdir(d)
     if tris is not None:
-        write_stl(os.path.join(d, "wall.stl"), tris)
+        write_ascii_stl_double(os.path.join(d, "wall.stl"), tris)
     fields.setdefault("velocity", "")
     fields.setdefault("steps", 3000)
     # LIGGGHTS' STL reader prints to the screen: -screen none would crash it
