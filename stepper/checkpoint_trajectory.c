@@ -259,12 +259,21 @@ static int copy_observables(hid_t f, jd_h5md *h, int64_t step, char *err, size_t
     return rc;
 }
 
+/* The rows of the bond table `group`, counted on its dataset `column`, into *n: 1, or 0 when
+ * the run wrote no such table, or -1 when it cannot be read. */
+static int table_rows(hid_t f, const char *group, const char *column, size_t *n) {
+    if (H5Lexists(f, group, H5P_DEFAULT) <= 0) return 0;
+    const hssize_t rows = rows_of(f, column, NULL);
+    if (rows < 0) return -1;
+    *n = (size_t)rows;
+    return 1;
+}
+
 /* /jdem/bonds rows formed up to step. */
 static int copy_bonds(hid_t f, jd_h5md *h, int64_t step, char *err, size_t errlen) {
-    if (H5Lexists(f, "/jdem/bonds", H5P_DEFAULT) <= 0) return 0;
-    const hssize_t nb = rows_of(f, "/jdem/bonds/formed_step", NULL);
-    if (nb < 0) return -1;
-    const size_t n = (size_t)nb;
+    size_t n;
+    const int present = table_rows(f, "/jdem/bonds", "/jdem/bonds/formed_step", &n);
+    if (present <= 0) return present;
     int64_t *ids = read_all(f, "/jdem/bonds/ids", H5T_NATIVE_INT64, 2 * n);
     int32_t *type = read_all(f, "/jdem/bonds/type", H5T_NATIVE_INT32, n);
     int64_t *formed = read_all(f, "/jdem/bonds/formed_step", H5T_NATIVE_INT64, n);
@@ -284,10 +293,9 @@ static int copy_bonds(hid_t f, jd_h5md *h, int64_t step, char *err, size_t errle
 
 /* /jdem/broken_bonds rows up to step. */
 static int copy_breaks(hid_t f, jd_h5md *h, int64_t step, char *err, size_t errlen) {
-    if (H5Lexists(f, "/jdem/broken_bonds", H5P_DEFAULT) <= 0) return 0;
-    const hssize_t ne = rows_of(f, "/jdem/broken_bonds/step", NULL);
-    if (ne < 0) return -1;
-    const size_t n = (size_t)ne;
+    size_t n;
+    const int present = table_rows(f, "/jdem/broken_bonds", "/jdem/broken_bonds/step", &n);
+    if (present <= 0) return present;
     static const char *const scalar[] = {"normal_force", "shear_force", "twisting_moment",
                                          "bending_moment", "sigma_max", "tau_max", "time"};
     double *col[7];

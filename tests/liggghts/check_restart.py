@@ -415,16 +415,25 @@ def option_mismatch(tmp):
           "non-printable bytes in the log: %r" % [c for c in log if not (c.isprintable() or c in "\n\t")][:8])
 
 
+def mesh_restart_at_200(tmp, name, case, deck):
+    """Run `deck` (case `case`) for 200 steps on 1 rank in the run directory `name`, writing its
+    restart file restarts/r.200; (directory, particle data file), or None after a failed check
+    NAME_runs."""
+    w = run_dir(tmp, name)
+    data = os.path.join(w, "particles.data")
+    particles(case, data)
+    rc, log = run(w, 1, deck, variables(w, data, 200, 200, 100, case=case))
+    return (w, data) if check(f"{name}_runs", rc == 0, log[-1500:]) else None
+
+
 def mesh_shape_mismatch(tmp):
     """The meshed box's file continued by a deck whose fix of the mesh wall's ID is a plane
     wall: an error that names both kinds (never a plane continuing from a mesh's history)."""
-    w = run_dir(tmp, "mesh_mismatch_writer")
-    data = os.path.join(w, "particles.data")
-    particles("mesh_box", data)
     box = os.path.join(DECKS, "mesh_box.in")
-    rc, log = run(w, 1, box, variables(w, data, 200, 200, 100, case="mesh_box"))
-    if not check("mesh_mismatch_writer_runs", rc == 0, log[-1500:]):
+    written = mesh_restart_at_200(tmp, "mesh_mismatch_writer", "mesh_box", box)
+    if not written:
         return
+    w, data = written
     with open(box) as f:
         text = f.read().replace("fix walls all wall/jiang mesh n_meshes 1 meshes box",
                                 "fix walls all wall/jiang plane corners -0.1 -0.1 0.0 0.1 -0.1 0.0 "
@@ -448,13 +457,11 @@ UNCLAIMED_MOTION = ("read_restart: the restart file holds the motion of fix turn
 def drum_without_motion(tmp):
     """The drum's file continued by the drum's deck without its fix move/mesh: the warning
     that names the motion left behind, once (the full deck, in the half-way cases, has none)."""
-    w = run_dir(tmp, "drum_motion_writer")
-    data = os.path.join(w, "particles.data")
-    particles("mesh_drum", data)
     drum = os.path.join(DECKS, "mesh_drum.in")
-    rc, log = run(w, 1, drum, variables(w, data, 200, 200, 100, case="mesh_drum"))
-    if not check("drum_motion_writer_runs", rc == 0, log[-1500:]):
+    written = mesh_restart_at_200(tmp, "drum_motion_writer", "mesh_drum", drum)
+    if not written:
         return
+    w, data = written
     resume = os.path.join(w, "restarts", "r.200")
     r = run_dir(tmp, "drum_motion_kept")
     rc, log = run(r, 1, drum, variables(r, data, 100, 200, 100, resume, "mesh_drum"))
