@@ -226,8 +226,9 @@ mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),bu
 	    $(if $(DT),-- --dt $(DT))
 
 # The tables of the finished units, seed | jdem | liggghts-jdem (Tables 4-3...4-5, the mixing
-# parameters, run times): out/mixing/ch4/report.md and summary.json, and the committed copy in
-# reference_runs/mixing/ch4/results/ (stamped with the commit).
+# parameters, run times) and Figs 4-11/4-12: out/mixing/ch4/report.md, summary.json and
+# fig4-1N_ENGINE.png, and the committed copy in reference_runs/mixing/ch4/results/; a result not
+# under out/ is taken from the committed summary.json with the commit it came from.
 # The fill's speed in jdem, liggghts-jdem and stock LIGGGHTS (1 and 2 cores each), measured in
 # one run: out/mixing/speed/report.md and summary.json (docs/mixing.md §10).
 .PHONY: mixing-speed

@@ -7,7 +7,12 @@ the box and the cylinders drawn; `clip` keeps only the spheres cut by the middle
 strip_plot: one parameter at the points per model (Figs 4-11, 4-12): the values as dark
 symbols on one vertical line per model, the seed's mean as a red square and its standard
 deviation as a grey bar (stats.py), and the ideal phi_v as a red dashed line.
+mixing_figure: the seed's Fig. 4-11 (pass 1) or 4-12 (pass 2) of one engine from the results of
+report_ch4.py (summary.json): its six panels (a)-(f), phi_v, phi_m, e, n, rho_b and Z, each a
+strip plot over the models with a finished fill of that pass.
 """
+import os
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -17,7 +22,7 @@ from matplotlib.collections import EllipseCollection  # noqa: E402
 from matplotlib.patches import Circle, Rectangle  # noqa: E402
 
 from . import stats  # noqa: E402
-from .params import big_mask  # noqa: E402
+from .params import IDEAL_PHI_V, big_mask  # noqa: E402
 
 BIG_COLOUR, SMALL_COLOUR = "#d62728", "#1f4fb4"
 VIEWS = {"front": (0, 2, 1), "side": (1, 2, 0)}  # (horizontal axis, vertical axis, depth axis)
@@ -62,25 +67,82 @@ def deposit_view(dep, path, view="front", box=((0, 0, 0), (1, 1, 2)), cylinders=
     return int(len(d))
 
 
+def draw_strip(ax, values_by_model, name, ideal=None):
+    """The strip plot on `ax`; returns the number of point markers drawn.  The artists carry
+    labels ("points LABEL", "mean LABEL", "std LABEL", "ideal") so that a test can read back
+    what was drawn."""
+    drawn = 0
+    for i, (label, values) in enumerate(values_by_model.items()):
+        v = np.asarray(values, dtype=float)
+        finite = v[np.isfinite(v)]   # phi_v is infinite at a point without small particles
+        ax.plot(np.full(len(finite), i), finite, "o", color="0.15", ms=4, label=f"points {label}")
+        drawn += len(finite)
+        s = stats.summary(v)
+        ax.errorbar(i + 0.15, s["mean"], yerr=s["std"], fmt="none", ecolor="0.6", elinewidth=6,
+                    label=f"std {label}")
+        ax.plot(i + 0.15, s["mean"], "s", color="red", ms=6, label=f"mean {label}")
+    if ideal is not None:
+        ax.axhline(ideal, color="red", ls="--", lw=1, label="ideal")
+    ax.set_xticks(range(len(values_by_model)), list(values_by_model))
+    ax.set_ylabel(name)
+    return drawn
+
+
 def strip_plot(values_by_model, path, name="phi_v", ideal=None, title=None):
     """values_by_model: {model label: the values at the points}.  Writes PNG; returns the number
     of point markers drawn."""
     fig, ax = plt.subplots(figsize=(6, 4), dpi=100)
-    drawn = 0
-    for i, (label, values) in enumerate(values_by_model.items()):
-        v = np.asarray(values, dtype=float)
-        finite = v[np.isfinite(v)]
-        ax.plot(np.full(len(finite), i), finite, "o", color="0.15", ms=4)
-        drawn += len(finite)
-        s = stats.summary(v)
-        ax.errorbar(i + 0.15, s["mean"], yerr=s["std"], fmt="none", ecolor="0.6", elinewidth=6)
-        ax.plot(i + 0.15, s["mean"], "s", color="red", ms=6)
-    if ideal is not None:
-        ax.axhline(ideal, color="red", ls="--", lw=1)
-    ax.set_xticks(range(len(values_by_model)), list(values_by_model))
-    ax.set_ylabel(name)
+    drawn = draw_strip(ax, values_by_model, name, ideal)
     ax.set_title(title or name)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
     return drawn
+
+
+# The panels (a)-(f) of Figs 4-11 and 4-12: (summary.json key, axis label); the ideal line on phi_v.
+FIGURE_PANELS = (("phi_v", "φv"), ("phi_m", "φm"), ("e", "e"), ("n", "n"),
+                 ("rho_b", "ρb [kg/m³]"), ("Z", "Z"))
+SEED_FIGURE = {1: "4-11", 2: "4-12"}
+
+
+def figure_name(engine, p):
+    """File name of the figure of one engine and pass, e.g. fig4-11_jdem.png."""
+    return "fig%s_%s.png" % (SEED_FIGURE[p], engine)
+
+
+def mixing_figure(results, engine, p):
+    """The open matplotlib figure of Fig. 4-11 (p = 1) or 4-12 (p = 2) for `engine` from
+    results[engine][model]["fill%d" % p]["points"] (report_ch4.py), or None when no model has
+    that fill.  The caller saves and closes it."""
+    by_number = sorted(results.get(engine, {}).items(), key=lambda item: int(item[0][len("model"):]))
+    fills = {model[len("model"):]: entry["fill%d" % p] for model, entry in by_number
+             if entry.get("fill%d" % p)}
+    if not fills:
+        return None
+    fig, axes = plt.subplots(2, 3, figsize=(12, 7), dpi=100)
+    for ax, letter, (key, label) in zip(axes.flat, "abcdef", FIGURE_PANELS):
+        values = {m: [q[key] for q in f["points"]] for m, f in fills.items()}
+        draw_strip(ax, values, label, IDEAL_PHI_V if key == "phi_v" else None)
+        ax.set_xlabel("model")
+        ax.set_title("(%s) %s" % (letter, label))
+    fig.suptitle("Fig. %s: mixing parameters at the 9 points of Table 4-2, %s, pass %d "
+                 "(dots: points; red square: trimmed mean; grey bar: its std; dashed: ideal φv)"
+                 % (SEED_FIGURE[p], engine, p), fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def write_mixing_figures(results, engines, directory):
+    """Write every Fig. 4-11/4-12 that has data into `directory`; returns {(engine, pass): file
+    name}."""
+    written = {}
+    for engine in engines:
+        for p in SEED_FIGURE:
+            fig = mixing_figure(results, engine, p)
+            if fig is None:
+                continue
+            fig.savefig(os.path.join(directory, figure_name(engine, p)))
+            plt.close(fig)
+            written[(engine, p)] = figure_name(engine, p)
+    return written

@@ -7,10 +7,18 @@
 Reads OUT/ENGINE/modelM/fillP.h5 (the mixing parameters at the 9 points of Table 4-2, from the
 last frame) and OUT/ENGINE/modelM/passP_cubeK.h5 (the compression of cube K: E, nu_xy, nu_xz of
 the orthotropic fit on the best-fit particle strain, and the unambiguous M and K0), and the
-units' wall and CPU seconds from OUT/ENGINE/modelM/.campaign_times.json.  Writes OUT/report.md and
-OUT/summary.json; with --results also there (the small results committed under
-reference_runs/mixing/ch4/results/), stamped with the commit they came from.  A unit not run is
-"—" in the tables and listed under "Not run"; nothing is estimated.
+units' wall and CPU seconds from OUT/ENGINE/modelM/.campaign_times.json.  Writes OUT/report.md,
+OUT/summary.json and the seed's Figs 4-11/4-12 (plots.mixing_figure, drawn from the summary);
+with --results also there (the small results committed under reference_runs/mixing/ch4/results/,
+the default for the default OUT when it exists).
+
+The working outputs under OUT do not travel with the repository, so every result not found
+under OUT (a fill, a jitter fill, a set of 9 cubes, a unit's times) is taken from the committed
+RESULTS/summary.json; a local result always wins.  Every entry of summary.json says where it
+came from ("source": the commit of the report that computed it, kept as it is when an old entry
+is written again), and report.md lists under each table the rows taken from an earlier commit.
+A unit that is neither local nor committed is "—" in the tables and listed under "Not run";
+nothing is estimated.
 """
 import argparse
 import json
@@ -20,9 +28,13 @@ import subprocess
 
 import numpy as np
 
-from scripts.mixing import claims_ch4, compression, deposit, params, stats
+from scripts.mixing import claims_ch4, compression, deposit, params, plots, stats
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+DEFAULT_OUT = os.path.join(ROOT, "out", "mixing", "ch4")
+# The committed results belong to the seed-dt campaign of DEFAULT_OUT only (the DT=guard/half
+# variants write elsewhere and must not be mixed with them).
+DEFAULT_RESULTS = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "results")
 
 ENGINES = ("jdem", "liggghts-jdem")
 MODELS = tuple("model%d" % m for m in range(1, 7))
@@ -84,7 +96,7 @@ def jitter_fills(d):
     return found
 
 
-def spread_table(found):
+def spread_table(found, taken):
     """The run-to-run spread: the first fill and its jittered realisations (generate.py
     --jitter), their trimmed means, and the sample std of those means."""
     lines = ["### Run-to-run spread (the first fill and its realisations with the stream shifted by "
@@ -92,14 +104,14 @@ def spread_table(found):
              "| engine | model | realisation | height [m] | φv | e | ρb [kg/m³] | Z |",
              "|---|---|---|---|---|---|---|---|"]
     keys = (("phi_v", "%.4f"), ("e", "%.3f"), ("rho_b", "%.0f"), ("Z", "%.2f"))
-    any_row = False
+    shown = set()   # (engine, model) of the rows
     for engine in ENGINES:
         for model in MODELS:
             entry = found[engine][model]
             runs = ([entry["fill1"]] if entry.get("fill1") else []) + entry.get("jitter", [])
             if len(runs) < 2:
                 continue
-            any_row = True
+            shown.add((engine, model))
             for k, r in enumerate(runs):
                 lines.append("| %s | %s | %s | %.3f | %s |" % (
                     engine, model, "K = %d" % k, r["deposit_height"],
@@ -108,11 +120,17 @@ def spread_table(found):
             lines.append("| %s | %s | std of the %d | %.3f | %s |" % (
                 engine, model, len(runs), std([r["deposit_height"] for r in runs]),
                 " | ".join(fmt % std([r["summary"][key]["mean"] for r in runs]) for key, fmt in keys)))
-    return "\n".join(lines) + "\n" if any_row else ""
+    if not shown:
+        return ""
+    jitter = [(k[0], "K = %d" % (k[3] + 1), model_number(k[1]), source)
+              for k, source in taken.items() if k[2] == "jitter"]
+    first = [r for r in taken_rows(taken, "fill1", "K = 0") if (r[0], "model%d" % r[2]) in shown]
+    return "\n".join(lines) + "\n" + earlier_note(first + jitter)
 
 
 def collect(out):
-    """{engine: {model: {"fillP": ..., "passP_cubes": [...], "times": ...}}} of the finished units."""
+    """{engine: {model: {"fillP": ..., "passP_cubes": [...], "times": ...}}} of the finished units,
+    and the units not finished as (engine, model, key of the entry, message)."""
     found, missing = {}, []
     for engine in ENGINES:
         for model in MODELS:
@@ -123,7 +141,7 @@ def collect(out):
                 if os.path.exists(fill):
                     entry["fill%d" % p] = fill_result(fill)
                 else:
-                    missing.append("%s/%s/fill%d" % (engine, model, p))
+                    missing.append((engine, model, "fill%d" % p, "%s/%s/fill%d" % (engine, model, p)))
                 if p == 1:
                     entry["jitter"] = [fill_result(j) for j in jitter_fills(d)]
                 cubes = [os.path.join(d, "pass%d_cube%d.h5" % (p, k)) for k in range(1, 10)]
@@ -132,11 +150,108 @@ def collect(out):
                     try:
                         entry["pass%d_cubes" % p] = [cube_result(c) for c in cubes]
                     except SystemExit as why:   # compression.py's message: a servo that did not complete
-                        missing.append("%s/%s/pass%d_cubes: %s" % (engine, model, p, why))
+                        missing.append((engine, model, "pass%d_cubes" % p,
+                                        "%s/%s/pass%d_cubes: %s" % (engine, model, p, why)))
                 else:
-                    missing.append("%s/%s/pass%d_cubes (%d of 9)" % (engine, model, p, len(done)))
+                    missing.append((engine, model, "pass%d_cubes" % p,
+                                    "%s/%s/pass%d_cubes (%d of 9)" % (engine, model, p, len(done))))
             found.setdefault(engine, {})[model] = entry
     return found, missing
+
+
+def committed_summary(results):
+    """The summary.json committed in the directory `results` ({} when there is none)."""
+    try:
+        with open(os.path.join(results, "summary.json")) as f:
+            return json.load(f)
+    except FileNotFoundError:
+        return {}
+
+
+def stamped(entry, source):
+    """A copy of a fill or cube result or a unit's times with its "source"; an entry that has one
+    keeps it (an old result written again is not restamped)."""
+    return dict(entry, source=entry.get("source", source))
+
+
+def merge_entry(mine, theirs, rev, theirs_rev, key, taken):
+    """The merged value of one entry of found[engine][model] (a fill, the jitter list, a cube
+    set, the times); `taken` gets key (+ index or unit) -> source for what came from theirs."""
+    name = key[-1]
+    if name == "times":
+        merged = {u: stamped(t, rev) for u, t in mine.get("times", {}).items()}
+        for u, t in theirs.get("times", {}).items():
+            if u not in merged:
+                merged[u] = stamped(t, theirs_rev)
+                taken[key + (u,)] = merged[u]["source"]
+        return merged
+    if name == "jitter":   # realisation K is the K-th of the list, local ones first (jitter_fills)
+        local, old = mine.get("jitter", []), theirs.get("jitter", [])
+        merged = [stamped(f, rev) for f in local]
+        for k in range(len(local), len(old)):
+            merged.append(stamped(old[k], theirs_rev))
+            taken[key + (k,)] = merged[-1]["source"]
+        return merged
+    if mine.get(name):
+        local = mine[name]
+        return [stamped(c, rev) for c in local] if isinstance(local, list) else stamped(local, rev)
+    old = theirs[name]
+    merged = [stamped(c, theirs_rev) for c in old] if isinstance(old, list) else stamped(old, theirs_rev)
+    taken[key] = (merged[0] if isinstance(merged, list) else merged)["source"]
+    return merged
+
+
+def merge(found, missing, committed, rev):
+    """found (local, stamped with rev) completed by the committed summary's entries that found
+    lacks; returns (merged, the messages of the units in neither, taken: {(engine, model, key
+    [, index or unit]): source} of the committed entries used)."""
+    theirs_all, theirs_rev = committed.get("results", {}), committed.get("commit", "unknown")
+    merged, taken = {}, {}
+    for engine in ENGINES:
+        for model in MODELS:
+            mine, theirs = found[engine][model], theirs_all.get(engine, {}).get(model, {})
+            names = ["times", "jitter"] + [k for k in ["fill%d" % p for p in PASSES] +
+                                           ["pass%d_cubes" % p for p in PASSES]
+                                           if mine.get(k) or theirs.get(k)]
+            merged.setdefault(engine, {})[model] = {
+                n: merge_entry(mine, theirs, rev, theirs_rev, (engine, model, n), taken) for n in names}
+    not_run = [message for engine, model, key, message in missing if not merged[engine][model].get(key)]
+    return merged, not_run, taken
+
+
+def model_ranges(numbers):
+    """[1, 2, 3, 5] -> "model1–3, 5"."""
+    numbers, runs = sorted(set(numbers)), []
+    for n in numbers:
+        if runs and n == runs[-1][1] + 1:
+            runs[-1][1] = n
+        else:
+            runs.append([n, n])
+    return "model" + ", ".join("%d" % a if a == b else "%d–%d" % (a, b) for a, b in runs)
+
+
+def earlier_note(rows):
+    """The footnote of a table: rows is [(engine, what, model number, source)] of its rows taken
+    from the committed summary, e.g. "- jdem model1–6 pass 1: from commit eda0a7e"."""
+    groups = {}
+    for engine, what, m, source in rows:
+        groups.setdefault((engine, what, source), []).append(m)
+    if not groups:
+        return ""
+    lines = ["- %s %s%s: from commit %s" % (engine, model_ranges(ms), what and " " + what, source)
+             for (engine, what, source), ms in groups.items()]
+    return ("\nFrom an earlier commit (the committed summary.json; no output under --out):\n\n"
+            + "\n".join(lines) + "\n")
+
+
+def model_number(model):
+    return int(model[len("model"):])
+
+
+def taken_rows(taken, name, what):
+    """earlier_note rows of the committed entries whose key is `name` (e.g. "fill1")."""
+    return [(k[0], what, model_number(k[1]), source) for k, source in taken.items()
+            if len(k) == 3 and k[2] == name]
 
 
 def cell(mean, std, fmt):
@@ -153,7 +268,7 @@ def ours(found, engine, model, p, key):
     return s["mean"], s["std"]
 
 
-def elastic_table(found, key, title, fmt):
+def elastic_table(found, taken, key, title, fmt):
     head = ("| Model | seed 1st | jdem 1st | liggghts-jdem 1st | seed 2nd | jdem 2nd | "
             "liggghts-jdem 2nd |\n|---|---|---|---|---|---|---|\n")
     rows = []
@@ -164,11 +279,16 @@ def elastic_table(found, key, title, fmt):
             cols.append(cell(s[2 * (p - 1)], s[2 * (p - 1) + 1], fmt))
             cols += [cell(*ours(found, e, model, p, key), fmt) for e in ENGINES]
         rows.append("| %d | %s |" % (m + 1, " | ".join(cols)))
-    return "### %s\n\nmean ± std over the 9 cubes, the highest and lowest dropped (docs/mixing.md §3)\n\n%s%s\n" % (
-        title, head, "\n".join(rows))
+    return "### %s\n\nmean ± std over the 9 cubes, the highest and lowest dropped (docs/mixing.md §3)\n\n%s%s\n%s" % (
+        title, head, "\n".join(rows), earlier_note(cube_rows(taken)))
 
 
-def constants_table(found):
+def cube_rows(taken):
+    """earlier_note rows of the committed cube sets of every pass."""
+    return [r for p in PASSES for r in taken_rows(taken, "pass%d_cubes" % p, "pass %d cubes" % p)]
+
+
+def constants_table(found, taken):
     """M (wall strain and best-fit strain) and K0 of every finished deposit: the unambiguous
     constants of a laterally confined cube (docs/model.md §10); the seed gives neither."""
     lines = ["### Constrained modulus M = σzz/εzz and K0 = (σxx+σyy)/(2σzz)", "",
@@ -185,10 +305,10 @@ def constants_table(found):
                 lines.append("| %s | %s | %d | %s | %s | %s | %s |" % (
                     engine, model, p, col("M_wall", "%.0f"), col("M_best_fit", "%.0f"),
                     col("K0", "%.3f"), col("cond", "%.0f")))
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n" + earlier_note(cube_rows(taken))
 
 
-def mixing_table(found):
+def mixing_table(found, taken):
     lines = ["### Mixing parameters at the 9 points of Table 4-2 (the seed gives plots only, Figs 4-11/4-12)",
              "", "trimmed mean ± std (ideal φv = %.4f)" % params.IDEAL_PHI_V, "",
              "| engine | model | pass | particles | height [m] | φv | e | ρb [kg/m³] | Z |",
@@ -204,10 +324,11 @@ def mixing_table(found):
                     engine, model, p, f["particles"], f["deposit_height"],
                     cell(s["phi_v"]["mean"], s["phi_v"]["std"], "%.4f"), cell(s["e"]["mean"], s["e"]["std"], "%.3f"),
                     cell(s["rho_b"]["mean"], s["rho_b"]["std"], "%.0f"), cell(s["Z"]["mean"], s["Z"]["std"], "%.2f")))
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n" + earlier_note(
+        [r for p in PASSES for r in taken_rows(taken, "fill%d" % p, "pass %d" % p)])
 
 
-def times_table(found):
+def times_table(found, taken):
     lines = ["### Run times of the finished units", "",
              "wall time on the shared machine, and the CPU time of the unit's processes",
              "", "| unit | wall [s] | CPU [s] |", "|---|---|---|"]
@@ -216,7 +337,9 @@ def times_table(found):
             for name, t in sorted(found[engine][model]["times"].items()):
                 cpu = t.get("cpu_seconds")
                 lines.append("| %s | %.0f | %s |" % (name, t["seconds"], "%.0f" % cpu if cpu is not None else "not recorded"))
-    return "\n".join(lines) + "\n"
+    units = [(u.split("/")[0], "units", model_number(u.split("/")[1]), source)
+             for k, source in taken.items() if k[2] == "times" for u in [k[3]]]
+    return "\n".join(lines) + "\n" + earlier_note(units)
 
 
 def commit():
@@ -224,13 +347,27 @@ def commit():
     return r.stdout.strip() or "unknown"
 
 
-def report(found, missing, rev):
+def figures_section(figures):
+    """Links to the written Figs 4-11/4-12 ({(engine, pass): file name})."""
+    lines = ["### Figs 4-11 and 4-12: the mixing parameters at the 9 points", "",
+             "drawn from summary.json (the rows of the first table, whatever their source); one "
+             "figure per engine and pass, panels (a)–(f) φv, φm, e, n, ρb, Z as in the seed", ""]
+    lines += ["![Fig. %s, %s, pass %d](%s)" % (plots.SEED_FIGURE[p], engine, p, name)
+              for (engine, p), name in sorted(figures.items())]
+    missing = ["Fig. %s (%s pass %d): no finished fill" % (plots.SEED_FIGURE[p], e, p)
+               for e in ENGINES for p in PASSES if (e, p) not in figures]
+    return "\n".join(lines + [""] + ["- " + m for m in missing]) + "\n"
+
+
+def report(found, missing, taken, figures, rev):
     parts = ["# Jiang (2021) Chapter 4 mixing campaign: seed | jdem | liggghts-jdem", "",
              "Generated by scripts/mixing/report_ch4.py from the finished units of `make mixing` "
-             "(commit %s). Every reconstruction the seed leaves open is a scene parameter "
-             "(docs/mixing.md §1).\n" % rev, mixing_table(found)]
-    parts += [elastic_table(found, k, t, f) for k, t, f in TABLES]
-    parts += [spread_table(found), constants_table(found), "### The seed's claims\n", claims_ch4.claims(found, ENGINES), times_table(found),
+             "(commit %s) and, for the units without output here, the committed results of earlier "
+             "commits (named under each table). Every reconstruction the seed leaves open is a scene "
+             "parameter (docs/mixing.md §1).\n" % rev, mixing_table(found, taken), figures_section(figures)]
+    parts += [elastic_table(found, taken, k, t, f) for k, t, f in TABLES]
+    parts += [spread_table(found, taken), constants_table(found, taken), "### The seed's claims\n",
+              claims_ch4.claims(found, ENGINES), times_table(found, taken),
               "### Not run\n", "\n".join("- " + m for m in missing) + "\n" if missing else "nothing\n"]
     return "\n".join(parts)
 
@@ -242,18 +379,30 @@ def write_atomic(path, text):
     os.replace(tmp, path)
 
 
+def results_dir(out, results):
+    """--results, or by default the committed results of the default OUT when they exist."""
+    if results:
+        return results
+    same_out = os.path.abspath(out) == os.path.abspath(DEFAULT_OUT)
+    return DEFAULT_RESULTS if same_out and os.path.isdir(DEFAULT_RESULTS) else None
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", default=os.path.join(ROOT, "out", "mixing", "ch4"))
-    ap.add_argument("--results", help="also write report.md and summary.json here")
+    ap.add_argument("--out", default=DEFAULT_OUT)
+    ap.add_argument("--results", help="take the results not under --out from DIR/summary.json, and "
+                    "write the report, summary and figures there too (default: %s for the default "
+                    "--out, when it exists)" % os.path.relpath(DEFAULT_RESULTS, ROOT))
     a = ap.parse_args()
-    found, missing = collect(a.out)
+    results = results_dir(a.out, a.results)
     rev = commit()
-    text = report(found, missing, rev)
+    found, missing, taken = merge(*collect(a.out), committed_summary(results) if results else {}, rev)
     summary = json.dumps({"commit": rev, "results": found, "not_run": missing}, indent=1, default=float)
-    for d in [a.out] + ([a.results] if a.results else []):
+    drawn_from = json.loads(summary)["results"]   # the figures show what summary.json holds
+    for d in [a.out] + ([results] if results else []):
         os.makedirs(d, exist_ok=True)
-        write_atomic(os.path.join(d, "report.md"), text)
+        figures = plots.write_mixing_figures(drawn_from, ENGINES, d)
+        write_atomic(os.path.join(d, "report.md"), report(found, missing, taken, figures, rev))
         write_atomic(os.path.join(d, "summary.json"), summary)
         print("report_ch4.py: wrote %s" % os.path.join(d, "report.md"))
 

@@ -1,6 +1,8 @@
 #!/usr/bin/python3
 """The campaign's pictures (scripts/mixing/plots.py), checked for content: the number of objects
-drawn, and the pixel fractions of the cohort colours, the obstacle and the ideal line."""
+drawn, and the pixel fractions of the cohort colours, the obstacle and the ideal line; the
+Figs 4-11/4-12 figure read back from its matplotlib objects against the summary it was drawn
+from."""
 import math
 import os
 import tempfile
@@ -8,7 +10,7 @@ import tempfile
 import matplotlib.image as mpimg
 import numpy as np
 
-from tests.mixing.common import check, finish
+from tests.mixing.common import check, close, finish
 from scripts.mixing import deposit, plots
 
 
@@ -69,7 +71,67 @@ def test_strip_plot(tmp):
     check("strip_plot_not_blank", float(img[:, :, :3].std()) > 0.05, "uniform image")
 
 
+def hand_results():
+    """summary.json's results for jdem pass 1: Models 1 and 3 (a point of Model 3 without small
+    spheres: phi_v infinite), no Model 2, no second pass."""
+    rng = np.random.default_rng(2)
+    keys = [k for k, _ in plots.FIGURE_PANELS]
+    fill = lambda: {"points": [{k: float(v) for k, v in zip(keys, rng.uniform(0, 1, 6))}
+                               for _ in range(9)]}
+    results = {"jdem": {"model3": {"fill1": fill()}, "model1": {"fill1": fill()},
+                        "model2": {"times": {}}}}
+    results["jdem"]["model3"]["fill1"]["points"][2]["phi_v"] = float("inf")
+    return results
+
+
+def trimmed(values):
+    """The seed's mean of 7 of 9 and the std of the same 7, by hand."""
+    kept = sorted(v for v in values if not math.isnan(v))[1:-1]
+    mean = sum(kept) / len(kept)
+    return mean, math.sqrt(sum((v - mean) ** 2 for v in kept) / (len(kept) - 1))
+
+
+def artist(ax, label):
+    found = [a for a in list(ax.lines) + list(ax.containers) if a.get_label() == label]
+    return found[0] if len(found) == 1 else None
+
+
+def test_mixing_figure():
+    results = hand_results()
+    fig = plots.mixing_figure(results, "jdem", 1)
+    axes = fig.axes
+    check("figure_has_six_panels", len(axes) == 6, f"{len(axes)} axes")
+    for ax, (key, _) in zip(axes, plots.FIGURE_PANELS):
+        ticks = [t.get_text() for t in ax.get_xticklabels()]
+        check(f"figure_{key}_models_in_order", ticks == ["1", "3"], f"{ticks}")
+        for i, m in enumerate(("1", "3")):
+            values = [q[key] for q in results["jdem"]["model" + m]["fill1"]["points"]]
+            pts = artist(ax, "points " + m)
+            finite = [v for v in values if math.isfinite(v)]
+            check(f"figure_{key}_model{m}_points", pts is not None
+                  and list(pts.get_ydata()) == finite and set(pts.get_xdata()) == {i},
+                  f"{None if pts is None else list(pts.get_ydata())} vs {finite}")
+            # phi_v = inf is the highest value: the trimmed mean drops it (stats.py)
+            mean, std = trimmed([v if math.isfinite(v) else float("inf") for v in values])
+            sq = artist(ax, "mean " + m)
+            close(f"figure_{key}_model{m}_mean", float(sq.get_ydata()[0]), mean, 1e-12)
+            bar = artist(ax, "std " + m).lines[2][0].get_segments()[0]
+            close(f"figure_{key}_model{m}_std_low", float(bar[0][1]), mean - std, 1e-12)
+            close(f"figure_{key}_model{m}_std_high", float(bar[1][1]), mean + std, 1e-12)
+        ideal = artist(ax, "ideal")
+        if key == "phi_v":
+            close("figure_ideal_phi_v", float(ideal.get_ydata()[0]), 0.0625, 1e-15)
+        else:
+            check(f"figure_{key}_no_ideal_line", ideal is None)
+    plots.plt.close(fig)
+    check("figure_none_without_second_pass", plots.mixing_figure(results, "jdem", 2) is None)
+    written = plots.write_mixing_figures(results, ("jdem", "liggghts-jdem"), tmp)
+    check("figures_written", written == {("jdem", 1): "fig4-11_jdem.png"}
+          and os.path.getsize(os.path.join(tmp, "fig4-11_jdem.png")) > 10000, f"{written}")
+
+
 tmp = tempfile.mkdtemp()
 test_views(tmp)
 test_strip_plot(tmp)
+test_mixing_figure()
 finish()
