@@ -219,6 +219,19 @@ def times_table(found):
     return "\n".join(lines) + "\n"
 
 
+def horizon_section(results=os.path.join(ROOT, "reference_runs", "mixing", "ch4", "results", "horizon")):
+    """The cross-engine horizon of the first fills: the table of `horizon_ch4.py summary` (the
+    cross/modelM/horizon units), as committed in RESULTS (make mixing-report refreshes it first)."""
+    from scripts.mixing import horizon_ch4
+    models = horizon_ch4.read_summary(results)
+    head = "### Cross-engine horizon of the first fills, jdem vs liggghts-jdem\n\n"
+    if not models:
+        return head + "not run (make mixing ENGINE=cross)\n"
+    return head + ("Particles matched by id; per frame (every 0.02 s) the larger of max |Δx| / R_max "
+                   "and max |Δv| / sqrt(g d_max), as in the pour study (docs/mixing.md §4); plot: "
+                   "horizon/horizon.png.\n\n") + horizon_ch4.table(models)
+
+
 def commit():
     r = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
     return r.stdout.strip() or "unknown"
@@ -230,6 +243,7 @@ def report(found, missing, rev):
              "(commit %s). Every reconstruction the seed leaves open is a scene parameter "
              "(docs/mixing.md §1).\n" % rev, mixing_table(found)]
     parts += [elastic_table(found, k, t, f) for k, t, f in TABLES]
+    parts.append(horizon_section())
     parts += [spread_table(found), constants_table(found), "### The seed's claims\n", claims_ch4.claims(found, ENGINES), times_table(found),
               "### Not run\n", "\n".join("- " + m for m in missing) + "\n" if missing else "nothing\n"]
     return "\n".join(parts)
