@@ -41,6 +41,7 @@ END_TIME = 4.0            # [s] the first seconds of the 27 s fill: cheap, and p
 FRAME_EVERY = 200         # steps: a frame every 0.02 s at the seed's dt
 G = 9.81                  # [m/s^2] the velocity scale sqrt(g d_max), as the pour study's
 RESULT = "horizon.json"
+WATCHDOG_STOP = 4         # the exit status of either engine's runner when the watchdog stopped it
 
 
 # ---- the runs -------------------------------------------------------------------------------
@@ -52,11 +53,21 @@ def write_scene(case, dt_arg, end_time, frame_every, path):
 
 
 def run_engines(scene, directory, force):
-    """Both engines on SCENE as the fill units run them: {engine: (trajectory, times)}."""
+    """Both engines on SCENE as the fill units run them: {engine: (trajectory, times)}.  A run
+    the watchdog stopped counts up to its stop (its closed OUT.h5.part; times["stopped"] says
+    why): the horizon lies long before that in the other runs."""
     runs = {}
     for engine in plan_ch4.ENGINES:
         out = os.path.join(directory, "fill.%s.h5" % engine)
-        runs[engine] = (out, engines.cpu_timed(plan_ch4.run_command(engine, scene, out, force)))
+        cmd = plan_ch4.run_command(engine, scene, out, force)
+        r, times = engines.cpu_timed_run(cmd)
+        if r.returncode == WATCHDOG_STOP and os.path.exists(out + ".part"):
+            times["stopped"] = next((line.strip() for line in r.stderr.splitlines()
+                                     if "watchdog" in line), "exit status 4")
+            out += ".part"
+        elif r.returncode != 0:
+            raise engines.failure(cmd, r.returncode, r.stdout, r.stderr)
+        runs[engine] = (out, times)
     return runs
 
 
@@ -151,20 +162,23 @@ def fmt(x, spec="%.2f"):
 
 def table(results):
     """The report's table: one row per model."""
-    lines = ["| model | first touch seen at [s] | first non-zero at [s] (value) | horizon < %.0e [s] | growth rate [1/s] "
-             "(fit window [s]) | e-folding time [s] | at the end (t = %s s) | particles at the end "
-             "| CPU jdem / liggghts-jdem [s] |" % (ROUNDOFF, fmt(results[0]["curve"]["time"][-1])
-                                                  if results else "T"),
+    lines = ["| model | first touch seen at [s] | first non-zero at [s] (value) | horizon < %.0e [s] "
+             "| growth rate [1/s] (fit window [s]) | e-folding time [s] | last common frame: "
+             "difference (t [s]) | particles then | CPU jdem / liggghts-jdem [s] |" % ROUNDOFF,
              "|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         d, g = r["divergence"], r["divergence"]["growth"]
-        lines.append("| %s | %s | %s (%s) | %s%s | %s | %s | %.2e | %d | %.0f / %.0f |" % (
+        lines.append("| %s | %s | %s (%s) | %s%s | %s | %s | %.2e (%s) | %d | %.0f / %.0f |" % (
             r["case"], fmt(r["first_touch"]), fmt(d["first_nonzero"]), fmt(d["first_value"], "%.1e"), fmt(d["horizon"]),
             "" if d["reaches_roundoff_level"] else " (never reached)",
             "%.1f (%.2f–%.2f)" % (g["rate"], g["from"], g["to"]) if g else "—",
             fmt(1.0 / g["rate"], "%.3f") if g and g["rate"] > 0 else "—", d["final"],
-            r["particles_at_end"], r["times"]["jdem"]["cpu"], r["times"]["liggghts-jdem"]["cpu"]))
-    return "\n".join(lines) + "\n"
+            fmt(r["curve"]["time"][-1]), r["particles_at_end"], r["times"]["jdem"]["cpu"],
+            r["times"]["liggghts-jdem"]["cpu"]))
+    stops = ["- %s, %s: %s" % (r["case"], e, t["stopped"]) for r in results
+             for e, t in r["times"].items() if "stopped" in t]
+    return "\n".join(lines) + "\n" + ("\nStopped by the watchdog (compared up to the stop):\n\n"
+                                      + "\n".join(stops) + "\n" if stops else "")
 
 
 def plot(results, path):
