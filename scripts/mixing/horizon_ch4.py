@@ -63,7 +63,7 @@ def run_engines(scene, directory, force):
         r, times = engines.cpu_timed_run(cmd)
         if r.returncode == WATCHDOG_STOP and os.path.exists(out + ".part"):
             times["stopped"] = next((line.strip() for line in r.stderr.splitlines()
-                                     if "watchdog" in line), "exit status 4")
+                                     if "watchdog:" in line), "exit status 4")   # its message
             out += ".part"
         elif r.returncode != 0:
             raise engines.failure(cmd, r.returncode, r.stdout, r.stderr)
@@ -175,7 +175,7 @@ def table(results):
             fmt(1.0 / g["rate"], "%.3f") if g and g["rate"] > 0 else "—", d["final"],
             fmt(r["curve"]["time"][-1]), r["particles_at_end"], r["times"]["jdem"]["cpu"],
             r["times"]["liggghts-jdem"]["cpu"]))
-    stops = ["- %s, %s: %s" % (r["case"], e, t["stopped"]) for r in results
+    stops = ["- %s, %s: %s" % (r["case"], e, t["stopped"].split("; the trajectory")[0]) for r in results
              for e, t in r["times"].items() if "stopped" in t]
     return "\n".join(lines) + "\n" + ("\nStopped by the watchdog (compared up to the stop):\n\n"
                                       + "\n".join(stops) + "\n" if stops else "")
