@@ -215,8 +215,9 @@ accuracy: all
 
 # Jiang's Chapter 4 mixing campaign (docs/mixing.md §4): the resumable units of
 # scripts/mixing/plan_ch4.py, with progress and an ETA; finished units are skipped.
-#   make mixing [MODEL=model2] [ENGINE=jdem|liggghts-jdem] [UNIT=jdem/model2/fill1]
+#   make mixing [MODEL=model2] [ENGINE=jdem|liggghts-jdem|cross] [UNIT=jdem/model2/fill1]
 #               [DT=seed|guard|half] [LIST=1]        outputs: out/mixing/ch4*/ENGINE/MODEL/
+# (ENGINE=cross: the cross-engine horizons, cross/modelM/horizon, which run both engines)
 # The engine's binary only when the selection names one engine (ENGINE=, or UNIT=ENGINE/...).
 MIXING_ENGINE = $(or $(ENGINE),$(firstword $(subst /, ,$(UNIT))))
 .PHONY: mixing
@@ -228,7 +229,8 @@ mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),bu
 # The tables of the finished units, seed | jdem | liggghts-jdem (Tables 4-3...4-5, the mixing
 # parameters, run times) and Figs 4-11/4-12: out/mixing/ch4/report.md, summary.json and
 # fig4-1N_ENGINE.png, and the committed copy in reference_runs/mixing/ch4/results/; a result not
-# under out/ is taken from the committed summary.json with the commit it came from.
+# under out/ is taken from the committed summary.json with the commit it came from.  First the
+# cross-engine horizons' table and plot (reference_runs/mixing/ch4/results/horizon/).
 # The fill's speed in jdem, liggghts-jdem and stock LIGGGHTS (1 and 2 cores each), measured in
 # one run: out/mixing/speed/report.md and summary.json (docs/mixing.md §10).
 .PHONY: mixing-speed
@@ -237,6 +239,7 @@ mixing-speed: all
 
 .PHONY: mixing-report
 mixing-report:
+	$(PY) scripts/mixing/horizon_ch4.py summary --results reference_runs/mixing/ch4/results/horizon
 	$(PY) scripts/mixing/report_ch4.py --results reference_runs/mixing/ch4/results
 
 clean:

@@ -106,6 +106,8 @@ class Times:
 
     def add(self, unit, seconds, cpu_seconds):
         self.seconds[unit.name] = {"seconds": seconds, "cpu_seconds": cpu_seconds, "cost": unit.cost}
+        # beside the plan's first output, whose directory a selection without that unit never made
+        os.makedirs(os.path.dirname(self.path), exist_ok=True)
         tmp = self.path + ".tmp"
         with open(tmp, "w") as f:
             json.dump(self.seconds, f, indent=1)

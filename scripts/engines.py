@@ -149,12 +149,21 @@ def timed(cmd, **kw):
 def cpu_timed(cmd, cwd=None):
     """Run CMD (checked); {"wall": s, "cpu": s, "load": the 1-minute load average before}, cpu =
     user + system time of its processes (less sensitive than wall to other jobs on the machine)."""
+    r, times = cpu_timed_run(cmd, cwd)
+    if r.returncode != 0:
+        raise failure(cmd, r.returncode, r.stdout, r.stderr)
+    return times
+
+
+def cpu_timed_run(cmd, cwd=None):
+    """Run CMD unchecked: (its CompletedProcess, the times of cpu_timed), for a caller that
+    handles a failure class itself (e.g. a run the watchdog stopped)."""
     def cpu():
         r = resource.getrusage(resource.RUSAGE_CHILDREN)
         return r.ru_utime + r.ru_stime
     load, wall, cpu0 = os.getloadavg()[0], time.monotonic(), cpu()
-    run(cmd, cwd=cwd, check=True)
-    return {"wall": time.monotonic() - wall, "cpu": cpu() - cpu0, "load": load}
+    r = run(cmd, cwd=cwd)
+    return r, {"wall": time.monotonic() - wall, "cpu": cpu() - cpu0, "load": load}
 
 
 class GnuTimed(NamedTuple):

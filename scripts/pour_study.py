@@ -37,10 +37,10 @@ import yaml
 
 from scripts import engines
 from scripts.engines import ROOT
+from scripts.trajectory_divergence import ROUNDOFF, divergence_summary
 
 JDEM, LIG = engines.JDEM, engines.LIGGGHTS_JDEM   # $JDEM and $LIGGGHTS_JDEM when set
 SCENE = os.path.join(ROOT, "reference_runs", "pour", "scene.yaml")
-ROUNDOFF = 1e-10          # scaled difference counted as round-off
 ENGINES = ("jdem", "lig1", "lig2", "lig2x", "builtin")
 PAIRS = (("jdem", "lig1"), ("lig1", "lig2"), ("lig1", "lig2x"), ("jdem", "builtin"))
 SEED_EVERY = 2000         # output.every of the seed runs (statistics only)
@@ -134,30 +134,6 @@ def scaled_difference(a, b, g=9.81):
     dx = np.abs(a["x"][ia] - b["x"][ib]).max(axis=(1, 2)) / rmax
     dv = np.abs(a["v"][ia] - b["v"][ib]).max(axis=(1, 2)) / math.sqrt(g * 2.0 * rmax)
     return a["time"][ia], dx, dv
-
-
-def horizon(t, diff, level=ROUNDOFF):
-    """Last time before the scaled difference first reaches LEVEL (the whole run if never)."""
-    above = np.nonzero(diff >= level)[0]
-    if len(above) == 0:
-        return float(t[-1]), False
-    return float(t[above[0] - 1]) if above[0] > 0 else 0.0, True
-
-
-def growth_rate(t, diff, lo=1e-12, hi=1e-3):
-    """Exponential rate [1/s]: least-squares slope of ln(diff) where LO < diff < HI, from the first
-    frame above LO to the first frame above HI (before saturation)."""
-    start = np.nonzero(diff > lo)[0]
-    if len(start) == 0:
-        return None
-    stop = np.nonzero(diff > hi)[0]
-    end = stop[0] if len(stop) else len(diff)
-    sel = np.arange(start[0], end)
-    sel = sel[diff[sel] > 0]
-    if len(sel) < 3:
-        return None
-    slope = np.polyfit(t[sel], np.log(diff[sel]), 1)[0]
-    return {"rate": float(slope), "from": float(t[sel[0]]), "to": float(t[sel[-1]])}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -286,14 +262,7 @@ def spread(stats, names):
 def divergence(a, b):
     """Round-off horizon and growth of the scaled difference between two loaded trajectories."""
     t, dx, dv = scaled_difference(a, b)
-    both = np.maximum(dx, dv)
-    nonzero = np.nonzero(both > 0)[0]
-    h, reached = horizon(t, both)
-    return (t, dx, dv), {
-        "first_nonzero": float(t[nonzero[0]]) if len(nonzero) else None,
-        "first_value": float(both[nonzero[0]]) if len(nonzero) else 0.0,
-        "horizon": h, "reaches_roundoff_level": reached, "growth": growth_rate(t, both),
-        "final": float(both[-1])}
+    return (t, dx, dv), divergence_summary(t, dx, dv)
 
 
 def analyze(out_dir):

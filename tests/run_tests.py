@@ -127,12 +127,14 @@ SUITES += [
 
 # The Ch. 4 mixing analysis (scripts/mixing) on synthetic deposits, the seed's claims on
 # hand-made results, its pictures, the generator of the second pass and the cubes (reference_runs/mixing/ch4/generate.py),
-# and the report's merge of local and committed results (scripts/mixing/report_ch4.py).
+# the report's merge of local and committed results (scripts/mixing/report_ch4.py) and the
+# cross-engine horizon on a synthetic pair of trajectories.
 SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py; a=$?; "
                                 f"{PY} tests/mixing/test_pictures.py; b=$?; "
                                 f"{PY} tests/mixing/test_generate.py; c=$?; "
                                 f"{PY} tests/mixing/test_claims.py; d=$?; "
-                                f"{PY} tests/mixing/test_report.py; e=$?; exit $((a | b | c | d | e))"],
+                                f"{PY} tests/mixing/test_report.py; e=$?; "
+                                f"{PY} tests/mixing/test_horizon.py; f=$?; exit $((a | b | c | d | e | f))"],
             "lines", {})]
 # The campaign driver (scripts/campaign.py) with dummy units, a killed run resumed.
 SUITES += [("campaign", [PY, "tests/mixing/test_campaign.py"], "lines", {})]

@@ -6,7 +6,8 @@
 Per engine (jdem, liggghts-jdem) and model 1-6: the first fill, the second-pass scene cut from
 it, the second fill, and per pass the 9 cube scenes and their 9 compressions; for Model 3 also
 two realisations of the first fill with the stream shifted by 1 and 2 micrometres (the run-to-run
-spread).  --dt picks the
+spread).  After them, per model, the cross-engine horizon (`cross/modelM/horizon`: the first
+seconds of the first fill in both engines, compared particle by particle).  --dt picks the
 time-step variant of the error-against-run-time study: `seed` (default) the seed's dt = 1e-4 s
 under out/mixing/ch4/, run with --force because the guard refuses it (docs/mixing.md §6);
 `guard` the guard's dt (what `time.dt: auto` resolves to) under out/mixing/ch4_dt_guard/; `half` half of it under
@@ -17,6 +18,7 @@ itself, by reading a probe scene that uses the feature (jdem resolve; for ligggh
 deck generator), so the gate lifts by itself once the feature lands.
 """
 import functools
+import json
 import os
 import shlex
 import subprocess
@@ -42,6 +44,8 @@ CUBE_PARTICLES, CUBE_TIME = 400, 10.0     # about 400 spheres in a 0.2 m cube, u
 CHECKPOINT_SECONDS = 300                  # a killed fill loses at most this much of its work
 SCENE_COST = 1e6                          # cutting: a read of the deposit
 SPREAD_MODEL, SPREAD_REALISATIONS = "model3", 2   # the run-to-run spread's fills (obstacles: phi_v > 0)
+HORIZON_TIME, HORIZON_FRAME_TIME = 4.0, 0.02      # [s] the cross-engine horizon's fill and frames
+HORIZON_COST = 3.3        # both engines: liggghts-jdem takes 2.3 x jdem's CPU (47 s and 106 s, model1, 4 s)
 
 
 def jdem():
@@ -246,10 +250,36 @@ def model_units(engine, model, variant):
         + spread_units(engine, model, variant)
 
 
+def valid_horizon(path):
+    try:
+        with open(path) as f:
+            doc = json.load(f)
+    except (OSError, ValueError) as e:
+        return f"not a horizon result: {e}"
+    return None if "divergence" in doc else "no divergence"
+
+
+def horizon_unit(model, variant):
+    """The cross-engine horizon (scripts/mixing/horizon_ch4.py): the first HORIZON_TIME s of the
+    first fill in both engines, frames every HORIZON_FRAME_TIME s, compared particle by particle."""
+    dt_arg, dt = variant_dt(variant, model)
+    out = os.path.join(OUT[variant], "cross", model, "horizon.json")
+    inserted = FILL_PARTICLES * HORIZON_TIME / FILL_TIME
+    return Unit(f"cross/{model}/horizon", [out],
+                [PY, os.path.join(HERE, "horizon_ch4.py"), "run", "--case", model, "--dt", dt_arg,
+                 *(["--force"] if variant == "seed" else []), "--end-time", repr(HORIZON_TIME),
+                 "--frame-every", str(max(1, round(HORIZON_FRAME_TIME / dt))), "--dir", "{dir}",
+                 "-o", "{out0}"],
+                model, "cross", validate=valid_horizon,
+                cost=HORIZON_COST * inserted * HORIZON_TIME / dt,
+                blocked=gate("liggghts-jdem", "conveyor inlet"))   # it asks jdem too
+
+
 def units(argv):
     import argparse
     ap = argparse.ArgumentParser(prog="plan_ch4.py")
     ap.add_argument("--dt", choices=sorted(OUT), default="seed",
                     help="time-step variant: the seed's 1e-4 s, the guard's dt, half of it")
     a = ap.parse_args(argv)
-    return [u for engine in ENGINES for model in MODELS for u in model_units(engine, model, a.dt)]
+    return [u for engine in ENGINES for model in MODELS for u in model_units(engine, model, a.dt)] \
+        + [horizon_unit(model, a.dt) for model in MODELS]

@@ -342,6 +342,19 @@ def times_table(found, taken):
     return "\n".join(lines) + "\n" + earlier_note(units)
 
 
+def horizon_section(results=os.path.join(ROOT, "reference_runs", "mixing", "ch4", "results", "horizon")):
+    """The cross-engine horizon of the first fills: the table of `horizon_ch4.py summary` (the
+    cross/modelM/horizon units), as committed in RESULTS (make mixing-report refreshes it first)."""
+    from scripts.mixing import horizon_ch4
+    models = horizon_ch4.read_summary(results)
+    head = "### Cross-engine horizon of the first fills, jdem vs liggghts-jdem\n\n"
+    if not models:
+        return head + "not run (make mixing ENGINE=cross)\n"
+    return head + ("Particles matched by id; per frame (every 0.02 s) the larger of max |Δx| / R_max "
+                   "and max |Δv| / sqrt(g d_max), as in the pour study (docs/mixing.md §4); plot: "
+                   "horizon/horizon.png.\n\n") + horizon_ch4.table(models)
+
+
 def commit():
     r = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
     return r.stdout.strip() or "unknown"
@@ -366,6 +379,7 @@ def report(found, missing, taken, figures, rev):
              "commits (named under each table). Every reconstruction the seed leaves open is a scene "
              "parameter (docs/mixing.md §1).\n" % rev, mixing_table(found, taken), figures_section(figures)]
     parts += [elastic_table(found, taken, k, t, f) for k, t, f in TABLES]
+    parts.append(horizon_section())
     parts += [spread_table(found, taken), constants_table(found, taken), "### The seed's claims\n",
               claims_ch4.claims(found, ENGINES), times_table(found, taken),
               "### Not run\n", "\n".join("- " + m for m in missing) + "\n" if missing else "nothing\n"]

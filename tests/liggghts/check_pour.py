@@ -44,6 +44,7 @@ import yaml
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 from scripts import engines, pour_study
+from scripts.trajectory_divergence import ROUNDOFF, horizon
 
 EVERY = 200
 HORIZON = {("lig1", "lig2x"): 0.110, ("jdem", "lig1"): 0.130}   # [s], see above
@@ -55,10 +56,10 @@ def check_horizon(traj, a, b, until):
     t, dx, dv = pour_study.scaled_difference(traj[a], traj[b])
     diff = np.maximum(dx, dv)[t <= until + 1e-12]
     worst = float(diff.max())
-    ok = worst < pour_study.ROUNDOFF
+    ok = worst < ROUNDOFF
     print("%s pour %s vs %s: max scaled difference %.1e up to t = %.3f s (< %.0e)%s" % (
-        "PASS" if ok else "FAIL", a, b, worst, until, pour_study.ROUNDOFF,
-        "" if ok else "; reached at t = %.4f s" % pour_study.horizon(t, np.maximum(dx, dv))[0]))
+        "PASS" if ok else "FAIL", a, b, worst, until, ROUNDOFF,
+        "" if ok else "; reached at t = %.4f s" % horizon(t, np.maximum(dx, dv))[0]))
     return ok
 
 

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """The campaign driver (scripts/campaign.py) with dummy units: resume after a killed run, skip of
 finished units, validation, selection by model / engine / unit, needs, progress and ETA."""
+import json
 import os
 import signal
 import subprocess
@@ -47,6 +48,9 @@ def units(argv):
     if os.environ.get("WITH_R"):  # r: the resumable unit's test only
         return plan + [Unit("r", [out("r")], WORKER + ["r", "{{out0}}"], model="m4", engine="e1",
                             validate=valid, resumes=True)]
+    if os.environ.get("WITH_F"):  # f: its own directory, the times file's test only
+        return plan + [Unit("f", [os.path.join(HERE, "out_f", "f.txt")], WORKER + ["f", "{{out0}}"],
+                            model="m5", engine="e4", validate=valid)]
     if not os.environ.get("WITH_D"):  # d and e: the not-yet-runnable test's only
         return plan
     return plan + [
@@ -178,11 +182,22 @@ def test_not_yet_runnable():
     check("unblocked_runs", r.returncode == 0 and runs(here) == ["d", "e"], f"ran {runs(here)}")
 
 
+def test_times_beside_unrun_first_unit():
+    """The measured times go beside the plan's first output (out/) even when the selection runs
+    only a unit elsewhere (out_f/) and out/ does not exist yet."""
+    here = setup()
+    r = campaign(here, "--unit", "f", env={"WITH_F": "1"})
+    times = os.path.join(here, "out", ".campaign_times.json")
+    check("times_beside_unrun_first_unit", r.returncode == 0 and runs(here) == ["f"]
+          and os.path.exists(times) and "f" in json.load(open(times)),
+          f"exit {r.returncode}, ran {runs(here)}: {r.stderr[-400:]}")
+
+
 def test_ch4_plan():
     """The plan of make mixing (docs/mixing.md §4): 2 engines x 6 models x (2 fills, 1 second-
     pass scene, 2 x (1 cube-scene unit + 9 compressions)) = 276 units, plus per engine the
-    spread model's realisations (2 x SPREAD_REALISATIONS), unique names, and every need an
-    earlier unit."""
+    spread model's realisations (2 x SPREAD_REALISATIONS) and the 6 cross-engine horizons last,
+    unique names, and every need an earlier unit."""
     from scripts.mixing import plan_ch4
     units = plan_ch4.units([])
     seen = set()
@@ -190,8 +205,13 @@ def test_ch4_plan():
     for u in units:
         order_ok &= all(n in seen for n in u.needs)
         seen.add(u.name)
-    want = 276 + 2 * plan_ch4.SPREAD_REALISATIONS
+    want = 276 + 2 * plan_ch4.SPREAD_REALISATIONS + 6
     check("ch4_plan_units", len(units) == want and len(seen) == want, f"{len(units)} units")
+    cross = [u.name for u in units[-6:] if u.engine == "cross"]
+    check("ch4_plan_horizons_last", cross == ["cross/model%d/horizon" % m for m in range(1, 7)]
+          and "--frame-every" in units[-1].command
+          and units[-1].command[units[-1].command.index("--frame-every") + 1] == "200",
+          f"{[u.name for u in units[-6:]]}")
     check("ch4_plan_needs_come_first", order_ok, "a need after its unit")
     m3 = [u.name for u in units if u.model == "model3" and u.engine == "liggghts-jdem"]
     check("ch4_plan_model_engine", len(m3) == 23 + plan_ch4.SPREAD_REALISATIONS
@@ -241,16 +261,24 @@ def test_ch4_dt_variants():
     safe = float(m.group(1)) if m else float("nan")
     for variant, dt, forced in (("seed", 1e-4, True), ("guard", safe, False),
                                 ("half", safe / 2, False)):
-        fill = plan_ch4.units(["--dt", variant])[0]
+        plan = plan_ch4.units(["--dt", variant])
+        fill, horizon = plan[0], plan[-1]
         cmd = fill.command[2]
         got = float(re.search(r"--dt (\S+)", cmd).group(1))
         check(f"ch4_dt_{variant}", abs(got - dt) <= 1e-5 * dt and ("--force" in cmd) == forced
               and fill.outputs[0].startswith(plan_ch4.OUT[variant] + os.sep),
               f"dt {got} (expected {dt:.6g}), command {cmd}, output {fill.outputs[0]}")
+        hc = horizon.command   # the same dt, frames every 0.02 s in steps of it
+        got = float(hc[hc.index("--dt") + 1])
+        check(f"ch4_horizon_dt_{variant}", abs(got - dt) <= 1e-5 * dt and ("--force" in hc) == forced
+              and int(hc[hc.index("--frame-every") + 1]) == round(0.02 / got)
+              and horizon.outputs[0].startswith(plan_ch4.OUT[variant] + os.sep),
+              f"command {hc}, output {horizon.outputs[0]}")
 
 
 test_validation_and_selection()
 test_not_yet_runnable()
+test_times_beside_unrun_first_unit()
 test_ch4_dt_variants()
 test_ch4_plan()
 test_ch4_fill_resumes()

@@ -110,4 +110,13 @@ r = gen("fill", "--case", "model1", "--dt", "-1", "-o", fill)
 check("fill_dt_bad", r.returncode == 2 and r.stderr.strip().endswith(
       "generate.py fill: error: argument --dt: '-1' is not valid; valid: a number > 0 [s], or "
       "auto"), r.stderr)
+# --frame-every: the horizon's dense frames, in steps of the scene's dt (after a --dt rescale)
+r = gen("fill", "--case", "model2", "--dt", "5e-05", "--frame-every", "400", "-o", fill)
+doc = yaml.safe_load(open(fill)) if r.returncode == 0 else {}
+check("fill_frame_every", doc.get("output") == {"every": 400, "observables_every": 2000},
+      f"{r.stderr}{doc.get('output')}")
+r = gen("fill", "--case", "model1", "--frame-every", "0", "-o", fill)
+check("fill_frame_every_bad", r.returncode == 2 and r.stderr.strip().endswith(
+      "generate.py fill: error: argument --frame-every: '0' is not valid; valid: a whole number "
+      "of steps >= 1"), r.stderr)
 finish()

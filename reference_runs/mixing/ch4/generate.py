@@ -4,7 +4,7 @@ first- or second-pass deposit, and the first-pass cases as scenes of their own (
 §1, §2, §4); every scene runs in both engines.
 
     generate.py fill --case modelM -o FILL1.yaml [--dt DT] [--sections N] [--end-time T]
-                     [--jitter K]
+                     [--jitter K] [--frame-every N]
     generate.py second-pass DEPOSIT.h5 --case modelM -o PASS2.yaml [--gap 0.06] [--dt DT]
     generate.py cubes DEPOSIT.h5 --case modelM -o DIR [--dt DT]  (writes DIR/cubeK.yaml, K = 1..9)
 
@@ -12,7 +12,9 @@ fill: the first-pass case of models.yaml as a scene of its own, optionally with 
 step (a number in s, or auto: the guard's) or a reduced stream (the first N sections, T s).
 --jitter K shifts the whole stream by K micrometres in y (the inlet's origin), a realisation of
 the same fill for the run-to-run spread: the fill is chaotic, so 1e-6 m grows into another
-deposit with the same statistics.
+deposit with the same statistics.  --frame-every N writes a frame every N steps (of the
+scene's dt) instead of the seed's snapshots: the dense frames of the cross-engine horizon
+(scripts/mixing/horizon_ch4.py).
 --dt sets the time step of every scene written (default: the seed's, models.yaml's time.dt); a
 number rescales the output cadence so that the frames stay at the same times (auto keeps the
 cadence in steps).
@@ -87,6 +89,8 @@ def fill(args):
         doc["inlets"][0]["stop"] = {"sections": args.sections}
     if args.end_time is not None:
         doc["time"]["end_time"] = args.end_time
+    if args.frame_every is not None:
+        doc["output"]["every"] = args.frame_every
     jitter = ""
     if args.jitter:
         doc["inlets"][0]["origin"][1] += JITTER * args.jitter
@@ -213,6 +217,13 @@ def time_step(text):
     return dt
 
 
+def steps(text):
+    """--frame-every: a whole number of steps >= 1."""
+    if not text.isdigit() or int(text) < 1:
+        raise argparse.ArgumentTypeError(f"'{text}' is not valid; valid: a whole number of steps >= 1")
+    return int(text)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="what", required=True)
@@ -228,6 +239,8 @@ def main():
             p.add_argument("--end-time", type=float, help="simulated time [s] (default 25)")
             p.add_argument("--jitter", type=int, default=0,
                            help="shift the stream by K micrometres in y (a realisation for the spread)")
+            p.add_argument("--frame-every", type=steps,
+                           help="a frame every N steps (default: the seed's snapshots, 1 s)")
         if name == "second-pass":
             p.add_argument("--gap", type=float, default=0.06,
                            help="[RECON] gap between queued cells [m], default 2 R_big")
