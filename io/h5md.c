@@ -634,6 +634,20 @@ int jd_h5md_set_walls(jd_h5md *h, size_t n, const jd_h5md_wall *walls, char *err
     return rc;
 }
 
+h5md_wall_mesh *h5md_walls_of(jd_h5md *h) { return &h->walls; }
+
+size_t h5md_rows_count(const jd_h5md *h) { return h->rows.n; }
+
+int jd_h5md_move_mesh(jd_h5md *h, size_t wall, const double (*triangles)[3][3], char *err,
+                      size_t errlen) {
+    const size_t n = h && wall < h->walls.n_walls ? h->walls.n_vertices[wall] / 3 : 0;
+    if (!h || h5md_walls_move_mesh(&h->walls, wall, triangles, n) != 0) {
+        h5md_set_err(err, errlen, "h5md: wall %zu is not a mesh wall given with moved = 1", wall);
+        return -1;
+    }
+    return 0;
+}
+
 int jd_h5md_close(jd_h5md *h, int ok, char *err, size_t errlen) {
     if (!h) return 0;
     if (err && errlen) err[0] = '\0';

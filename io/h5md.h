@@ -106,15 +106,21 @@ int jd_h5md_write_observable(jd_h5md *h, const char *name, int64_t step, double 
                              double value, char *err, size_t errlen);
 
 /* A wall as drawn in the output (/jdem/walls): its geometry at time 0 and its motion, a rigid
- * translation x(t) = x(0) + velocity t (both engines move walls so). */
+ * translation x(t) = x(0) + velocity t (both engines move plane and cylinder walls so), or for
+ * a mesh whose engine moves it otherwise (LIGGGHTS' fix move/mesh rotate) its triangles at
+ * each frame (jd_h5md_move_mesh). */
 typedef struct jd_h5md_wall {
     const char *name;
-    int type;               /* 0 plane (the quadrilateral corners), 1 cylinder (axis, radius) */
+    int type;               /* 0 plane (the quadrilateral corners), 1 cylinder (axis, radius),
+                               2 triangle mesh (triangles) */
     double corners[4][3];   /* [m] plane */
     double axis[2][3];      /* [m] cylinder: end points of the axis segment */
     double radius;          /* [m] cylinder */
     int inside;             /* cylinder: 1 container, 0 obstacle */
     double velocity[3];     /* [m/s] */
+    size_t n_triangles;     /* mesh: its triangles, in the STL's order */
+    const double (*triangles)[3][3]; /* [m] mesh: their corners at time 0 */
+    int moved;              /* mesh: 1 = the engine gives its triangles at every frame */
 } jd_h5md_wall;
 
 /* Record the run's walls (once, before the first frame; n may be 0).  Each frame then carries
@@ -122,6 +128,12 @@ typedef struct jd_h5md_wall {
  * JD_H5MD_CYLINDER_FACETS quadrilaterals around the axis.  Returns 0 or -1 with err. */
 int jd_h5md_set_walls(jd_h5md *h, size_t n, const jd_h5md_wall *walls, char *err, size_t errlen);
 #define JD_H5MD_CYLINDER_FACETS 32
+
+/* The triangles (n_triangles of them, as set) of mesh wall `wall` (its index in the set_walls
+ * list; a wall given with moved = 1) where they are now: the next frames draw them there.
+ * 0, or -1 with err (not such a wall). */
+int jd_h5md_move_mesh(jd_h5md *h, size_t wall, const double (*triangles)[3][3], char *err,
+                      size_t errlen);
 
 /* A bond as recorded in /connectivity. */
 typedef struct jd_h5md_bond {

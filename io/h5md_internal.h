@@ -80,6 +80,11 @@ typedef struct h5md_wall_mesh {
     size_t nv, nq;   /* vertices, quadrilaterals */
     double *vert0;   /* [nv][3] vertices at time 0 [m] */
     double *vel;     /* [nv][3] their velocity [m/s] */
+    double *now;     /* [nv][3] where a moved mesh's vertices are (jd_h5md_move_mesh) [m] */
+    unsigned char *given; /* [nv] 1: the vertex of a moved mesh (its position is `now`) */
+    size_t n_walls;
+    size_t *first_vertex; /* [n_walls] each wall's first vertex */
+    size_t *n_vertices;   /* [n_walls] and its count; a moved mesh's vertices are `given` */
     hid_t position;  /* /jdem/walls/mesh/vertex_position [F][nv][3] when moving */
 } h5md_wall_mesh;
 
@@ -88,6 +93,12 @@ int h5md_walls_write(hid_t file, size_t n, const jd_h5md_wall *walls, h5md_wall_
 /* Append the vertices of frame `frame` at `time` [s] (moving walls only).  0 / -1. */
 int h5md_walls_frame(h5md_wall_mesh *m, hsize_t frame, double time);
 void h5md_walls_free(h5md_wall_mesh *m);
+/* The writer's walls (h5md.c), for the resumed run's copy of a prefix (h5md_resume.c). */
+h5md_wall_mesh *h5md_walls_of(struct jd_h5md *h);
+/* The writer's particle rows so far (h5md.c). */
+size_t h5md_rows_count(const struct jd_h5md *h);
+/* A moved mesh's triangles where they are now.  0 / -1 (wall k is not a moved mesh of n_tri). */
+int h5md_walls_move_mesh(h5md_wall_mesh *m, size_t k, const double (*tri)[3][3], size_t n_tri);
 
 /* A run of consecutive live rows [start, start + count) in one frame. */
 typedef struct xdmf_run {

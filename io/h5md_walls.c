@@ -3,13 +3,16 @@
  * description and motion law in /jdem/walls, and the surface mesh the sidecar draws.
  *
  * The mesh is quadrilaterals only (Xdmf's Quadrilateral topology, one kind of cell per grid):
- * a plane is its own quadrilateral, a cylinder JD_H5MD_CYLINDER_FACETS facets around its axis.
+ * a plane is its own quadrilateral, a cylinder JD_H5MD_CYLINDER_FACETS facets around its axis,
+ * a triangle of a mesh wall a quadrilateral whose last two corners are one vertex (ParaView
+ * draws it as the triangle).
  * Every quadrilateral is counter-clockwise seen from the wall's active side (its normal points
  * at the particles), so a viewer that culls back faces shows a container's far walls and hides
  * the near ones that would cover the particles.
  * Walls move by rigid translation, so a frame's vertices are the time-0 vertices plus
- * velocity x time; the writer stores them per frame only when some wall moves (a run whose
- * walls stand still carries one vertex list, not one per frame).
+ * velocity x time, except a mesh that its engine moves otherwise (`moved`), whose vertices are
+ * where jd_h5md_move_mesh last put them; the writer stores them per frame only when some wall
+ * moves (a run whose walls stand still carries one vertex list, not one per frame).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -31,12 +34,31 @@ static void perpendicular_pair(const double a[3], double u[3], double w[3]) {
 }
 
 static size_t wall_vertices(const jd_h5md_wall *w) {
-    return w->type == 1 ? 2 * JD_H5MD_CYLINDER_FACETS : 4;
+    return w->type == 1 ? 2 * JD_H5MD_CYLINDER_FACETS : w->type == 2 ? 3 * w->n_triangles : 4;
+}
+
+static size_t wall_quads(const jd_h5md_wall *w) {
+    return w->type == 1 ? JD_H5MD_CYLINDER_FACETS : w->type == 2 ? w->n_triangles : 1;
+}
+
+static int wall_moves(const jd_h5md_wall *w) {
+    return (w->type == 2 && w->moved) || w->velocity[0] != 0.0 || w->velocity[1] != 0.0 ||
+           w->velocity[2] != 0.0;
 }
 
 /* Vertices (at time 0) and quadrilaterals (indices from v0) of wall k. */
 static void tessellate(const jd_h5md_wall *w, int32_t k, int64_t v0, double *vert, int64_t *quad,
                        int32_t *quad_wall, size_t *nq) {
+    if (w->type == 2) { /* the STL's winding: its normal, the right-hand rule, faces the active side */
+        if (w->n_triangles) memcpy(vert, w->triangles, w->n_triangles * sizeof *w->triangles);
+        for (size_t t = 0; t < w->n_triangles; t++) {
+            const int64_t c = v0 + 3 * (int64_t)t, tri[4] = {c, c + 1, c + 2, c + 2};
+            memcpy(&quad[4 * t], tri, sizeof tri);
+            quad_wall[t] = k;
+        }
+        *nq = w->n_triangles;
+        return;
+    }
     if (w->type != 1) {
         memcpy(vert, w->corners, sizeof w->corners);
         for (int c = 0; c < 4; c++) quad[c] = v0 + c;
@@ -132,23 +154,35 @@ int h5md_walls_write(hid_t file, size_t n, const jd_h5md_wall *walls, h5md_wall_
     m->position = H5I_INVALID_HID;
     for (size_t k = 0; k < n; k++) {
         m->nv += wall_vertices(&walls[k]);
-        m->nq += walls[k].type == 1 ? JD_H5MD_CYLINDER_FACETS : 1;
-        for (int d = 0; d < 3; d++) m->moving |= walls[k].velocity[d] != 0.0;
+        m->nq += wall_quads(&walls[k]);
+        m->moving |= wall_moves(&walls[k]);
     }
+    m->n_walls = n;
     m->vert0 = malloc((m->nv ? m->nv : 1) * 3 * sizeof *m->vert0);
     m->vel = malloc((m->nv ? m->nv : 1) * 3 * sizeof *m->vel);
+    m->now = malloc((m->nv ? m->nv : 1) * 3 * sizeof *m->now);
+    m->given = calloc(m->nv ? m->nv : 1, 1);
+    m->first_vertex = malloc((n ? n : 1) * sizeof *m->first_vertex);
+    m->n_vertices = malloc((n ? n : 1) * sizeof *m->n_vertices);
     int64_t *quad = malloc((m->nq ? m->nq : 1) * 4 * sizeof *quad);
     int32_t *quad_wall = malloc((m->nq ? m->nq : 1) * sizeof *quad_wall);
     double *zero = calloc(m->nv ? m->nv : 1, sizeof *zero);
     int rc = -1;
-    if (!m->vert0 || !m->vel || !quad || !quad_wall || !zero) goto done;
+    if (!m->vert0 || !m->vel || !m->now || !m->given || !m->first_vertex || !m->n_vertices ||
+        !quad || !quad_wall || !zero)
+        goto done;
     size_t v = 0, q = 0;
     for (size_t k = 0; k < n; k++) {
         size_t nq;
         tessellate(&walls[k], (int32_t)k, (int64_t)v, m->vert0 + 3 * v, quad + 4 * q,
                    quad_wall + q, &nq);
-        for (size_t j = v; j < v + wall_vertices(&walls[k]); j++)
+        m->first_vertex[k] = v;
+        m->n_vertices[k] = wall_vertices(&walls[k]);
+        for (size_t j = v; j < v + wall_vertices(&walls[k]); j++) {
             memcpy(m->vel + 3 * j, walls[k].velocity, 3 * sizeof *m->vel);
+            memcpy(m->now + 3 * j, m->vert0 + 3 * j, 3 * sizeof *m->now);
+            m->given[j] = walls[k].type == 2 && walls[k].moved;
+        }
         v += wall_vertices(&walls[k]);
         q += nq;
     }
@@ -180,16 +214,31 @@ int h5md_walls_frame(h5md_wall_mesh *m, hsize_t frame, double time) {
     if (!m->present || !m->moving || m->nv == 0) return 0;
     double *x = malloc(m->nv * 3 * sizeof *x);
     if (!x) return -1;
-    for (size_t j = 0; j < 3 * m->nv; j++) x[j] = m->vert0[j] + m->vel[j] * time;
+    for (size_t j = 0; j < 3 * m->nv; j++)
+        x[j] = m->given[j / 3] ? m->now[j] : m->vert0[j] + m->vel[j] * time;
     const hsize_t rest[2] = {m->nv, 3};
     const int rc = h5md_append_row(m->position, frame, 3, rest, H5T_NATIVE_DOUBLE, x);
     free(x);
     return rc;
 }
 
+int h5md_walls_move_mesh(h5md_wall_mesh *m, size_t k, const double (*tri)[3][3], size_t n_tri) {
+    if (!m->present || k >= m->n_walls || !m->given[m->first_vertex[k]] ||
+        m->n_vertices[k] != 3 * n_tri)
+        return -1;
+    memcpy(m->now + 3 * m->first_vertex[k], tri, n_tri * sizeof *tri);
+    return 0;
+}
+
 void h5md_walls_free(h5md_wall_mesh *m) {
     h5md_close_id(&m->position);
     free(m->vert0);
     free(m->vel);
-    m->vert0 = m->vel = NULL;
+    free(m->now);
+    free(m->given);
+    free(m->first_vertex);
+    free(m->n_vertices);
+    m->vert0 = m->vel = m->now = NULL;
+    m->given = NULL;
+    m->first_vertex = m->n_vertices = NULL;
 }

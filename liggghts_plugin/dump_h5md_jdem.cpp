@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <unistd.h>
 
 #include "atom.h"
 #include "error.h"
@@ -16,7 +17,9 @@
 #include "update.h"
 
 #include "fix_wall_jiang.h"
+#include "fix_wall_jiang_mesh.h"
 #include "h5md.h"
+#include "h5md_resume.h"
 #include "jdem_observables.h"
 #include "pair_gran_jiang.h"
 
@@ -33,7 +36,8 @@ enum { COL_ID = 0, COL_TYPE, COL_R, COL_M, COL_X, COL_V = COL_X + 3, COL_W = COL
        COL_F = COL_W + 3, COL_T = COL_F + 3, NCOL = COL_T + 3 };
 
 DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
-    : Dump(lmp, narg, arg), h5(NULL), energy(true), grow(-1), natoms0(-1), last_step(-1), observables_every(0), stop_frame(false) {
+    : Dump(lmp, narg, arg), h5(NULL), energy(true), grow(-1), natoms0(-1), last_step(-1), observables_every(0), stop_frame(false),
+      resume_step(-1) {
   if (narg < 5) error->all(FLERR, "Illegal dump h5md/jdem command: dump ID group h5md/jdem N FILE.h5");
   path = arg[4];
   if (path.find('*') != std::string::npos || path.find('%') != std::string::npos)
@@ -59,8 +63,14 @@ DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
       if (std::strcmp(arg[i + 1], "yes") == 0) grow = 1;
       else if (std::strcmp(arg[i + 1], "no") == 0) grow = 0;
       else error->all(FLERR, "dump h5md/jdem: grow must be yes or no");
+    } else if (k == "resume") {
+      /* the dump is defined after read_restart: this step is the one the file was written at */
+      if (std::strcmp(arg[i + 1], "yes") == 0) resume_step = update->ntimestep;
+      else if (std::strcmp(arg[i + 1], "no") != 0)
+        error->all(FLERR, "dump h5md/jdem: resume must be yes or no");
     } else {
-      error->all(FLERR, "dump h5md/jdem: unknown keyword (valid: scene, case, scene_yaml, energy, grow)");
+      error->all(FLERR, "dump h5md/jdem: unknown keyword (valid: scene, case, scene_yaml, energy, "
+                 "grow, resume)");
     }
   }
   size_one = NCOL;
@@ -95,6 +105,14 @@ struct RowById {
 }  // namespace
 
 void DumpH5mdJdem::write() {
+  gather_mesh_walls(last_step < 0);
+  if (resume_step >= 0 && update->ntimestep <= resume_step) {
+    /* the interrupted run wrote this step's frame and samples (or the uninterrupted run writes
+     * none here): they are in the copied prefix */
+    if (!h5) open_resumed();
+    last_step = update->ntimestep;
+    return;
+  }
   const int nlocal = atom->nlocal;
   const int *mask = atom->mask, *tag = atom->tag, *type = atom->type;
   double **x = atom->x, **v = atom->v, **omega = atom->omega, **f = atom->f, **torque = atom->torque;
@@ -153,7 +171,9 @@ void DumpH5mdJdem::write() {
       }
     }
 
-    if (!h5) {
+    if (!h5 && resume_step >= 0) {
+      failed = resume_file(err, sizeof err);
+    } else if (!h5) {
       if (grow < 0) grow = insertion_fix() ? 1 : 0;
       failed = create_file(all, order, dt, err, sizeof err);
       natoms0 = (bigint)nat;
@@ -182,7 +202,12 @@ void DumpH5mdJdem::write() {
       fr.force = frc.data();
       fr.torque = trq.data();
       fr.rows = grow ? &frame_rows : NULL;
-      if (jd_h5md_write_frame(h5, &fr, err, sizeof err) != 0) failed = 1;
+      for (size_t k = 0; k < moved_meshes.size() && !failed; k++)
+        if (jd_h5md_move_mesh(h5, moved_meshes[k].first,
+                              (const double(*)[3][3])mesh_tris[moved_meshes[k].second].data(), err,
+                              sizeof err) != 0)
+          failed = 1;
+      if (!failed && jd_h5md_write_frame(h5, &fr, err, sizeof err) != 0) failed = 1;
     }
     if (!failed && sample && write_contact_observables(all_obs, step, time, err, sizeof err) != 0)
       failed = 1;
@@ -242,12 +267,18 @@ int DumpH5mdJdem::create_file(const std::vector<double> &all, const std::vector<
   parts.radius = rad.data();
   parts.mass = mass.data();
   parts.growing = grow;
-  if (grow) {
-    row_id = ids;
-    row_species = species;
-    row_radius = rad;
-    row_mass = mass;
-    for (size_t i = 0; i < nat; i++) row_of[ids[i]] = i;
+  return open_file(parts, dt, err, errlen);
+}
+
+/* Rank 0: the file with the particle set `parts` (a growing set's first rows) and the walls. */
+int DumpH5mdJdem::open_file(const jd_h5md_particles &parts, double dt, char *err, size_t errlen) {
+  if (parts.growing) {
+    row_id.assign(parts.id, parts.id + parts.n);
+    row_species.assign(parts.species, parts.species + parts.n);
+    row_radius.assign(parts.radius, parts.radius + parts.n);
+    row_mass.assign(parts.mass, parts.mass + parts.n);
+    for (size_t i = 0; i < parts.n; i++)
+      if (parts.id[i] >= 0) row_of[parts.id[i]] = i;
   }
   jd_h5md_meta meta;
   std::memset(&meta, 0, sizeof meta);
@@ -267,7 +298,69 @@ int DumpH5mdJdem::create_file(const std::vector<double> &all, const std::vector<
     walls.push_back(jd_h5md_wall());
     w->output_geometry(&walls.back(), now);
   }
+  /* then the meshes, as build/jdem orders its walls; a moved mesh's triangles at every frame */
+  moved_meshes.clear();
+  size_t m = 0;
+  for (int f = 0; f < modify->nfix; f++) {
+    const FixWallJiangMesh *w = dynamic_cast<FixWallJiangMesh *>(modify->fix[f]);
+    for (size_t k = 0; w && k < w->n_meshes(); k++, m++) {
+      jd_h5md_wall wall;
+      std::memset(&wall, 0, sizeof wall);
+      wall.name = w->mesh_name(k);
+      wall.type = 2;
+      wall.n_triangles = mesh_tris[m].size() / 9;
+      wall.triangles = (const double(*)[3][3])mesh_tris[m].data();
+      wall.moved = w->mesh_moves(k);
+      if (wall.moved) moved_meshes.push_back(std::make_pair(walls.size(), m));
+      walls.push_back(wall);
+    }
+  }
   return jd_h5md_set_walls(h5, walls.size(), walls.empty() ? NULL : walls.data(), err, errlen) != 0;
+}
+
+/* Collective: the triangles of each mesh of the fixes wall/jiang mesh into mesh_tris (rank 0),
+ * in the order of the walls after the plane and cylinder walls: all of them (first frame), else
+ * those LIGGGHTS moves (the others are drawn where they were at the first frame). */
+void DumpH5mdJdem::gather_mesh_walls(bool all) {
+  size_t m = 0;
+  for (int f = 0; f < modify->nfix; f++) {
+    FixWallJiangMesh *w = dynamic_cast<FixWallJiangMesh *>(modify->fix[f]);
+    for (size_t k = 0; w && k < w->n_meshes(); k++, m++) {
+      if (mesh_tris.size() <= m) mesh_tris.resize(m + 1);
+      if (all || w->mesh_moves(k)) mesh_tris[m] = w->gather_triangles(k);
+    }
+  }
+}
+
+/* Rank 0, resume yes: the interrupted run's OUT.part moved aside, a fresh OUT.part with its
+ * particle rows and its prefix up to resume_step copied in (io/h5md_resume.h). */
+int DumpH5mdJdem::resume_file(char *err, size_t errlen) {
+  char src[4200];
+  if (jd_h5md_resume_source(path.c_str(), (int64_t)resume_step, src, sizeof src, err, errlen) != 0)
+    return 1;
+  jd_h5md_particles rows;
+  if (jd_h5md_resume_rows(src, (int64_t)resume_step, &rows, err, errlen) != 0) return 1;
+  grow = rows.growing;
+  natoms0 = (bigint)rows.n;
+  int failed = open_file(rows, update->dt, err, errlen);
+  jd_h5md_resume_rows_free(&rows);
+  if (!failed && jd_h5md_resume_copy(src, h5, (int64_t)resume_step, (int64_t)resume_step, err,
+                                     errlen) != 0)
+    failed = 1;
+  if (!failed) unlink(src); /* its prefix is in OUT.part now, flushed */
+  return failed;
+}
+
+/* Collective: resume_file on rank 0 at a step whose frame the prefix holds. */
+void DumpH5mdJdem::open_resumed() {
+  int failed = 0;
+  char err[1024] = "";
+  if (me == 0) failed = resume_file(err, sizeof err);
+  MPI_Bcast(&failed, 1, MPI_INT, 0, world);
+  if (failed) {
+    MPI_Bcast(err, sizeof err, MPI_CHAR, 0, world);
+    error->all(FLERR, (std::string("dump h5md/jdem: ") + err).c_str());
+  }
 }
 
 /* Rank 0, growing set: the rows of this frame.  An atom keeps the row it got when it first
@@ -351,6 +444,7 @@ int DumpH5mdJdem::write_bond_observables(const double all_obs[JDO_N], bigint ste
 }
 
 void DumpH5mdJdem::write_observable_sample() {
+  if (resume_step >= 0 && update->ntimestep <= resume_step) return; /* in the copied prefix */
   double all_obs[JDO_N];
   reduce_observables(all_obs);
   bonds.count(lmp);

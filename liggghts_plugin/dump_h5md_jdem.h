@@ -1,5 +1,5 @@
 /* dump_h5md_jdem.h — `dump ID group h5md/jdem N FILE.h5 [scene NAME] [case NAME]
- *                    [scene_yaml PATH] [energy yes|no] [grow yes|no]`: jdem's H5MD trajectory (io/h5md.h),
+ *                    [scene_yaml PATH] [energy yes|no] [grow yes|no] [resume yes|no]`: jdem's H5MD trajectory (io/h5md.h),
  * written on rank 0 through the shared C writer.
  *
  * Every N steps: position, velocity, angular velocity, force, torque of the group's atoms,
@@ -18,7 +18,14 @@
  * set that changes (H5MD 1.1's time-dependent id, -1 in empty rows; an atom keeps its row, new
  * atoms get new rows in id order); the default is yes when the input has an insertion fix
  * (style insert/... or jdem/inlet) at the first frame, else the set must not change.  The
- * walls of every fix wall/jiang go to /jdem/walls. */
+ * walls of every fix wall/jiang go to /jdem/walls, the meshes of fix wall/jiang mesh after the
+ * planes and cylinders (their triangles at every frame when fix move/mesh moves them).  resume yes, in a script that continues an
+ * interrupted run from its restart file (the dump defined after read_restart): the interrupted
+ * run's FILE.h5.part (or FILE.h5.resume, after an interrupted resume) is moved to
+ * FILE.h5.resume, and its frames, observables and bond tables up to the restart file's step
+ * are copied into a fresh FILE.h5.part (io/h5md_resume.h), which the run then continues: the
+ * result equals the uninterrupted run's trajectory when that run wrote its restart files at the
+ * same steps. */
 #ifndef JDEM_DUMP_H5MD_JDEM_H
 #define JDEM_DUMP_H5MD_JDEM_H
 
@@ -32,6 +39,7 @@
 #include "jdem_observables.h"
 
 struct jd_h5md;
+struct jd_h5md_particles;
 
 /* Set by liggghts-jdem's main() once the input script has finished, and around `undump`: the
  * dump's destructor then completes the file (PATH.part -> PATH).  Any other destruction is
@@ -83,6 +91,10 @@ class DumpH5mdJdem : public Dump {
   bool insertion_fix() const;
   int create_file(const std::vector<double> &all, const std::vector<int> &order, double dt,
                   char *err, size_t errlen);
+  int open_file(const struct jd_h5md_particles &parts, double dt, char *err, size_t errlen);
+  int resume_file(char *err, size_t errlen);
+  void gather_mesh_walls(bool all);
+  void open_resumed();
   void place_rows(const std::vector<double> &all, const std::vector<int> &order,
                   std::vector<double> &pos, std::vector<double> &vel, std::vector<double> &angv,
                   std::vector<double> &frc, std::vector<double> &trq);
@@ -104,6 +116,11 @@ class DumpH5mdJdem : public Dump {
   std::vector<std::string> wall_names;
   std::vector<double> wall_values;
   bool stop_frame;          /* write() is writing the frame of a run stopped early */
+  bigint resume_step;       /* resume yes: the step read_restart resumed at; -1: a new file */
+  /* the mesh walls (after the plane and cylinder walls): each one's triangles [ntri][3][3] (rank
+   * 0), and (wall index, mesh) of those LIGGGHTS moves, whose triangles go with every frame */
+  std::vector<std::vector<double> > mesh_tris;
+  std::vector<std::pair<size_t, size_t> > moved_meshes;
   JdemBondOutput bonds;
 };
 

@@ -8,6 +8,7 @@
 #include "force.h"
 #include "memory.h"
 #include "modify.h"
+#include "update.h"
 
 #include "jdem_kernel.h"
 #include "jdem_restart.h"
@@ -56,18 +57,20 @@ void FixJdemRestart::write_restart(FILE *fp) {
   PairGranJiang *pair = dynamic_cast<PairGranJiang *>(force->pair);
   JdemRestartState st;
   if (pair) {
-    const double shared[NSHARED] = {(double)pair->wall_rule, (double)pair->damping_map,
-                                    (double)pair->xi_limit, (double)pair->tangential_rule,
-                                    pair->mu_r, pair->rolling ? 1.0 : 0.0,
-                                    pair->energy_accounts ? 1.0 : 0.0};
+    const double shared[NPAIR] = {(double)pair->wall_rule, (double)pair->damping_map,
+                                  (double)pair->xi_limit, (double)pair->tangential_rule,
+                                  pair->mu_r, pair->rolling ? 1.0 : 0.0,
+                                  pair->energy_accounts ? 1.0 : 0.0};
     const double sums[NSUMS] = {pair->e_damp_cum, pair->e_fric_cum, pair->e_elastic_now,
                                 pair->contacts_now};
-    st.shared.assign(shared, shared + NSHARED);
+    st.shared.assign(shared, shared + NPAIR);
     st.sums.assign(sums, sums + NSUMS);
   } else {
-    st.shared.assign(NSHARED, -1.0);
+    st.shared.assign(NPAIR, -1.0);
     st.sums.assign(NSUMS, 0.0);
   }
+  st.shared.push_back(update->atime);
+  st.shared.push_back(jdem_restart_pack_i64((int64_t)update->atimestep));
   jdem_restart_write_state(lmp, fp, st);
 }
 
@@ -76,6 +79,11 @@ void FixJdemRestart::write_restart(FILE *fp) {
 void FixJdemRestart::restart(char *buf) {
   const JdemRestartState st = jdem_restart_read_state(lmp, buf, "fix jdem_restart (jdem/restart)",
                                                       NSHARED, NSUMS);
+  /* the clock as the writer had it, so that the time of every later step (atime + (step -
+   * atimestep) dt: the dump's, the bond breaks') has the uninterrupted run's bits; LIGGGHTS'
+   * restart file does not keep it */
+  update->atime = st.shared[NPAIR];
+  update->atimestep = (bigint)jdem_restart_unpack_i64(st.shared[NPAIR + 1]);
   PairGranJiang *pair = dynamic_cast<PairGranJiang *>(force->pair);
   if (!pair) return;
   pair->e_damp_cum = st.sums[0];

@@ -8,7 +8,8 @@
  *    fix is defined after the script's fixes), so that the first half kick of the next step is
  *    the uninterrupted run's;
  *  - global: the pair style's options (checked against a later pair_style line,
- *    jdem_restart_check_pair_style) and each rank's contact observables of the pair style
+ *    jdem_restart_check_pair_style), the clock (update->atime and atimestep, which LIGGGHTS'
+ *    file does not keep; restored when the file is read) and each rank's contact observables of the pair style
  *    (cumulative damping and friction dissipation, elastic energy and contacts at the last
  *    force evaluation).
  * resuming(): from the creation with a file's data until the end of the next set-up; the set-up
@@ -52,7 +53,8 @@ class FixJdemRestart : public Fix {
 
  private:
   enum { SAVED = 6 };                 /* force [N] and torque [N m] */
-  enum { NSHARED = 7, NSUMS = 4 };    /* the global state's counts */
+  enum { NPAIR = 7 };                 /* the pair style's options */
+  enum { NSHARED = NPAIR + 2, NSUMS = 4 }; /* the global state's counts: options, clock, sums */
   bool resuming_;
   double **saved;
   int nmax_saved;

@@ -50,7 +50,7 @@ namespace LAMMPS_NS {
 class FixWallJiang : public Fix {
  public:
   int wall_type() const { return wtype; } /* the wall's atom type (material) */
-  bool is_mesh() const { return shape == 2; } /* fix wall/jiang mesh (not in the trajectory yet) */
+  bool is_mesh() const { return shape == 2; } /* fix wall/jiang mesh */
   /* The wall for the trajectory (io/h5md.h): its geometry at time 0, i.e. now (`time` [s])
    * less velocity x time, its velocity, and the fix ID as its name. */
   void output_geometry(jd_h5md_wall *w, double time) const;

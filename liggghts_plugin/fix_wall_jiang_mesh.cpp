@@ -17,6 +17,7 @@
 #include "tri_mesh.h"
 #include "update.h"
 
+#include "jdem_bond_output.h"
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
 #include "jdem_restart.h"
@@ -88,6 +89,29 @@ void FixWallJiangMesh::post_force(int vflag) { compute_mesh(true); }
  * ids (the STL's order), so that edge and vertex contacts belong to the same triangle as in the
  * standalone engine.  Rebuilt when the mesh moves (the welding compares coordinates) or the
  * rank's set of triangles changes. */
+const char *FixWallJiangMesh::mesh_name(size_t k) const { return meshes[k].fix->id; }
+
+bool FixWallJiangMesh::mesh_moves(size_t k) const { return meshes[k].fix->triMesh()->isMoving(); }
+
+std::vector<double> FixWallJiangMesh::gather_triangles(size_t k) const {
+  TriMesh *tm = meshes[k].fix->triMesh();
+  std::vector<double> mine;
+  for (int t = 0; t < tm->sizeLocal(); t++) {
+    double row[10];
+    row[0] = tm->id(t);
+    for (int c = 0; c < 3; c++) tm->node(t, c, &row[1 + 3 * c]);
+    mine.insert(mine.end(), row, row + 10);
+  }
+  const std::vector<double> all = jdem_gather_rows(world, mine);
+  const size_t n = all.size() / 10;
+  std::vector<std::pair<double, size_t> > by_id(n);
+  for (size_t r = 0; r < n; r++) by_id[r] = std::make_pair(all[10 * r], r);
+  std::sort(by_id.begin(), by_id.end());
+  std::vector<double> corners(9 * n);
+  for (size_t t = 0; t < n; t++) std::copy(&all[10 * by_id[t].second + 1], &all[10 * by_id[t].second + 10], &corners[9 * t]);
+  return corners;
+}
+
 void FixWallJiangMesh::rebuild_topology(Mesh &m) {
   TriMesh *tm = m.fix->triMesh();
   const int nall = tm->sizeLocal() + tm->sizeGhost();

@@ -38,6 +38,14 @@ class FixWallJiangMesh : public FixWallJiang {
   void setup(int);
   void post_force(int);
 
+  /* For dump h5md/jdem: the meshes of the fix; mesh k's name (its fix mesh/surface ID), whether
+   * LIGGGHTS moves it (fix move/mesh), and its triangles' corners [ntri][3][3] in id order, the
+   * STL's [m] (collective: every rank's own triangles, on rank 0; empty elsewhere). */
+  size_t n_meshes() const { return meshes.size(); }
+  const char *mesh_name(size_t k) const;
+  bool mesh_moves(size_t k) const;
+  std::vector<double> gather_triangles(size_t k) const;
+
  private:
   /* One mesh of the fix: LIGGGHTS' fix, and the kernel's view of the triangles this rank holds. */
   struct Mesh {

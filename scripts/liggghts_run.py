@@ -2,6 +2,7 @@
 """liggghts_run.py — run one case of a jdem scene in LIGGGHTS (build/liggghts-jdem).
 
     scripts/liggghts_run.py SCENE [--case NAME] -o OUT.h5 [--np N] [--force]
+                            [--checkpoint-every N [--resume]]
 
 Resolves the scene with `build/jdem resolve` first (a bad scene changes nothing on disk), then
 takes an exclusive lock on the deck directory OUT minus .h5 plus `.deck/` (in.jdem,
@@ -10,8 +11,19 @@ runs.  It generates the deck with scene_to_liggghts.py there and runs build/ligg
 (through mpirun for N > 1; the root flags of Open MPI are added only when running as root).
 The dump writes OUT.h5.part and renames it, with its OUT.xdmf, only once the run is complete: an
 earlier OUT.h5 and OUT.xdmf stay in place until then, and a stopped run leaves OUT.h5.part.
+While LIGGGHTS runs, a line `liggghts_run: step S/N (P %), ETA T` goes to stderr every minute,
+S the newest step that its log's thermo output or its newest restart file shows.
 SIGINT and SIGTERM are forwarded to LIGGGHTS (or mpirun) and waited for: it stops at its next
 step and keeps OUT.h5.part.  --force runs an unsafe time step anyway (fix jdem/guard ... force).
+
+--checkpoint-every N writes a LIGGGHTS restart file every N steps, restart.STEP in the deck
+directory; the two newest are kept.  --resume then continues an interrupted run (killed, or
+stopped by a signal) of the same resolved scene from the older of the two, which is complete
+however the run ended (the newer may have been cut off while it was written): the deck reads it
+instead of creating the particles, and its dump continues OUT.h5.part (dump h5md/jdem resume
+yes).  The result equals the uninterrupted run's with the same N, bit for bit.  A run
+interrupted before its second restart file, or whose scene has changed since, starts again from
+the beginning (it says so); a completed run removes its restart files.
 
 Exit status (the classes of `jdem`'s):
   0        the trajectory OUT.h5 is complete
@@ -31,6 +43,9 @@ import re
 import signal
 import subprocess
 import sys
+import time
+
+import yaml
 
 from scripts import engines
 
@@ -100,15 +115,21 @@ class Child:
             self.forwarded += 1
             os.kill(self.proc.pid, sig)
 
-    def run(self, cmd, cwd, lock_fd):
+    def run(self, cmd, cwd, lock_fd, every=None):
+        """Run CMD in CWD; (status, stdout, stderr).  EVERY: called every few seconds meanwhile."""
         # the lock is passed on: it holds while LIGGGHTS runs, even if this script is killed
         self.proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                      text=True, errors="replace", process_group=0, pass_fds=(lock_fd,))
         if self.signal and not self.forwarded:
             self.forwarded += 1
             os.kill(self.proc.pid, self.signal)
-        out, err = self.proc.communicate()
-        return self.proc.returncode, out, err
+        while True:
+            try:
+                out, err = self.proc.communicate(timeout=5.0)
+                return self.proc.returncode, out, err
+            except subprocess.TimeoutExpired:
+                if every:
+                    every()
 
 
 def resolve(a):
@@ -124,8 +145,9 @@ def resolve(a):
     return r.stdout, EXIT_OK
 
 
-def write_deck(a, text, deck_dir, out):
-    """resolved.yaml and the deck in DECK_DIR; 0 or the exit status of a failure (shown)."""
+def write_deck(a, text, deck_dir, out, resume=None):
+    """resolved.yaml and the deck in DECK_DIR (continuing from the restart file RESUME); 0 or
+    the exit status of a failure (shown)."""
     resolved = os.path.join(deck_dir, "resolved.yaml")
     try:
         with open(resolved, "w") as f:
@@ -133,12 +155,108 @@ def write_deck(a, text, deck_dir, out):
     except OSError as e:
         say("cannot write %s: %s" % (resolved, e))
         return EXIT_IO
+    restart = ["--restart-every", str(a.checkpoint_every)] if a.checkpoint_every else []
     r = engines.write_deck(resolved, os.path.join(deck_dir, "in.jdem"), "--trajectory", out,
-                           *(["--force"] if a.force else []))
+                           *(["--force"] if a.force else []), *restart,
+                           *(["--resume", resume] if resume else []))
     if r.returncode != 0:
         say("deck generation failed (exit %d):\n%s" % (r.returncode, r.stderr))
         return r.returncode if r.returncode in (EXIT_INPUT, EXIT_IO) else EXIT_INTERNAL
     return EXIT_OK
+
+
+RESTART_NAME = re.compile(r"^restart\.(\d+)$")
+KEEP_RESTARTS = 2
+
+
+def restart_files(deck_dir):
+    """The restart files restart.STEP in DECK_DIR, oldest first."""
+    try:
+        names = os.listdir(deck_dir)
+    except OSError:
+        return []
+    found = [(int(m.group(1)), os.path.join(deck_dir, n)) for n in names for m in [RESTART_NAME.match(n)] if m]
+    return [path for _, path in sorted(found)]
+
+
+def prune_restart_files(deck_dir):
+    """All but the KEEP_RESTARTS newest (complete: LIGGGHTS writes one file at a time)."""
+    for path in restart_files(deck_dir)[:-KEEP_RESTARTS]:
+        try:
+            os.unlink(path)
+        except FileNotFoundError:
+            pass
+
+
+def resume_file(a, deck_dir, text, out):
+    """The restart file to continue from (None: start from the beginning), after saying why."""
+    present = restart_files(deck_dir)
+    if not a.resume:
+        return None
+    try:
+        with open(os.path.join(deck_dir, "resolved.yaml")) as f:
+            same_scene = f.read() == text
+    except OSError:
+        same_scene = False
+    kept = any(os.path.exists(out + suffix) for suffix in (".part", ".resume"))
+    why = ("no interrupted run to continue" if not kept or not present else
+           "the scene differs from the interrupted run's" if not same_scene else
+           "the interrupted run wrote one restart file only" if len(present) < 2 else None)
+    if why:
+        say("--resume: %s; starting from the beginning" % why)
+        return None
+    say("--resume: continuing from %s" % present[-2])
+    return present[-2]
+
+
+THERMO_STEP = re.compile(r"^\s*(\d+)\s+\S")
+
+
+class Progress:
+    """The run's step from its log (thermo lines) and its restart files, shown every minute."""
+
+    def __init__(self, deck_dir, total_steps, every=60.0):
+        self.deck_dir, self.total, self.every = deck_dir, total_steps, every
+        self.start = self.last_shown = time.monotonic()
+        self.first_step = None
+
+    def step(self):
+        steps = [int(f.rsplit(".", 1)[1]) for f in restart_files(self.deck_dir)]
+        for line in tail(os.path.join(self.deck_dir, "log.lammps"), 40).splitlines():
+            m = THERMO_STEP.match(line)
+            if m:
+                steps.append(int(m.group(1)))
+        return max(steps) if steps else None
+
+    def __call__(self):
+        now = time.monotonic()
+        if not self.total or (self.first_step is not None and now - self.last_shown < self.every):
+            return
+        s = self.step()
+        if s is None:
+            return
+        if self.first_step is None:   # the first step seen (a continued run's is its file's)
+            self.first_step, self.start = s, now
+            return
+        self.last_shown = now
+        done = s - self.first_step
+        eta = "%.0f s" % ((self.total - s) * (now - self.start) / done) if done > 0 else "unknown"
+        say("step %d/%d (%.0f %%), ETA %s" % (s, self.total, 100.0 * s / self.total, eta))
+
+
+def total_steps(text):
+    try:
+        return int(yaml.safe_load(text)["time"]["steps"])
+    except (yaml.YAMLError, KeyError, TypeError, ValueError):
+        return 0
+
+
+def remove_restart_files(deck_dir):
+    for path in restart_files(deck_dir):
+        try:
+            os.unlink(path)
+        except FileNotFoundError:
+            pass
 
 
 def liggghts_command(a, deck_dir):
@@ -154,9 +272,16 @@ def main():
     ap.add_argument("-o", "--output", required=True, help="trajectory (H5MD) to write")
     ap.add_argument("--np", type=int, default=1, help="MPI ranks (default 1)")
     ap.add_argument("--force", action="store_true", help="run even if the time step is unsafe")
+    ap.add_argument("--checkpoint-every", type=int, default=0, metavar="N",
+                    help="write a restart file every N steps (restart.STEP in the deck directory)")
+    ap.add_argument("--resume", action="store_true",
+                    help="continue an interrupted run from its restart files, if it left them")
     ap.add_argument("--jdem", default=engines.JDEM)
     ap.add_argument("--liggghts", default=engines.LIGGGHTS_JDEM)
     a = ap.parse_args()
+    if a.resume and a.checkpoint_every <= 0:
+        say("--resume needs --checkpoint-every N > 0, the cadence of the interrupted run's restart files")
+        return EXIT_INPUT
     child = Child()
 
     if os.path.isdir(a.output):  # build/jdem's message and exit status (io/h5md_file.c)
@@ -179,18 +304,28 @@ def main():
     if lock is None:
         say("another run is writing %s (it holds the lock on %s); this one is not started" % (out, deck_dir))
         return EXIT_IO
-    rc = write_deck(a, text, deck_dir, out)
+    resume = resume_file(a, deck_dir, text, out)
+    if resume is None:
+        remove_restart_files(deck_dir)
+    rc = write_deck(a, text, deck_dir, out, resume)
     if rc != EXIT_OK:
         return rc
     if child.signal:
         return 128 + child.signal
 
     run = liggghts_command(a, deck_dir)
-    rc, stdout, stderr = child.run(run, deck_dir, lock)
+    progress = Progress(deck_dir, total_steps(text))
+
+    def meanwhile():
+        prune_restart_files(deck_dir)
+        progress()
+
+    rc, stdout, stderr = child.run(run, deck_dir, lock, meanwhile)
     log = os.path.join(deck_dir, "log.lammps")
     if rc < 0:
         rc = 128 - rc
     if rc == 0 and os.path.exists(out):
+        remove_restart_files(deck_dir)
         return EXIT_OK
     if rc >= 128:
         status = rc

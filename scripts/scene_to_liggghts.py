@@ -406,9 +406,10 @@ def inlet_lines(scene, tid, deck_dir, record):
 
 
 def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=False, particles=None,
-               inlet_record=None):
+               inlet_record=None, restart=None):
     """The deck of SCENE.  PARTICLES: its particles, gathered by a ParticleStream while
-    resolved_stream.read_resolved read the scene; None: SCENE["particles"] is their list."""
+    resolved_stream.read_resolved read the scene; None: SCENE["particles"] is their list.
+    RESTART: None, or a Restart (restart files every N steps; the deck continuing from one)."""
     deck_dir = os.path.dirname(os.path.abspath(deck_path))
     os.makedirs(deck_dir, exist_ok=True)
     if particles is None:
@@ -421,13 +422,31 @@ def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=
             raise
     try:
         write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
-                         inlet_record)
+                         inlet_record, restart or Restart())
     finally:
         particles.remove()
 
 
+class Restart:
+    """Restart files of a deck: every `every` steps (0: none) the deck writes a file named by
+    `pattern` with its step for the '*' (LIGGGHTS' `restart N FILE.*`); `resume`, a restart file
+    the deck continues from instead of creating its particles (its dump continues the
+    interrupted run's trajectory, dump h5md/jdem `resume yes`, and runs up to the scene's last
+    step).  The uninterrupted run and its continuations write their files at the same steps:
+    LIGGGHTS rebuilds the neighbour lists when it writes one, which a continuation must match."""
+
+    def __init__(self, every=0, pattern=None, resume=None):
+        self.every, self.pattern, self.resume = int(every), pattern, resume
+
+
+def restart_lines(restart):
+    if restart.every <= 0:
+        return []
+    return ["restart         %d %s\n" % (restart.every, word(os.path.abspath(restart.pattern), "path"))]
+
+
 def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
-                     inlet_record):
+                     inlet_record, restart):
     mats = scene["materials"]
     names = list(mats.keys())
     ntypes = len(names)
@@ -466,7 +485,7 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
     # the run is at least `every` steps long), as build/jdem writes them
     every = min(int((scene.get("output") or {}).get("every", 1)), steps)
 
-    if particles.count:
+    if particles.count and not restart.resume:
         particles.write_data(os.path.join(deck_dir, "particles.data"), ntypes, lo, hi)
 
     def pairs_line(k):
@@ -489,7 +508,9 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         fail("--builtin: LIGGGHTS has no parallel bonds")
     L.append("communicate     single vel yes%s\n" % (" cutoff %s" % num(ghost_cut) if ghost_cut else ""))
     L.append("boundary        f f f\n")
-    if particles.count:
+    if restart.resume:
+        L.append("read_restart    %s\n" % word(os.path.abspath(restart.resume), "path"))
+    elif particles.count:
         L.append("read_data       particles.data\n")
     else:  # read_data of no atoms turns the atom ids off (LIGGGHTS: no id > 0), which the inlets need
         L.append("region          domain block %s %s %s %s %s %s units box\n" % tuple(
@@ -569,6 +590,7 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
     L.extend(guard_lines(scene, builtin, force))
     L.append("\ntimestep        %s\n" % num(dt))
     L.append("thermo          %d\n" % max(1, steps // 10))
+    L.append("thermo_modify   flush yes   # scripts/liggghts_run.py shows the run's progress from the log\n")
     # the observables on their own cadence (output.observables_every), also between frames (the
     # last fix: after those that change the state at end_of_step)
     out = scene.get("output") or {}
@@ -577,8 +599,10 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
     L.append("dump d all h5md/jdem %d %s scene %s case %s scene_yaml %s%s\n" % (
         every, dump_path(traj_path), word(scene.get("name", "scene"), "scene name"),
         word(scene.get("case", scene.get("name", "case")), "case name"),
-        word(os.path.abspath(resolved_path), "path"), "" if energy_bookkeeping(scene) else " energy no"))
-    L.append("run             %d\n" % steps)
+        word(os.path.abspath(resolved_path), "path"), ("" if energy_bookkeeping(scene) else " energy no")
+        + (" resume yes" if restart.resume else "")))
+    L.extend(restart_lines(restart))
+    L.append("run             %d%s\n" % (steps, " upto" if restart.resume else ""))
     with open(deck_path, "w") as f:
         f.write("".join(L))
 
@@ -594,6 +618,12 @@ def main():
                     help="run even if the time step is unsafe (fix jdem/guard ... force)")
     ap.add_argument("--inlet-record", metavar="FILE",
                     help="the inlets write every insertion to FILE as `jdem run --inlet-record` (CSV)")
+    ap.add_argument("--restart-every", type=int, default=0, metavar="N",
+                    help="write a restart file every N steps, named by --restart-pattern")
+    ap.add_argument("--restart-pattern", metavar="FILE.*",
+                    help="their names, the step for the '*' (default: restart.* next to the deck)")
+    ap.add_argument("--resume", metavar="FILE",
+                    help="continue from this restart file (the trajectory from the interrupted run's)")
     a = ap.parse_args()
     source = "stdin" if a.resolved == "-" else a.resolved
     deck_dir = os.path.dirname(os.path.abspath(a.output))
@@ -613,7 +643,11 @@ def main():
             scene = read_resolved(f, particles)
         if not isinstance(scene, dict):
             raise TypeError("the resolved scene is not a mapping")
-        write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin, a.force, particles, a.inlet_record)
+        pattern = a.restart_pattern or os.path.join(deck_dir, "restart.*")
+        if "*" not in pattern:
+            fail("--restart-pattern %r: the name needs a '*' for the step" % pattern)
+        write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin, a.force, particles, a.inlet_record,
+                   Restart(a.restart_every, pattern, a.resume))
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
         fail("%s: cannot read the resolved scene: %s" % (source, e))
     except (KeyError, TypeError, ValueError, AttributeError, IndexError, RecursionError, OverflowError) as e:

@@ -73,16 +73,6 @@ enum { JD_CHECKPOINT_REFUSED = -1, JD_CHECKPOINT_NO_MEMORY = -2 };
 int jd_checkpoint_read(jd_sim *s, jd_checkpointer *ck, const char *path, char *err,
                        size_t errlen);
 
-/* checkpoint_trajectory.c.  Before a resumed run writes to the trajectory OUT: the killed run's
- * OUT.part (or, after an interrupted resume, OUT.resume) is moved to OUT.resume, and its
- * frames, observables and bond tables up to the checkpoint (frames up to frame_step, the
- * rest up to step) are copied into the fresh writer h; OUT.resume is then removed.  0, or -1
- * with err. */
-int jd_checkpoint_trajectory_source(const char *out, int64_t frame_step, char *src,
-                                    size_t srclen, char *err, size_t errlen);
-int jd_checkpoint_trajectory_copy(const char *src, struct jd_h5md *h, int64_t frame_step,
-                                  int64_t step, char *err, size_t errlen);
-
 /* What the checkpoint needs of the modules whose state is private to their files. */
 /* loads.c: the loaded particles (n), their indices and the 6 n forces of the last evaluation */
 size_t sim_loads_state(jd_loads *l, int32_t **index, double **f_prev);

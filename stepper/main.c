@@ -18,6 +18,7 @@
 
 #include "checkpoint.h"
 #include "h5md.h"
+#include "h5md_resume.h"
 #include "scene.h"
 #include "sim.h"
 
@@ -454,9 +455,11 @@ static void free_output_particles(jd_h5md_particles *p) {
     free((void *)p->radius);
 }
 
-/* The scene's walls into the trajectory (/jdem/walls), as they stand at time 0. */
+/* The scene's walls into the trajectory (/jdem/walls), as they stand at time 0: the plane and
+ * cylinder walls in scene order, then the mesh walls (static) in scene order. */
 static int output_walls(const jd_scene *sc, jd_h5md *h, char *err, size_t errlen) {
-    jd_h5md_wall *w = calloc(sc->n_walls ? sc->n_walls : 1, sizeof *w);
+    const size_t n = sc->n_walls + sc->n_mesh_walls;
+    jd_h5md_wall *w = calloc(n ? n : 1, sizeof *w);
     if (!w) {
         snprintf(err, errlen, "out of memory for the walls' output");
         return -1;
@@ -469,7 +472,12 @@ static int output_walls(const jd_scene *sc, jd_h5md *h, char *err, size_t errlen
         memcpy(w[k].axis, s->axis, sizeof w[k].axis);
         memcpy(w[k].velocity, s->velocity, sizeof w[k].velocity);
     }
-    const int rc = jd_h5md_set_walls(h, sc->n_walls, w, err, errlen);
+    for (size_t k = 0; k < sc->n_mesh_walls; k++) {
+        const jd_mesh_wall *m = &sc->mesh_walls[k];
+        w[sc->n_walls + k] = (jd_h5md_wall){.name = m->name, .type = 2, .n_triangles = m->ntri,
+                                            .triangles = (const double(*)[3][3])m->corner};
+    }
+    const int rc = jd_h5md_set_walls(h, n, w, err, errlen);
     free(w);
     return rc;
 }
@@ -543,16 +551,16 @@ static int setup_checkpoints(const cli *c, const jd_scene *sc, jd_sim *sim, cons
 }
 
 /* The trajectory of a resumed run: the stopped run's prefix moved aside, a fresh OUT.part
- * with that prefix copied in (checkpoint_trajectory.c).  NULL after reporting, with *rc. */
+ * with that prefix copied in (io/h5md_resume.h).  NULL after reporting, with *rc. */
 static jd_h5md *resume_output(const jd_scene *sc, const jd_sim *sim, const char *out, int *rc) {
     char src[4200], err[1024] = "";
-    if (jd_checkpoint_trajectory_source(out, sim->frame_step, src, sizeof src, err, sizeof err)) {
+    if (jd_h5md_resume_source(out, sim->frame_step, src, sizeof src, err, sizeof err)) {
         fprintf(stderr, "jdem: %s\n", err);
         *rc = EXIT_INPUT;
         return NULL;
     }
     jd_h5md *h = create_output(sc, sim, out, rc);
-    if (h && jd_checkpoint_trajectory_copy(src, h, sim->frame_step, sim->step, err, sizeof err)) {
+    if (h && jd_h5md_resume_copy(src, h, sim->frame_step, sim->step, err, sizeof err)) {
         fprintf(stderr, "jdem: %s\n", err);
         jd_h5md_close(h, 0, err, sizeof err);
         *rc = EXIT_IO;

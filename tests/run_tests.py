@@ -64,6 +64,9 @@ SUITES += [("liggghts-watchdog", [PY, "tests/liggghts/check_watchdog.py"], "line
 # Restart files in LIGGGHTS: continued runs == the uninterrupted run bit for bit on 1 and 2 ranks
 # (history, bonds, servo, kill -9), and restart files across stock and our pair styles.
 SUITES += [("liggghts-restart", [PY, "tests/liggghts/check_restart.py"], "lines", {})]
+# scripts/liggghts_run.py --checkpoint-every/--resume: a killed or stopped run continued from its
+# restart files equals the uninterrupted run bit for bit (1 and 2 ranks)
+SUITES += [("liggghts-runner-resume", [PY, "tests/liggghts/check_runner_resume.py"], "lines", {})]
 # jdem checkpoints: kill -9 after a checkpoint, resume, == the uninterrupted run bit for bit on
 # 1 and 2 threads (bed, servo, inlet, bonds); SIGTERM; refused checkpoints; a failed write.
 SUITES += [("checkpoint", [PY, "tests/checkpoint/test_checkpoint.py"], "lines", {})]

@@ -41,7 +41,8 @@ ENGINES = ("jdem", "liggghts-jdem")
 SEED_DT = 1.0e-4
 FILL_PARTICLES, FILL_TIME = 41280, 25.0   # 80 sections of 516 spheres over 25 s
 CUBE_PARTICLES, CUBE_TIME = 400, 10.0     # about 400 spheres in a 0.2 m cube, up to 10 s
-CHECKPOINT_SECONDS = 300                  # a killed fill loses at most this much of its work
+CHECKPOINT_SECONDS = 300                  # a killed jdem fill loses at most this much of its work
+RESTART_STEPS = 2000                      # liggghts-jdem: a restart file every 0.2 s of a fill
 SCENE_COST = 1e6                          # cutting: a read of the deposit
 SPREAD_MODEL, SPREAD_REALISATIONS = "model3", 2   # the run-to-run spread's fills (obstacles: phi_v > 0)
 HORIZON_TIME, HORIZON_FRAME_TIME = 4.0, 0.02      # [s] the cross-engine horizon's fill and frames
@@ -165,22 +166,26 @@ def run_command(engine, scene, out, force):
 
 
 def resumable(engine):
-    """Whether the engine's fills checkpoint and continue after an interruption (jdem only:
-    the LIGGGHTS runner does not restart yet)."""
-    return engine == "jdem"
+    """Whether the engine's fills checkpoint and continue after an interruption (both: jdem's
+    checkpoints, LIGGGHTS' restart files through scripts/liggghts_run.py)."""
+    return engine in ENGINES
 
 
-def fill_command(engine, scene, force, generate=None, checkpoint_seconds=CHECKPOINT_SECONDS):
+def fill_command(engine, scene, force, generate=None, checkpoint_seconds=CHECKPOINT_SECONDS,
+                 restart_steps=RESTART_STEPS):
     """sh argv running `scene` into "{out0}" (after the shell line `generate`, which writes it).
     jdem checkpoints every checkpoint_seconds of wall time and, when an interrupted run left
-    its checkpoint in the unit's directory, continues from it (docs/mixing.md §4)."""
+    its checkpoint in the unit's directory, continues from it; liggghts-jdem writes a restart
+    file every restart_steps steps and continues from the last complete one (docs/mixing.md §4)."""
     run = " ".join(a if a in ('"$1"', '"$2"') else shlex.quote(a)
                    for a in run_command(engine, '"$1"', '"$2"', force))
-    if resumable(engine):
+    if engine == "jdem":
         run += f" --checkpoint-seconds {checkpoint_seconds}"
         # no braces: the campaign driver fills the "{...}" placeholders of every word
         run = (f'ck="$(dirname "$2")/$(basename "$2" .h5).ckpt.h5"; '
                f'if [ -f "$ck" ]; then {run} --resume "$ck"; else {run}; fi')
+    else:   # the runner continues from its deck directory's restart files, if any
+        run += f" --checkpoint-every {restart_steps} --resume"
     return ["sh", "-c", (generate + " && " if generate else "") + run, "fill", scene, "{out0}"]
 
 

@@ -20,7 +20,10 @@ binary STL as float32 too), so both engines see the same triangles:
 - jdem on 1 and 2 threads on the funnel: the same bits; its energy balance closes to 1e-3 (the
   plane walls' standard, tests/engine/test_energy_balance.py) with the mesh's dissipation;
 - the watchdog's overlap trip names the mesh wall; --checkpoint-every is refused with a mesh
-  wall (checkpoints do not carry its history yet).
+  wall (checkpoints do not carry its history yet);
+- the funnel's trajectories draw the mesh (/jdem/walls, docs/output.md): type 2, one
+  quadrilateral per triangle whose corners are the STL's triangle (the last one twice), in both
+  engines, equal to the triangles this script wrote.
 One PASS/FAIL line per check.
 """
 import math
@@ -244,6 +247,33 @@ def cross_engine(c, tmp, name, particles, tris, steps, what, threads=False):
     return jd
 
 
+def drawn_triangles(path):
+    """(wall types, [T][3][3] the mesh's triangles as /jdem/walls/mesh draws them)."""
+    with h5py.File(path, "r") as f:
+        types = f["jdem/walls/type"][()]
+        quads = f["jdem/walls/mesh/quads"][()]
+        vert = f["jdem/walls/mesh/vertices"][()]
+        wall = f["jdem/walls/mesh/wall"][()]
+    mesh = [k for k, t in enumerate(types) if t == 2]
+    q = quads[np.isin(wall, mesh)]
+    degenerate = bool(np.all(q[:, 2] == q[:, 3]))
+    return types, vert[q[:, :3]], degenerate
+
+
+def check_drawn_mesh(c, name, tris, paths):
+    want = np.array(tris, float)
+    for engine, path in paths:
+        try:
+            types, drawn, degenerate = drawn_triangles(path)
+        except (OSError, KeyError) as exc:
+            c.check("%s: %s draws the mesh in /jdem/walls" % (name, engine), False, str(exc))
+            continue
+        c.check("%s: %s draws the mesh in /jdem/walls: %d triangles (type 2, quads with the last "
+                "corner twice) = the STL's %d exactly" % (name, engine, len(drawn), len(want)),
+                list(types) == [2] and degenerate and drawn.shape == want.shape and np.array_equal(drawn, want),
+                "types %s, degenerate %s, shapes %s %s" % (list(types), degenerate, drawn.shape, want.shape))
+
+
 def main():
     c = Checks()
     for b in (JDEM, LIG):
@@ -267,10 +297,13 @@ def main():
         drops = [particle((0.018 * math.cos(2 * math.pi * k / 5 + 0.3),
                            0.018 * math.sin(2 * math.pi * k / 5 + 0.3), 0.014 + 0.001 * k), r=0.003)
                  for k in range(5)]
-        jd = cross_engine(c, tmp, "funnel", drops, funnel(16, 0.008, 0.03, 0.02), 8000,
+        tris = funnel(16, 0.008, 0.03, 0.02)
+        jd = cross_engine(c, tmp, "funnel", drops, tris, 8000,
                           "five spheres dropped into a meshed funnel", threads=True)
         if jd:
             check_funnel_path(c, jd, 0.003)
+            check_drawn_mesh(c, "funnel", tris, [("jdem", jd), ("liggghts-jdem",
+                                                               os.path.join(os.path.dirname(jd), "liggghts.h5"))])
     return 1 if c.failed else 0
 
 

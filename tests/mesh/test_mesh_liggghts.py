@@ -225,6 +225,39 @@ def check_bad_input(c, tmp):
                 rc != 0 and want in lines, out[-800:])
 
 
+def check_drawn_rotation(c, tmp):
+    """dump h5md/jdem draws a mesh that fix move/mesh rotate turns where it is at every frame:
+    the STL's triangles turned by 2 pi t / period about z (to 1e-12 m: move/mesh turns the
+    nodes by an increment each step), and a static mesh's triangles as the STL gives them."""
+    tris = floor_triangles()
+    move = "fix mv all move/mesh mesh cad rotate origin 0 0 0 axis 0 0 1 period 1.0\n"
+    walls = mesh(move=move) + "\ndump h all h5md/jdem 10 drawn.h5"
+    d, out, a = run(tmp, "drawn_turning_mesh", tris, atoms=atoms((0.03, 0.0, R - 1e-6)), walls=walls, steps=50)
+    path = os.path.join(tmp, "drawn_turning_mesh", "drawn.h5")
+    if not c.check("drawn mesh: the turning run writes its trajectory", a is not None and os.path.exists(path),
+                   out[-1500:]):
+        return
+    import h5py
+    with h5py.File(path, "r") as f:
+        types = list(f["jdem/walls/type"][()])
+        quads = f["jdem/walls/mesh/quads"][()]
+        pos = f["jdem/walls/mesh/vertex_position"][()] if "vertex_position" in f["jdem/walls/mesh"] else None
+        t = f["particles/all/position/time"][()]
+    want0 = np.array(tris, float)
+    if not c.check("drawn mesh: a moved mesh's vertices are stored per frame (type 2, %d frames)" % len(t),
+                   types == [2] and pos is not None and len(pos) == len(t) == 6, "types %s" % types):
+        return
+    worst = 0.0
+    for f_, time in enumerate(t):
+        ph = 2.0 * np.pi * time / 1.0
+        rot = np.array([[np.cos(ph), -np.sin(ph), 0.0], [np.sin(ph), np.cos(ph), 0.0], [0.0, 0.0, 1.0]])
+        drawn = pos[f_][quads[:, :3]]
+        worst = max(worst, float(np.abs(drawn - want0 @ rot.T).max()))
+    c.check("drawn mesh: every frame's triangles = the STL's turned by 2 pi t / period "
+            "(max |diff| %.2g m <= 1e-12 m, turned by up to %.3g rad)" % (worst, 2 * np.pi * t[-1]),
+            worst <= 1e-12 and t[-1] > 0)
+
+
 def main():
     c = Checks()
     if not os.access(LIG, os.X_OK):
@@ -237,6 +270,7 @@ def main():
         check_conveyor(c, tmp)
         check_move_linear(c, tmp)
         check_rotation(c, tmp)
+        check_drawn_rotation(c, tmp)
         check_bad_input(c, tmp)
     return 1 if c.failed else 0
 

@@ -7,11 +7,13 @@ included.  Each case is run by its engine and its sidecar opened by Debian's Par
   co1     Chung-Ooi test 1 (tests/engine/scenes/chung_ooi_1.yaml)           both engines
   inlet   the conveyor fill (tests/inlet/fill_small.yaml), a growing set    build/jdem
   insert  fix insert/pack (tests/paraview/insert_pack.in), a growing set    liggghts-jdem
+  tray    five spheres in an STL tray (floor and four sides, 10 triangles) both engines
 Checks, each against the .h5 read with h5py: scripts/h5md_check.py passes; the reader is
 Xdmf3ReaderS; time steps = frames; at the middle and the last frame the particle points and
 vertex cells = the live particles (ids >= 0) and every particle array is there; the bond line
 cells = the bonds formed by then and not broken by then (from /jdem/bonds, /jdem/broken_bonds);
-the wall cells = 1 per plane + 32 per cylinder (/jdem/walls/type); a growing set grows.  The
+the wall cells = 1 per plane + 32 per cylinder + 1 per mesh triangle (/jdem/walls/type and
+/jdem/walls/mesh/wall); a growing set grows.  The
 PNG of the last frame (spheres blue, walls grey, bonds red, white background) has spheres, grey
 pixels over at least a tenth of the walls' extent and red ones in the bonds' extent.
 Needs `make paraview-deps`.  One line per check: "PASS name" / "FAIL name: detail".
@@ -28,6 +30,7 @@ import tempfile
 
 import h5py
 import matplotlib.image as mpimg
+from tests.mesh.stl_files import write_binary_stl
 import numpy as np
 
 from scripts import engines
@@ -40,7 +43,8 @@ CASES = [("pour", "reference_runs/pour/scene.yaml", ("jdem", "liggghts-jdem")),
          ("block", "tests/liggghts/bond_scenes/block_drop.yaml", ("jdem", "liggghts-jdem")),
          ("co1", "tests/engine/scenes/chung_ooi_1.yaml", ("jdem", "liggghts-jdem")),
          ("inlet", "tests/inlet/fill_small.yaml", ("jdem",)),
-         ("insert", "tests/paraview/insert_pack.in", ("liggghts-jdem",))]
+         ("insert", "tests/paraview/insert_pack.in", ("liggghts-jdem",)),
+         ("tray", None, ("jdem", "liggghts-jdem"))]
 failed = 0
 
 
@@ -58,6 +62,35 @@ def short_pour(tmp):
     text = text.replace("end_time: 0.6", "end_time: 0.1").replace("every: 2000", "every: 1000")
     path = os.path.join(tmp, "pour.yaml")
     open(path, "w").write(text)
+    return path
+
+
+def tray_triangles(L=0.04, H=0.02):
+    """An open box [0, L]^2 x [0, H] as an STL mesh: each triangle counter-clockwise seen from
+    inside (its right-hand normal points at the particles), as the box walls of the pour."""
+    o, x, y, xy = (0.0, 0.0, 0.0), (L, 0.0, 0.0), (0.0, L, 0.0), (L, L, 0.0)
+    up = lambda p: (p[0], p[1], H)
+    return [(o, x, xy), (o, xy, y),                                  # floor, normal +z
+            (o, y, up(y)), (o, up(y), up(o)),                        # x = 0, normal +x
+            (x, up(x), up(xy)), (x, up(xy), xy),                     # x = L, normal -x
+            (o, up(o), up(x)), (o, up(x), x),                        # y = 0, normal +y
+            (y, xy, up(xy)), (y, up(xy), up(y))]                     # y = L, normal -y
+
+
+def tray_scene(tmp):
+    """Five spheres dropped into the meshed tray (binary STL, float32 corners)."""
+    write_binary_stl(os.path.join(tmp, "tray.stl"), tray_triangles())
+    drops = "\n".join("  - {material: glass, radius: 0.003, position: [%r, %r, %r]}" % (
+        0.02 + 0.01 * np.cos(2 * np.pi * k / 5), 0.02 + 0.01 * np.sin(2 * np.pi * k / 5), 0.008 + 0.001 * k)
+        for k in range(5))
+    path = os.path.join(tmp, "tray.yaml")
+    with open(path, "w") as f:
+        f.write("jdem_scene: 1\nname: paraview_tray\ntime: {dt: 1.0e-5, steps: 3000}\n"
+                "output: {every: 500}\ngravity: [0, 0, -9.81]\nmaterials:\n"
+                "  glass: {youngs_modulus: 1.0e7, poisson_ratio: 0.3, density: 2500, restitution: 0.5,"
+                " friction: 0.3}\n  plate: {restitution: 0.5, friction: 0.3}\n"
+                "particles:\n%s\nwalls:\n  - {name: tray, type: mesh, file: tray.stl, material: plate}\n"
+                % drops)
     return path
 
 
@@ -106,7 +139,9 @@ def expected(path):
                 bonds[k] = sum(1 for p, fs in zip(pairs, formed)
                                if fs <= s and broke.get(p, np.iinfo(np.int64).max) > s)
         types = f["jdem/walls/type"][()] if "jdem/walls" in f else np.zeros(0)
-        walls = int(sum(CYLINDER_FACETS if t == 1 else 1 for t in types))
+        quad_wall = f["jdem/walls/mesh/wall"][()] if "jdem/walls" in f else np.zeros(0)
+        walls = int(sum(CYLINDER_FACETS if t == 1 else int(np.sum(quad_wall == k)) if t == 2 else 1
+                        for k, t in enumerate(types)))
     return steps, live, bonds, walls
 
 
@@ -204,7 +239,7 @@ def main(argv):
         return 1
     tmp = tempfile.mkdtemp(prefix="jdem_paraview_")
     for case, scene, case_engines in CASES:
-        path = os.path.join(ROOT, scene)
+        path = tray_scene(tmp) if case == "tray" else os.path.join(ROOT, scene)
         if case == "pour" and not pngs:
             path = short_pour(tmp)
         for engine in case_engines:

@@ -1,5 +1,6 @@
 /*
- * checkpoint_trajectory.c — the trajectory of a resumed run (docs/output.md "Resumed runs").
+ * h5md_resume.c — the trajectory of a resumed run, in both engines (h5md_resume.h;
+ * docs/output.md "Resumed runs").
  *
  * The resumed run writes the same file the uninterrupted run would: OUT.part from the start,
  * renamed to OUT at the end.  Its prefix, everything the killed run wrote up to the checkpoint,
@@ -18,8 +19,8 @@
 #include <sys/file.h>
 #include <unistd.h>
 
-#include "checkpoint.h"
-#include "h5md.h"
+#include "h5md_internal.h"
+#include "h5md_resume.h"
 
 static const char *const vector_groups[5] = {"position", "velocity", "angular_velocity", "force",
                                               "torque"};
@@ -86,7 +87,7 @@ static int not_in_use(const char *part, char *err, size_t errlen) {
     return busy ? -1 : 0;
 }
 
-int jd_checkpoint_trajectory_source(const char *out, int64_t frame_step, char *src,
+int jd_h5md_resume_source(const char *out, int64_t frame_step, char *src,
                                     size_t srclen, char *err, size_t errlen) {
     char part[4200];
     snprintf(part, sizeof part, "%s.part", out);
@@ -154,12 +155,60 @@ static int copy_frame(hid_t f, hsize_t frame, int64_t step, double time, size_t 
     return jd_h5md_write_frame(h, &fr, err, errlen) == 0 ? 0 : -2;
 }
 
+/* The first id each of the n rows of a growing set's id/value [nf][n] shows over its frames
+ * [0, upto) (-1: none); returns the rows live in those frames (rows are added in order, so they
+ * are the first ones), or (size_t)-1 when the ids cannot be read. */
+static size_t first_row_ids(hid_t f, hsize_t nf, hsize_t upto, size_t n, int64_t *first) {
+    int64_t *ids = read_all(f, "/particles/all/id/value", H5T_NATIVE_INT64, (size_t)nf * n);
+    if (!ids) return (size_t)-1;
+    size_t live = 0;
+    for (size_t r = 0; r < n; r++) {
+        first[r] = -1;
+        for (hsize_t k = 0; k < upto && first[r] < 0; k++) first[r] = ids[k * n + r];
+        if (first[r] >= 0) live = r + 1;
+    }
+    free(ids);
+    return live;
+}
+
+/* The number of frames up to frame_step (steps: the nf frames' steps, ascending). */
+static hsize_t prefix_frames(const int64_t *steps, hssize_t nf, int64_t frame_step) {
+    hsize_t k = 0;
+    while (steps && (hssize_t)k < nf && steps[k] <= frame_step) k++;
+    return k;
+}
+
+/* Frame `frame`'s vertices of the moved meshes (src's vertex_position) as where they are now in
+ * h, so that the copied frame draws them where the interrupted run did.  0 / -1. */
+static int moved_mesh_vertices(hid_t f, hsize_t frame, h5md_wall_mesh *m) {
+    const char *name = "/jdem/walls/mesh/vertex_position";
+    hsize_t dims[3];
+    int any = 0;
+    for (size_t j = 0; m->given && j < m->nv; j++) any |= m->given[j];
+    if (!any) return 0;
+    if (rows_of(f, name, dims) <= (hssize_t)frame || dims[1] != m->nv) return -1;
+    double *row = malloc(3 * m->nv * sizeof *row);
+    hid_t d = row ? H5Dopen2(f, name, H5P_DEFAULT) : -1, fs = d >= 0 ? H5Dget_space(d) : -1;
+    const hsize_t start[3] = {frame, 0, 0}, count[3] = {1, m->nv, 3}, mdim[1] = {3 * m->nv};
+    hid_t ms = H5Screate_simple(1, mdim, NULL);
+    const int ok = fs >= 0 && ms >= 0 &&
+                   H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
+                   H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, row) >= 0;
+    if (ms >= 0) H5Sclose(ms);
+    if (fs >= 0) H5Sclose(fs);
+    if (d >= 0) H5Dclose(d);
+    for (size_t j = 0; ok && j < m->nv; j++)
+        if (m->given[j]) memcpy(m->now + 3 * j, row + 3 * j, 3 * sizeof *row);
+    free(row);
+    return ok ? 0 : -1;
+}
+
 static int copy_frames(hid_t f, jd_h5md *h, int64_t frame_step, char *err, size_t errlen) {
     hsize_t dims[3];
     const hssize_t nf = rows_of(f, "/particles/all/position/step", NULL);
     if (nf <= 0) return 0;
     if (rows_of(f, "/particles/all/position/value", dims) != nf) return -1;
-    const size_t n = (size_t)dims[1];
+    size_t n = (size_t)dims[1];
     int64_t *steps = read_all(f, "/particles/all/position/step", H5T_NATIVE_INT64, (size_t)nf);
     double *times = read_all(f, "/particles/all/position/time", H5T_NATIVE_DOUBLE, (size_t)nf);
     double *vec = malloc(15 * (n ? n : 1) * sizeof *vec);
@@ -169,8 +218,26 @@ static int copy_frames(hid_t f, jd_h5md *h, int64_t frame_step, char *err, size_
                         H5Oget_info_by_name(f, "/particles/all/id", &info, H5P_DEFAULT) >= 0 &&
                         info.type == H5O_TYPE_GROUP;
     int rc = steps && times && vec && ids ? 0 : -1;
-    for (hssize_t k = 0; rc == 0 && k < nf && steps[k] <= frame_step; k++)
-        rc = copy_frame(f, (hsize_t)k, steps[k], times[k], n, growing, vec, ids, h, err, errlen);
+    if (rc == 0 && growing) {
+        /* the rows live in the prefix's frames, or the writer's own (build/jdem makes every row
+         * at the start): the rows the interrupted run added later follow its later frames,
+         * which the resumed run assigns again */
+        const size_t live =
+            first_row_ids(f, (hsize_t)nf, prefix_frames(steps, nf, frame_step), n, ids);
+        const size_t own = h5md_rows_count(h);
+        rc = live == (size_t)-1 || own > n ? -1 : 0;
+        if (rc == 0) n = live > own ? live : own;
+    }
+    h5md_wall_mesh *walls = h5md_walls_of(h);
+    double *now = walls->now ? malloc((walls->nv ? walls->nv : 1) * 3 * sizeof *now) : NULL;
+    if (now) memcpy(now, walls->now, walls->nv * 3 * sizeof *now); /* where they are at the resume */
+    for (hssize_t k = 0; rc == 0 && k < nf && steps[k] <= frame_step; k++) {
+        rc = moved_mesh_vertices(f, (hsize_t)k, walls);
+        if (rc == 0)
+            rc = copy_frame(f, (hsize_t)k, steps[k], times[k], n, growing, vec, ids, h, err, errlen);
+    }
+    if (now) memcpy(walls->now, now, walls->nv * 3 * sizeof *now);
+    free(now);
     free(steps);
     free(times);
     free(vec);
@@ -330,7 +397,7 @@ static int copy_breaks(hid_t f, jd_h5md *h, int64_t step, char *err, size_t errl
     return rc;
 }
 
-int jd_checkpoint_trajectory_copy(const char *src, jd_h5md *h, int64_t frame_step, int64_t step,
+int jd_h5md_resume_copy(const char *src, jd_h5md *h, int64_t frame_step, int64_t step,
                                   char *err, size_t errlen) {
     H5E_auto2_t fn;
     void *data;
@@ -347,4 +414,69 @@ int jd_checkpoint_trajectory_copy(const char *src, jd_h5md *h, int64_t frame_ste
         snprintf(err, errlen, "cannot resume: the trajectory '%s' of the interrupted run cannot "
                  "be read back up to step %lld (damaged?); it is kept", src, (long long)step);
     return rc ? -1 : 0;
+}
+
+int jd_h5md_resume_rows(const char *src, int64_t frame_step, jd_h5md_particles *rows, char *err,
+                        size_t errlen) {
+    memset(rows, 0, sizeof *rows);
+    H5E_auto2_t fn;
+    void *data;
+    H5Eget_auto2(H5E_DEFAULT, &fn, &data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    hid_t f = open_ro(src);
+    hsize_t dims[3] = {0, 0, 0};
+    const hssize_t n_static = f >= 0 ? rows_of(f, "/particles/all/radius", NULL) : -1;
+    H5O_info_t info;
+    rows->growing = f >= 0 && H5Lexists(f, "/particles/all/id", H5P_DEFAULT) > 0 &&
+                    H5Oget_info_by_name(f, "/particles/all/id", &info, H5P_DEFAULT) >= 0 &&
+                    info.type == H5O_TYPE_GROUP;
+    int ok = n_static >= 0;
+    size_t n = ok ? (size_t)n_static : 0;
+    int64_t *id = malloc((n ? n : 1) * sizeof *id);
+    ok = ok && id;
+    if (ok && rows->growing) {
+        const hssize_t nf = rows_of(f, "/particles/all/id/value", dims);
+        int64_t *steps =
+            nf > 0 ? read_all(f, "/particles/all/id/step", H5T_NATIVE_INT64, (size_t)nf) : NULL;
+        const size_t live =
+            nf > 0 && steps && dims[1] == n
+                ? first_row_ids(f, (hsize_t)nf, prefix_frames(steps, nf, frame_step), n, id)
+                : (size_t)-1;
+        ok = nf == 0 || live != (size_t)-1;
+        n = nf > 0 && ok ? live : 0;
+        free(steps);
+    } else if (ok) {
+        int64_t *all = read_all(f, "/particles/all/id", H5T_NATIVE_INT64, n);
+        ok = all != NULL;
+        if (ok) memcpy(id, all, n * sizeof *id);
+        free(all);
+    }
+    int32_t *species = ok ? read_all(f, "/particles/all/species", H5T_NATIVE_INT32, (size_t)n_static) : NULL;
+    double *radius = ok ? read_all(f, "/particles/all/radius", H5T_NATIVE_DOUBLE, (size_t)n_static) : NULL;
+    double *mass = ok ? read_all(f, "/particles/all/mass", H5T_NATIVE_DOUBLE, (size_t)n_static) : NULL;
+    ok = ok && species && radius && mass;
+    if (f >= 0) H5Fclose(f);
+    H5Eset_auto2(H5E_DEFAULT, fn, data);
+    rows->n = n;
+    rows->id = id;
+    rows->species = species;
+    rows->radius = radius;
+    rows->mass = mass;
+    if (!ok) {
+        jd_h5md_resume_rows_free(rows);
+        snprintf(err, errlen, "cannot resume: the particle rows of the trajectory '%s' of the "
+                 "interrupted run cannot be read (damaged?); it is kept", src);
+        return -1;
+    }
+    return 0;
+}
+
+void jd_h5md_resume_rows_free(jd_h5md_particles *rows) {
+    free((void *)rows->id);
+    free((void *)rows->species);
+    free((void *)rows->radius);
+    free((void *)rows->mass);
+    const int growing = rows->growing;
+    memset(rows, 0, sizeof *rows);
+    rows->growing = growing;
 }
