@@ -149,7 +149,10 @@ void jd_inlet_particle_at_step(const jd_inlet_spec *s, int64_t copy, size_t p, i
  * is placed at x(c, p, start) (the members not yet across the plane still at their rigid belt
  * positions), so no bond ever joins an inserted particle to one not yet inserted.  The copy's
  * bonds are formed at that step, unstressed (the belt is rigid: every bond has its section
- * length), between the ids the stream's id rule gives. */
+ * length), between the ids the stream's id rule gives.  The spec's group arrays (n_groups,
+ * group_first, group_member, group_of) name the groups; jd_inlet_stream/jd_inlet_pop then insert
+ * each member at jd_inlet_insertion_step.  The engine forms the bonds (the stepper: the
+ * resolved section's bonds of every copy whose group was popped at the step). */
 
 /* Start step of a group of copy c: the smallest k*(c, p) over members[0 .. n_members) (indices
  * in the section); JD_INLET_NEVER when n_members = 0.  O(n_members). */
