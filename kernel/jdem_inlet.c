@@ -102,6 +102,14 @@ void jd_inlet_bond_ids(const jd_inlet_spec *s, int64_t copy, size_t i, size_t j,
     ids[1] = base + (int64_t)hi;
 }
 
+int64_t jd_inlet_insertion_step(const jd_inlet_spec *s, int64_t copy, size_t p) {
+    const int32_t g = s->n_groups ? s->group_of[p] : -1;
+    if (g < 0)
+        return jd_inlet_crossing_step(s, copy, p);
+    const size_t first = s->group_first[g];
+    return jd_inlet_group_start(s, copy, &s->group_member[first], s->group_first[g + 1] - first);
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* Checks                                                                                   */
 /* ---------------------------------------------------------------------------------------- */
@@ -182,6 +190,43 @@ static jd_inlet_status check_values(const jd_inlet_spec *s, int allow_unbounded,
     return JD_INLET_OK;
 }
 
+/* Every group non-empty, its members valid indices listed in increasing order and marked with
+ * it in group_of; every particle marked with a group is one of its members. */
+static jd_inlet_status check_groups(const jd_inlet_spec *s, char *msg, size_t len) {
+    if (!s->n_groups)
+        return JD_INLET_OK;
+    if (!s->group_first || !s->group_member || !s->group_of) {
+        snprintf(msg, len, "%zu bonded groups without their member arrays", s->n_groups);
+        return JD_INLET_BAD_GROUP;
+    }
+    size_t listed = 0;
+    for (size_t g = 0; g < s->n_groups; g++) {
+        if (s->group_first[g + 1] <= s->group_first[g]) {
+            snprintf(msg, len, "bonded group %zu has no members; valid: at least one", g);
+            return JD_INLET_BAD_GROUP;
+        }
+        for (size_t m = s->group_first[g]; m < s->group_first[g + 1]; m++) {
+            const size_t p = s->group_member[m];
+            if (p >= s->n || s->group_of[p] != (int32_t)g ||
+                (m > s->group_first[g] && p <= s->group_member[m - 1])) {
+                snprintf(msg, len, "bonded group %zu: member %zu is not a section particle of "
+                                   "that group listed in increasing order", g, p);
+                return JD_INLET_BAD_GROUP;
+            }
+            listed++;
+        }
+    }
+    size_t marked = 0;
+    for (size_t p = 0; p < s->n; p++)
+        marked += s->group_of[p] >= 0;
+    if (marked != listed) {
+        snprintf(msg, len, "%zu section particles are marked with a bonded group, %zu listed as "
+                           "members; valid: the same particles", marked, listed);
+        return JD_INLET_BAD_GROUP;
+    }
+    return JD_INLET_OK;
+}
+
 static jd_inlet_status check_geometry(const jd_inlet_spec *s, char *msg, size_t len) {
     const double vn = dot3(s->plane_normal, s->velocity);
     if (!(vn > 0.0)) {
@@ -255,6 +300,8 @@ jd_inlet_status jd_inlet_check(const jd_inlet_spec *s, int allow_unbounded, char
                                size_t msglen) {
     jd_inlet_status st = check_values(s, allow_unbounded, msg, msglen);
     if (st == JD_INLET_OK)
+        st = check_groups(s, msg, msglen);
+    if (st == JD_INLET_OK)
         st = check_geometry(s, msg, msglen);
     if (st == JD_INLET_OK)
         st = check_overlaps(s, msg, msglen);
@@ -271,7 +318,7 @@ jd_inlet_status jd_inlet_check(const jd_inlet_spec *s, int allow_unbounded, char
 static void aim(const jd_inlet_spec *s, jd_inlet_cursor *cur, int64_t copy, size_t p) {
     cur->copy = copy;
     cur->step = s->max_sections > 0 && copy >= s->max_sections ? JD_INLET_NEVER
-                                                                : jd_inlet_crossing_step(s, copy, p);
+                                                                : jd_inlet_insertion_step(s, copy, p);
 }
 
 static void update_next(const jd_inlet_spec *s, jd_inlet_stream *st) {
@@ -322,7 +369,7 @@ size_t jd_inlet_pop(const jd_inlet_spec *s, jd_inlet_stream *st, int64_t step,
                 update_next(s, st);
                 return count;
             }
-            jd_inlet_particle_at_crossing(s, c, p, &out[count++]);
+            jd_inlet_particle_at_step(s, c, p, step, &out[count++]);
             st->inserted++;
             aim(s, cur, c + 1, p);
         }

@@ -28,8 +28,10 @@
  * the round-off; it is found from the estimate ceil(-a/w) and corrected by evaluating s itself.
  * N need not be a unit vector: only the sign of s matters.
  *
- * Ids and order.  Particle p of copy c has id first_id + c n + p.  The particles that cross at
- * one step are inserted in increasing id (copy, then position in the section).
+ * Ids and order.  Particle p of copy c has id first_id + c n + p.  The particles inserted at
+ * one step are inserted in increasing id (copy, then position in the section).  A particle of a
+ * bonded group (spec.group_of, "Bonded groups of a section" below) is inserted at its group's
+ * start step instead of its own crossing step; every other one at its crossing step.
  *
  * Stop rule.  Copies are inserted whole: copy c belongs to the stream if c < max_sections (when
  * max_sections > 0) and its start step (the smallest k* of its particles) is < stop_step.  A
@@ -77,6 +79,13 @@ typedef struct jd_inlet_spec {
                                neighbouring copies), fraction of the smaller radius, >= 0:
                                JD_INLET_OVERLAP_TOL, or for cells cut from a deposit the largest
                                contact overlap it may hold (the watchdog's limit)      [-]   */
+    /* Bonded groups (see "Bonded groups of a section" below); n_groups = 0 (and NULL arrays):
+     * none, every particle is inserted at its own crossing step. */
+    size_t n_groups;             /* groups of the section                              [-]   */
+    const size_t *group_first;   /* [n_groups + 1]: group g's members are
+                                    group_member[group_first[g] .. group_first[g + 1])  [-]   */
+    const size_t *group_member;  /* section indices, increasing within a group         [-]   */
+    const int32_t *group_of;     /* [n] the group of each particle, or -1: in none     [-]   */
 } jd_inlet_spec;
 
 /* Result codes of jd_inlet_check. */
@@ -89,8 +98,10 @@ typedef enum {
     JD_INLET_ALREADY_INSIDE, /* a particle of copy 0 is on the domain side at step 0           */
     JD_INLET_OVERLAP,        /* two particles of one copy overlap                               */
     JD_INLET_PERIOD_OVERLAP, /* a particle overlaps one of a neighbouring copy across L         */
-    JD_INLET_NO_STOP_RULE    /* max_sections = 0 and stop_step = JD_INLET_NO_STOP (the engine
+    JD_INLET_NO_STOP_RULE,   /* max_sections = 0 and stop_step = JD_INLET_NO_STOP (the engine
                                 must then have a deposit-height rule: pass allow_unbounded)    */
+    JD_INLET_BAD_GROUP       /* group arrays missing or inconsistent (an index >= n, a particle
+                                in two groups, an empty group, group_of not matching)          */
 } jd_inlet_status;
 
 /* Check a description.  Returns JD_INLET_OK, or a code with a one-line message in msg (naming
@@ -138,7 +149,10 @@ void jd_inlet_particle_at_step(const jd_inlet_spec *s, int64_t copy, size_t p, i
  * is placed at x(c, p, start) (the members not yet across the plane still at their rigid belt
  * positions), so no bond ever joins an inserted particle to one not yet inserted.  The copy's
  * bonds are formed at that step, unstressed (the belt is rigid: every bond has its section
- * length), between the ids the stream's id rule gives. */
+ * length), between the ids the stream's id rule gives.  The spec's group arrays (n_groups,
+ * group_first, group_member, group_of) name the groups; jd_inlet_stream/jd_inlet_pop then insert
+ * each member at jd_inlet_insertion_step.  The engine forms the bonds (the stepper: the
+ * resolved section's bonds of every copy whose group was popped at the step). */
 
 /* Start step of a group of copy c: the smallest k*(c, p) over members[0 .. n_members) (indices
  * in the section); JD_INLET_NEVER when n_members = 0.  O(n_members). */
@@ -148,6 +162,10 @@ int64_t jd_inlet_group_start(const jd_inlet_spec *s, int64_t copy, const size_t 
 /* The ids of the bond joining section particles i and j (i != j) in copy c, the smaller first
  * (the order of the resolved `bonds:` entries): first_id + c n + min(i, j), then the larger. */
 void jd_inlet_bond_ids(const jd_inlet_spec *s, int64_t copy, size_t i, size_t j, int64_t ids[2]);
+
+/* The step at which particle p of copy c is inserted (the stop rule is not applied here): the
+ * start step of its group (s->group_of[p] >= 0), else its own crossing step k*.  O(group size). */
+int64_t jd_inlet_insertion_step(const jd_inlet_spec *s, int64_t copy, size_t p);
 
 /* The state of a stream during a run: one cursor per section particle (an array of n that the
  * engine allocates), the next copy of that particle due and its step.  The engine compares the
@@ -169,7 +187,7 @@ typedef struct jd_inlet_stream {
 void jd_inlet_stream_init(const jd_inlet_spec *s, jd_inlet_stream *st, jd_inlet_cursor *cursor);
 
 /* Insert the particles due at `step` (call it whenever step == st->next_step; a step with nothing
- * due returns 0).  Writes at most cap particles in insertion order (increasing id) and returns
+ * due returns 0): each at jd_inlet_insertion_step, at its position x(c, p, step).  Writes at most cap particles in insertion order (increasing id) and returns
  * how many it wrote; when more than cap are due, the rest stay due (call again with the same
  * step).  Updates st->next_step. */
 size_t jd_inlet_pop(const jd_inlet_spec *s, jd_inlet_stream *st, int64_t step,

@@ -457,6 +457,10 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         fail("--inlet-record: the scene has no inlets")
     if not particles.count and not inlets:
         fail("the scene has no particles")
+    for k, inlet in enumerate(inlets):
+        if inlet["section"].get("bonds"):
+            fail("inlets.%d.section.bonds: bonded blocks in an inlet section (section.blocks) are "
+                 "not in liggghts-jdem yet (issue 26); valid: run this scene with build/jdem" % k)
     add_inlets_to_extent(scene, particles)
     model = scene.get("model") or {}
     table = interaction_table(scene, names)

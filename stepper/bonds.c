@@ -119,6 +119,13 @@ static int add_bond(jd_bonds *b, const jd_particles *ps, int32_t i, int32_t j, i
     return 0;
 }
 
+int sim_bonds_form(jd_bonds *b, const jd_particles *ps, int32_t i, int32_t j, int32_t type,
+                   int64_t step) {
+    if (add_bond(b, ps, i, j, type, step) == 0) return 0;
+    b->failed = "out of memory forming the bonds of an inlet's blocks";
+    return -1;
+}
+
 static long index_of_id(const jd_scene *sc, int64_t id) {
     size_t lo = 0, hi = sc->n_particles;
     while (lo < hi) {
@@ -128,11 +135,27 @@ static long index_of_id(const jd_scene *sc, int64_t id) {
     return lo < sc->n_particles && sc->id[lo] == id ? (long)lo : -1;
 }
 
-int sim_bonds_init(jd_bonds **bonds, const jd_particles *ps, const jd_scene *sc, char *err,
-                   size_t errlen) {
+/* Whether every particle of the run, the inlets' included, has the radius of the first. */
+static int one_radius(const jd_particles *ps, const jd_scene *sc, double *r) {
+    int have = 0, same = 1;
+    for (size_t i = 0; i < ps->n; i++) {
+        if (!have) *r = ps->radius[i], have = 1;
+        same &= ps->radius[i] == *r;
+    }
+    for (size_t k = 0; k < sc->n_inlets; k++)
+        for (size_t p = 0; p < sc->inlets[k].n; p++) {
+            if (!have) *r = sc->inlets[k].radius[p], have = 1;
+            same &= sc->inlets[k].radius[p] == *r;
+        }
+    return have && same;
+}
+
+int sim_bonds_init(jd_bonds **bonds, const jd_particles *ps, const jd_scene *sc, size_t capacity,
+                   char *err, size_t errlen) {
     if (!sc->n_bond_types) return 0;
     jd_bonds *b = calloc(1, sizeof *b);
-    if (!b || !(b->ever = calloc(ps->n ? ps->n : 1, 1))) {
+    if (b) b->ever_cap = capacity > ps->n ? capacity : ps->n;
+    if (!b || !(b->ever = calloc(b->ever_cap ? b->ever_cap : 1, 1))) {
         free(b);
         snprintf(err, errlen, "out of memory for the bonds");
         return -1;
@@ -148,13 +171,11 @@ int sim_bonds_init(jd_bonds **bonds, const jd_particles *ps, const jd_scene *sc,
         b->features |= jd_bond_laws(p[t].gamma);
     }
     b->params = p;
-    int one_radius = 1;
-    for (size_t i = 1; i < ps->n; i++) one_radius &= ps->radius[i] == ps->radius[0];
-    if (one_radius && ps->n) {
+    double r = 0.0;
+    if (one_radius(ps, sc, &r)) {
         jd_bond_section *sec = malloc(b->n_types * sizeof *sec);
         if (!sec) goto oom;
-        for (size_t t = 0; t < b->n_types; t++)
-            sec[t] = jd_bond_section_of(p[t].lambda, ps->radius[0], ps->radius[0]);
+        for (size_t t = 0; t < b->n_types; t++) sec[t] = jd_bond_section_of(p[t].lambda, r, r);
         b->sec_type = sec;
     }
     for (size_t k = 0; k < sc->n_bonds; k++) {
@@ -554,7 +575,7 @@ void sim_bonds_permute(jd_bonds *b, const int32_t *new_index, size_t n) {
         b->i[k] = new_index[b->i[k]];
         b->j[k] = new_index[b->j[k]];
     }
-    unsigned char *ever = malloc(n ? n : 1);
+    unsigned char *ever = calloc(b->ever_cap ? b->ever_cap : 1, 1); /* inserted later: 0 */
     if (!ever) {
         b->failed = "out of memory renumbering the bonded particles";
         return;
@@ -567,7 +588,41 @@ void sim_bonds_permute(jd_bonds *b, const int32_t *new_index, size_t n) {
 /* ---------------------------------------------------------------------------------------- */
 /* Guard                                                                                     */
 
+/* The largest over an inlet's section particles of the sum of their section bonds' bounds (every
+ * copy of a particle has the bonds of the section; copies are not bonded to each other). */
+static double inlet_omega2(const jd_scene *sc, const jd_inlet *in) {
+    if (!in->n_bonds) return 0.0;
+    double *w2 = calloc(in->n, sizeof *w2);
+    if (!w2) return INFINITY;
+    for (size_t k = 0; k < in->n_bonds; k++) {
+        const int32_t i = in->bond_pair[2 * k], j = in->bond_pair[2 * k + 1];
+        double dx[3];
+        for (int d = 0; d < 3; d++) dx[d] = in->rel[3 * j + d] - in->rel[3 * i + d];
+        const double wk = jd_bond_omega2_pair(
+            &sc->bond_types[in->bond_type[k]].p, in->radius[i], in->radius[j],
+            jd_sphere_mass(in->radius[i], sc->materials[in->material[i]].density),
+            jd_sphere_mass(in->radius[j], sc->materials[in->material[j]].density),
+            sqrt(jd_dot(dx, dx)));
+        w2[i] += wk;
+        w2[j] += wk;
+    }
+    double wmax2 = 0.0;
+    for (size_t p = 0; p < in->n; p++) wmax2 = fmax(wmax2, w2[p]);
+    free(w2);
+    return wmax2;
+}
+
+static double scene_omega2(const jd_scene *sc);
+
 double sim_bonds_omega2(const jd_scene *sc) {
+    double wmax2 = sc->n_bond_types ? scene_omega2(sc) : 0.0;
+    for (size_t k = 0; sc->n_bond_types && k < sc->n_inlets; k++)
+        wmax2 = fmax(wmax2, inlet_omega2(sc, &sc->inlets[k]));
+    return wmax2;
+}
+
+/* The scene's own bonds and rules (its particles at step 0). */
+static double scene_omega2(const jd_scene *sc) {
     if (!sc->n_bond_types || (!sc->n_bonds && !sc->n_bond_rules)) return 0.0;
     double *w2 = calloc(sc->n_particles ? sc->n_particles : 1, sizeof *w2);
     if (!w2) return INFINITY; /* cannot assess: report as unsafe */

@@ -5,7 +5,8 @@
  * parallel with the bond.
  *
  * Bonds are stored by particle index (a = i, b = j as formed, i.e. the smaller id first), in
- * formation order: the scene's step-0 bonds sorted by ids, then each rule's bonds sorted by ids.
+ * formation order: the scene's step-0 bonds sorted by ids, then each rule's bonds sorted by ids,
+ * and an inlet's block bonds at their insertion steps (inlet.c: by inlet, then ids).
  * Only intact bonds are kept; a bond that breaks is removed at the end of the loop that broke it
  * (order kept) after its event is recorded and its energies are moved to the totals.  A spatial
  * re-sort of the particles remaps the list with sim_bonds_permute().
@@ -71,6 +72,7 @@ typedef struct jd_bonds {
     size_t out_cap;
     size_t next_rule;          /* first scene rule not yet applied */
     unsigned char *ever;       /* per particle: 1 once it has been bonded (fragment count) */
+    size_t ever_cap;           /* entries of ever: every particle the run can hold (inlets) */
     /* output not yet written */
     jd_h5md_bond *formed;      /* bonds formed since the last sim_bonds_output */
     size_t n_formed, formed_cap;
@@ -93,10 +95,15 @@ typedef struct jd_bond_observables {
 /* The values in the order of jd_bond_observable_names (kernel/jdem_observables.h). */
 void sim_bond_observables_values(const jd_bond_observables *o, double out[JD_N_BOND_OBSERVABLES]);
 
-/* Set up *bonds from the scene and its particles ps (NULL when the scene has no bond types).  0
- * or -1 with err. */
+/* Set up *bonds from the scene and its particles ps (NULL when the scene has no bond types);
+ * capacity: every particle the run can hold (the inlets' included).  0 or -1 with err. */
 int sim_bonds_init(jd_bonds **bonds, const struct jd_particles *ps, const struct jd_scene *sc,
-                   char *err, size_t errlen);
+                   size_t capacity, char *err, size_t errlen);
+/* Form an intact, unstressed bond between particle indices i and j (either order: a = the smaller
+ * id) at `step`, recorded for /connectivity (an inlet's block, inlet.c).  0, or -1 when out of
+ * memory (also set in b->failed, which stops the run at the next sim_bonds_output). */
+int sim_bonds_form(jd_bonds *b, const struct jd_particles *ps, int32_t i, int32_t j, int32_t type,
+                   int64_t step);
 void sim_bonds_free(jd_bonds **bonds);
 /* Bytes the bonds hold (the bond arrays at their capacity, the output not yet written); 0 for
  * NULL. */

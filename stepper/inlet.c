@@ -18,6 +18,10 @@
  * Cost.  Before each step the run loop compares the step with next_step (the smallest cursor
  * step over the inlets); only at a step where particles are due does it pop them, append them
  * and rebuild the neighbour list.
+ *
+ * Bonded blocks.  The kernel inserts a bonded group whole at its start step; the section's bonds
+ * of the copies inserted at a step are formed right after their particles are appended
+ * (form_block_bonds), unstressed, and written to /connectivity at that step.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -217,6 +221,43 @@ static void check_height(jd_sim *s, size_t k) {
     jd_inlet_height_stop(&r->st, s->step, top, def->height);
 }
 
+/* Engine index of the particle with id `id` among the particles [n0, n1) just appended (their
+ * ids increase: the stream's insertion order), or -1. */
+static long appended_index(const jd_sim_inlets *in, size_t n0, size_t n1, int64_t id) {
+    size_t lo = n0, hi = n1;
+    while (lo < hi) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (in->id[mid] < id) lo = mid + 1; else hi = mid;
+    }
+    return lo < n1 && in->id[lo] == id ? (long)lo : -1;
+}
+
+/* The bonds of the groups inlet k inserted at this step, the particles [n0, n1): a group is
+ * inserted whole (kernel/jdem_inlet.h), so a section bond (i, j) of copy c forms exactly when
+ * (c, i) is among them.  Copies in increasing order, each copy's bonds in the section's (i, j)
+ * order: the bonds of a step in increasing (id_a, id_b).  Indices [n0, n1) are still the append
+ * order (the neighbour build that may renumber comes after). */
+static int form_block_bonds(jd_sim *s, size_t k, size_t n0, size_t n1) {
+    const jd_sim_inlets *in = s->inlets;
+    const jd_inlet *def = &s->run.scene->inlets[k];
+    const jd_inlet_spec *sp = &in->run[k].spec;
+    if (!def->n_bonds || !s->bonds || n0 == n1) return 0;
+    const int64_t n = (int64_t)sp->n;
+    for (int64_t c = (in->id[n0] - sp->first_id) / n, last = (in->id[n1 - 1] - sp->first_id) / n;
+         c <= last; c++)
+        for (size_t b = 0; b < def->n_bonds; b++) {
+            int64_t ids[2];
+            jd_inlet_bond_ids(sp, c, (size_t)def->bond_pair[2 * b], (size_t)def->bond_pair[2 * b + 1], ids);
+            const long i = appended_index(in, n0, n1, ids[0]);
+            if (i < 0) continue; /* its group was inserted at another step */
+            const long j = appended_index(in, n0, n1, ids[1]);
+            if (j < 0 || sim_bonds_form(s->bonds, &s->particles, (int32_t)i, (int32_t)j,
+                                        def->bond_type[b], s->step))
+                return -1;
+        }
+    return 0;
+}
+
 static int insert_due(jd_sim *s, char *err, size_t errlen) {
     jd_sim_inlets *in = s->inlets;
     if (s->step != in->next_step) return 0;
@@ -226,11 +267,18 @@ static int insert_due(jd_sim *s, char *err, size_t errlen) {
     in->next_step = JD_INLET_NEVER;
     for (size_t k = 0; k < in->n_inlets; k++) {
         inlet_run *r = &in->run[k];
+        const size_t n0 = s->particles.n;
         size_t got;
         while (r->st.next_step == s->step &&
                (got = jd_inlet_pop(&r->spec, &r->st, s->step, in->buf, in->buf_cap)) > 0) {
             for (size_t q = 0; q < got && s->particles.n < in->cap; q++) append(s, &in->buf[q]);
             added += got;
+        }
+        if (form_block_bonds(s, k, n0, s->particles.n) != 0) {
+            snprintf(err, errlen, "step %lld: a bond of inlet '%s' joins a particle not inserted "
+                     "with its block, or memory ran out", (long long)s->step,
+                     s->run.scene->inlets[k].name);
+            return -1;
         }
         in->next_step = r->st.next_step < in->next_step ? r->st.next_step : in->next_step;
     }

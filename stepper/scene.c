@@ -356,9 +356,10 @@ static int read_scene(loader *L) {
         scene_read_deposits(L) ||
         scene_read_inlets(L) || scene_read_walls(L) || scene_read_bonds(L))
         return -1;
-    if (s->n_inlets && s->n_bond_types)
-        return sd_fail(&L->c, sd_get(&L->c, L->root, "bond_types"), "bond_types", "bonds "
-                       "together with inlets; valid: one of the two");
+    if (s->n_inlets && s->n_bond_rules)
+        return sd_fail(&L->c, sd_get(&L->c, L->root, "bond_rules"), "bond_rules", "bond rules "
+                       "together with inlets; valid: one of the two (an inlet's bonded blocks "
+                       "are section.blocks)");
     if (s->n_particles == 0 && s->n_inlets == 0) {
         const yaml_node_t *p = sd_get(&L->c, L->root, "particles");
         return sd_fail(&L->c, p ? p : L->root, "particles", "no particles; valid: at least one "
@@ -476,6 +477,11 @@ void scene_free(jd_scene *scene) {
         free(scene->inlets[k].rel);
         free(scene->inlets[k].radius);
         free(scene->inlets[k].material);
+        free(scene->inlets[k].bond_pair);
+        free(scene->inlets[k].bond_type);
+        free(scene->inlets[k].group_first);
+        free(scene->inlets[k].group_member);
+        free(scene->inlets[k].group_of);
     }
     free(scene->inlets);
     memset(scene, 0, sizeof *scene);

@@ -117,6 +117,17 @@ typedef struct jd_inlet {
     int64_t every;            /* JD_INLET_STOP_HEIGHT: steps between checks, >= 1 */
     int settled;              /* the section holds particles of a settled deposit (from_deposit):
                                  its overlaps are checked against watchdog.max_overlap_fraction */
+    /* Bonds between section particles (section.blocks, section.bonds; docs/scenes.md "Bonded
+     * blocks in an inlet section"), formed in every copy when its group is inserted. */
+    size_t n_bonds;
+    int32_t *bond_pair;       /* 2 n_bonds section indices, smaller first, sorted by (first, second) */
+    int32_t *bond_type;       /* n_bonds indices into bond_types */
+    /* Bonded groups: the connected components of those bonds (kernel/jdem_inlet.h), numbered by
+     * their smallest member; each is inserted whole at its first member's crossing step. */
+    size_t n_groups;
+    size_t *group_first;      /* n_groups + 1 offsets into group_member */
+    size_t *group_member;     /* members of each group, increasing */
+    int32_t *group_of;        /* n: the group of each particle, -1: none */
 } jd_inlet;
 
 typedef struct jd_scene {

@@ -285,6 +285,22 @@ static int emit_inlet_stop(yaml_emitter_t *e, const jd_inlet *in) {
     return map_end(e);
 }
 
+/* An inlet section's bonds (its blocks' and explicit ones), by section index, sorted; only
+ * for a section that has any. */
+static int emit_section_bonds(yaml_emitter_t *e, const jd_scene *s, const jd_inlet *in) {
+    if (!in->n_bonds) return 0;
+    if (str(e, "bonds") || seq_start(e, 0)) return 1;
+    for (size_t k = 0; k < in->n_bonds; k++) {
+        char pair[2][24];
+        for (int d = 0; d < 2; d++) snprintf(pair[d], sizeof pair[d], "%d", in->bond_pair[2 * k + d]);
+        if (map_start(e, 1) || str(e, "pair") || seq_start(e, 1) ||
+            scalar(e, pair[0], YAML_PLAIN_SCALAR_STYLE) || scalar(e, pair[1], YAML_PLAIN_SCALAR_STYLE) ||
+            seq_end(e) || key_str(e, "type", s->bond_types[in->bond_type[k]].name) || map_end(e))
+            return 1;
+    }
+    return seq_end(e);
+}
+
 /* Inlets (docs/mixing.md 2.1): the section as explicit particles, every default explicit; only
  * for scenes with inlets, so the others resolve as before. */
 static int emit_inlets(yaml_emitter_t *e, const jd_scene *s) {
@@ -301,7 +317,8 @@ static int emit_inlets(yaml_emitter_t *e, const jd_scene *s) {
                 (in->settled && (str(e, "settled") || scalar(e, "true", YAML_PLAIN_SCALAR_STYLE))) ||
                 map_end(e))
                 return 1;
-        if (seq_end(e) || map_end(e) || key_vec(e, "origin", in->origin) ||
+        if (seq_end(e) || emit_section_bonds(e, s, in) || map_end(e) ||
+            key_vec(e, "origin", in->origin) ||
             key_vec(e, "velocity", in->velocity) || str(e, "plane") || map_start(e, 1) ||
             key_vec(e, "point", in->plane_point) || key_vec(e, "normal", in->plane_normal) ||
             map_end(e) || key_num(e, "period", in->period) || key_num(e, "offset", in->offset) ||

@@ -192,6 +192,14 @@ static int generate_lattice(loader *L, const yaml_node_t *lat, int32_t gen, latt
     return rc;
 }
 
+int scene_generate_lattice(loader *L, const yaml_node_t *lat, const char *path, int32_t gen,
+                           int64_t counts[3], int64_t *next_id) {
+    lattice g = {0};
+    if (read_lattice(L, lat, path, &g) || generate_lattice(L, lat, gen, &g, next_id)) return -1;
+    for (int d = 0; d < 3; d++) counts[d] = g.counts[d];
+    return 0;
+}
+
 int scene_generate_list(loader *L, const yaml_node_t *list, const char *prefix,
                         int lattice_only, int64_t *next_id) {
     if (sd_sequence(&L->c, list, prefix,

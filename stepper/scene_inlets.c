@@ -17,7 +17,8 @@
 
 static const char *const INLET_KEYS[] = {"name", "section", "origin", "velocity", "plane",
                                          "period", "offset", "first_id", "stop", NULL};
-static const char *const SECTION_KEYS[] = {"generate", "particles", "from_deposit", NULL};
+static const char *const SECTION_KEYS[] = {"blocks", "generate", "particles", "from_deposit",
+                                            "bonds", NULL};
 static const char *const SECTION_PARTICLE_KEYS[] = {"material", "radius", "position", "settled",
                                                     NULL};
 static const char *const BOOLEANS[] = {"false", "true", NULL};
@@ -56,7 +57,8 @@ static int take_section(loader *L, size_t from, jd_inlet *in, const yaml_node_t 
     const size_t n = s->n_particles - from;
     if (n == 0)
         return sd_fail(&L->c, at, path, "no particles; valid: at least one particle in "
-                       "section.generate, section.particles or section.from_deposit");
+                       "section.blocks, section.generate, section.particles or "
+                       "section.from_deposit");
     in->n = n;
     in->rel = malloc(3 * n * sizeof *in->rel);
     in->radius = malloc(n * sizeof *in->radius);
@@ -70,15 +72,20 @@ static int take_section(loader *L, size_t from, jd_inlet *in, const yaml_node_t 
     return 0;
 }
 
-static int read_section(loader *L, const yaml_node_t *m, const char *path, jd_inlet *in) {
+/* The section's particles in the order blocks, generate, particles, from_deposit (blocks first:
+ * a bonded section with its unbonded spheres in generate gives every sphere the id it has in
+ * the same section unbonded, with the lattice first in generate), then its bonds. */
+static int read_section(loader *L, const yaml_node_t *m, const char *path, jd_inlet *in,
+                        section_blocks **blocks) {
     char sub[SD_PATH_MAX], item[SD_PATH_MAX];
     sd_join(sub, path, "section");
     const yaml_node_t *sec = sd_get(&L->c, m, "section");
     if (!sec)
-        return sd_missing(&L->c, m, path, "section", "a mapping with generate, particles and/or "
-                          "from_deposit");
+        return sd_missing(&L->c, m, path, "section", "a mapping with blocks, generate, particles "
+                          "and/or from_deposit");
     if (sd_keys(&L->c, sec, sub, SECTION_KEYS)) return -1;
     const size_t from = L->s->n_particles;
+    if (scene_read_section_blocks(L, sec, sub, blocks)) return -1;
     const yaml_node_t *gen = sd_get(&L->c, sec, "generate"), *parts = sd_get(&L->c, sec, "particles"),
                       *deposits = sd_get(&L->c, sec, "from_deposit");
     int64_t unused_id = 1; /* ids are the stream's */
@@ -94,7 +101,7 @@ static int read_section(loader *L, const yaml_node_t *m, const char *path, jd_in
     }
     sd_join(item, sub, "from_deposit");
     if (deposits && scene_read_deposit_list(L, deposits, item)) return -1;
-    return take_section(L, from, in, sec, sub);
+    return take_section(L, from, in, sec, sub) || scene_read_section_bonds(L, sec, sub, in, *blocks);
 }
 
 static int read_plane(loader *L, const yaml_node_t *m, const char *path, jd_inlet *in) {
@@ -172,11 +179,17 @@ static int read_inlet(loader *L, const yaml_node_t *m, const char *path, jd_inle
         if (strcmp(other->name, in->name) == 0)
             return sd_fail(&L->c, name, sub, "duplicate inlet name '%s'; valid: unique names",
                            in->name);
-    return read_section(L, m, path, in) || sd_req_vec3(&L->c, m, path, "origin", in->origin) ||
-           sd_req_vec3(&L->c, m, path, "velocity", in->velocity) || read_plane(L, m, path, in) ||
-           sd_req_num(&L->c, m, path, "period", SD_POSITIVE, &in->period) ||
-           sd_opt_num(&L->c, m, path, "offset", SD_NONNEGATIVE, &in->offset) ||
-           read_first_id(L, m, path, in) || read_stop(L, m, path, in);
+    section_blocks *blocks = NULL;
+    const int rc = read_section(L, m, path, in, &blocks) ||
+                   sd_req_vec3(&L->c, m, path, "origin", in->origin) ||
+                   sd_req_vec3(&L->c, m, path, "velocity", in->velocity) ||
+                   read_plane(L, m, path, in) ||
+                   sd_req_num(&L->c, m, path, "period", SD_POSITIVE, &in->period) ||
+                   sd_opt_num(&L->c, m, path, "offset", SD_NONNEGATIVE, &in->offset) ||
+                   read_first_id(L, m, path, in) || read_stop(L, m, path, in) ||
+                   scene_check_section_blocks(L, path, in, blocks);
+    scene_free_section_blocks(blocks);
+    return rc;
 }
 
 int scene_read_inlets(loader *L) {
@@ -208,7 +221,9 @@ void scene_inlet_spec(const jd_scene *sc, size_t k, jd_inlet_spec *out) {
                            .max_sections = in->stop == JD_INLET_STOP_SECTIONS ? in->sections : 0,
                            .stop_step = JD_INLET_NO_STOP,
                            .overlap_tol = in->settled ? sc->watchdog.max_overlap_fraction
-                                                      : JD_INLET_OVERLAP_TOL};
+                                                      : JD_INLET_OVERLAP_TOL,
+                           .n_groups = in->n_groups, .group_first = in->group_first,
+                           .group_member = in->group_member, .group_of = in->group_of};
     memcpy(out->origin, in->origin, sizeof out->origin);
     memcpy(out->velocity, in->velocity, sizeof out->velocity);
     memcpy(out->plane_point, in->plane_point, sizeof out->plane_point);

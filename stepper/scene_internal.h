@@ -84,6 +84,24 @@ int scene_read_generators(loader *L);
 int scene_generate_list(loader *L, const yaml_node_t *list, const char *prefix,
                         int lattice_only, int64_t *next_id);
 
+/* scene_generate.c: one lattice mapping `lat` at `path` (the generate section's lattice keys),
+ * its particles appended with ids from *next_id, its counts into counts. */
+int scene_generate_lattice(loader *L, const yaml_node_t *lat, const char *path, int32_t gen,
+                           int64_t counts[3], int64_t *next_id);
+
+/* scene_inlet_blocks.c (docs/scenes.md "Bonded blocks in an inlet section"): an inlet section's
+ * blocks (read before its other particles, at section index 0) and explicit section bonds
+ * (after them), into in->bond_pair/bond_type; the groups; the blocks' fit (after the whole
+ * inlet entry at `path` is read: the belt and the period are known). */
+typedef struct section_blocks section_blocks;
+int scene_read_section_blocks(loader *L, const yaml_node_t *sec, const char *path,
+                              section_blocks **out);
+int scene_read_section_bonds(loader *L, const yaml_node_t *sec, const char *path, jd_inlet *in,
+                             section_blocks *blocks);
+int scene_check_section_blocks(loader *L, const char *path, const jd_inlet *in,
+                               const section_blocks *blocks);
+void scene_free_section_blocks(section_blocks *blocks);
+
 /* scene_inlets.c: the inlets section (after the particles and generators, before the sort),
  * and its kernel check once dt is final. */
 int scene_read_inlets(loader *L);

@@ -260,7 +260,8 @@ static int setup(jd_sim *s, char *err, size_t errlen) {
     if (sim_walls_init(&s->walls, &s->run, err, errlen) != 0 ||
         sim_mesh_walls_init(&s->meshes, &s->run, err, errlen) != 0)
         return -1;
-    if (sim_bonds_init(&s->bonds, &s->particles, s->run.scene, err, errlen) != 0 ||
+    if (sim_bonds_init(&s->bonds, &s->particles, s->run.scene,
+                       sim_inlets_capacity(s->run.scene), err, errlen) != 0 ||
         sim_loads_init(&s->loads, s->run.scene, err, errlen) != 0 ||
         sim_inlets_init(s, err, errlen) != 0)
         return -1;
@@ -456,6 +457,9 @@ int sim_run_checkpointed(jd_sim *s, jd_h5md *h, int show_progress, jd_checkpoint
         if ((rc = sim_watchdog_step(&s->watch, &s->particles, &s->run, s->step, err, errlen)) != 0)
             break;
         if (s->inlets && (rc = sim_inlets_step(s, err, errlen)) != 0) break;
+        /* the bonds of blocks inserted at this step: in the trajectory before a checkpoint */
+        if (s->bonds && s->bonds->n_formed && (rc = sim_bonds_output(s->bonds, s->step, h, err, errlen)) != 0)
+            break;
         const double t0 = sim_clock();
         if (s->step != written && due(s->step, sc->output_every, last)) {
             if ((rc = write_frame(s, h, err, errlen)) != 0) break;

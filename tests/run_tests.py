@@ -35,6 +35,10 @@ SUITES += [(f"engine-{t}-sanitized", [PY, f"tests/engine/test_{t}.py"], "lines",
            for t in ENGINE_TESTS]
 # The conveyor inlet: the stream against its closed form, the growing trajectory, the energy.
 SUITES += [("inlet", [PY, "tests/inlet/test_inlet.py"], "lines", {})]
+# Bonded blocks in the inlet's section (Ch. 5): insertion at the block's first crossing, the
+# bonds of each copy (count, ids, order, unstressed), free fall whole, breakage on the floor,
+# the long axis, and the sanitizer build on the same scene.
+SUITES += [("inlet-bonded", [PY, "tests/inlet/test_bonded_section.py"], "lines", {})]
 # The inlet in both engines: the same insertion stream bit for bit on 1 and 2 ranks, the same
 # particles and states at every frame, the inflow energy, fix jdem/inlet's bad arguments.
 SUITES += [("inlet-cross-engine", [PY, "tests/inlet/test_inlet_liggghts.py"], "lines", {})]

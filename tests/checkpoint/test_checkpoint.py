@@ -1,7 +1,8 @@
 """jdem checkpoints (docs/scenes.md "Checkpoints"): a run killed with SIGKILL after a checkpoint
 and resumed from it equals the uninterrupted run bit for bit (every dataset of the trajectory,
 tests/checkpoint/compare_h5.py), on 1 and 2 threads, for a settling bed with walls, friction
-and rolling, a servo compression, an inlet stream and a bonded beam; SIGTERM writes a
+and rolling, a servo compression, an inlet stream, a bonded beam and an inlet of bonded blocks
+(the checkpoint between two copies' insertions); SIGTERM writes a
 checkpoint and exits 143; bad checkpoints are refused with their messages; a failed
 checkpoint write keeps the previous checkpoint and stops the run (exit 3)."""
 import os
@@ -27,6 +28,8 @@ CASES = [  # scene, case, checkpoint every N steps
     ("tests/engine/scenes/servo_columns.yaml", None, 500),
     ("tests/checkpoint/scenes/inlet_stream.yaml", None, None),
     ("reference_runs/stability/bonded_beam.yaml", "tip_load", 20000),
+    # a checkpoint between the two copies' block insertions (steps 1330 and 2730)
+    ("tests/inlet/bonded_section.yaml", None, 2500),
 ]
 
 

@@ -165,6 +165,13 @@ static const char *diff_inlet(const jd_inlet *a, const jd_inlet *b) {
     SAME(height);
     SAME(below_speed);
     SAME(every);
+    SAME(n_bonds);
+    SAME_ARRAY(bond_pair, 2 * a->n_bonds);
+    SAME_ARRAY(bond_type, a->n_bonds);
+    SAME(n_groups);
+    SAME_ARRAY(group_first, a->n_groups ? a->n_groups + 1 : 0);
+    SAME_ARRAY(group_member, a->n_groups ? a->group_first[a->n_groups] : 0);
+    SAME_ARRAY(group_of, a->n_groups ? a->n : 0);
     return NULL;
 }
 

@@ -416,6 +416,57 @@ static void bonded_block_starts_with_its_first_sphere(void **state) {
     assert_int_equal(ids[1], 7 + 64 + 5);
 }
 
+/* The stream of a section of two spheres in a row along the belt (rel_x = 0 and -0.02) bonded
+ * into one group, and a third, unbonded sphere behind them (rel_x = -0.05): with origin
+ * -0.0505, dt = 1 ms and L = 0.3 m their own crossing steps are 51, 71 and 101 (+ 300 c).  The
+ * pair is popped whole at 51 + 300 c, the trailing sphere at x = -0.0195 + 0.3 ... on the belt,
+ * the unbonded one alone at its own step. */
+static void stream_inserts_a_group_whole(void **state) {
+    (void)state;
+    const double rel[9] = {0.0, 0.0, 0.0, -0.02, 0.0, 0.0, -0.05, 0.0, 0.0};
+    const double radius[3] = {0.01, 0.01, 0.01};
+    const int32_t species[3] = {1, 1, 1};
+    const size_t first[2] = {0, 2}, member[2] = {0, 1};
+    const int32_t group_of[3] = {0, 0, -1};
+    jd_inlet_spec s = one_sphere(rel, radius, species);
+    s.n = 3;
+    s.period = 0.3;
+    s.max_sections = 2;
+    s.n_groups = 1;
+    s.group_first = first;
+    s.group_member = member;
+    s.group_of = group_of;
+    char msg[256];
+    assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_OK);
+    jd_inlet_cursor cursor[3];
+    jd_inlet_stream st;
+    jd_inlet_stream_init(&s, &st, cursor);
+    const int64_t due[4] = {51, 101, 351, 401};
+    const size_t count[4] = {2, 1, 2, 1};
+    for (int e = 0; e < 4; e++) {
+        assert_int_equal(st.next_step, due[e]);
+        jd_inlet_particle out[3];
+        assert_int_equal(jd_inlet_pop(&s, &st, due[e], out, 3), count[e]);
+        const int64_t c = e / 2;
+        for (size_t q = 0; q < count[e]; q++) {
+            assert_int_equal(out[q].step, due[e]);
+            assert_int_equal(out[q].id, 7 + 3 * c + (int64_t)(e % 2 ? 2 : q));
+        }
+        if (count[e] == 2) { /* the pair: the trailing sphere 0.02 m behind, on the belt */
+            assert_rel(out[0].position[0], 0.0005, 1e-9);
+            assert_rel(out[1].position[0], -0.0195, 1e-9);
+        }
+    }
+    assert_int_equal(st.next_step, JD_INLET_NEVER);
+    assert_int_equal(jd_inlet_insertion_step(&s, 1, 1), 351);
+    assert_int_equal(jd_inlet_crossing_step(&s, 1, 1), 371);
+    const int32_t bad_of[3] = {0, -1, -1}; /* member 1 not marked with its group */
+    s.group_of = bad_of;
+    assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_BAD_GROUP);
+    assert_string_equal(msg, "bonded group 0: member 1 is not a section particle of that group "
+                             "listed in increasing order");
+}
+
 int run_inlet_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(crossing_step_of_each_copy),
@@ -431,6 +482,7 @@ int run_inlet_tests(void) {
         cmocka_unit_test(height_rule),
         cmocka_unit_test(record_line_round_trip),
         cmocka_unit_test(bonded_block_starts_with_its_first_sphere),
+        cmocka_unit_test(stream_inserts_a_group_whole),
     };
     return cmocka_run_group_tests_name("inlet", tests, NULL, NULL);
 }
