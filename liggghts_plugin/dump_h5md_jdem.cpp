@@ -37,8 +37,9 @@ enum { COL_ID = 0, COL_TYPE, COL_R, COL_M, COL_X, COL_V = COL_X + 3, COL_W = COL
 
 DumpH5mdJdem::DumpH5mdJdem(LAMMPS *lmp, int narg, char **arg)
     : Dump(lmp, narg, arg), h5(NULL), energy(true), grow(-1), natoms0(-1), last_step(-1), observables_every(0), stop_frame(false),
-      resume_step(-1) {
+      resume_step(-1), resume_opened(false) {
   if (narg < 5) error->all(FLERR, "Illegal dump h5md/jdem command: dump ID group h5md/jdem N FILE.h5");
+  frame_every = force->inumeric(FLERR, arg[3]);
   path = arg[4];
   if (path.find('*') != std::string::npos || path.find('%') != std::string::npos)
     error->all(FLERR, "dump h5md/jdem writes one file: no '*' or '%' in the file name");
@@ -109,10 +110,11 @@ void DumpH5mdJdem::write() {
   if (resume_step >= 0 && update->ntimestep <= resume_step) {
     /* the interrupted run wrote this step's frame and samples (or the uninterrupted run writes
      * none here): they are in the copied prefix */
-    if (!h5) open_resumed();
+    open_resumed();
     last_step = update->ntimestep;
     return;
   }
+  if (resume_step >= 0) open_resumed();
   const int nlocal = atom->nlocal;
   const int *mask = atom->mask, *tag = atom->tag, *type = atom->type;
   double **x = atom->x, **v = atom->v, **omega = atom->omega, **f = atom->f, **torque = atom->torque;
@@ -171,9 +173,7 @@ void DumpH5mdJdem::write() {
       }
     }
 
-    if (!h5 && resume_step >= 0) {
-      failed = resume_file(err, sizeof err);
-    } else if (!h5) {
+    if (!h5) {
       if (grow < 0) grow = insertion_fix() ? 1 : 0;
       failed = create_file(all, order, dt, err, sizeof err);
       natoms0 = (bigint)nat;
@@ -336,7 +336,10 @@ void DumpH5mdJdem::gather_mesh_walls(bool all) {
  * particle rows and its prefix up to resume_step copied in (io/h5md_resume.h). */
 int DumpH5mdJdem::resume_file(char *err, size_t errlen) {
   char src[4200];
-  if (jd_h5md_resume_source(path.c_str(), (int64_t)resume_step, src, sizeof src, err, errlen) != 0)
+  /* the interrupted run's last frame at or before resume_step; it may have been killed before
+   * the frame after it */
+  const bigint prefix_frame = resume_step - resume_step % frame_every;
+  if (jd_h5md_resume_source(path.c_str(), (int64_t)prefix_frame, src, sizeof src, err, errlen) != 0)
     return 1;
   jd_h5md_particles rows;
   if (jd_h5md_resume_rows(src, (int64_t)resume_step, &rows, err, errlen) != 0) return 1;
@@ -351,8 +354,11 @@ int DumpH5mdJdem::resume_file(char *err, size_t errlen) {
   return failed;
 }
 
-/* Collective: resume_file on rank 0 at a step whose frame the prefix holds. */
+/* Collective, resume yes: resume_file on rank 0, once, before the first frame or observable
+ * sample (the run may resume between two frames). */
 void DumpH5mdJdem::open_resumed() {
+  if (resume_opened) return;
+  resume_opened = true;
   int failed = 0;
   char err[1024] = "";
   if (me == 0) failed = resume_file(err, sizeof err);
@@ -445,6 +451,7 @@ int DumpH5mdJdem::write_bond_observables(const double all_obs[JDO_N], bigint ste
 
 void DumpH5mdJdem::write_observable_sample() {
   if (resume_step >= 0 && update->ntimestep <= resume_step) return; /* in the copied prefix */
+  if (resume_step >= 0) open_resumed();
   double all_obs[JDO_N];
   reduce_observables(all_obs);
   bonds.count(lmp);

@@ -117,6 +117,8 @@ class DumpH5mdJdem : public Dump {
   std::vector<double> wall_values;
   bool stop_frame;          /* write() is writing the frame of a run stopped early */
   bigint resume_step;       /* resume yes: the step read_restart resumed at; -1: a new file */
+  bool resume_opened;       /* resume yes: the file is open with the interrupted run's prefix */
+  bigint frame_every;       /* N of `dump ID group h5md/jdem N FILE`: steps between frames */
   /* the mesh walls (after the plane and cylinder walls): each one's triangles [ntri][3][3] (rank
    * 0), and (wall index, mesh) of those LIGGGHTS moves, whose triangles go with every frame */
   std::vector<std::vector<double> > mesh_tris;

@@ -13,7 +13,7 @@ The dump writes OUT.h5.part and renames it, with its OUT.xdmf, only once the run
 earlier OUT.h5 and OUT.xdmf stay in place until then, and a stopped run leaves OUT.h5.part.
 While LIGGGHTS runs, a line `liggghts_run: step S/N (P %), ETA T` goes to stderr every minute,
 S the newest step that its log's thermo output or its newest restart file shows.
-SIGINT and SIGTERM are forwarded to LIGGGHTS (or mpirun) and waited for: it stops at its next
+SIGINT and SIGTERM are forwarded to LIGGGHTS (or to mpirun's ranks) and waited for: it stops at its next
 step and keeps OUT.h5.part.  --force runs an unsafe time step anyway (fix jdem/guard ... force).
 
 --checkpoint-every N writes a LIGGGHTS restart file every N steps, restart.STEP in the deck
@@ -104,6 +104,7 @@ class Child:
 
     def __init__(self):
         self.proc = None
+        self.mpirun = False
         self.signal = 0
         self.forwarded = 0  # signals sent: a second one takes LIGGGHTS' default action
         for sig in (signal.SIGINT, signal.SIGTERM):
@@ -113,16 +114,29 @@ class Child:
         self.signal = sig
         if self.proc is not None and self.proc.poll() is None:
             self.forwarded += 1
-            os.kill(self.proc.pid, sig)
+            self.signal_run(sig)
+
+    def signal_run(self, sig):
+        """SIG to LIGGGHTS, or to mpirun's ranks once they run.  Open MPI 4 passes a SIGTERM on
+        to its ranks only about a second later and kills them a second after that
+        (odls_base_sigkill_timeout), which can cut off the last frame of a large run; a rank sent
+        the signal itself stops at its next step, and mpirun then ends with it."""
+        ranks = subprocess.run(["pgrep", "-P", str(self.proc.pid)], capture_output=True, text=True).stdout.split()
+        for pid in (ranks if self.mpirun else []) or [self.proc.pid]:
+            try:
+                os.kill(int(pid), sig)
+            except ProcessLookupError:
+                pass
 
     def run(self, cmd, cwd, lock_fd, every=None):
         """Run CMD in CWD; (status, stdout, stderr).  EVERY: called every few seconds meanwhile."""
         # the lock is passed on: it holds while LIGGGHTS runs, even if this script is killed
+        self.mpirun = os.path.basename(cmd[0]) == "mpirun"
         self.proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                      text=True, errors="replace", process_group=0, pass_fds=(lock_fd,))
         if self.signal and not self.forwarded:
             self.forwarded += 1
-            os.kill(self.proc.pid, self.signal)
+            self.signal_run(self.signal)
         while True:
             try:
                 out, err = self.proc.communicate(timeout=5.0)

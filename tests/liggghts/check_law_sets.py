@@ -6,7 +6,8 @@ and the fuzz corpus excepted) is resolved, shortened to one step and run by buil
 prints "jdem:   law set X") and, through its generated deck, by build/liggghts-jdem (pair_style
 gran/jiang prints "gran/jiang: law set X").  Cases whose inputs to the rule are the same (the
 interaction table, mu_r, tangential_stiffness, the materials of the particles and of the walls, output.energy) are run
-once.  Then hand-written LIGGGHTS scripts: rolling friction given without the `rolling on`
+once.  A scene whose deck the generator refuses as not in liggghts-jdem yet (exit 2 and that
+message) is run by build/jdem alone.  Then hand-written LIGGGHTS scripts: rolling friction given without the `rolling on`
 keyword must stop with the exact error; `rolling on` where no pair has rolling friction runs the
 stepper's law set (no rolling law).
 
@@ -60,9 +61,14 @@ def jdem_law_set(resolved, tmp):
 
 
 def write_deck(resolved, deck_dir):
+    """(exit status, stderr) of the deck generator on RESOLVED."""
     os.makedirs(deck_dir, exist_ok=True)
     r = engines.write_deck(resolved, os.path.join(deck_dir, "in.jdem"), "--trajectory", os.path.join(deck_dir, "l.h5"))
-    return r.returncode == 0, r.stderr[-300:]
+    return r.returncode, r.stderr[-300:]
+
+
+# the generator's refusal of a scene feature the plugin does not have yet (exit 2)
+NOT_YET = re.compile(r"^scene_to_liggghts: \S+: .* not in liggghts-jdem yet \(issue \d+\); valid: ", re.M)
 
 
 def liggghts_deck_run(deck_dir):
@@ -106,8 +112,13 @@ def every_scene(tmp):
                 continue
             mine = jdem_law_set(resolved, tmp)
             deck = os.path.join(tmp, "deck%d" % len(seen))
-            ok, err = write_deck(resolved, deck)
-            theirs = liggghts_law_set(deck) if ok else "deck generation failed: " + err
+            rc, err = write_deck(resolved, deck)
+            if rc == 2 and NOT_YET.search(err):
+                # no law set to compare; a later scene with the same inputs is compared instead
+                report(name + " refused_as_not_yet_in_the_plugin", mine != "" and not mine.startswith("none"),
+                       "jdem selects %s" % mine)
+                continue
+            theirs = liggghts_law_set(deck) if rc == 0 else "deck generation failed: " + err
             seen[key] = mine
             report(name, mine == theirs and not mine.startswith("none"),
                    "jdem selects %s, liggghts-jdem %s" % (mine, theirs))
@@ -121,7 +132,8 @@ def hand_written(tmp):
     resolved = os.path.join(tmp, "rolling.yaml")
     doc, err = resolve_short(scene, case, resolved)
     deck = os.path.join(tmp, "hand")
-    ok, err = write_deck(resolved, deck)
+    rc, err = write_deck(resolved, deck)
+    ok = rc == 0
     path = os.path.join(deck, "in.jdem")
     text = open(path).read()
     if not ok or " rolling on" not in text:
@@ -141,7 +153,7 @@ def hand_written(tmp):
     with open(resolved, "w") as f:
         yaml.safe_dump(doc, f)
     mine = jdem_law_set(resolved, tmp)
-    ok, err = write_deck(resolved, deck)
+    ok = write_deck(resolved, deck)[0] == 0
     text = open(path).read()
     open(path, "w").write(text.replace(" rolling off", " rolling on"))
     theirs = liggghts_law_set(deck)
@@ -158,8 +170,8 @@ def hand_written(tmp):
         yaml.safe_dump(doc, f)
     mine = jdem_law_set(mindlin, tmp)
     bare = os.path.join(tmp, "mindlin_frictionless")
-    ok, err = write_deck(mindlin, bare)
-    theirs = liggghts_law_set(bare) if ok else "deck generation failed: " + err
+    rc, err = write_deck(mindlin, bare)
+    theirs = liggghts_law_set(bare) if rc == 0 else "deck generation failed: " + err
     report("hand_written tangential_stiffness mindlin without friction: no mindlin law",
            mine == theirs and "mindlin" not in mine and not mine.startswith("none"),
            "jdem selects %s, liggghts-jdem %s" % (mine, theirs))

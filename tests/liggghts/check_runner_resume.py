@@ -6,7 +6,7 @@ restart files (--checkpoint-every N --resume; docs/liggghts.md "Restarts").
 
 The case is the conveyor fill of tests/checkpoint/scenes/inlet_stream.yaml (12 sections on a
 belt, 120,000 steps, a frame every 5000 and observables every 1000 steps), with a restart file
-every 10,000 steps.  The reference of every check is the same run uninterrupted: a continued run
+every 6000 steps, so that a run resumes between two frames.  The reference of every check is the same run uninterrupted: a continued run
 must equal it bit for bit (==, NaN == NaN in the empty rows of the growing set) in every dataset
 of its trajectory but /h5md (the file's author and creator), on 1 and 2 MPI ranks:
   killed   the runner and LIGGGHTS killed with SIGKILL once the restart file of step 60000
@@ -30,21 +30,16 @@ import time
 
 import h5py
 import numpy as np
+from tests.engine.engine_common import Checks
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 SCENE = os.path.join(ROOT, "tests", "checkpoint", "scenes", "inlet_stream.yaml")
 RUNNER = [sys.executable, os.path.join(ROOT, "scripts", "liggghts_run.py")]
-EVERY, KILL_AFTER = 10000, 60000
+EVERY, KILL_AFTER = 6000, 60000
 
-failed = 0
-
-
-def check(name, ok, detail=""):
-    global failed
-    print(("PASS %s" % name) if ok else ("FAIL %s: %s" % (name, detail)), flush=True)
-    failed += 0 if ok else 1
-    return ok
+checks = Checks()
+check = checks.check
 
 
 def runner(scene, out, np_, *extra):
@@ -66,11 +61,10 @@ def interrupted(out, np_, how):
     while proc.poll() is None and time.time() < deadline and max(restart_steps(deck) or [0]) < KILL_AFTER:
         time.sleep(0.001)
     if how == "kill":
-        # LIGGGHTS (or mpirun) runs in a process group of its own: kill it, then the runner
-        kids = subprocess.run(["pgrep", "-P", str(proc.pid)], capture_output=True, text=True).stdout.split()
-        for pid in kids:
-            os.killpg(int(pid), signal.SIGKILL)
-        os.kill(proc.pid, signal.SIGKILL)
+        # the runner was started in a session of its own, and everything it started is in it:
+        # LIGGGHTS or mpirun (in a process group of its own) and Open MPI's ranks (each in one
+        # of its own), so a kill of the session leaves no rank running on
+        subprocess.run(["pkill", "-KILL", "-s", str(proc.pid)])
     else:
         os.kill(proc.pid, signal.SIGTERM)
     return proc.wait(), restart_steps(deck)
@@ -161,8 +155,8 @@ def main():
             print("kept %s" % tmp)
         else:
             shutil.rmtree(tmp, ignore_errors=True)
-    print("%d failed" % failed)
-    return 1 if failed else 0
+    print("%d failed" % checks.failed)
+    return 1 if checks.failed else 0
 
 
 if __name__ == "__main__":
