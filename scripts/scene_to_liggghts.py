@@ -124,13 +124,9 @@ def bounding_box(scene, particles):
     T = steps * float(scene["time"]["dt"])
     g = [float(c) for c in scene.get("gravity", [0, 0, 0])]
     for w in scene.get("walls") or []:
-        if w["type"] == "mesh":  # static: its extent, scaled
-            try:
-                extent = stl_extent(str(w["file"]))
-            except ValueError as e:
-                fail("wall %s: %s" % (w["name"], e))
-            for p in extent:
-                grow([c * float(w["scale"]) for c in p])
+        if w["type"] == "mesh":
+            for p in mesh_reach(w, T):
+                grow(p)
             continue
         pts = w["corners"] if w["type"] == "plane" else w["axis"]
         r = 0.0 if w["type"] == "plane" else float(w["radius"])
@@ -150,6 +146,34 @@ def bounding_box(scene, particles):
     return [lo[d] - margin for d in range(3)], [hi[d] + margin for d in range(3)]
 
 
+def mesh_reach(w, T):
+    """Points whose box holds mesh wall w over a run of T seconds: its scaled extent, moved by
+    its velocity over T, or the box of the sphere it sweeps about the rotation's origin."""
+    try:
+        extent = [[c * float(w["scale"]) for c in p] for p in stl_extent(str(w["file"]))]
+    except ValueError as e:
+        fail("wall %s: %s" % (w["name"], e))
+    rot = w.get("rotation")
+    if rot:
+        o = [float(c) for c in rot["origin"]]
+        r = max(math.dist(p, o) for p in extent)
+        return extent + [[o[d] + s * r for d in range(3)] for s in (-1.0, 1.0)]
+    v = [float(c) for c in w.get("velocity", [0, 0, 0])]
+    return extent + [[p[d] + v[d] * T for d in range(3)] for p in extent]
+
+
+def mesh_motion_lines(w, mid, taken):
+    """fix move/mesh for a mesh wall with a velocity (linear) or a rotation (rotate)."""
+    v, rot = [float(c) for c in w.get("velocity", [0, 0, 0])], w.get("rotation")
+    if rot:
+        how = "rotate origin %s axis %s period %s" % (vec(rot["origin"]), vec(rot["axis"]), num(rot["period"]))
+    elif any(v):
+        how = "linear %s" % vec(v)
+    else:
+        return []
+    return ["fix %s all move/mesh mesh %s %s\n" % (identifier(w["name"], "move_", taken), mid, how)]
+
+
 def axis_of(vector):
     """Index of the coordinate axis a vector lies along, or None."""
     nonzero = [d for d in range(3) if float(vector[d]) != 0.0]
@@ -163,9 +187,12 @@ def mesh_lines(meshes, tid, taken):
     for fid, w in meshes:
         scale = float(w.get("scale", 1.0))
         mid = identifier(w["name"], "m_", taken)
-        L.append("fix %s all mesh/surface file %s type %d%s\n" % (
+        belt = [float(c) for c in w.get("surface_velocity", [0, 0, 0])]
+        L.append("fix %s all mesh/surface file %s type %d%s%s\n" % (
             mid, word(w["file"], "mesh file"), tid[w["material"]],
-            "" if scale == 1.0 else " scale %s" % num(scale)))
+            "" if scale == 1.0 else " scale %s" % num(scale),
+            " surface_vel %s" % vec(belt) if any(belt) else ""))
+        L.extend(mesh_motion_lines(w, mid, taken))
         L.append("fix %s all wall/jiang mesh n_meshes 1 meshes %s\n" % (fid, mid))
     return L
 

@@ -309,6 +309,7 @@ int sim_step(jd_sim *s, int seen, char *err, size_t errlen) {
     }
     /* fix move/mesh moves the walls in the same phase as the particles */
     sim_walls_move(&s->walls, s->run.dt);
+    if (s->meshes) sim_mesh_walls_move(s->meshes, s->run.dt, s->lists.skin);
     const double t1 = sim_clock();
     if ((moved || sim_neighbour_walls_moved(&s->walls, s->lists.skin)) &&
         sim_neighbour_build(s, err, errlen) != 0)

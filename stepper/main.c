@@ -456,7 +456,8 @@ static void free_output_particles(jd_h5md_particles *p) {
 }
 
 /* The scene's walls into the trajectory (/jdem/walls), as they stand at time 0: the plane and
- * cylinder walls in scene order, then the mesh walls (static) in scene order. */
+ * cylinder walls in scene order, then the mesh walls in scene order (a moving one again at every
+ * frame, sim.c). */
 static int output_walls(const jd_scene *sc, jd_h5md *h, char *err, size_t errlen) {
     const size_t n = sc->n_walls + sc->n_mesh_walls;
     jd_h5md_wall *w = calloc(n ? n : 1, sizeof *w);
@@ -475,7 +476,8 @@ static int output_walls(const jd_scene *sc, jd_h5md *h, char *err, size_t errlen
     for (size_t k = 0; k < sc->n_mesh_walls; k++) {
         const jd_mesh_wall *m = &sc->mesh_walls[k];
         w[sc->n_walls + k] = (jd_h5md_wall){.name = m->name, .type = 2, .n_triangles = m->ntri,
-                                            .triangles = (const double(*)[3][3])m->corner};
+                                            .triangles = (const double(*)[3][3])m->corner,
+                                            .moved = m->motion.kind != JD_MESH_STILL};
     }
     const int rc = jd_h5md_set_walls(h, n, w, err, errlen);
     free(w);

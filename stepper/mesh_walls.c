@@ -1,5 +1,5 @@
 /*
- * mesh_walls.c — static STL mesh walls in the stepper (mesh_walls.h): set-up, candidates,
+ * mesh_walls.c — STL mesh walls in the stepper (mesh_walls.h): set-up, motion, candidates,
  * the serial force loop, the observables.
  */
 #include <math.h>
@@ -10,9 +10,33 @@
 #include "h5md.h"
 #include "mesh_walls.h"
 
-/* The topology of scene wall `in` into m (the scene reader has run the same build). */
+static int nonzero3(const double v[3]) { return v[0] != 0.0 || v[1] != 0.0 || v[2] != 0.0; }
+
+/* The wall's velocity at the corners of a moving or conveyor mesh. */
+static void corner_velocities(jd_sim_mesh *m, const double surface_velocity[3]) {
+    if (m->motion.kind != JD_MESH_STILL)
+        jd_mesh_motion_velocity(&m->motion, 3 * m->topo.ntri, (const double(*)[3])m->corner,
+                                (double(*)[3])m->vnode);
+    else
+        for (size_t t = 0; t < m->topo.ntri; t++)
+            jd_mesh_conveyor_velocity(surface_velocity, (const double(*)[3])m->corner[t], m->vnode[t]);
+}
+
+/* The corners, motion and topology of scene wall `in` into m (the scene reader has run the
+ * same build). */
 static int mesh_init(jd_sim_mesh *m, const jd_mesh_wall *in, size_t stride, char *err, size_t errlen) {
     const size_t n = in->ntri;
+    const int moving = in->motion.kind != JD_MESH_STILL;
+    m->motion = in->motion;
+    m->corner = malloc(n * sizeof *m->corner);
+    if (moving || nonzero3(in->surface_velocity)) m->vnode = malloc(n * sizeof *m->vnode);
+    if (moving) m->corner_at_build = malloc(n * sizeof *m->corner_at_build);
+    if (!m->corner || (moving && (!m->vnode || !m->corner_at_build)) ||
+        (nonzero3(in->surface_velocity) && !m->vnode)) {
+        snprintf(err, errlen, "out of memory for the corners of mesh wall '%s'", in->name);
+        return -1;
+    }
+    memcpy(m->corner, in->corner, n * sizeof *m->corner);
     jd_mesh_storage *st = &m->storage;
     st->vertex = malloc(3 * n * sizeof *st->vertex);
     st->tri_vertex = malloc(n * sizeof *st->tri_vertex);
@@ -29,10 +53,11 @@ static int mesh_init(jd_sim_mesh *m, const jd_mesh_wall *in, size_t stride, char
         snprintf(err, errlen, "out of memory for the topology of mesh wall '%s'", in->name);
         return -1;
     }
-    if (jd_mesh_build(n, (const double(*)[3][3])in->corner, st, &m->topo, &bad) != JD_MESH_OK) {
+    if (jd_mesh_build(n, (const double(*)[3][3])m->corner, st, &m->topo, &bad) != JD_MESH_OK) {
         snprintf(err, errlen, "mesh wall '%s': triangle %zu is degenerate", in->name, bad);
         return -1;
     }
+    if (m->vnode) corner_velocities(m, in->surface_velocity);
     return 0;
 }
 
@@ -77,6 +102,9 @@ void sim_mesh_walls_free(jd_mesh_walls *mw) {
         free(st->vertex_valence);
         free(st->scratch);
         free(mw->mesh[k].hist.slots);
+        free(mw->mesh[k].corner);
+        free(mw->mesh[k].vnode);
+        free(mw->mesh[k].corner_at_build);
     }
     free(mw->mesh);
     free(mw->next);
@@ -124,10 +152,10 @@ static int push_candidate(jd_mesh_walls *mw, size_t at, int32_t t) {
     return 0;
 }
 
-/* Every triangle within R + skin of each particle's position now (the build's), ascending per
- * particle and mesh; particles left without candidates lose their history (they cannot touch
- * the mesh before the next build).  Brute force over the triangles: meshes here are small
- * (docs/model.md section 11). */
+/* Every triangle within R + skin of each particle's position at the last neighbour build,
+ * ascending per particle and mesh; particles left without candidates lose their history (they
+ * cannot touch the mesh before the next build).  Brute force over the triangles: meshes here
+ * are small (docs/model.md section 11). */
 static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
     const jd_particles *ps = &s->particles;
     const size_t np = ps->n;
@@ -141,9 +169,10 @@ static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
         jd_sim_mesh *m = &mw->mesh[k];
         if (history_reserve(&m->hist, n_orig) != 0) return -1;
         size_t *start = mw->cand_start + k * (np + 1);
+        if (m->corner_at_build) memcpy(m->corner_at_build, m->corner, m->topo.ntri * sizeof *m->corner);
         for (size_t i = 0; i < np; i++) {
             start[i] = at;
-            const double *x = ps->x + 3 * i, reach = ps->radius[i] + s->lists.skin;
+            const double *x = s->lists.x_build + 3 * i, reach = ps->radius[i] + s->lists.skin;
             for (size_t t = 0; t < m->topo.ntri; t++) {
                 jd_mesh_closest c;
                 jd_mesh_closest_feature(&m->topo, (int32_t)t, x, &c);
@@ -164,7 +193,37 @@ static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
     }
     mw->built_at = s->lists.n_builds;
     mw->n_particles = np;
+    mw->moved_far = 0;
     return 0;
+}
+
+void sim_mesh_walls_move(jd_mesh_walls *mw, double dt, double skin) {
+    for (size_t k = 0; k < mw->n; k++) {
+        jd_sim_mesh *m = &mw->mesh[k];
+        if (m->motion.kind == JD_MESH_STILL) continue;
+        const size_t nc = 3 * m->topo.ntri;
+        jd_mesh_motion_step(&m->motion, dt, nc, (double(*)[3])m->corner);
+        size_t bad = 0;
+        if (jd_mesh_build(m->topo.ntri, (const double(*)[3][3])m->corner, &m->storage, &m->topo, &bad) !=
+                JD_MESH_OK && !mw->error[0])
+            snprintf(mw->error, sizeof mw->error, "mesh wall %zu: triangle %zu became degenerate "
+                     "as it moved", k, bad);
+        corner_velocities(m, NULL);
+        const double *now = &m->corner[0][0][0], *then = &m->corner_at_build[0][0][0];
+        for (size_t c = 0; c < nc && !mw->moved_far; c++) {
+            double d2 = 0.0;
+            for (int d = 0; d < 3; d++) d2 += (now[3 * c + d] - then[3 * c + d]) * (now[3 * c + d] - then[3 * c + d]);
+            mw->moved_far = d2 > 0.25 * skin * skin;
+        }
+    }
+}
+
+int sim_mesh_walls_moving(const jd_mesh_walls *mw, size_t k) {
+    return mw->mesh[k].motion.kind != JD_MESH_STILL;
+}
+
+const double (*sim_mesh_walls_corners(const jd_mesh_walls *mw, size_t k))[3][3] {
+    return (const double(*)[3][3])mw->mesh[k].corner;
 }
 
 /* The old slots no contact continues: their dissipation is booked before they are cleared. */
@@ -212,11 +271,13 @@ static void sphere_forces(jd_sim *s, jd_mesh_walls *mw, size_t k, size_t i, size
                                  -1 - (int32_t)(s->walls.n + k), g->delta, R);
         jd_geom_wall_material(F, g, ps->kw[i], ps->mass[i], ps->inertia[i]);
         jd_kinematics kin;
-        memset(&kin, 0, sizeof kin); /* a static wall: vb = wb = 0 */
+        memset(&kin, 0, sizeof kin); /* wb = 0; vb = 0 unless the mesh moves */
         for (int d = 0; d < 3; d++) {
             kin.va[d] = ps->v[3 * i + d];
             kin.wa[d] = ps->omega[3 * i + d];
         }
+        if (m->vnode)
+            jd_mesh_point_velocity(&m->topo, sc.feature[c], (const double(*)[3])m->vnode[sc.feature[c]->tri], kin.vb);
         double *rec = mw->next + c * stride + 3;
         jd_contact_state st, kept;
         jd_rolling_state rs, rs_kept;
@@ -240,7 +301,7 @@ static void sphere_forces(jd_sim *s, jd_mesh_walls *mw, size_t k, size_t i, size
 
 void sim_mesh_walls_forces(jd_sim *s) {
     jd_mesh_walls *mw = s->meshes;
-    if (mw->built_at != s->lists.n_builds && build_candidates(mw, s) != 0) {
+    if ((mw->built_at != s->lists.n_builds || mw->moved_far) && build_candidates(mw, s) != 0) {
         snprintf(mw->error, sizeof mw->error, "out of memory for the mesh walls' candidates");
         return;
     }

@@ -1,15 +1,20 @@
 /*
- * mesh_walls.h — static triangle-mesh walls (STL, docs/scenes.md "Mesh walls") in the standalone
- * engine: each particle's candidate triangles, the kernel's per-sphere rule
+ * mesh_walls.h — triangle-mesh walls (STL, docs/scenes.md "Mesh walls") in the standalone
+ * engine, still, moving (translation, rotation) or with a conveyor surface: the motion
+ * (kernel/jdem_mesh_motion.h), each particle's candidate triangles, the kernel's per-sphere rule
  * (kernel/jdem_mesh.h: jd_mesh_sphere_contacts, jd_mesh_history_next) and the wall law of the
  * plane walls, evaluated serially after the parallel contact loops so that any number of threads
  * gives the same bits.  The order matches liggghts-jdem's fix wall/jiang mesh: the meshes in
  * scene order, the particles in ascending index, each particle's candidates in ascending
  * triangle, its contacts in that order.
  *
- * Designed for moving meshes to come: the topology (jd_mesh) is built once from the corners;
- * a moving mesh would move the corners, rebuild the welded vertex table and give
- * jd_mesh_point_velocity its corners' velocities (zero here).
+ * A moving mesh moves its corners in the drift, as fix move/mesh does in LIGGGHTS' initial
+ * integration, and rebuilds its topology from them (the vertex and edge ids follow the
+ * coordinates, as the plugin's do).  Its candidates hold every triangle within R + skin of
+ * each particle's position at the last neighbour build, from the triangles where they were at
+ * the candidates' build: they are rebuilt with the neighbour list, and in between once some
+ * corner has moved more than skin / 2 since (the particle has moved at most skin / 2 since
+ * the neighbour build, so a triangle within R now was within R + skin then).
  */
 #ifndef JDEM_MESH_WALLS_H
 #define JDEM_MESH_WALLS_H
@@ -34,6 +39,10 @@ typedef struct jd_mesh_history {
 /* One mesh wall as the engine holds it. */
 typedef struct jd_sim_mesh {
     int material;            /* the wall's material (index into materials)          */
+    jd_mesh_motion motion;   /* how it moves (still, translating, rotating)          */
+    double (*corner)[3][3];  /* [ntri] the triangles' corners now [m]                */
+    double (*vnode)[3][3];   /* [ntri] the wall's velocity at each corner [m/s]; NULL: at rest */
+    double (*corner_at_build)[3][3]; /* moving: the corners at the candidates' build [m] */
     jd_mesh topo;            /* the kernel's topology (vertices, edges, valences)   */
     jd_mesh_storage storage; /* the arrays topo points into (one allocation each)   */
     jd_mesh_history hist;
@@ -46,6 +55,7 @@ typedef struct jd_mesh_walls {
     size_t n;
     jd_sim_mesh *mesh;
     int64_t built_at;        /* lists.n_builds of the candidates, -1: none yet       */
+    int moved_far;           /* a moving mesh's corner moved more than skin / 2 since the build */
     size_t n_particles;      /* particles the candidates were built for              */
     size_t *cand_start;      /* [n][n_particles + 1] offsets into cand_tri, mesh-major */
     int32_t *cand_tri;       /* candidate triangles, ascending per particle and mesh  */
@@ -69,6 +79,16 @@ void sim_mesh_walls_free(jd_mesh_walls *mw);
 /* The mesh walls' part of an observable sample: the stored energy and the contacts of the live
  * slots, and the dissipation of live and ended contacts, added to o. */
 void sim_mesh_walls_observables(const jd_mesh_walls *mw, jd_observables *o);
+
+/* One time step dt [s] of every moving mesh (corners, topology, corner velocities); notes
+ * when a corner has moved more than skin / 2 [m] since the candidates' build. */
+void sim_mesh_walls_move(jd_mesh_walls *mw, double dt, double skin);
+
+/* 1 when some mesh wall moves (its triangles go with every frame). */
+int sim_mesh_walls_moving(const jd_mesh_walls *mw, size_t k);
+
+/* The triangles [ntri][3][3] of mesh wall k where they are now [m]. */
+const double (*sim_mesh_walls_corners(const jd_mesh_walls *mw, size_t k))[3][3];
 
 /* Each mesh wall's force (wall_force/NAME/x, y, z) at this step, like the plane walls'. */
 int sim_mesh_walls_write_observables(const jd_mesh_walls *mw, const jd_run_constants *run,

@@ -12,6 +12,7 @@
 #include <stdio.h>
 
 #include "jdem_bond.h"
+#include "jdem_mesh_motion.h"
 #include "jdem_servo.h"
 
 #define JD_NAME_MAX 64
@@ -61,7 +62,11 @@ typedef struct jd_mesh_wall {
     char file[1024];          /* the STL file, relative paths resolved against the scene's folder */
     double scale;             /* the STL coordinates times scale are metres [m per STL unit] */
     size_t ntri;              /* triangles, in the STL's order */
-    double (*corner)[3][3];   /* [ntri] the triangles' corners, scaled [m] */
+    double (*corner)[3][3];   /* [ntri] the triangles' corners, scaled [m], at time 0 */
+    jd_mesh_motion motion;    /* velocity or rotation (kernel/jdem_mesh_motion.h); still by default */
+    double rotation_period;   /* rotation: the period as given [s] (0 when not rotating) */
+    double rotation_axis[3];  /* rotation: the axis as given */
+    double surface_velocity[3]; /* a conveyor surface's velocity [m/s]; (0, 0, 0): none */
 } jd_mesh_wall;
 
 /* Run-time watchdog (docs/scenes.md "Watchdog"): limits that stop a run that goes wrong. */

@@ -227,9 +227,20 @@ static int emit_mesh_wall(yaml_emitter_t *e, const jd_scene *s, const jd_mesh_wa
         snprintf(absolute, sizeof absolute, "%s/%s", cwd, w->file);
         file = absolute;
     }
-    return map_start(e, 0) || key_str(e, "name", w->name) || key_str(e, "type", "mesh") ||
-           key_str(e, "file", file) || key_num(e, "scale", w->scale) ||
-           key_str(e, "material", s->materials[w->material].name) || map_end(e);
+    const jd_mesh_motion *m = &w->motion;
+    const double still[3] = {0.0, 0.0, 0.0};
+    if (map_start(e, 0) || key_str(e, "name", w->name) || key_str(e, "type", "mesh") ||
+        key_str(e, "file", file) || key_num(e, "scale", w->scale) ||
+        key_str(e, "material", s->materials[w->material].name) ||
+        key_vec(e, "velocity", m->kind == JD_MESH_TRANSLATING ? m->velocity : still) ||
+        key_vec(e, "surface_velocity", w->surface_velocity))
+        return 1;
+    if (m->kind == JD_MESH_ROTATING &&
+        (str(e, "rotation") || map_start(e, 1) || key_vec(e, "origin", m->origin) ||
+         key_vec(e, "axis", w->rotation_axis) || key_num(e, "period", w->rotation_period) ||
+         map_end(e)))
+        return 1;
+    return map_end(e);
 }
 
 static const char *const BENDINGS[] = {"potyondy_cundall", "jiang2021_literal"};

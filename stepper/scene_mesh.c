@@ -101,6 +101,60 @@ static int check_topology(loader *L, const yaml_node_t *at, const char *sub, con
     return 0;
 }
 
+static int nonzero3(const double v[3]) { return v[0] != 0.0 || v[1] != 0.0 || v[2] != 0.0; }
+
+static const char *const ROTATION_KEYS[] = {"origin", "axis", "period", NULL};
+
+/* walls.K.rotation: {origin, axis, period} (fix move/mesh rotate), checked by the kernel. */
+static int read_rotation(loader *L, const yaml_node_t *w, const char *path, jd_mesh_wall *mw) {
+    const yaml_node_t *r = sd_get(&L->c, w, "rotation");
+    char sub[SD_PATH_MAX], key[SD_PATH_MAX];
+    sd_join(sub, path, "rotation");
+    double origin[3];
+    if (sd_keys(&L->c, r, sub, ROTATION_KEYS) || sd_req_vec3(&L->c, r, sub, "origin", origin) ||
+        sd_req_vec3(&L->c, r, sub, "axis", mw->rotation_axis) ||
+        sd_req_num(&L->c, r, sub, "period", SD_ANY, &mw->rotation_period))
+        return -1;
+    if (!nonzero3(mw->rotation_axis)) {
+        sd_join(key, sub, "axis");
+        return sd_fail(&L->c, sd_get(&L->c, r, "axis"), key, "the rotation axis is (0, 0, 0); "
+                       "valid: a non-zero direction (any length)");
+    }
+    if (jd_mesh_motion_rotating(&mw->motion, origin, mw->rotation_axis, mw->rotation_period) != 0) {
+        sd_join(key, sub, "period");
+        return sd_fail(&L->c, sd_get(&L->c, r, "period"), key, "the period is %g; valid: a "
+                       "non-zero finite time per turn [s] (negative: the other way round)",
+                       mw->rotation_period);
+    }
+    return 0;
+}
+
+/* velocity, rotation and surface_velocity: at most one motion, and a conveyor surface only on
+ * a mesh that stays (LIGGGHTS' move/mesh replaces the surface's velocity by the motion's). */
+static int read_motion(loader *L, const yaml_node_t *w, const char *path, jd_mesh_wall *mw) {
+    double v[3] = {0.0, 0.0, 0.0};
+    char sub[SD_PATH_MAX];
+    jd_mesh_motion_still(&mw->motion);
+    if (sd_opt_vec3(&L->c, w, path, "velocity", v) ||
+        sd_opt_vec3(&L->c, w, path, "surface_velocity", mw->surface_velocity))
+        return -1;
+    if (nonzero3(v)) jd_mesh_motion_translating(&mw->motion, v);
+    if (sd_get(&L->c, w, "rotation")) {
+        sd_join(sub, path, "rotation");
+        if (nonzero3(v))
+            return sd_fail(&L->c, sd_get(&L->c, w, "rotation"), sub, "the mesh has a velocity "
+                           "and a rotation; valid: one motion per mesh wall (velocity or rotation)");
+        if (read_rotation(L, w, path, mw)) return -1;
+    }
+    if (nonzero3(mw->surface_velocity) && mw->motion.kind != JD_MESH_STILL) {
+        sd_join(sub, path, "surface_velocity");
+        return sd_fail(&L->c, sd_get(&L->c, w, "surface_velocity"), sub, "a conveyor surface "
+                       "on a moving mesh; valid: surface_velocity on a mesh wall without "
+                       "velocity or rotation");
+    }
+    return 0;
+}
+
 int scene_read_mesh_wall(loader *L, const yaml_node_t *w, const char *path, jd_mesh_wall *mw) {
     char sub[SD_PATH_MAX];
     sd_join(sub, path, "file");
@@ -117,5 +171,5 @@ int scene_read_mesh_wall(loader *L, const yaml_node_t *w, const char *path, jd_m
     if (sd_opt_num(&L->c, w, path, "scale", SD_POSITIVE, &mw->scale) ||
         read_stl(L, file, sub, mw))
         return -1;
-    return check_topology(L, file, sub, mw);
+    return check_topology(L, file, sub, mw) || read_motion(L, w, path, mw);
 }

@@ -16,7 +16,9 @@ static const char *const PLANE_KEYS[] = {"name",     "type",    "corners", "mate
 static const char *const SERVO_KEYS[] = {"target", "gain", "tolerance", "max_speed", "hold", NULL};
 static const char *const CYLINDER_KEYS[] = {"name",     "type",     "axis",    "radius", "side",
                                             "material", "velocity", "present", NULL};
-static const char *const MESH_KEYS[] = {"name", "type", "file", "material", "scale", NULL};
+static const char *const MESH_KEYS[] = {"name",     "type",     "file",     "material",
+                                        "scale",    "velocity", "rotation", "surface_velocity",
+                                        NULL};
 static const char *const BOOLEANS[] = {"false", "true", NULL};
 
 /* Enum spellings, indexed by the kernel's enum values. */

@@ -343,6 +343,10 @@ static int check_finite(const jd_particles *ps, int64_t step, char *err, size_t 
 static int write_frame(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
     if (check_finite(&s->particles, s->step, err, errlen) != 0) return -1;
     if (!h) return 0;
+    for (size_t k = 0; s->meshes && k < s->meshes->n; k++)
+        if (sim_mesh_walls_moving(s->meshes, k) &&
+            jd_h5md_move_mesh(h, s->run.scene->n_walls + k, sim_mesh_walls_corners(s->meshes, k), err, errlen))
+            return JD_RUN_OUTPUT;
     jd_particles *ps = &s->particles;
     sim_vectors_to_scene_order(ps);
     jd_h5md_frame fr = {.step = s->step, .time = (double)s->step * s->run.dt, .position = ps->x,

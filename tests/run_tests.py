@@ -53,6 +53,10 @@ SUITES += [("mesh-liggghts", [PY, "tests/mesh/test_mesh_liggghts.py"], "lines", 
 # liggghts-jdem bit for bit (edges, a vertex, a funnel), 1 vs 2 threads.
 SUITES += [("mesh-engines", [PY, "tests/mesh/test_mesh_engines.py"], "lines", {}),
            ("mesh-engines-sanitized", [PY, "tests/mesh/test_mesh_engines.py"], "lines", SANITIZED)]
+# Moving meshes (velocity, rotation) and conveyor surfaces: jdem against closed forms and
+# against liggghts-jdem's fix move/mesh and surface_vel, bit for bit on 1 and 2 ranks.
+SUITES += [("mesh-motion", [PY, "tests/mesh/test_mesh_motion.py"], "lines", {}),
+           ("mesh-motion-sanitized", [PY, "tests/mesh/test_mesh_motion.py"], "lines", SANITIZED)]
 # The law set (kernel/jdem_laws.h) each engine selects, for every scene of reference_runs/ and
 # tests/, and hand-written decks that leave out `rolling on`.
 SUITES += [("law-sets", [PY, "tests/liggghts/check_law_sets.py"], "lines", {})]

@@ -4,6 +4,7 @@
 int run_inlet_tests(void);
 int run_servo_tests(void);
 int run_mesh_tests(void);
+int run_mesh_motion_tests(void);
 
 int main(void) {
     int failed = 0;
@@ -20,5 +21,6 @@ int main(void) {
     failed += run_inlet_tests();
     failed += run_servo_tests();
     failed += run_mesh_tests();
+    failed += run_mesh_motion_tests();
     return failed;
 }
