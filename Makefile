@@ -216,7 +216,8 @@ accuracy: all
 # Jiang's Chapter 4 mixing campaign (docs/mixing.md §4): the resumable units of
 # scripts/mixing/plan_ch4.py, with progress and an ETA; finished units are skipped.
 #   make mixing [MODEL=model2] [ENGINE=jdem|liggghts-jdem|cross] [UNIT=jdem/model2/fill1]
-#               [DT=seed|guard|half] [LIST=1]        outputs: out/mixing/ch4*/ENGINE/MODEL/
+#               [DT=seed|guard|half] [NP=2] [LIST=1]  outputs: out/mixing/ch4*/ENGINE/MODEL/
+# (NP: the MPI ranks of each liggghts-jdem fill)
 # (ENGINE=cross: the cross-engine horizons, cross/modelM/horizon, which run both engines)
 # The engine's binary only when the selection names one engine (ENGINE=, or UNIT=ENGINE/...).
 MIXING_ENGINE = $(or $(ENGINE),$(firstword $(subst /, ,$(UNIT))))
@@ -224,7 +225,7 @@ MIXING_ENGINE = $(or $(ENGINE),$(firstword $(subst /, ,$(UNIT))))
 mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),build/liggghts-jdem build/jdem,all))
 	$(PY) scripts/campaign.py scripts/mixing/plan_ch4.py $(if $(MODEL),--model $(MODEL)) \
 	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
-	    $(if $(DT),-- --dt $(DT))
+	    $(if $(DT)$(NP),--) $(if $(DT),--dt $(DT)) $(if $(NP),--ranks $(NP))
 
 # The tables of the finished units, seed | jdem | liggghts-jdem (Tables 4-3...4-5, the mixing
 # parameters, run times) and Figs 4-11/4-12: out/mixing/ch4/report.md, summary.json and

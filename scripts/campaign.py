@@ -43,6 +43,7 @@ class Unit:
                                 # (a feature still missing); such a unit is reported, not run
     resumes: bool = False       # the command continues from what an interrupted run of it left
                                 # in "{dir}" (a checkpoint), so that directory is kept
+    ranks: int = 1              # the processes it runs on (MPI ranks), recorded with its times
 
 
 def non_empty(path):
@@ -105,7 +106,8 @@ class Times:
             self.seconds = {}
 
     def add(self, unit, seconds, cpu_seconds):
-        self.seconds[unit.name] = {"seconds": seconds, "cpu_seconds": cpu_seconds, "cost": unit.cost}
+        self.seconds[unit.name] = {"seconds": seconds, "cpu_seconds": cpu_seconds, "cost": unit.cost,
+                                   "ranks": unit.ranks}
         # beside the plan's first output, whose directory a selection without that unit never made
         os.makedirs(os.path.dirname(self.path), exist_ok=True)
         tmp = self.path + ".tmp"
@@ -212,9 +214,11 @@ def main(argv):
     ap.add_argument("--engine")
     ap.add_argument("--unit")
     ap.add_argument("--list", action="store_true", help="list the units and whether they are done")
-    ap.add_argument("plan_args", nargs="*")
-    a = ap.parse_args(argv)
-    units = load_plan(a.plan, a.plan_args)
+    # the plan's own arguments follow "--", wherever the driver's options stand (argparse alone
+    # matches an optional positional list once, next to `plan`, and refuses later ones)
+    cut = argv.index("--") if "--" in argv else len(argv)
+    a = ap.parse_args(argv[:cut])
+    units = load_plan(a.plan, argv[cut + 1:])
     names = [u.name for u in units]
     if len(set(names)) != len(names):
         print(f"campaign: {a.plan}: unit names are not unique", file=sys.stderr)

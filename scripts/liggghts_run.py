@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """liggghts_run.py — run one case of a jdem scene in LIGGGHTS (build/liggghts-jdem).
 
-    scripts/liggghts_run.py SCENE [--case NAME] -o OUT.h5 [--np N] [--force]
+    scripts/liggghts_run.py SCENE [--case NAME] -o OUT.h5 [--np N [--processors PX PY PZ]] [--force]
                             [--checkpoint-every N [--resume]]
 
 Resolves the scene with `build/jdem resolve` first (a bad scene changes nothing on disk), then
@@ -38,6 +38,7 @@ On failure the tail of the log follows the message.
 import argparse
 import errno
 import fcntl
+import math
 import os
 import re
 import signal
@@ -172,7 +173,8 @@ def write_deck(a, text, deck_dir, out, resume=None):
     restart = ["--restart-every", str(a.checkpoint_every)] if a.checkpoint_every else []
     r = engines.write_deck(resolved, os.path.join(deck_dir, "in.jdem"), "--trajectory", out,
                            *(["--force"] if a.force else []), *restart,
-                           *(["--resume", resume] if resume else []))
+                           *(["--resume", resume] if resume else []),
+                           *(["--processors", *a.processors] if a.processors else []))
     if r.returncode != 0:
         say("deck generation failed (exit %d):\n%s" % (r.returncode, r.stderr))
         return r.returncode if r.returncode in (EXIT_INPUT, EXIT_IO) else EXIT_INTERNAL
@@ -285,6 +287,8 @@ def main():
     ap.add_argument("--case", default=None)
     ap.add_argument("-o", "--output", required=True, help="trajectory (H5MD) to write")
     ap.add_argument("--np", type=int, default=1, help="MPI ranks (default 1)")
+    ap.add_argument("--processors", nargs=3, metavar=("PX", "PY", "PZ"),
+                    help="their grid (LIGGGHTS' processors command; default: LIGGGHTS chooses)")
     ap.add_argument("--force", action="store_true", help="run even if the time step is unsafe")
     ap.add_argument("--checkpoint-every", type=int, default=0, metavar="N",
                     help="write a restart file every N steps (restart.STEP in the deck directory)")
@@ -293,6 +297,11 @@ def main():
     ap.add_argument("--jdem", default=engines.JDEM)
     ap.add_argument("--liggghts", default=engines.LIGGGHTS_JDEM)
     a = ap.parse_args()
+    if a.processors and "*" not in a.processors and \
+            all(c.isdigit() for c in a.processors) and math.prod(map(int, a.processors)) != a.np:
+        say("--processors %s makes %d ranks, --np is %d; valid: a grid whose product is --np "
+            "(or '*' in one place)" % (" ".join(a.processors), math.prod(map(int, a.processors)), a.np))
+        return EXIT_INPUT
     if a.resume and a.checkpoint_every <= 0:
         say("--resume needs --checkpoint-every N > 0, the cadence of the interrupted run's restart files")
         return EXIT_INPUT

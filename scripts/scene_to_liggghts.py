@@ -433,10 +433,11 @@ def inlet_lines(scene, tid, deck_dir, record):
 
 
 def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=False, particles=None,
-               inlet_record=None, restart=None):
+               inlet_record=None, restart=None, processors=None):
     """The deck of SCENE.  PARTICLES: its particles, gathered by a ParticleStream while
     resolved_stream.read_resolved read the scene; None: SCENE["particles"] is their list.
-    RESTART: None, or a Restart (restart files every N steps; the deck continuing from one)."""
+    RESTART: None, or a Restart (restart files every N steps; the deck continuing from one).
+    PROCESSORS: None, or the rank grid [PX, PY, PZ] (strings: counts or '*')."""
     deck_dir = os.path.dirname(os.path.abspath(deck_path))
     os.makedirs(deck_dir, exist_ok=True)
     if particles is None:
@@ -449,7 +450,7 @@ def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=
             raise
     try:
         write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
-                         inlet_record, restart or Restart())
+                         inlet_record, restart or Restart(), processors)
     finally:
         particles.remove()
 
@@ -473,7 +474,7 @@ def restart_lines(restart):
 
 
 def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
-                     inlet_record, restart):
+                     inlet_record, restart, processors):
     mats = scene["materials"]
     names = list(mats.keys())
     ntypes = len(names)
@@ -539,6 +540,8 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         fail("--builtin: LIGGGHTS has no parallel bonds")
     L.append("communicate     single vel yes%s\n" % (" cutoff %s" % num(ghost_cut) if ghost_cut else ""))
     L.append("boundary        f f f\n")
+    if processors:   # before the box exists: LIGGGHTS fixes the rank grid with it
+        L.append("processors      %s\n" % " ".join(processors))
     if restart.resume:
         L.append("read_restart    %s\n" % word(os.path.abspath(restart.resume), "path"))
     elif particles.count:
@@ -655,7 +658,13 @@ def main():
                     help="their names, the step for the '*' (default: restart.* next to the deck)")
     ap.add_argument("--resume", metavar="FILE",
                     help="continue from this restart file (the trajectory from the interrupted run's)")
+    ap.add_argument("--processors", nargs=3, metavar=("PX", "PY", "PZ"),
+                    help="the MPI rank grid (LIGGGHTS' processors command; '*' lets it choose)")
     a = ap.parse_args()
+    for c in a.processors or []:
+        if c != "*" and not (c.isdigit() and int(c) > 0):
+            fail("--processors %s: %r is not a rank count; valid: a positive integer or *"
+                 % (" ".join(a.processors), c))
     source = "stdin" if a.resolved == "-" else a.resolved
     deck_dir = os.path.dirname(os.path.abspath(a.output))
     os.makedirs(deck_dir, exist_ok=True)
@@ -678,7 +687,7 @@ def main():
         if "*" not in pattern:
             fail("--restart-pattern %r: the name needs a '*' for the step" % pattern)
         write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin, a.force, particles, a.inlet_record,
-                   Restart(a.restart_every, pattern, a.resume))
+                   Restart(a.restart_every, pattern, a.resume), a.processors)
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
         fail("%s: cannot read the resolved scene: %s" % (source, e))
     except (KeyError, TypeError, ValueError, AttributeError, IndexError, RecursionError, OverflowError) as e:

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "checkpoint_io.h"
+#include "mesh_walls.h"
 
 #define FORMAT_NAME "jdem checkpoint"
 #define VALID_CHECKPOINT "valid: a checkpoint written by 'jdem run --checkpoint' for this scene"
@@ -216,6 +217,7 @@ static int derive(jd_sim *s, char *err, size_t errlen) {
         snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads.n);
         return -1;
     }
+    if (s->meshes && sim_mesh_walls_restored(s->meshes, err, errlen) != 0) return -1;
     return sim_walls_reserve(&s->walls, s->lists.wall_pairs.n, err, errlen);
 }
 

@@ -11,6 +11,7 @@
 
 #include "checkpoint_io.h"
 #include "jdem_inlet.h"
+#include "mesh_walls.h"
 
 _Static_assert(sizeof(jd_energy_terms) % sizeof(double) == 0, "jd_energy_terms is all doubles");
 _Static_assert(sizeof(jd_inlet_cursor) == 2 * sizeof(int64_t), "a cursor is two int64");
@@ -175,6 +176,85 @@ static void ck_loads(ck_io *io, jd_loads *l) {
     ck_doubles(io, "loads/previous_force", 6 * have, f_prev);
 }
 
+/* The offsets ascend from 0 to total, mesh after mesh, and each mesh's triangles exist. */
+static int candidates_valid(const jd_mesh_walls *mw, size_t np, size_t total) {
+    size_t prev = 0;
+    for (size_t k = 0; k < mw->n; k++) {
+        const size_t *start = mw->cand_start + k * (np + 1);
+        const int32_t ntri = (int32_t)mw->mesh[k].topo.ntri;
+        for (size_t i = 0; i <= np; i++) {
+            if (start[i] < prev || start[i] > total) return 0;
+            prev = start[i];
+        }
+        for (size_t c = start[0]; c < start[np]; c++)
+            if (mw->cand_tri[c] < 0 || mw->cand_tri[c] >= ntri) return 0;
+    }
+    return prev == total;
+}
+
+/* The candidate lists as they are (mesh-major offsets, then the triangles), checked for
+ * order and range on reading. */
+static void ck_mesh_candidates(ck_io *io, jd_mesh_walls *mw, size_t capacity) {
+    _Static_assert(sizeof(size_t) == sizeof(uint64_t), "offsets are stored as uint64");
+    ck_int64(io, "meshes/candidates_built_at", &mw->built_at);
+    ck_int(io, "meshes/candidates_stale", &mw->moved_far);
+    size_t np = mw->n_particles;
+    ck_count(io, "meshes/candidates_particles", &np, capacity);
+    if (io->failed || mw->built_at < 0) return;
+    const size_t n_off = mw->n * (np + 1);
+    size_t total = io->reading ? 0 : mw->cand_start[n_off - 1];
+    ck_count(io, "meshes/candidates", &total, SIZE_MAX / 64);
+    if (io->failed) return;
+    if (io->reading) {
+        if (sim_mesh_candidates_reserve(mw, np, total) != 0) {
+            io->no_memory = 1;
+            ck_fail(io, "out of memory restoring %zu mesh candidates", total);
+            return;
+        }
+        mw->n_particles = np;
+    }
+    ck_array(io, "meshes/candidates_start", H5T_NATIVE_UINT64, n_off, mw->cand_start);
+    ck_int32s(io, "meshes/candidates_triangle", total, mw->cand_tri);
+    if (io->reading && !io->failed && !candidates_valid(mw, np, total))
+        ck_fail(io, "checkpoint '%s' is damaged: the mesh candidates are out of order or range; "
+                "valid: a checkpoint written completely by jdem run", io->path);
+}
+
+/* Per mesh wall its corners (a moving mesh's moved incrementally, as LIGGGHTS moves them), the
+ * corners at the candidates' build, the last force, and every particle's history slots. */
+static void ck_meshes(ck_io *io, jd_mesh_walls *mw, size_t capacity) {
+    size_t n = mw->n;
+    ck_count(io, "meshes/n", &n, mw->n);
+    if (io->reading && !io->failed && n != mw->n)
+        ck_fail(io, "checkpoint '%s' has %zu mesh walls, the scene %zu", io->path, n, mw->n);
+    char p[64];
+    for (size_t k = 0; k < mw->n && !io->failed; k++) {
+        jd_sim_mesh *m = &mw->mesh[k];
+        size_t ntri = m->topo.ntri, stride = m->hist.stride, nh = m->hist.n;
+        ck_count(io, NAME(p, "meshes/%zu/triangles", k), &ntri, m->topo.ntri);
+        ck_count(io, NAME(p, "meshes/%zu/history_doubles", k), &stride, m->hist.stride);
+        if (io->reading && !io->failed && (ntri != m->topo.ntri || stride != m->hist.stride))
+            ck_fail(io, "checkpoint '%s': mesh wall %zu has %zu triangles and %zu history "
+                    "doubles per slot, this run %zu and %zu", io->path, k, ntri, stride,
+                    m->topo.ntri, m->hist.stride);
+        ck_doubles(io, NAME(p, "meshes/%zu/corners", k), 9 * ntri, &m->corner[0][0][0]);
+        if (m->corner_at_build)
+            ck_doubles(io, NAME(p, "meshes/%zu/corners_at_build", k), 9 * ntri, &m->corner_at_build[0][0][0]);
+        ck_doubles(io, NAME(p, "meshes/%zu/force", k), 3, m->force);
+        ck_count(io, NAME(p, "meshes/%zu/history_particles", k), &nh, capacity);
+        if (io->failed) return;
+        if (io->reading && sim_mesh_history_resize(&m->hist, nh) != 0) {
+            io->no_memory = 1;
+            ck_fail(io, "out of memory restoring the history of mesh wall %zu", k);
+            return;
+        }
+        ck_doubles(io, NAME(p, "meshes/%zu/history", k), nh * JD_MESH_SLOTS * stride, m->hist.slots);
+    }
+    ck_double(io, "meshes/damping_dropped", &mw->e_damp_dropped);
+    ck_double(io, "meshes/friction_dropped", &mw->e_fric_dropped);
+    ck_mesh_candidates(io, mw, capacity);
+}
+
 /* The streams' cursors and counters, the ids and trajectory rows of the particles inserted. */
 static void ck_inlets(ck_io *io, jd_sim *s) {
     jd_inlet_state_view v;
@@ -207,4 +287,5 @@ void ck_state(ck_io *io, jd_sim *s) {
     if (s->bonds) ck_bonds(io, s->bonds, s->particles.n);
     if (s->loads) ck_loads(io, s->loads);
     if (s->inlets) ck_inlets(io, s);
+    if (s->meshes) ck_meshes(io, s->meshes, sim_inlets_capacity(s->run.scene));
 }

@@ -523,13 +523,6 @@ static int setup_checkpoints(const cli *c, const jd_scene *sc, jd_sim *sim, cons
     const uint64_t hash = jd_checkpoint_scene_hash(yaml);
     free(yaml);
     const int writes = c->checkpoint || c->checkpoint_every || c->checkpoint_seconds;
-    if ((writes || c->resume) && sc->n_mesh_walls) {
-        /* a checkpoint does not carry the mesh walls' contact history yet (mesh_walls.h) */
-        fprintf(stderr, "jdem: %s: checkpoints do not carry the contact history of mesh walls "
-                "(wall '%s') yet; valid: run this scene without --checkpoint, --checkpoint-every, "
-                "--checkpoint-seconds and --resume\n", sc->path, sc->mesh_walls[0].name);
-        return EXIT_INPUT;
-    }
     const size_t stem = strlen(out) > 3 && !strcmp(out + strlen(out) - 3, ".h5") ? strlen(out) - 3
                                                                                  : strlen(out);
     const int k = c->checkpoint ? snprintf(path, len, "%s", c->checkpoint)

@@ -140,6 +140,37 @@ static void history_drop(jd_mesh_walls *mw, jd_mesh_history *h, size_t o, unsign
     memset(slot, 0, JD_MESH_SLOTS * h->stride * sizeof *slot);
 }
 
+int sim_mesh_history_resize(jd_mesh_history *h, size_t n) {
+    free(h->slots);
+    h->slots = NULL;
+    h->n = 0;
+    return history_reserve(h, n);
+}
+
+int sim_mesh_candidates_reserve(jd_mesh_walls *mw, size_t n_particles, size_t n_candidates) {
+    free(mw->cand_start);
+    mw->cand_start = malloc(mw->n * (n_particles + 1) * sizeof *mw->cand_start);
+    if (n_candidates > mw->cand_cap) {
+        int32_t *p = realloc(mw->cand_tri, n_candidates * sizeof *p);
+        if (!p) return -1;
+        mw->cand_tri = p;
+        mw->cand_cap = n_candidates;
+    }
+    return mw->cand_start ? 0 : -1;
+}
+
+/* Room for a sphere's evaluation over `widest` candidates. */
+static int scratch_reserve(jd_mesh_walls *mw, size_t widest) {
+    if (widest <= mw->scratch_cap) return 0;
+    free(mw->closest);
+    free(mw->is_contact);
+    mw->closest = malloc(widest * sizeof *mw->closest);
+    mw->is_contact = malloc(widest);
+    if (!mw->closest || !mw->is_contact) return -1;
+    mw->scratch_cap = widest;
+    return 0;
+}
+
 static int push_candidate(jd_mesh_walls *mw, size_t at, int32_t t) {
     if (at == mw->cand_cap) {
         const size_t cap = mw->cand_cap ? 2 * mw->cand_cap : 1024;
@@ -183,14 +214,7 @@ static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
         }
         start[np] = at;
     }
-    if (widest > mw->scratch_cap) {
-        free(mw->closest);
-        free(mw->is_contact);
-        mw->closest = malloc(widest * sizeof *mw->closest);
-        mw->is_contact = malloc(widest);
-        if (!mw->closest || !mw->is_contact) return -1;
-        mw->scratch_cap = widest;
-    }
+    if (scratch_reserve(mw, widest) != 0) return -1;
     mw->built_at = s->lists.n_builds;
     mw->n_particles = np;
     mw->moved_far = 0;
@@ -216,6 +240,29 @@ void sim_mesh_walls_move(jd_mesh_walls *mw, double dt, double skin) {
             mw->moved_far = d2 > 0.25 * skin * skin;
         }
     }
+}
+
+int sim_mesh_walls_restored(jd_mesh_walls *mw, char *err, size_t errlen) {
+    size_t widest = 1;
+    for (size_t k = 0; k < mw->n; k++) {
+        jd_sim_mesh *m = &mw->mesh[k];
+        const size_t *start = mw->cand_start + k * (mw->n_particles + 1);
+        for (size_t i = 0; mw->built_at >= 0 && i < mw->n_particles; i++)
+            if (start[i + 1] - start[i] > widest) widest = start[i + 1] - start[i];
+        if (m->motion.kind == JD_MESH_STILL) continue;
+        size_t bad = 0;
+        if (jd_mesh_build(m->topo.ntri, (const double(*)[3][3])m->corner, &m->storage, &m->topo, &bad) !=
+            JD_MESH_OK) {
+            snprintf(err, errlen, "mesh wall %zu: triangle %zu of the checkpoint is degenerate", k, bad);
+            return -1;
+        }
+        corner_velocities(m, NULL);
+    }
+    if (scratch_reserve(mw, widest) != 0) {
+        snprintf(err, errlen, "out of memory for the mesh walls' scratch");
+        return -1;
+    }
+    return 0;
 }
 
 int sim_mesh_walls_moving(const jd_mesh_walls *mw, size_t k) {

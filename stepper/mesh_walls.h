@@ -29,7 +29,7 @@
  * survives the renumbering), JD_MESH_SLOTS slots of `stride` doubles in the kernel's layout
  * (jdem_mesh.h: the contact's normal, then the law's record, jd_record_load/store).  The
  * whole state is the flat array `slots` (n x JD_MESH_SLOTS x stride doubles), so a checkpoint
- * can carry it as one block; checkpoints do not do so yet and are refused with mesh walls. */
+ * carries it as one block. */
 typedef struct jd_mesh_history {
     size_t stride;  /* 3 + the law set's contact and rolling records [doubles]     */
     size_t n;       /* scene indices with room, 0 .. n - 1 (grows with the inlets) */
@@ -89,6 +89,18 @@ int sim_mesh_walls_moving(const jd_mesh_walls *mw, size_t k);
 
 /* The triangles [ntri][3][3] of mesh wall k where they are now [m]. */
 const double (*sim_mesh_walls_corners(const jd_mesh_walls *mw, size_t k))[3][3];
+
+/* What a checkpoint needs (checkpoint_state.c stores the corners, the corners at the
+ * candidates' build, the histories, the candidate lists and the dissipation of ended contacts
+ * as they are, so that a resumed run evaluates the same candidates in the same order):
+ * - room for exactly n scene indices in h, every slot empty (0, or -1 out of memory);
+ * - room for the candidate lists of n_particles particles holding n_candidates entries in all
+ *   (0, or -1 out of memory);
+ * - after they are read: each moving mesh's topology and corner velocities from its corners,
+ *   and the scratch for the longest candidate list (0, or -1 with err). */
+int sim_mesh_history_resize(jd_mesh_history *h, size_t n);
+int sim_mesh_candidates_reserve(jd_mesh_walls *mw, size_t n_particles, size_t n_candidates);
+int sim_mesh_walls_restored(jd_mesh_walls *mw, char *err, size_t errlen);
 
 /* Each mesh wall's force (wall_force/NAME/x, y, z) at this step, like the plane walls'. */
 int sim_mesh_walls_write_observables(const jd_mesh_walls *mw, const jd_run_constants *run,

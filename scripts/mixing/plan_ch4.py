@@ -1,7 +1,7 @@
 """plan_ch4.py — the units of `make mixing` for scripts/campaign.py (docs/mixing.md §4).
 
     scripts/campaign.py scripts/mixing/plan_ch4.py [--model modelM] [--engine ENGINE] [--list]
-                        [-- --dt seed|guard|half]
+                        [-- --dt seed|guard|half] [--ranks N]
 
 Per engine (jdem, liggghts-jdem) and model 1-6: the first fill, the second-pass scene cut from
 it, the second fill, and per pass the 9 cube scenes and their 9 compressions; for Model 3 also
@@ -11,7 +11,9 @@ seconds of the first fill in both engines, compared particle by particle).  --dt
 time-step variant of the error-against-run-time study: `seed` (default) the seed's dt = 1e-4 s
 under out/mixing/ch4/, run with --force because the guard refuses it (docs/mixing.md §6);
 `guard` the guard's dt (what `time.dt: auto` resolves to) under out/mixing/ch4_dt_guard/; `half` half of it under
-out/mixing/ch4_dt_half/.  A unit's cost for the ETA is its particle-steps.
+out/mixing/ch4_dt_half/.  --ranks N runs each liggghts-jdem fill on N MPI ranks (a run on more
+ranks sums forces in another order: another realisation, as the spread's are).  A unit's cost for
+the ETA is its particle-steps.
 
 A unit whose engine lacks a feature it needs is "not yet runnable": the plan asks the engine
 itself, by reading a probe scene that uses the feature (jdem resolve; for liggghts-jdem also the
@@ -157,12 +159,26 @@ def variant_dt(variant, model):
 
 
 # ---- units ----------------------------------------------------------------------------------
-def run_command(engine, scene, out, force):
-    """argv running `scene` (a path or a "{...}" placeholder) into `out`."""
+def rank_args(ranks):
+    """liggghts_run.py's arguments for a fill on `ranks` MPI ranks: the grid splits y only, the
+    box's and the stream's plane of symmetry (y = 0.5 m), so the ranks share the deposit and the
+    falling stream about equally; LIGGGHTS' own choice splits z, leaving one rank the stream."""
+    return [] if ranks == 1 else ["--np", str(ranks), "--processors", "1", str(ranks), "1"]
+
+
+def fill_ranks(engine, ranks):
+    """The MPI ranks a fill of the engine runs on (jdem: one process)."""
+    return ranks if engine == "liggghts-jdem" else 1
+
+
+def run_command(engine, scene, out, force, ranks=1):
+    """argv running `scene` (a path or a "{...}" placeholder) into `out`; liggghts-jdem on
+    `ranks` MPI ranks."""
     extra = ["--force"] if force else []
     if engine == "jdem":
         return [jdem(), "run", scene, "-o", out, *extra]   # its progress line shows in the log
-    return [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out, *extra]
+    return [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out, *extra,
+            *rank_args(ranks)]
 
 
 def resumable(engine):
@@ -172,13 +188,13 @@ def resumable(engine):
 
 
 def fill_command(engine, scene, force, generate=None, checkpoint_seconds=CHECKPOINT_SECONDS,
-                 restart_steps=RESTART_STEPS):
+                 restart_steps=RESTART_STEPS, ranks=1):
     """sh argv running `scene` into "{out0}" (after the shell line `generate`, which writes it).
     jdem checkpoints every checkpoint_seconds of wall time and, when an interrupted run left
     its checkpoint in the unit's directory, continues from it; liggghts-jdem writes a restart
     file every restart_steps steps and continues from the last complete one (docs/mixing.md §4)."""
     run = " ".join(a if a in ('"$1"', '"$2"') else shlex.quote(a)
-                   for a in run_command(engine, '"$1"', '"$2"', force))
+                   for a in run_command(engine, '"$1"', '"$2"', force, ranks))
     if engine == "jdem":
         run += f" --checkpoint-seconds {checkpoint_seconds}"
         # no braces: the campaign driver fills the "{...}" placeholders of every word
@@ -189,16 +205,16 @@ def fill_command(engine, scene, force, generate=None, checkpoint_seconds=CHECKPO
     return ["sh", "-c", (generate + " && " if generate else "") + run, "fill", scene, "{out0}"]
 
 
-def fill1_command(engine, model, dt_arg, force, jitter=0):
+def fill1_command(engine, model, dt_arg, force, jitter=0, ranks=1):
     """Write the case's scene with the variant's dt (and the stream's jitter) into the unit's
     directory, then run it."""
     name = f"fill1_jitter{jitter}" if jitter else "fill1"
     return fill_command(engine, "{dir}/%s.yaml" % name, force,
                         f'{shlex.quote(PY)} {shlex.quote(GENERATE)} fill --case {model} '
-                        f'--dt {dt_arg} --jitter {jitter} -o "$1"')
+                        f'--dt {dt_arg} --jitter {jitter} -o "$1"', ranks=ranks)
 
 
-def spread_units(engine, model, variant):
+def spread_units(engine, model, variant, ranks):
     """The run-to-run spread: the first fill again with the stream shifted by K micrometres
     (generate.py --jitter), K = 1..SPREAD_REALISATIONS, for SPREAD_MODEL only."""
     if model != SPREAD_MODEL or variant != "seed":
@@ -206,9 +222,10 @@ def spread_units(engine, model, variant):
     base = os.path.join(OUT[variant], engine, model)
     dt_arg, dt = variant_dt(variant, model)
     return [Unit(f"{engine}/{model}/fill1_jitter{k}", [os.path.join(base, f"fill1_jitter{k}.h5")],
-                 fill1_command(engine, model, dt_arg, True, k), model, engine,
+                 fill1_command(engine, model, dt_arg, True, k, ranks), model, engine,
                  validate=valid_trajectory, cost=FILL_PARTICLES * FILL_TIME / dt,
-                 blocked=gate(engine, "conveyor inlet"), resumes=resumable(engine))
+                 blocked=gate(engine, "conveyor inlet"), resumes=resumable(engine),
+                 ranks=fill_ranks(engine, ranks))
             for k in range(1, SPREAD_REALISATIONS + 1)]
 
 
@@ -230,7 +247,7 @@ def pass_units(engine, model, p, deposit, base, dt_arg, dt, force):
     return units
 
 
-def model_units(engine, model, variant):
+def model_units(engine, model, variant, ranks):
     base = os.path.join(OUT[variant], engine, model)
     fill1, fill2 = os.path.join(base, "fill1.h5"), os.path.join(base, "fill2.h5")
     pass2 = os.path.join(base, "pass2.yaml")
@@ -239,20 +256,20 @@ def model_units(engine, model, variant):
     force = variant == "seed"   # the guard refuses the seed's dt (docs/mixing.md §6)
     fill_cost = FILL_PARTICLES * FILL_TIME / dt
     units = [
-        Unit(f"{pre}/fill1", [fill1], fill1_command(engine, model, dt_arg, force), model, engine,
+        Unit(f"{pre}/fill1", [fill1], fill1_command(engine, model, dt_arg, force, ranks=ranks), model, engine,
              validate=valid_trajectory, cost=fill_cost, blocked=gate(engine, "conveyor inlet"),
-             resumes=resumable(engine)),
+             resumes=resumable(engine), ranks=fill_ranks(engine, ranks)),
         Unit(f"{pre}/pass2_scene", [pass2], [PY, GENERATE, "second-pass", fill1, "--case", model,
                                              "--dt", dt_arg, "-o", "{out0}"],
              model, engine, needs=[f"{pre}/fill1"], validate=valid_scene, cost=SCENE_COST),
-        Unit(f"{pre}/fill2", [fill2], fill_command(engine, pass2, force), model, engine,
+        Unit(f"{pre}/fill2", [fill2], fill_command(engine, pass2, force, ranks=ranks), model, engine,
              needs=[f"{pre}/pass2_scene"], validate=valid_trajectory, cost=fill_cost,
-             resumes=resumable(engine),
+             resumes=resumable(engine), ranks=fill_ranks(engine, ranks),
              blocked=gate(engine, "conveyor inlet", "inlet section from a deposit")),
     ]
     return units + pass_units(engine, model, 1, fill1, base, dt_arg, dt, force) \
         + pass_units(engine, model, 2, fill2, base, dt_arg, dt, force) \
-        + spread_units(engine, model, variant)
+        + spread_units(engine, model, variant, ranks)
 
 
 def valid_horizon(path):
@@ -285,6 +302,10 @@ def units(argv):
     ap = argparse.ArgumentParser(prog="plan_ch4.py")
     ap.add_argument("--dt", choices=sorted(OUT), default="seed",
                     help="time-step variant: the seed's 1e-4 s, the guard's dt, half of it")
+    ap.add_argument("--ranks", type=int, default=1,
+                    help="MPI ranks of each liggghts-jdem fill (default 1; jdem runs its own threads)")
     a = ap.parse_args(argv)
-    return [u for engine in ENGINES for model in MODELS for u in model_units(engine, model, a.dt)] \
+    if a.ranks < 1:
+        ap.error("--ranks %d: valid: a positive number of MPI ranks" % a.ranks)
+    return [u for engine in ENGINES for model in MODELS for u in model_units(engine, model, a.dt, a.ranks)] \
         + [horizon_unit(model, a.dt) for model in MODELS]

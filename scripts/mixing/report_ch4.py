@@ -330,13 +330,15 @@ def mixing_table(found, taken):
 
 def times_table(found, taken):
     lines = ["### Run times of the finished units", "",
-             "wall time on the shared machine, and the CPU time of the unit's processes",
-             "", "| unit | wall [s] | CPU [s] |", "|---|---|---|"]
+             "wall time on the shared machine, the CPU time of the unit's processes, and the "
+             "MPI ranks it ran on", "", "| unit | wall [s] | CPU [s] | ranks |", "|---|---|---|---|"]
     for engine in ENGINES:
         for model in MODELS:
             for name, t in sorted(found[engine][model]["times"].items()):
-                cpu = t.get("cpu_seconds")
-                lines.append("| %s | %.0f | %s |" % (name, t["seconds"], "%.0f" % cpu if cpu is not None else "not recorded"))
+                cpu, ranks = t.get("cpu_seconds"), t.get("ranks")
+                lines.append("| %s | %.0f | %s | %s |" % (
+                    name, t["seconds"], "%.0f" % cpu if cpu is not None else "not recorded",
+                    ranks if ranks is not None else 1))   # before ranks were recorded: all ran on one
     units = [(u.split("/")[0], "units", model_number(u.split("/")[1]), source)
              for k, source in taken.items() if k[2] == "times" for u in [k[3]]]
     return "\n".join(lines) + "\n" + earlier_note(units)

@@ -2,9 +2,11 @@
 and resumed from it equals the uninterrupted run bit for bit (every dataset of the trajectory,
 tests/checkpoint/compare_h5.py), on 1 and 2 threads, for a settling bed with walls, friction
 and rolling, a servo compression, an inlet stream, a bonded beam and an inlet of bonded blocks
-(the checkpoint between two copies' insertions); SIGTERM writes a
+(the checkpoint between two copies' insertions), a bed in a turning meshed drum and spheres
+on a meshed conveyor (the mesh's moved corners, its contact history and candidates); SIGTERM writes a
 checkpoint and exits 143; bad checkpoints are refused with their messages; a failed
 checkpoint write keeps the previous checkpoint and stops the run (exit 3)."""
+import math
 import os
 import re
 import shutil
@@ -17,6 +19,8 @@ import time
 import h5py
 
 from tests.checkpoint.compare_h5 import differences
+from tests.mesh.test_mesh_engines import floor_grid, particle
+from tests.mesh.test_mesh_motion import CENTRE, drum, write_case
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -31,6 +35,26 @@ CASES = [  # scene, case, checkpoint every N steps
     # a checkpoint between the two copies' block insertions (steps 1330 and 2730)
     ("tests/inlet/bonded_section.yaml", None, 2500),
 ]
+
+
+def mesh_cases(d):
+    """(scene, case, every) of two mesh scenes written into d: 18 spheres, touching each other,
+    dropped into a drum that turns about an axis off the origin, checkpointed once they lie on
+    its wall; 9 spheres on a still meshed conveyor, checkpointed while they speed up."""
+    R = 0.004
+    bed = [particle((CENTRE[0] + 2.2 * R * (i - 1), CENTRE[1] + 2.2 * R * (j - 0.5),
+                     CENTRE[2] - 0.03 + 2.05 * R * k), r=R)
+           for i in range(3) for j in range(2) for k in range(3)]
+    turning = "rotation: {origin: [%r, %r, %r], axis: [0, 1, 0], period: -0.8}" % CENTRE
+    # resting on the belt with Hertz's static overlap (tests/mesh/test_mesh_motion.check_belt),
+    # so that they keep their contacts while the belt speeds them up
+    r, m = 0.005, 4.0 / 3.0 * math.pi * 0.005 ** 3 * 2500.0
+    delta = (m * 9.81 / (4.0 / 3.0 * 1.0e7 / (1.0 - 0.09) * math.sqrt(r))) ** (2.0 / 3.0)
+    belt = [particle((0.012 * (i - 1), 0.012 * (j - 1), r - delta), r=r)
+            for i in range(3) for j in range(3)]
+    return [(write_case(d, "mesh_drum", drum(32, 0.05, 0.06, CENTRE), bed, turning, 40000), None, 12000),
+            (write_case(d, "mesh_belt", floor_grid(8, 2.0 ** -3), belt, "surface_velocity: [0.1, 0.05, 0]",
+                        20000), None, 6000)]
 
 
 def check(name, ok, detail=""):
@@ -66,6 +90,8 @@ def wait_for(path, proc, limit=600):
 
 def killed_and_resumed(d, scene, case, every, threads):
     tag = f"{os.path.basename(scene)[:-5]} {threads} thread(s)"
+    if tag.startswith("scene "):   # a generated case: its folder names it
+        tag = os.path.basename(os.path.dirname(scene)) + tag[5:]
     a, b = os.path.join(d, "a.h5"), os.path.join(d, "b.h5")
     ck = os.path.join(d, "b.ckpt.h5")
     every = every or steps_of(scene, case) // 4
@@ -180,7 +206,7 @@ def failed_write(d):
 
 def main():
     with tempfile.TemporaryDirectory() as d:
-        for scene, case, every in CASES:
+        for scene, case, every in CASES + mesh_cases(d):
             for threads in (1, 2):
                 sub = tempfile.mkdtemp(dir=d)
                 killed_and_resumed(sub, scene, case, every, threads)

@@ -19,8 +19,8 @@ binary STL as float32 too), so both engines see the same triangles:
   pyramid (a vertex contact), a few spheres dropped into a meshed funnel;
 - jdem on 1 and 2 threads on the funnel: the same bits; its energy balance closes to 1e-3 (the
   plane walls' standard, tests/engine/test_energy_balance.py) with the mesh's dissipation;
-- the watchdog's overlap trip names the mesh wall; --checkpoint-every is refused with a mesh
-  wall (checkpoints do not carry its history yet);
+- the watchdog's overlap trip names the mesh wall (checkpoints with mesh walls:
+  tests/checkpoint/test_checkpoint.py);
 - the funnel's trajectories draw the mesh (/jdem/walls, docs/output.md): type 2, one
   quadrilateral per triangle whose corners are the STL's triangle (the last one twice), in both
   engines, equal to the triangles this script wrote.
@@ -214,7 +214,7 @@ def check_funnel_path(c, jd, R):
 
 def check_refusals(c, tmp):
     """The watchdog's overlap trip names the mesh wall (a sphere of radius R placed 0.2 R into the
-    floor: the fraction is 0.2 at step 0); checkpoints are refused with a mesh wall."""
+    floor: the fraction is 0.2 at step 0)."""
     scene = write_case(tmp, "overlap", [particle((0.001, 0.001, 0.004))], [MESH_WALL],
                        floor_grid(4, 2.0 ** -6), steps=10,
                        extra="watchdog: {enabled: true, max_overlap_fraction: 0.1}\n")
@@ -222,10 +222,6 @@ def check_refusals(c, tmp):
     rc, err = run_jdem(scene, out)
     want = "overlap fraction 0.2 for particle(s) 1 against wall 'cad' exceeds 0.1"
     c.check("watchdog: an overlap with a mesh wall trips naming the wall (%r)" % want,
-            rc != 0 and want in err, "exit %d: %s" % (rc, err))
-    rc, err = run_jdem(scene, out + "2", "--checkpoint-every", "5")
-    want = "checkpoints do not carry the contact history of mesh walls (wall 'cad') yet"
-    c.check("checkpoints with a mesh wall: refused with a message (%r)" % want,
             rc != 0 and want in err, "exit %d: %s" % (rc, err))
 
 

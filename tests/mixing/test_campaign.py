@@ -276,10 +276,27 @@ def test_ch4_dt_variants():
               f"command {hc}, output {horizon.outputs[0]}")
 
 
+def test_ch4_ranks():
+    """--ranks N (make mixing NP=N): each liggghts-jdem fill on N ranks split along y, jdem's
+    fills and the cubes unchanged; the plan's arguments after "--" follow the driver's options."""
+    from scripts.mixing import plan_ch4
+    plan = {u.name: u for u in plan_ch4.units(["--ranks", "2"])}
+    lig, jd = plan["liggghts-jdem/model1/fill1"].command[2], plan["jdem/model1/fill1"].command[2]
+    cube = plan["liggghts-jdem/model1/pass1_cube1"].command
+    check("ch4_ranks_fill", "--np 2 --processors 1 2 1" in lig and "--np" not in jd
+          and "--np" not in cube, f"liggghts-jdem: {lig}; jdem: {jd}; cube: {cube}")
+    r = subprocess.run([sys.executable, CAMPAIGN, os.path.join(ROOT, "scripts", "mixing", "plan_ch4.py"),
+                        "--unit", "liggghts-jdem/model1/fill1", "--list", "--", "--ranks", "2"],
+                       capture_output=True, text=True)
+    check("ch4_plan_args_after_options", r.returncode == 0 and
+          r.stdout.split()[1:2] == ["liggghts-jdem/model1/fill1"], r.stdout + r.stderr)
+
+
 test_validation_and_selection()
 test_not_yet_runnable()
 test_times_beside_unrun_first_unit()
 test_ch4_dt_variants()
+test_ch4_ranks()
 test_ch4_plan()
 test_ch4_fill_resumes()
 finish()
