@@ -112,6 +112,7 @@ void sim_mesh_walls_free(jd_mesh_walls *mw) {
     free(mw->cand_tri);
     free(mw->closest);
     free(mw->is_contact);
+    sim_mesh_cells_free(&mw->cells);
     free(mw);
 }
 
@@ -183,10 +184,24 @@ static int push_candidate(jd_mesh_walls *mw, size_t at, int32_t t) {
     return 0;
 }
 
+/* Particle i's candidates of mesh m from its position x [m] and reach [m] appended at *at:
+ * the grid's triangles near x within reach (every triangle with allpairs), ascending. */
+static int particle_candidates(jd_mesh_walls *mw, const jd_sim_mesh *m, const double *x, double reach,
+                               int allpairs, size_t *at) {
+    const long near = allpairs ? (long)m->topo.ntri : sim_mesh_cells_near(&mw->cells, x, reach);
+    if (near < 0) return -1;
+    for (long e = 0; e < near; e++) {
+        const int32_t t = allpairs ? (int32_t)e : mw->cells.found[e];
+        jd_mesh_closest c;
+        jd_mesh_closest_feature(&m->topo, t, x, &c);
+        if ((allpairs || c.dist2 < reach * reach) && push_candidate(mw, (*at)++, t) != 0) return -1;
+    }
+    return 0;
+}
+
 /* Every triangle within R + skin of each particle's position at the last neighbour build,
  * ascending per particle and mesh; particles left without candidates lose their history (they
- * cannot touch the mesh before the next build).  Brute force over the triangles: meshes here
- * are small (docs/model.md section 11). */
+ * cannot touch the mesh before the next build). */
 static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
     const jd_particles *ps = &s->particles;
     const size_t np = ps->n;
@@ -194,21 +209,25 @@ static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
     mw->cand_start = malloc((mw->n * (np + 1)) * sizeof *mw->cand_start);
     if (!mw->cand_start) return -1;
     size_t at = 0, widest = 1, n_orig = 0;
-    for (size_t i = 0; i < np; i++)
+    double r_max = 0.0;
+    for (size_t i = 0; i < np; i++) {
         if ((size_t)ps->orig[i] + 1 > n_orig) n_orig = (size_t)ps->orig[i] + 1;
+        r_max = fmax(r_max, ps->radius[i]);
+    }
     for (size_t k = 0; k < mw->n; k++) {
         jd_sim_mesh *m = &mw->mesh[k];
         if (history_reserve(&m->hist, n_orig) != 0) return -1;
         size_t *start = mw->cand_start + k * (np + 1);
         if (m->corner_at_build) memcpy(m->corner_at_build, m->corner, m->topo.ntri * sizeof *m->corner);
+        if (!s->opt.allpairs &&
+            sim_mesh_cells_build(&mw->cells, m->topo.ntri, (const double(*)[3][3])m->corner,
+                                 r_max + s->lists.skin) != 0)
+            return -1;
         for (size_t i = 0; i < np; i++) {
             start[i] = at;
-            const double *x = s->lists.x_build + 3 * i, reach = ps->radius[i] + s->lists.skin;
-            for (size_t t = 0; t < m->topo.ntri; t++) {
-                jd_mesh_closest c;
-                jd_mesh_closest_feature(&m->topo, (int32_t)t, x, &c);
-                if (c.dist2 < reach * reach && push_candidate(mw, at++, (int32_t)t) != 0) return -1;
-            }
+            if (particle_candidates(mw, m, s->lists.x_build + 3 * i, ps->radius[i] + s->lists.skin,
+                                    s->opt.allpairs, &at) != 0)
+                return -1;
             if (at == start[i]) history_drop(mw, &m->hist, (size_t)ps->orig[i], s->run.features);
             if (at - start[i] > widest) widest = at - start[i];
         }

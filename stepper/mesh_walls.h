@@ -8,6 +8,10 @@
  * scene order, the particles in ascending index, each particle's candidates in ascending
  * triangle, its contacts in that order.
  *
+ * Candidates come from a grid of the mesh's triangles (mesh_cells.h), rebuilt with them; the
+ * reference option JDEM_NEIGHBOUR=allpairs makes every triangle a candidate of every particle
+ * instead, which must give the same bits (only triangles within R take part in a contact).
+ *
  * A moving mesh moves its corners in the drift, as fix move/mesh does in LIGGGHTS' initial
  * integration, and rebuilds its topology from them (the vertex and edge ids follow the
  * coordinates, as the plugin's do).  Its candidates hold every triangle within R + skin of
@@ -23,6 +27,7 @@
 #include <stdint.h>
 
 #include "jdem_mesh.h"
+#include "mesh_cells.h"
 #include "sim.h"
 
 /* The contact history of one mesh wall: per particle, keyed by its scene index (orig[i], which
@@ -60,6 +65,7 @@ typedef struct jd_mesh_walls {
     size_t *cand_start;      /* [n][n_particles + 1] offsets into cand_tri, mesh-major */
     int32_t *cand_tri;       /* candidate triangles, ascending per particle and mesh  */
     size_t cand_cap;
+    jd_mesh_cells cells;     /* the grid of the mesh whose candidates are being built    */
     /* scratch of one sphere's evaluation, sized for the largest candidate list */
     jd_mesh_closest *closest;
     unsigned char *is_contact;

@@ -19,6 +19,8 @@ binary STL as float32 too), so both engines see the same triangles:
   pyramid (a vertex contact), a few spheres dropped into a meshed funnel;
 - jdem on 1 and 2 threads on the funnel: the same bits; its energy balance closes to 1e-3 (the
   plane walls' standard, tests/engine/test_energy_balance.py) with the mesh's dissipation;
+- the candidates from the triangle grid give the same bits as every triangle taken as a
+  candidate (JDEM_NEIGHBOUR=allpairs), for the funnel and for spheres sliding across a wide floor;
 - the watchdog's overlap trip names the mesh wall (checkpoints with mesh walls:
   tests/checkpoint/test_checkpoint.py);
 - the funnel's trajectories draw the mesh (/jdem/walls, docs/output.md): type 2, one
@@ -119,9 +121,33 @@ def write_case(tmp, name, particles, walls, tris=None, steps=3000, e=0.5, mu=0.3
 MESH_WALL = "  - {name: cad, type: mesh, file: mesh.stl, material: plate}"
 
 
-def run_jdem(scene, out, *args):
-    r = subprocess.run([JDEM, "run", scene, "-o", out, "--quiet", *args], capture_output=True, text=True)
+def run_jdem(scene, out, *args, env=None):
+    r = subprocess.run([JDEM, "run", scene, "-o", out, "--quiet", *args], capture_output=True, text=True,
+                       env={**os.environ, **(env or {})})
     return r.returncode, r.stderr
+
+
+ALL_TRIANGLES = {"JDEM_NEIGHBOUR": "allpairs"}   # every triangle a candidate of every particle
+
+
+def check_cells_vs_all_triangles(c, tmp, funnel_scene):
+    """The candidates from the triangle grid (stepper/mesh_cells.h) against every triangle as a
+    candidate: the same bits, for the funnel and for 25 spheres sliding fast across a floor of
+    2048 triangles (about 40 x 40 cells), apart from each other (the reference option also
+    lists every particle pair unsorted, which changes the order of sphere-sphere sums)."""
+    cases = [("funnel", funnel_scene)]
+    spheres = [particle((-0.2 + 0.08 * i, -0.2 + 0.08 * j, 0.0051 + 0.0002 * (i + j)), (2.0, 1.2, 0.0))
+               for i in range(5) for j in range(5)]
+    cases.append(("wide floor", write_case(tmp, "wide_floor", spheres, [MESH_WALL], floor_grid(32, 2.0 ** -6),
+                                           steps=3000)))
+    for name, scene in cases:
+        d = os.path.dirname(scene)
+        cells, every = os.path.join(d, "cells.h5"), os.path.join(d, "all_triangles.h5")
+        rc = [run_jdem(scene, cells), run_jdem(scene, every, env=ALL_TRIANGLES)]
+        if c.check("%s: jdem runs with the grid's candidates and with every triangle" % name,
+                   rc[0][0] == 0 and rc[1][0] == 0, rc[0][1] + rc[1][1]):
+            same_bits(c, "%s: candidates from the triangle grid == every triangle a candidate, bit "
+                      "for bit" % name, cells, every)
 
 
 def run_liggghts(scene, out):
@@ -298,6 +324,7 @@ def main():
                           "five spheres dropped into a meshed funnel", threads=True)
         if jd:
             check_funnel_path(c, jd, 0.003)
+            check_cells_vs_all_triangles(c, tmp, os.path.join(os.path.dirname(jd), "scene.yaml"))
             check_drawn_mesh(c, "funnel", tris, [("jdem", jd), ("liggghts-jdem",
                                                                os.path.join(os.path.dirname(jd), "liggghts.h5"))])
     return 1 if c.failed else 0
