@@ -97,6 +97,38 @@ typedef struct jd_plane {
  * JD_GEOM_DEGENERATE or JD_GEOM_NOT_PLANAR. */
 int jd_plane_init(jd_plane *w, const double corners[4][3], double tol);
 
+/* 1 when the point xc [m], on the plane of w, lies inside the quadrilateral (edges included):
+ * ((P_{k+1} - P_k) x (xc - P_k)).n_w >= 0 for the four edges; else 0. */
+static inline int jd_plane_covers(const jd_plane *w, const double xc[3]) {
+    for (int k = 0; k < 4; k++) {
+        const double *p = w->p[k], *q = w->p[(k + 1) & 3];
+        const double e[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        const double c[3] = {xc[0] - p[0], xc[1] - p[1], xc[2] - p[2]};
+        double cr[3];
+        jd_cross(e, c, cr);
+        if (jd_dot(cr, w->n) < 0.0) return 0;
+    }
+    return 1;
+}
+
+/* Which side of plane w a point x [m] is on, among the points that project onto the
+ * quadrilateral: +1 in front (n_w.(x - P1) > 0, the side the plane acts on), -1 behind, 0 on
+ * the plane or projecting outside it. */
+static inline int jd_plane_side(const jd_plane *w, const double x[3]) {
+    const double rel[3] = {x[0] - w->p[0][0], x[1] - w->p[0][1], x[2] - w->p[0][2]};
+    const double sd = jd_dot(w->n, rel);
+    const double xc[3] = {x[0] - sd * w->n[0], x[1] - sd * w->n[1], x[2] - sd * w->n[2]};
+    if (sd == 0.0 || !jd_plane_covers(w, xc)) return 0;
+    return sd > 0.0 ? 1 : -1;
+}
+
+/* The set-up rule both engines apply to a plane, from the counts of particles over it in front
+ * (jd_plane_side +1) and behind (-1): 1 when it is wound away from the particles (some behind,
+ * none in front: every one would pass through it), else 0 (no particle over it says nothing). */
+static inline int jd_plane_wound_away(double n_front, double n_behind) {
+    return n_front == 0.0 && n_behind > 0.0;
+}
+
 /* Sphere (centre x [m], radius R [m]) against plane w.  s = n_w.(x - P1) is the signed
  * distance; contact when 0 < s < R and the projection x_C = x - s n_w lies inside the quad
  * (((P_{k+1} - P_k) x (x_C - P_k)).n_w >= 0 for the four edges; edge and corner contacts of a
@@ -108,14 +140,7 @@ static inline int jd_geom_plane(const jd_plane *w, const double x[3], double R,
     const double sd = jd_dot(w->n, rel);
     if (!(sd > 0.0 && sd < R)) return 0;
     const double xc[3] = {x[0] - sd * w->n[0], x[1] - sd * w->n[1], x[2] - sd * w->n[2]};
-    for (int k = 0; k < 4; k++) {
-        const double *p = w->p[k], *q = w->p[(k + 1) & 3];
-        const double e[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-        const double c[3] = {xc[0] - p[0], xc[1] - p[1], xc[2] - p[2]};
-        double cr[3];
-        jd_cross(e, c, cr);
-        if (jd_dot(cr, w->n) < 0.0) return 0;
-    }
+    if (!jd_plane_covers(w, xc)) return 0;
     g->delta = R - sd;
     const double la = R - g->delta;
     for (int k = 0; k < 3; k++) {
@@ -166,6 +191,25 @@ static inline int jd_geom_cylinder(const jd_cylinder *c, const double x[3], doub
     }
     g->r_roll = R;
     return 1;
+}
+
+/* The velocity out [m/s] of the point p [m] on the surface of cylinder c when the cylinder
+ * translates at v [m/s] and spins at omega [rad/s] about its axis (right-handed about a1 - a0;
+ * the shape does not change, so the geometry above does not see the spin):
+ * v + omega u x (p - a0), u = (a1 - a0)/|a1 - a0|; exactly v when omega = 0. */
+static inline void jd_cylinder_surface_velocity(const jd_cylinder *c, const double v[3], double omega,
+                                                const double p[3], double out[3]) {
+    if (omega == 0.0) {
+        for (int k = 0; k < 3; k++) out[k] = v[k];
+        return;
+    }
+    const double ab[3] = {c->a1[0] - c->a0[0], c->a1[1] - c->a0[1], c->a1[2] - c->a0[2]};
+    const double s = omega / sqrt(jd_dot(ab, ab));
+    const double w[3] = {s * ab[0], s * ab[1], s * ab[2]};
+    const double r[3] = {p[0] - c->a0[0], p[1] - c->a0[1], p[2] - c->a0[2]};
+    out[0] = v[0] + (w[1] * r[2] - w[2] * r[1]);
+    out[1] = v[1] + (w[2] * r[0] - w[0] * r[2]);
+    out[2] = v[2] + (w[0] * r[1] - w[1] * r[0]);
 }
 
 /* ------------------------------------------------------------------------------------------ */

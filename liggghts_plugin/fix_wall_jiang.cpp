@@ -39,10 +39,11 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
       "Illegal fix wall/jiang command: fix ID group wall/jiang plane corners x1 y1 z1 x2 y2 z2 "
       "x3 y3 z3 x4 y4 z4 type T [velocity vx vy vz] [name NAME] [servo target S gain G tolerance "
       "E max_speed V hold H] | cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T "
-      "[velocity vx vy vz] [name NAME] | mesh n_meshes N meshes ID1 ... IDN";
+      "[velocity vx vy vz] [omega W] [name NAME] | mesh n_meshes N meshes ID1 ... IDN";
   std::memset(&plane, 0, sizeof plane);
   std::memset(&cyl, 0, sizeof cyl);
   vel[0] = vel[1] = vel[2] = 0.0;
+  spin = 0.0;
   int iarg = 3;
   if (narg < 4) error->all(FLERR, usage);
   const std::string kind = arg[iarg++];
@@ -85,6 +86,10 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
       parse_servo(narg, arg, ++iarg);
     } else if (shape == 1 && k == "radius" && iarg + 1 < narg) {
       cyl.rc = force->numeric(FLERR, arg[iarg + 1]);
+      iarg += 2;
+    } else if (shape == 1 && k == "omega" && iarg + 1 < narg) {
+      spin = force->numeric(FLERR, arg[iarg + 1]);
+      if (!std::isfinite(spin)) error->all(FLERR, "fix wall/jiang: omega must be a finite angular velocity [rad/s]");
       iarg += 2;
     } else if (shape == 1 && k == "side" && iarg + 1 < narg) {
       const std::string s = arg[iarg + 1];
@@ -184,35 +189,18 @@ void FixWallJiang::setup(int vflag) {
 }
 
 /* A plane acts on its active side only: a plane wound the wrong way lets every particle pass.
- * Of the group's particles whose centre projects onto the quadrilateral, count those in front
- * of it and those behind it (over all ranks); when some are behind and none in front, the
- * winding is wrong (a plane with no particle over it has nothing to say yet: a later run's
- * set-up, after an insertion, checks again). */
-static void difference(double out[3], const double a[3], const double b[3]) {
-  for (int k = 0; k < 3; k++) out[k] = a[k] - b[k];
-}
-
+ * The group's particles over the quadrilateral are counted in front of it and behind it (over
+ * all ranks) and judged by the kernel's rule (jd_plane_wound_away; a plane with no particle
+ * over it has nothing to say yet: a later run's set-up, after an insertion, checks again). */
 void FixWallJiang::check_winding() {
   double side[2] = {0.0, 0.0}, all[2]; /* in front, behind */
   for (int i = 0; i < atom->nlocal; i++) {
     if (!(atom->mask[i] & groupbit)) continue;
-    double d[3];
-    difference(d, atom->x[i], plane.p[0]);
-    const double s = jd_dot(plane.n, d);
-    double xc[3];
-    for (int k = 0; k < 3; k++) xc[k] = atom->x[i][k] - s * plane.n[k];
-    bool over = true;
-    for (int e = 0; e < 4 && over; e++) {
-      double edge[3], to[3], c[3];
-      difference(edge, plane.p[(e + 1) % 4], plane.p[e]);
-      difference(to, xc, plane.p[e]);
-      jd_cross(edge, to, c);
-      over = jd_dot(c, plane.n) >= 0.0;
-    }
-    if (over && s != 0.0) side[s > 0.0 ? 0 : 1] += 1.0;
+    const int s = jd_plane_side(&plane, atom->x[i]);
+    if (s != 0) side[s > 0 ? 0 : 1] += 1.0;
   }
   MPI_Allreduce(side, all, 2, MPI_DOUBLE, MPI_SUM, world);
-  if (!(all[0] == 0.0 && all[1] > 0.0)) return;
+  if (!jd_plane_wound_away(all[0], all[1])) return;
   char msg[768];
   std::snprintf(msg, sizeof msg,
                 "fix %s wall/jiang plane: its active side, normal (%g, %g, %g) = (P2-P1) x (P3-P1), "
@@ -220,8 +208,8 @@ void FixWallJiang::check_winding() {
                 "behind it, so they would pass through it. List the corners counter-clockwise as "
                 "seen from the particles: reverse their order (P4 P3 P2 P1), which turns the normal "
                 "to (%g, %g, %g)",
-                id, plane.n[0], plane.n[1], plane.n[2], all[1], group->names[igroup], -plane.n[0],
-                -plane.n[1], -plane.n[2]);
+                id, plane.n[0], plane.n[1], plane.n[2], all[1], group->names[igroup], 0.0 - plane.n[0],
+                0.0 - plane.n[1], 0.0 - plane.n[2]);
   error->all(FLERR, msg);
 }
 
@@ -344,7 +332,12 @@ void FixWallJiang::loop(bool commit) {
     jd_kinematics k;
     jd_copy3(k.va, v[i]);
     jd_copy3(k.wa, omega[i]);
-    jd_copy3(k.vb, vel);
+    if (shape == 1) { /* the surface's velocity where the sphere touches it */
+      const double p[3] = {x[i][0] + g.ra[0], x[i][1] + g.ra[1], x[i][2] + g.ra[2]};
+      jd_cylinder_surface_velocity(&cyl, vel, spin, p, k.vb);
+    } else {
+      jd_copy3(k.vb, vel);
+    }
     k.wb[0] = k.wb[1] = k.wb[2] = 0.0;
     JdHistory<F> hs(h, roll_at, commit);
     jd_contact_result out;
@@ -354,7 +347,7 @@ void FixWallJiang::loop(bool commit) {
     const int carries = jd_contact(laws, &co, &g, &k, dt, hs.st, hs.rs, &out);
     if (F & JD_F_ENERGY) {
       /* f_prev is booked only with the energies; the work also over the step a contact ends */
-      work += jd_wall_work(f_prev, out.f, vel, dt);
+      work += jd_wall_work(f_prev, out.f, k.vb, dt);
       jd_contact_harvest(hs.st, 1.0, &e_damp, &e_fric);
       if (carries) e_el += jd_contact_elastic_energy(hs.st);
     }

@@ -110,6 +110,7 @@ class FixWallJiang : public Fix {
   jd_plane plane;
   jd_cylinder cyl;
   double vel[3];
+  double spin; /* cylinder: angular velocity about its axis, right-handed about a1 - a0 [rad/s] */
   int wtype;
   int slen; /* doubles of history per atom (a mesh: JD_MESH_SLOTS x (normal, state)) */
   double **hist;

@@ -590,9 +590,12 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         if observed:
             vel += " name %s" % word(w["name"], "wall name") + servo_words(w)
         fid = identifier(w["name"], "w_", taken)
+        spin = float(w.get("angular_velocity", 0.0)) if w["type"] == "cylinder" else 0.0
+        if spin:
+            vel = " omega %s" % num(spin) + vel
         if builtin:
             if vel:
-                fail("wall %s: --builtin supports fixed walls only (no velocity, no servo)" % w["name"])
+                fail("wall %s: --builtin supports fixed walls only (no velocity, spin or servo)" % w["name"])
             L.append("fix %s all wall/gran %s primitive type %d %s\n" % (
                 fid, builtin_model, tid[w["material"]], primitive_wall(w)))
         elif w["type"] == "plane":

@@ -595,10 +595,12 @@ static JD_ALWAYS_INLINE double wall_loop(const jd_particles *ps, const jd_run_co
         B->j[nb] = L->j[c];
         B->delta[nb] = g.delta;
         B->k_co[nb] = ps->species[i] * nm + (int32_t)w->material;
+        double vw[3];
+        wall_point_velocity(w, ps->x + 3 * (size_t)i, g.ra, vw);
         for (int d = 0; d < 3; d++) {
             B->n[d][nb] = g.n[d];
             B->ra[d][nb] = g.ra[d];
-            B->vw[d][nb] = w->v[d];
+            B->vw[d][nb] = vw[d];
         }
         if (++nb == JD_BATCH) {
             wall_batch_evaluate(ps, run, L, F, B, nb);
@@ -671,10 +673,10 @@ static double plain_wall_loop(const jd_particles *ps, const jd_run_constants *ru
         if (jd_overlap_excessive(g.delta, ps->radius[i], INFINITY, run->max_overlap))
             sim_watchdog_overlap(trip, i, -1 - L->j[c], g.delta, ps->radius[i]);
         jd_kinematics k;
+        wall_point_velocity(w, ps->x + 3 * (size_t)i, g.ra, k.vb);
         for (int d = 0; d < 3; d++) {
             k.va[d] = ps->v[3 * (size_t)i + d];
             k.wa[d] = ps->omega[3 * (size_t)i + d];
-            k.vb[d] = w->v[d];
             k.wb[d] = 0.0;
         }
         const jd_pair_coeffs co =
@@ -686,7 +688,7 @@ static double plain_wall_loop(const jd_particles *ps, const jd_run_constants *ru
         const double f_prev[3] = {st.f_prev[0], st.f_prev[1], st.f_prev[2]};
         const int carries = jd_contact(F, &co, &g, &k, run->dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
         hist_store(L, F, c, &st, &rs);
-        if (F & JD_F_ENERGY) work += jd_wall_work(f_prev, out.f, w->v, run->dt);
+        if (F & JD_F_ENERGY) work += jd_wall_work(f_prev, out.f, k.vb, run->dt);
         if (!carries) continue;
         for (int d = 0; d < 3; d++) {
             a.f[3 * (size_t)i + d] -= out.f[d];

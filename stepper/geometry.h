@@ -68,4 +68,16 @@ static inline int sim_wall_geom(const jd_particles *ps, int32_t i, const jd_sim_
     return 1;
 }
 
+/* The velocity vb [m/s] of wall w at the contact point x + ra [m] of a particle at x: its
+ * translation, plus a cylinder's spin about its axis. */
+static inline void wall_point_velocity(const jd_sim_wall *w, const double x[3], const double ra[3],
+                                       double vb[3]) {
+    if (w->type != JD_WALL_CYLINDER) {
+        for (int d = 0; d < 3; d++) vb[d] = w->v[d];
+        return;
+    }
+    const double p[3] = {x[0] + ra[0], x[1] + ra[1], x[2] + ra[2]};
+    jd_cylinder_surface_velocity(&w->cyl, w->v, w->spin, p, vb);
+}
+
 #endif /* JDEM_GEOMETRY_H */

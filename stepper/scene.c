@@ -366,7 +366,7 @@ static int read_scene(loader *L) {
                        "particle in particles or generate");
     }
     if (scene_read_interactions(L) || scene_sort_particles(L) || scene_check_overlaps(L) ||
-        scene_check_wall_overlaps(L) || scene_resolve_bonds(L))
+        scene_check_wall_overlaps(L) || scene_check_plane_winding(L) || scene_resolve_bonds(L))
         return -1;
     if (!L->max_impact_given && default_impact_speed(L)) return -1;
     return (L->s->dt_auto && auto_dt(L)) || scene_check_inlets(L);

@@ -47,6 +47,7 @@ typedef struct jd_wall {
     double axis[2][3];        /* [m] end points of the axis segment */
     double radius;            /* [m] */
     int inside;               /* 0: obstacle (contact on the outer surface), 1: container */
+    double angular_velocity;  /* spin about the axis, right-handed about axis[1] - axis[0] [rad/s] */
     /* servo (plane walls only, docs/scenes.md "Servo walls") */
     int has_servo;            /* 1: the wall moves along its normal by the servo law */
     jd_servo_spec servo;      /* target, gain, tolerance, max_speed; hold_steps is set by the

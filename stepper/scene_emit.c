@@ -207,7 +207,8 @@ static int emit_wall(yaml_emitter_t *e, const jd_scene *s, const jd_wall *w) {
         return 1;
     if (plane ? emit_points(e, "corners", w->corners, 4)
               : emit_points(e, "axis", w->axis, 2) || key_num(e, "radius", w->radius) ||
-                    key_str(e, "side", w->inside ? "inside" : "outside"))
+                    key_str(e, "side", w->inside ? "inside" : "outside") ||
+                    key_num(e, "angular_velocity", w->angular_velocity))
         return 1;
     if (key_str(e, "material", s->materials[w->material].name)) return 1;
     if (!w->has_servo) return key_vec(e, "velocity", w->velocity) || map_end(e);

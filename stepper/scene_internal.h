@@ -118,6 +118,8 @@ int scene_read_deposit_list(loader *L, const yaml_node_t *list, const char *path
 
 /* scene_walls.c */
 int scene_read_walls(loader *L);
+/* After the particles: no plane wound away from the particles over it (the kernel's rule). */
+int scene_check_plane_winding(loader *L);
 
 /* scene_materials.c: material index named by scalar node n, or -1 after reporting. */
 int scene_material_ref(loader *L, const yaml_node_t *n, const char *path);

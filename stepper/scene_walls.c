@@ -1,11 +1,12 @@
 /*
  * scene_walls.c — the walls section: planar quadrilaterals and cylinders, with their geometry
- * checks, and STL meshes (scene_mesh.c).
+ * checks (a plane wound away from the particles is refused), and STL meshes (scene_mesh.c).
  */
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
+#include "jdem_geometry.h"
 #include "scene_internal.h"
 
 /* Relative tolerance of docs/scenes.md: wall geometry, fraction of the wall's size. */
@@ -14,8 +15,9 @@
 static const char *const PLANE_KEYS[] = {"name",     "type",    "corners", "material",
                                          "velocity", "present", "servo",   NULL};
 static const char *const SERVO_KEYS[] = {"target", "gain", "tolerance", "max_speed", "hold", NULL};
-static const char *const CYLINDER_KEYS[] = {"name",     "type",     "axis",    "radius", "side",
-                                            "material", "velocity", "present", NULL};
+static const char *const CYLINDER_KEYS[] = {"name",     "type",     "axis",    "radius",
+                                            "side",     "material", "velocity", "present",
+                                            "angular_velocity", NULL};
 static const char *const MESH_KEYS[] = {"name",     "type",     "file",     "material",
                                         "scale",    "velocity", "rotation", "surface_velocity",
                                         NULL};
@@ -79,7 +81,8 @@ static int read_cylinder(loader *L, const yaml_node_t *w, const char *path, jd_w
     if (!axis) return sd_missing(&L->c, w, path, "axis", "[[x, y, z], [x, y, z]]");
     if (sd_points(&L->c, axis, sub, 2, &wall->axis[0][0]) ||
         sd_req_num(&L->c, w, path, "radius", SD_POSITIVE, &wall->radius) ||
-        sd_opt_enum(&L->c, w, path, "side", CYLINDER_SIDES, &wall->inside))
+        sd_opt_enum(&L->c, w, path, "side", CYLINDER_SIDES, &wall->inside) ||
+        sd_opt_num(&L->c, w, path, "angular_velocity", SD_ANY, &wall->angular_velocity))
         return -1;
     double d[3];
     sub3(wall->axis[1], wall->axis[0], d);
@@ -238,6 +241,51 @@ int scene_read_walls(loader *L) {
         if (read_wall(L, sd_item(&L->c, list, i), path, L->s->n_walls, &present)) return -1;
         if (present) L->s->n_walls++;
         else memset(&L->s->walls[L->s->n_walls], 0, sizeof L->s->walls[0]);
+    }
+    return 0;
+}
+
+/* The mapping of the wall named name in the walls list and its path walls.K. */
+static const yaml_node_t *wall_node(loader *L, const char *name, char path[SD_PATH_MAX]) {
+    const yaml_node_t *list = sd_get(&L->c, L->root, "walls");
+    for (size_t i = 0; list && i < sd_len(list); i++) {
+        const yaml_node_t *w = sd_item(&L->c, list, i);
+        const char *s = sd_scalar(sd_get(&L->c, w, "name"));
+        if (s && strcmp(s, name) == 0) {
+            sd_join_index(path, "walls", i);
+            return w;
+        }
+    }
+    snprintf(path, SD_PATH_MAX, "walls");
+    return list;
+}
+
+/* A plane acts on its active side only, so one wound away from the particles lets every one of
+ * them through: of the particles over each plane at the start, count those in front and behind
+ * and apply the kernel's rule (jd_plane_wound_away), as fix wall/jiang does at its set-up. */
+int scene_check_plane_winding(loader *L) {
+    const jd_scene *s = L->s;
+    for (size_t k = 0; k < s->n_walls; k++) {
+        const jd_wall *w = &s->walls[k];
+        jd_plane p;
+        if (w->type != JD_WALL_PLANE || jd_plane_init(&p, w->corners, 1e-6) != JD_GEOM_OK)
+            continue;
+        double side[2] = {0.0, 0.0}; /* in front, behind */
+        for (size_t i = 0; i < s->n_particles; i++) {
+            const int at = jd_plane_side(&p, &s->position[3 * i]);
+            if (at != 0) side[at > 0 ? 0 : 1] += 1.0;
+        }
+        if (!jd_plane_wound_away(side[0], side[1])) continue;
+        char path[SD_PATH_MAX], sub[SD_PATH_MAX];
+        const yaml_node_t *node = wall_node(L, w->name, path);
+        sd_join(sub, path, "corners");
+        return sd_fail(&L->c, sd_get(&L->c, node, "corners") ? sd_get(&L->c, node, "corners") : node,
+                       sub, "plane '%s' faces away from the particles: its normal (%.3g, %.3g, "
+                       "%.3g) = (P2-P1) x (P3-P1), and all %.0f particles over it are behind it, "
+                       "so they would pass through it; valid: the corners counter-clockwise as "
+                       "seen from the particles (reverse their order, which turns the normal to "
+                       "(%.3g, %.3g, %.3g))", w->name, p.n[0], p.n[1], p.n[2], side[1], 0.0 - p.n[0],
+                       0.0 - p.n[1], 0.0 - p.n[2]);
     }
     return 0;
 }

@@ -158,6 +158,8 @@ typedef struct jd_sim_wall {
     double v[3];       /* translation velocity [m/s] */
     jd_plane plane;
     jd_cylinder cyl;
+    double spin;       /* cylinder: angular velocity about its axis [rad/s]
+                          (jd_cylinder_surface_velocity) */
     double disp[3];    /* translation since the last neighbour build [m] */
     double force[3];   /* the particles' total force on the wall at the last evaluation [N]
                           (scenes with a servo wall: wall_forces) */

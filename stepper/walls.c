@@ -42,6 +42,7 @@ int sim_walls_init(jd_walls *walls, const jd_run_constants *run, char *err, size
             memcpy(w->cyl.a1, in->axis[1], sizeof w->cyl.a1);
             w->cyl.rc = in->radius;
             w->cyl.inside = in->inside;
+            w->spin = in->angular_velocity;
             const double ab[3] = {in->axis[1][0] - in->axis[0][0], in->axis[1][1] - in->axis[0][1],
                                   in->axis[1][2] - in->axis[0][2]};
             if (!(jd_dot(ab, ab) > 0.0)) {

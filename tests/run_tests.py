@@ -57,6 +57,10 @@ SUITES += [("mesh-engines", [PY, "tests/mesh/test_mesh_engines.py"], "lines", {}
 # against liggghts-jdem's fix move/mesh and surface_vel, bit for bit on 1 and 2 ranks.
 SUITES += [("mesh-motion", [PY, "tests/mesh/test_mesh_motion.py"], "lines", {}),
            ("mesh-motion-sanitized", [PY, "tests/mesh/test_mesh_motion.py"], "lines", SANITIZED)]
+# A drum from primitives (a cylinder with angular_velocity, fix wall/jiang ... omega): one
+# sphere against the rolling pendulum's closed form and liggghts-jdem bit for bit on 1 and 2
+# ranks; a bed's angle of repose against the same drum as 128 turning mesh facets.
+SUITES += [("drum", [PY, "tests/mesh/test_drum.py"], "lines", {})]
 # The law set (kernel/jdem_laws.h) each engine selects, for every scene of reference_runs/ and
 # tests/, and hand-written decks that leave out `rolling on`.
 SUITES += [("law-sets", [PY, "tests/liggghts/check_law_sets.py"], "lines", {})]

@@ -28,7 +28,7 @@ import subprocess
 
 import numpy as np
 
-from scripts.mixing import claims_ch4, compression, deposit, params, plots, stats
+from scripts.mixing import agreement_ch4, claims_ch4, compression, deposit, params, plots, stats
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_OUT = os.path.join(ROOT, "out", "mixing", "ch4")
@@ -382,7 +382,7 @@ def report(found, missing, taken, figures, rev):
              "parameter (docs/mixing.md §1).\n" % rev, mixing_table(found, taken), figures_section(figures)]
     parts += [elastic_table(found, taken, k, t, f) for k, t, f in TABLES]
     parts.append(horizon_section())
-    parts += [spread_table(found, taken), constants_table(found, taken), "### The seed's claims\n",
+    parts += [spread_table(found, taken), agreement_ch4.table(found), constants_table(found, taken), "### The seed's claims\n",
               claims_ch4.claims(found, ENGINES), times_table(found, taken),
               "### Not run\n", "\n".join("- " + m for m in missing) + "\n" if missing else "nothing\n"]
     return "\n".join(parts)

@@ -386,7 +386,7 @@ def wound_plane(c, tmp):
     want = ("ERROR: fix floor wall/jiang plane: its active side, normal (0, 0, -1) = (P2-P1) x (P3-P1), "
             "faces away from the particles: all 50 particles of group all over the plane are behind it, "
             "so they would pass through it. List the corners counter-clockwise as seen from the "
-            "particles: reverse their order (P4 P3 P2 P1), which turns the normal to (-0, -0, 1)")
+            "particles: reverse their order (P4 P3 P2 P1), which turns the normal to (0, 0, 1)")
     c.check("plane: a floor wound away from the particles is refused with the winding to use",
             rc != 0 and any(l.startswith(want) for l in log.splitlines()), log[-400:])
     rc, log, _ = run_text(tmp, "plane_up", POUR.format(E=5e6, dt=2e-6, floor=FLOOR_UP, extra="", steps=1).replace(

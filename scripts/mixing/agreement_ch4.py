@@ -1,0 +1,97 @@
+"""agreement_ch4.py — the two engines' deposits against the run-to-run spread (report_ch4.py;
+issue 23: "deposit statistics agree within the measured run-to-run spread").
+
+Past the cross-engine horizon (under a second of the fill) jdem and liggghts-jdem are two
+realisations of the same chaotic fill, so their deposits can differ by what two realisations of
+one engine differ by.  For every model and pass with both engines' fill, each statistic's
+difference |jdem - liggghts-jdem| is set against 2 sqrt(2) s: s the sample standard deviation of
+that statistic over the realisations of one fill (the first fill and its jittered repeats,
+generate.py --jitter), sqrt(2) for the difference of two independent runs, 2 for two standard
+deviations.  s is the model's own where it has realisations, else pooled over the models that
+have them (the intensive statistics: phi_v, packing fraction, rho_b, Z); the deposit height (the
+highest particle top) is set against its own model's spread only, since an obstacle that holds a
+particle on its top sets it.
+"""
+import math
+
+import numpy as np
+
+ENGINES = ("jdem", "liggghts-jdem")
+MODELS = tuple("model%d" % m for m in range(1, 7))
+PASSES = (1, 2)
+# (label, how to read it from a fill_result, format); packing fraction = 1 - n (porosity)
+STATISTICS = (("height [m]", lambda r: r["deposit_height"], "%.3f", False),
+              ("φv", lambda r: r["summary"]["phi_v"]["mean"], "%.4f", True),
+              ("packing fraction", lambda r: 1.0 - r["summary"]["n"]["mean"], "%.4f", True),
+              ("ρb [kg/m³]", lambda r: r["summary"]["rho_b"]["mean"], "%.0f", True),
+              ("Z", lambda r: r["summary"]["Z"]["mean"], "%.3f", True))
+
+
+def realisations(entry):
+    """The first fill and its jittered realisations of one engine and model."""
+    return ([entry["fill1"]] if entry.get("fill1") else []) + entry.get("jitter", [])
+
+
+def spreads(found):
+    """{(model or None for the pool, label): (s, source)}: each model's sample std over its
+    realisations, and the pooled one (over every engine and model with at least two)."""
+    out, pooled = {}, {}
+    for engine in ENGINES:
+        for model in MODELS:
+            runs = realisations(found.get(engine, {}).get(model, {}))
+            if len(runs) < 2:
+                continue
+            for label, get, _, _ in STATISTICS:
+                vals = [get(r) for r in runs]
+                s = float(np.std(vals, ddof=1))
+                out[(model, label)] = (s, "%s %s, %d realisations" % (engine, model, len(runs)))
+                acc = pooled.setdefault(label, [0.0, 0, []])
+                acc[0] += s * s * (len(vals) - 1)
+                acc[1] += len(vals) - 1
+                acc[2].append("%s %s" % (engine, model))
+    for label, (ss, dof, names) in pooled.items():
+        out[(None, label)] = (math.sqrt(ss / dof), "pooled: " + ", ".join(names))
+    return out
+
+
+def spread_for(s, model, label, intensive):
+    return s.get((model, label)) or (s.get((None, label)) if intensive else None)
+
+
+def rows(found):
+    """One row per model, pass and statistic with both engines' fill: (model, pass, label,
+    jdem, liggghts-jdem, |difference|, bound or None, spread source, held or None)."""
+    s, out = spreads(found), []
+    for model in MODELS:
+        for p in PASSES:
+            a = found.get("jdem", {}).get(model, {}).get("fill%d" % p)
+            b = found.get("liggghts-jdem", {}).get(model, {}).get("fill%d" % p)
+            if not (a and b):
+                continue
+            for label, get, fmt, intensive in STATISTICS:
+                diff = abs(get(a) - get(b))
+                sp = spread_for(s, model, label, intensive)
+                bound = 2.0 * math.sqrt(2.0) * sp[0] if sp else None
+                out.append((model, p, label, fmt % get(a), fmt % get(b), fmt % diff,
+                            fmt % bound if sp else "—", sp[1] if sp else "no spread measured",
+                            None if bound is None else diff <= bound))
+    return out
+
+
+def table(found):
+    """The markdown section, "" when no model has both engines' fill."""
+    found_rows = rows(found)
+    if not found_rows:
+        return ""
+    lines = ["### Cross-engine deposits against the run-to-run spread", "",
+             "past the horizon the engines are two realisations of one chaotic fill: |jdem − "
+             "liggghts-jdem| against 2√2 s, s the std over one fill's realisations (the model's "
+             "own, else pooled for the intensive statistics; the height, the highest particle "
+             "top, only against its own model's); scripts/mixing/agreement_ch4.py", "",
+             "| model | pass | statistic | jdem | liggghts-jdem | difference | 2√2 s | s from | agree |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for model, p, label, a, b, d, bound, source, ok in found_rows:
+        lines.append("| %s | %d | %s | %s | %s | %s | %s | %s | %s |" % (
+            model, p, label, a, b, d, bound, source,
+            "—" if ok is None else ("held" if ok else "not held")))
+    return "\n".join(lines) + "\n"
