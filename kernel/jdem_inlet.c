@@ -95,6 +95,64 @@ int64_t jd_inlet_group_start(const jd_inlet_spec *s, int64_t copy, const size_t 
     return first;
 }
 
+/* The root of x's component; path halving.  Every union makes the smaller root the parent, so a
+ * component's root is its smallest member. */
+static int32_t component_root(int32_t *parent, int32_t x) {
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+size_t jd_inlet_groups(size_t n, size_t n_bonds, const int32_t *pair, int32_t *parent,
+                       int32_t *group_of, size_t *group_first, size_t *group_member) {
+    for (size_t p = 0; p < n; p++) {
+        parent[p] = (int32_t)p;
+        group_of[p] = -1;
+    }
+    for (size_t k = 0; k < n_bonds; k++) {
+        const int32_t x = component_root(parent, pair[2 * k]), y = component_root(parent, pair[2 * k + 1]);
+        if (x != y) parent[x < y ? y : x] = x < y ? x : y;
+        group_of[pair[2 * k]] = group_of[pair[2 * k + 1]] = -2; /* bonded, not numbered yet */
+    }
+    /* the root is the smallest member, so it is numbered before the rest of its group */
+    size_t groups = 0;
+    for (size_t p = 0; p < n; p++) {
+        if (group_of[p] == -1) continue;
+        const int32_t r = component_root(parent, (int32_t)p);
+        group_of[p] = r == (int32_t)p ? (int32_t)groups++ : group_of[r];
+    }
+    /* counting sort by group: group_first[g] serves as g's cursor, then shifts to its start */
+    for (size_t g = 0; g <= groups; g++) group_first[g] = 0;
+    for (size_t p = 0; p < n; p++)
+        if (group_of[p] >= 0) group_first[group_of[p] + 1]++;
+    for (size_t g = 0; g < groups; g++) group_first[g + 1] += group_first[g];
+    for (size_t p = 0; p < n; p++)
+        if (group_of[p] >= 0) group_member[group_first[group_of[p]]++] = p;
+    for (size_t g = groups; g > 0; g--) group_first[g] = group_first[g - 1];
+    group_first[0] = 0;
+    return groups;
+}
+
+double jd_inlet_bond_omega2(const jd_inlet_spec *s, const double *mass, size_t n_bonds,
+                            const int32_t *pair, const int32_t *type,
+                            const jd_bond_params *const *params, double *work) {
+    for (size_t p = 0; p < s->n; p++) work[p] = 0.0;
+    for (size_t k = 0; k < n_bonds; k++) {
+        const int32_t i = pair[2 * k], j = pair[2 * k + 1];
+        double dx[3];
+        for (int d = 0; d < 3; d++) dx[d] = s->rel[3 * j + d] - s->rel[3 * i + d];
+        const double wk = jd_bond_omega2_pair(params[type[k]], s->radius[i], s->radius[j], mass[i],
+                                              mass[j], sqrt(jd_dot(dx, dx)));
+        work[i] += wk;
+        work[j] += wk;
+    }
+    double wmax2 = 0.0;
+    for (size_t p = 0; p < s->n; p++) wmax2 = work[p] > wmax2 ? work[p] : wmax2;
+    return wmax2;
+}
+
 void jd_inlet_bond_ids(const jd_inlet_spec *s, int64_t copy, size_t i, size_t j, int64_t ids[2]) {
     const int64_t base = s->first_id + copy * (int64_t)s->n;
     const size_t lo = i < j ? i : j, hi = i < j ? j : i;

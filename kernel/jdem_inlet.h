@@ -45,6 +45,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "jdem_bond.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -162,6 +164,23 @@ int64_t jd_inlet_group_start(const jd_inlet_spec *s, int64_t copy, const size_t 
 /* The ids of the bond joining section particles i and j (i != j) in copy c, the smaller first
  * (the order of the resolved `bonds:` entries): first_id + c n + min(i, j), then the larger. */
 void jd_inlet_bond_ids(const jd_inlet_spec *s, int64_t copy, size_t i, size_t j, int64_t ids[2]);
+
+/* The groups of a section from its bonds (pairs [2 n_bonds] of section indices < n): the
+ * connected components of the bond graph, numbered in the order of their smallest member; a
+ * particle in no bond is in no group.  Fills group_of [n] (-1: none), group_first [n_groups + 1]
+ * (the caller gives room for n + 1) and group_member [n] (each group's members increasing), with
+ * parent [n] as work space, and returns n_groups: the spec's group arrays.  O(n + n_bonds). */
+size_t jd_inlet_groups(size_t n, size_t n_bonds, const int32_t *pair, int32_t *parent,
+                       int32_t *group_of, size_t *group_first, size_t *group_member);
+
+/* For the time-step guard (kernel/jdem_guard.h, bond_omega2): the largest over the section's
+ * particles of the sum of jd_bond_omega2_pair over its bonds, each at its section length
+ * (the length it is formed at) [rad^2/s^2].  pair [2 n_bonds] as for jd_inlet_groups;
+ * params[type[b]] the parameters of bond b's type; mass [n] the section particles' masses [kg];
+ * work [n].  0 without bonds. */
+double jd_inlet_bond_omega2(const jd_inlet_spec *s, const double *mass, size_t n_bonds,
+                            const int32_t *pair, const int32_t *type,
+                            const jd_bond_params *const *params, double *work);
 
 /* The step at which particle p of copy c is inserted (the stop rule is not applied here): the
  * start step of its group (s->group_of[p] >= 0), else its own crossing step k*.  O(group size). */

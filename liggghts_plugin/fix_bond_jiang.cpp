@@ -240,8 +240,9 @@ bool FixBondJiang::bonded_anywhere(int i, int tag_b) const {
 
 /* Store a new bond between local atom i (the lower id) and atom j (local or ghost) and record
  * it; false when i already holds max_bonds bonds of this type. */
-bool FixBondJiang::add_bond(int i, int j, int rule) {
-  const int partner_tag = atom->tag[j];
+bool FixBondJiang::add_bond(int i, int j, int rule) { return add_bond_to(i, atom->tag[j], rule); }
+
+bool FixBondJiang::add_bond_to(int i, int partner_tag, int rule) {
   if (nbond[i] >= max_bonds) return false;
   const int k = nbond[i]++;
   partner[i][k] = partner_tag;
@@ -258,6 +259,10 @@ static void too_many(Error *error, int tag, int max_bonds) {
   std::snprintf(msg, sizeof msg, "fix bond/jiang: atom %d would have more than %d bonds (raise max_bonds)",
                 tag, max_bonds);
   error->one(FLERR, msg);
+}
+
+void FixBondJiang::form_inlet_bond(int i, int partner_tag) {
+  if (!add_bond_to(i, partner_tag, -1)) too_many(error, atom->tag[i], max_bonds);
 }
 
 /* Rank 0 reads the file and broadcasts the pairs; the rank owning the lower id stores each. */

@@ -114,6 +114,13 @@ class FixBondJiang : public Fix {
    * after this fix's set-up (explicit bonds are read then). */
   double omega2_max();
 
+  /* Form a bond, unstressed, between local atom i and the atom of id partner_tag > tag[i] (it
+   * need not be present on this rank yet): fix jdem/inlet's bonded blocks, at their insertion
+   * step, recorded as an explicit bond (rule -1).  Stops the run past max_bonds. */
+  void form_inlet_bond(int i, int partner_tag);
+  /* The bond type's parameters (fix jdem/guard bounds the inlets' future bonds with them). */
+  const jd_bond_params &bond_params() const { return params; }
+
   /* This rank's intact bonds as (lower id, higher id) pairs. */
   void local_bonds(std::vector<int> &pairs) const;
   int local_count() const;
@@ -137,6 +144,7 @@ class FixBondJiang : public Fix {
   void form_due();
   bool bonded_anywhere(int i, int tag_b) const;
   bool add_bond(int i, int j, int rule);
+  bool add_bond_to(int i, int partner_tag, int rule);
   /* A bond's record: its kernel state.  The cross-section is computed where it is needed
    * (jd_bond_section_of, as the stepper does for mixed radii): every atom keeps max_bonds
    * records, so 7 doubles fewer per record is 28 % less bond memory, at the same speed. */

@@ -3,6 +3,7 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -190,6 +191,10 @@ void FixJdemGuard::setup(int) {
   for (int k = 0; k < modify->nfix; k++) {
     FixBondJiang *b = dynamic_cast<FixBondJiang *>(modify->fix[k]);
     if (b) in.bond_omega2 += b->omega2_max();
+  }
+  for (int k = 0; k < modify->nfix; k++) { /* the inlets' future bonds, as build/jdem bounds them */
+    FixJdemInlet *inlet = dynamic_cast<FixJdemInlet *>(modify->fix[k]);
+    if (inlet) in.bond_omega2 = std::max(in.bond_omega2, inlet->section_bond_omega2());
   }
   in.dt = update->dt;
   jd_guard_result r;

@@ -4,6 +4,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <climits>
 #include <cmath>
@@ -20,6 +21,7 @@
 #include "modify.h"
 #include "update.h"
 
+#include "fix_bond_jiang.h"
 #include "jdem_input_file.h"
 #include "jdem_restart.h"
 #include "jdem_kernel.h"
@@ -172,9 +174,22 @@ void FixJdemInlet::parse(int narg, char **arg) {
   if (record_path) open_record(record_path, append);
 }
 
-/* Rank 0 reads the section file and broadcasts it ("TYPE RADIUS DENSITY X Y Z" per line). */
+/* A section line "bond I J T" (the word "bond" read) into out as I J T; a message otherwise. */
+static bool bond_line(std::istringstream &ls, std::vector<int> &out) {
+  long long v[3];
+  std::string rest;
+  if (!(ls >> v[0] >> v[1] >> v[2]) || (ls >> rest) || v[0] < 0 || v[1] < 0 || v[2] < 0 ||
+      v[0] == v[1] || v[0] > INT_MAX || v[1] > INT_MAX || v[2] > INT_MAX)
+    return false;
+  out.insert(out.end(), {(int)v[0], (int)v[1], (int)v[2]});
+  return true;
+}
+
+/* Rank 0 reads the section file and broadcasts it: "TYPE RADIUS DENSITY X Y Z" per particle,
+ * "bond I J T" per bond. */
 void FixJdemInlet::read_section(const char *path) {
   std::vector<double> rows; /* type radius density x y z */
+  std::vector<int> bonds;   /* i j type */
   char msg[512] = "";
   int bad = 0;
   if (comm->me == 0) {
@@ -187,16 +202,27 @@ void FixJdemInlet::read_section(const char *path) {
       const size_t hash = line.find('#');
       if (hash != std::string::npos) line.erase(hash);
       std::istringstream ls(line);
+      std::string first;
+      if (!(ls >> first)) continue;
+      if (first == "bond") {
+        if (!bond_line(ls, bonds)) {
+          std::snprintf(msg, sizeof msg, "fix jdem/inlet: section file %s line %d: expected \"bond I J "
+                        "T\": two different section particle indices I, J >= 0 and a bond type T >= 0",
+                        path, lineno);
+          bad = 1;
+        }
+        continue;
+      }
+      std::istringstream nums(line);
       double v[6];
       std::string rest;
-      if (!(ls >> v[0])) continue;
-      bool ok = (ls >> v[1] >> v[2] >> v[3] >> v[4] >> v[5]) && !(ls >> rest) && v[0] >= 1 &&
-                v[0] <= atom->ntypes && v[0] == std::floor(v[0]) && v[1] > 0.0 && v[2] > 0.0;
+      bool ok = (nums >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5]) && !(nums >> rest) &&
+                v[0] >= 1 && v[0] <= atom->ntypes && v[0] == std::floor(v[0]) && v[1] > 0.0 && v[2] > 0.0;
       for (int k = 0; k < 6 && ok; k++) ok = std::isfinite(v[k]);
       if (!ok) {
         std::snprintf(msg, sizeof msg, "fix jdem/inlet: section file %s line %d: expected \"TYPE RADIUS "
-                      "DENSITY X Y Z\" with TYPE between 1 and %d, RADIUS > 0 and DENSITY > 0", path,
-                      lineno, atom->ntypes);
+                      "DENSITY X Y Z\" with TYPE between 1 and %d, RADIUS > 0 and DENSITY > 0, or "
+                      "\"bond I J T\"", path, lineno, atom->ntypes);
         bad = 1;
       }
       rows.insert(rows.end(), v, v + 6);
@@ -204,12 +230,20 @@ void FixJdemInlet::read_section(const char *path) {
     if (why.empty() && !bad && rows.empty())
       why = std::string("fix jdem/inlet: section file ") + path +
             ": holds no particles (lines \"TYPE RADIUS DENSITY X Y Z\")";
+    for (size_t b = 0; why.empty() && !bad && b < bonds.size(); b += 3)
+      if (bonds[b] >= (int)(rows.size() / 6) || bonds[b + 1] >= (int)(rows.size() / 6)) {
+        std::snprintf(msg, sizeof msg, "fix jdem/inlet: section file %s: bond %d %d joins a particle "
+                      "that does not exist; valid: indices 0 to %d (the particle lines in order)",
+                      path, bonds[b], bonds[b + 1], (int)(rows.size() / 6) - 1);
+        bad = 1;
+      }
     if (!why.empty() && !bad) {
       std::snprintf(msg, sizeof msg, "%s", why.c_str());
       bad = 1;
     }
   }
   jdem_share_input(lmp, bad, msg, sizeof msg, rows);
+  jdem_share_input(lmp, 0, msg, sizeof msg, bonds);
   const int n = (int)rows.size();
   for (int r = 0; r < n; r += 6) {
     type0.push_back((int32_t)rows[r] - 1);
@@ -221,6 +255,69 @@ void FixJdemInlet::read_section(const char *path) {
   spec.rel = rel.data();
   spec.radius = radius.data();
   spec.species = type0.data();
+  sort_bonds(bonds, path);
+  make_groups();
+}
+
+/* The section's bonds, smaller index first, sorted by (I, J) as build/jdem resolves them. */
+void FixJdemInlet::sort_bonds(const std::vector<int> &bonds, const char *path) {
+  std::vector<std::array<int, 3> > b;
+  for (size_t k = 0; k < bonds.size(); k += 3)
+    b.push_back({std::min(bonds[k], bonds[k + 1]), std::max(bonds[k], bonds[k + 1]), bonds[k + 2]});
+  std::sort(b.begin(), b.end(), [](const std::array<int, 3> &x, const std::array<int, 3> &y) {
+    return x[0] != y[0] ? x[0] < y[0] : x[1] < y[1];
+  });
+  for (size_t k = 0; k < b.size(); k++) {
+    if (k > 0 && b[k][0] == b[k - 1][0] && b[k][1] == b[k - 1][1]) {
+      char msg[400];
+      std::snprintf(msg, sizeof msg, "fix jdem/inlet: section file %s: section particles %d and %d "
+                    "are bonded twice; valid: at most one bond per pair", path, b[k][0], b[k][1]);
+      error->all(FLERR, msg);
+    }
+    bond_pair.insert(bond_pair.end(), {b[k][0], b[k][1]});
+    bond_type.push_back(b[k][2]);
+  }
+}
+
+/* The groups the kernel inserts whole: the bonds' connected components (jd_inlet_groups). */
+void FixJdemInlet::make_groups() {
+  if (bond_type.empty()) return;
+  std::vector<int32_t> parent(spec.n);
+  group_of.resize(spec.n);
+  group_first.resize(spec.n + 1);
+  group_member.resize(spec.n);
+  spec.n_groups = jd_inlet_groups(spec.n, bond_type.size(), bond_pair.data(), parent.data(),
+                                  group_of.data(), group_first.data(), group_member.data());
+  spec.group_first = group_first.data();
+  spec.group_member = group_member.data();
+  spec.group_of = group_of.data();
+}
+
+/* The fix bond/jiang of each bond type (the n-th of the input is type n - 1). */
+void FixJdemInlet::find_bond_fixes() {
+  bond_fix.clear();
+  for (int k = 0; k < modify->nfix; k++) {
+    FixBondJiang *b = dynamic_cast<FixBondJiang *>(modify->fix[k]);
+    if (b) bond_fix.push_back(b);
+  }
+  for (size_t k = 0; k < bond_type.size(); k++)
+    if (bond_type[k] >= (int)bond_fix.size()) {
+      char msg[300];
+      std::snprintf(msg, sizeof msg, "fix %s jdem/inlet: a section bond has type %d, but the input "
+                    "defines %d fix bond/jiang; valid: types 0 to %d (the n-th fix bond/jiang is type "
+                    "n - 1)", id, bond_type[k], (int)bond_fix.size(), (int)bond_fix.size() - 1);
+      error->all(FLERR, msg);
+    }
+}
+
+double FixJdemInlet::section_bond_omega2() {
+  if (bond_type.empty()) return 0.0;
+  std::vector<const jd_bond_params *> params;
+  for (size_t t = 0; t < bond_fix.size(); t++) params.push_back(&bond_fix[t]->bond_params());
+  std::vector<double> mass(spec.n), work(spec.n);
+  for (size_t p = 0; p < spec.n; p++) mass[p] = jd_sphere_mass(radius[p], density[p]);
+  return jd_inlet_bond_omega2(&spec, mass.data(), bond_type.size(), bond_pair.data(),
+                              bond_type.data(), params.data(), work.data());
 }
 
 /* A new record (its header first), or the record an earlier fix jdem/inlet of the deck started:
@@ -258,6 +355,7 @@ int FixJdemInlet::max_type() { return *std::max_element(type0.begin(), type0.end
 
 /* At the first run: the time step is known now (the deck sets it after the fixes). */
 void FixJdemInlet::init() {
+  find_bond_fixes();
   if (started) {
     if (update->dt != spec.dt)
       error->all(FLERR, "fix jdem/inlet: the time step changed after the stream started; valid: "
@@ -360,7 +458,31 @@ void FixJdemInlet::pre_exchange() {
   atom->nghost = 0; /* the ghosts are rebuilt by this step's borders() */
   atom->map_init();
   atom->map_set();
+  form_block_bonds(due);
   insert_seconds += MPI_Wtime() - t0;
+}
+
+/* The section bonds of the groups inserted at this step (due: in increasing id): a group is
+ * inserted whole, so a bond of copy c forms exactly when its lower id is due; the rank owning
+ * that atom stores it. */
+void FixJdemInlet::form_block_bonds(const std::vector<jd_inlet_particle> &due) {
+  if (bond_type.empty()) return;
+  const auto is_due = [&due](int64_t tag) {
+    const auto at = std::lower_bound(due.begin(), due.end(), tag,
+                                     [](const jd_inlet_particle &p, int64_t t) { return p.id < t; });
+    return at != due.end() && at->id == tag;
+  };
+  for (int64_t c = due.front().copy; c <= due.back().copy; c++)
+    for (size_t b = 0; b < bond_type.size(); b++) {
+      int64_t ids[2];
+      jd_inlet_bond_ids(&spec, c, (size_t)bond_pair[2 * b], (size_t)bond_pair[2 * b + 1], ids);
+      if (!is_due(ids[0])) continue; /* its group was inserted at another step */
+      if (!is_due(ids[1]))
+        error->all(FLERR, "fix jdem/inlet: a section bond joins a particle not inserted with its "
+                          "block (internal error)");
+      const int i = atom->map((int)ids[0]);
+      if (i >= 0 && i < atom->nlocal) bond_fix[bond_type[b]]->form_inlet_bond(i, (int)ids[1]);
+    }
 }
 
 /* The stepper's state of a particle at its insertion step (the step's final half kick left out). */

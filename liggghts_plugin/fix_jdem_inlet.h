@@ -9,7 +9,13 @@
  * SECTION: one line per section particle, "TYPE RADIUS DENSITY X Y Z" (atom type, [m], [kg/m^3],
  * position relative to the section origin [m]; '#' comments); particle p of copy c gets the atom
  * id first_id + c n + p, the type, radius and density of line p and the mass 4/3 pi R^3 rho
- * (jd_sphere_mass, as read_data).  The other keywords are the fields of jd_inlet_spec and the
+ * (jd_sphere_mass, as read_data).  Bonded blocks (Jiang (2021) Ch. 5): lines "bond I J T" join
+ * section particles I and J (0-based, in the order of the particle lines) by a bond of type T
+ * (0-based: the T+1-th fix bond/jiang of the input, as /connectivity/bond_type counts them).
+ * The bonds' connected components are groups the kernel inserts whole (jd_inlet_groups,
+ * "Bonded groups of a section" in kernel/jdem_inlet.h); at a group's insertion step the rank
+ * that owns a bond's lower id forms it in that fix bond/jiang, unstressed, copies in increasing
+ * order and each copy's bonds in (I, J) order, as build/jdem does.  The other keywords are the fields of jd_inlet_spec and the
  * scene's stop rule (the deck generator writes them from the resolved scene's inlets:).  record:
  * rank 0 writes every insertion as `jdem run --inlet-record` does (jd_inlet_record_line), in a
  * new file; append_record: after the lines of an earlier fix jdem/inlet (a deck with several
@@ -83,6 +89,9 @@ class FixJdemInlet : public Fix {
   const std::vector<int32_t> &section_types() const { return type0; }
   const std::vector<double> &section_radii() const { return radius; }
   const std::vector<double> &section_densities() const { return density; }
+  /* For fix jdem/guard: the section's bonds' frequency bound (jd_inlet_bond_omega2), 0 without
+   * bonds [rad^2/s^2]; valid after init(). */
+  double section_bond_omega2();
 
  private:
   void parse(int narg, char **arg);
@@ -93,10 +102,18 @@ class FixJdemInlet : public Fix {
   void check_created(const std::vector<jd_inlet_particle> &due, int created_here);
   void settle_new_particles();
   void height_rule();
+  void sort_bonds(const std::vector<int> &bonds, const char *path);
+  void make_groups();
+  void find_bond_fixes();
+  void form_block_bonds(const std::vector<jd_inlet_particle> &due);
 
   jd_inlet_spec spec;
   std::vector<double> rel, radius, density;
   std::vector<int32_t> type0; /* atom type - 1 of each section particle (spec.species) */
+  /* the section's bonds (I < J, sorted by (I, J)), their types, and the groups they make */
+  std::vector<int32_t> bond_pair, bond_type, group_of;
+  std::vector<size_t> group_first, group_member;
+  std::vector<class FixBondJiang *> bond_fix; /* fix bond/jiang of each bond type, in input order */
   std::vector<jd_inlet_cursor> cursor;
   jd_inlet_stream stream;
   bool started;

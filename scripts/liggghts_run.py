@@ -2,7 +2,7 @@
 """liggghts_run.py — run one case of a jdem scene in LIGGGHTS (build/liggghts-jdem).
 
     scripts/liggghts_run.py SCENE [--case NAME] -o OUT.h5 [--np N [--processors PX PY PZ]] [--force]
-                            [--checkpoint-every N [--resume]]
+                            [--checkpoint-every N [--resume]] [--inlet-record FILE]
 
 Resolves the scene with `build/jdem resolve` first (a bad scene changes nothing on disk), then
 takes an exclusive lock on the deck directory OUT minus .h5 plus `.deck/` (in.jdem,
@@ -15,6 +15,7 @@ While LIGGGHTS runs, a line `liggghts_run: step S/N (P %), ETA T` goes to stderr
 S the newest step that its log's thermo output or its newest restart file shows.
 SIGINT and SIGTERM are forwarded to LIGGGHTS (or to mpirun's ranks) and waited for: it stops at its next
 step and keeps OUT.h5.part.  --force runs an unsafe time step anyway (fix jdem/guard ... force).
+--inlet-record FILE writes the inlets' insertions as `jdem run --inlet-record` does.
 
 --checkpoint-every N writes a LIGGGHTS restart file every N steps, restart.STEP in the deck
 directory; the two newest are kept.  --resume then continues an interrupted run (killed, or
@@ -174,7 +175,8 @@ def write_deck(a, text, deck_dir, out, resume=None):
     r = engines.write_deck(resolved, os.path.join(deck_dir, "in.jdem"), "--trajectory", out,
                            *(["--force"] if a.force else []), *restart,
                            *(["--resume", resume] if resume else []),
-                           *(["--processors", *a.processors] if a.processors else []))
+                           *(["--processors", *a.processors] if a.processors else []),
+                           *(["--inlet-record", os.path.abspath(a.inlet_record)] if a.inlet_record else []))
     if r.returncode != 0:
         say("deck generation failed (exit %d):\n%s" % (r.returncode, r.stderr))
         return r.returncode if r.returncode in (EXIT_INPUT, EXIT_IO) else EXIT_INTERNAL
@@ -294,6 +296,8 @@ def main():
                     help="write a restart file every N steps (restart.STEP in the deck directory)")
     ap.add_argument("--resume", action="store_true",
                     help="continue an interrupted run from its restart files, if it left them")
+    ap.add_argument("--inlet-record", metavar="FILE",
+                    help="write every inlet insertion (CSV) as `jdem run --inlet-record` does")
     ap.add_argument("--jdem", default=engines.JDEM)
     ap.add_argument("--liggghts", default=engines.LIGGGHTS_JDEM)
     a = ap.parse_args()

@@ -308,9 +308,21 @@ def bond_lines(scene, tid, deck_dir, particles, skin):
             L.append("group %s union %s\n" % (gname, parts[0]))
         else:
             L.append("group %s union all\n" % gname)
+    # the inlets' section bonds (fix jdem/inlet forms them in every copy): each is held by the
+    # copy's particle of the lower section index, one section length long
+    section_held = {name: {} for name in types}
+    for k, inlet in enumerate(scene.get("inlets") or []):
+        sec = inlet["section"]
+        for b in sec.get("bonds") or []:
+            i, j = sorted(int(q) for q in b["pair"])
+            if b["type"] not in per_type:
+                fail("inlets.%d.section.bonds: unknown bond type %s" % (k, b["type"]))
+            held = section_held[b["type"]]
+            held[(k, i)] = held.get((k, i), 0) + 1
+            longest = max(longest, math.dist(sec["particles"][i]["position"], sec["particles"][j]["position"]))
     for name, t in types.items():
         pairs = sorted(per_type[name])
-        held = {}
+        held = dict(section_held[name])
         for a, _ in pairs:
             held[a] = held.get(a, 0) + 1
         # slots per atom: what the explicit bonds need, or room for 12 (FCC) when rules may add
@@ -418,6 +430,12 @@ def inlet_lines(scene, tid, deck_dir, record):
             for p in inlet["section"]["particles"]:
                 f.write("%d %s %s %s\n" % (tid[p["material"]], num(p["radius"]),
                                            num(mats[p["material"]]["density"]), vec(p["position"])))
+            bonds = inlet["section"].get("bonds") or []
+            if bonds:   # bond type T: the (T+1)-th fix bond/jiang, the scene's bond_types in order
+                f.write("# bonds: bond I J T (section indices, bond type)\n")
+                order = list(scene.get("bond_types") or {})
+                f.writelines("bond %d %d %d\n" % (int(b["pair"][0]), int(b["pair"][1]), order.index(b["type"]))
+                             for b in bonds)
         plane = inlet["plane"]
         words = "file %s origin %s velocity %s plane %s %s period %s offset %s first_id %d %s" % (
             fname, vec(inlet["origin"]), vec(inlet["velocity"]), vec(plane["point"]), vec(plane["normal"]),
@@ -485,10 +503,6 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         fail("--inlet-record: the scene has no inlets")
     if not particles.count and not inlets:
         fail("the scene has no particles")
-    for k, inlet in enumerate(inlets):
-        if inlet["section"].get("bonds"):
-            fail("inlets.%d.section.bonds: bonded blocks in an inlet section (section.blocks) are "
-                 "not in liggghts-jdem yet (issue 26); valid: run this scene with build/jdem" % k)
     add_inlets_to_extent(scene, particles)
     model = scene.get("model") or {}
     table = interaction_table(scene, names)

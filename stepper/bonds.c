@@ -10,6 +10,7 @@
 
 #include "bonds.h"
 #include "checkpoint.h"
+#include "jdem_inlet.h"
 #include "sim.h"
 
 /* The pragmas are guarded: the scene checker and the fuzzer link this file (for the guard's
@@ -592,23 +593,20 @@ void sim_bonds_permute(jd_bonds *b, const int32_t *new_index, size_t n) {
  * copy of a particle has the bonds of the section; copies are not bonded to each other). */
 static double inlet_omega2(const jd_scene *sc, const jd_inlet *in) {
     if (!in->n_bonds) return 0.0;
-    double *w2 = calloc(in->n, sizeof *w2);
-    if (!w2) return INFINITY;
-    for (size_t k = 0; k < in->n_bonds; k++) {
-        const int32_t i = in->bond_pair[2 * k], j = in->bond_pair[2 * k + 1];
-        double dx[3];
-        for (int d = 0; d < 3; d++) dx[d] = in->rel[3 * j + d] - in->rel[3 * i + d];
-        const double wk = jd_bond_omega2_pair(
-            &sc->bond_types[in->bond_type[k]].p, in->radius[i], in->radius[j],
-            jd_sphere_mass(in->radius[i], sc->materials[in->material[i]].density),
-            jd_sphere_mass(in->radius[j], sc->materials[in->material[j]].density),
-            sqrt(jd_dot(dx, dx)));
-        w2[i] += wk;
-        w2[j] += wk;
+    double *work = malloc(2 * in->n * sizeof *work);
+    const jd_bond_params **params = malloc(sc->n_bond_types * sizeof *params);
+    double wmax2 = INFINITY; /* cannot assess: report as unsafe */
+    if (work && params) {
+        double *mass = work + in->n;
+        for (size_t p = 0; p < in->n; p++)
+            mass[p] = jd_sphere_mass(in->radius[p], sc->materials[in->material[p]].density);
+        for (size_t t = 0; t < sc->n_bond_types; t++) params[t] = &sc->bond_types[t].p;
+        const jd_inlet_spec spec = {.n = in->n, .rel = in->rel, .radius = in->radius};
+        wmax2 = jd_inlet_bond_omega2(&spec, mass, in->n_bonds, in->bond_pair, in->bond_type,
+                                     params, work);
     }
-    double wmax2 = 0.0;
-    for (size_t p = 0; p < in->n; p++) wmax2 = fmax(wmax2, w2[p]);
-    free(w2);
+    free(work);
+    free(params);
     return wmax2;
 }
 

@@ -187,57 +187,19 @@ static int by_pair(const void *x, const void *y) {
     return p[1] < q[1] ? -1 : p[1] > q[1];
 }
 
-static int32_t find(int32_t *parent, int32_t x) {
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
-}
-
-/* The connected components of the bonds, numbered by their smallest member. */
+/* The connected components of the bonds (the kernel's rule, jd_inlet_groups). */
 static int make_groups(jd_inlet *in) {
-    int32_t *parent = malloc(in->n * sizeof *parent), *id_of_root = malloc(in->n * sizeof *id_of_root);
+    int32_t *parent = malloc(in->n * sizeof *parent);
     in->group_of = malloc(in->n * sizeof *in->group_of);
-    if (!parent || !id_of_root || !in->group_of) {
+    in->group_first = malloc((in->n + 1) * sizeof *in->group_first);
+    in->group_member = malloc(in->n * sizeof *in->group_member);
+    if (!parent || !in->group_of || !in->group_first || !in->group_member) {
         free(parent);
-        free(id_of_root);
         return -1;
     }
-    for (size_t p = 0; p < in->n; p++) {
-        parent[p] = (int32_t)p;
-        id_of_root[p] = -1;
-        in->group_of[p] = -1;
-    }
-    for (size_t k = 0; k < in->n_bonds; k++) {
-        const int32_t x = find(parent, in->bond_pair[2 * k]), y = find(parent, in->bond_pair[2 * k + 1]);
-        if (x != y) parent[x < y ? y : x] = x < y ? x : y;
-    }
-    for (size_t k = 0; k < in->n_bonds; k++) /* bonded particles belong to a group */
-        for (int e = 0; e < 2; e++) in->group_of[in->bond_pair[2 * k + e]] = 0;
-    size_t groups = 0;
-    for (size_t p = 0; p < in->n; p++) {
-        if (in->group_of[p] < 0) continue;
-        const int32_t r = find(parent, (int32_t)p);
-        if (id_of_root[r] < 0) id_of_root[r] = (int32_t)groups++;
-        in->group_of[p] = id_of_root[r];
-    }
+    in->n_groups = jd_inlet_groups(in->n, in->n_bonds, in->bond_pair, parent, in->group_of,
+                                   in->group_first, in->group_member);
     free(parent);
-    free(id_of_root);
-    in->n_groups = groups;
-    in->group_first = calloc(groups + 1, sizeof *in->group_first);
-    in->group_member = malloc((in->n ? in->n : 1) * sizeof *in->group_member);
-    if (!in->group_first || !in->group_member) return -1;
-    for (size_t p = 0; p < in->n; p++)
-        if (in->group_of[p] >= 0) in->group_first[in->group_of[p] + 1]++;
-    for (size_t g = 0; g < groups; g++) in->group_first[g + 1] += in->group_first[g];
-    size_t *fill = calloc(groups ? groups : 1, sizeof *fill);
-    if (!fill) return -1;
-    for (size_t p = 0; p < in->n; p++) {
-        const int32_t g = in->group_of[p];
-        if (g >= 0) in->group_member[in->group_first[g] + fill[g]++] = p;
-    }
-    free(fill);
     return 0;
 }
 

@@ -21,8 +21,7 @@ two sections of one 2 x 2 x 8 weakly bonded block and one big sphere.
 * axis: the Ch. 5 section with `axis: x` (tests/scenes/good/inlet_blocks.yaml) resolves into 16
   groups of 32 spheres, each 8 spheres long along x and 2 across in y and z.
 * sanitizer: build/san/jdem runs the scene clean and records the same insertions.
-* deck generator: refuses the resolved section bonds (liggghts-jdem has no bonded inlet yet)
-  with its exact message.
+* liggghts-jdem: tests/inlet/test_bonded_inlet_liggghts.py (suite inlet-bonded-cross-engine).
 """
 import csv
 import math
@@ -210,16 +209,6 @@ def main():
             check_bonds(inlet, f, starts, abc, spacing, rec)
             check_fall_and_floor(sc, f, starts)
         check_axis()
-        res = os.path.join(tmp, "resolved.yaml")
-        with open(res, "w") as out:
-            subprocess.run([JDEM, "resolve", SCENE], stdout=out, check=True)
-        deck = subprocess.run(["/usr/bin/python3", "-m", "scripts.scene_to_liggghts", res, "-o",
-                               os.path.join(tmp, "deck", "in.deck"), "--trajectory",
-                               os.path.join(tmp, "l.h5")], capture_output=True, text=True, cwd=ROOT)
-        check("deck generator refuses section bonds with its message", deck.returncode == 2 and
-              deck.stderr == "scene_to_liggghts: inlets.0.section.bonds: bonded blocks in an inlet "
-              "section (section.blocks) are not in liggghts-jdem yet (issue 26); valid: run this "
-              "scene with build/jdem\n", deck.stderr)
         if os.path.exists(SAN):
             san_rec = os.path.join(tmp, "san.csv")
             p = subprocess.run([SAN, "run", SCENE, "-o", os.path.join(tmp, "san.h5"), "--inlet-record",

@@ -467,6 +467,38 @@ static void stream_inserts_a_group_whole(void **state) {
                              "listed in increasing order");
 }
 
+/* jd_inlet_groups on a hand-worked graph of 8 particles: bonds 5-6, 1-3, 6-2, 3-7 (given out of
+ * order, the larger index first in one) make the components {1, 3, 7} and {2, 5, 6}, numbered by
+ * their smallest members 1 and 2; particles 0 and 4 are in no bond, so in no group.  The result
+ * passes the kernel's own group check of a spec. */
+static void groups_are_the_bond_components(void **state) {
+    (void)state;
+    const int32_t pair[8] = {5, 6, 1, 3, 6, 2, 3, 7};
+    int32_t parent[8], group_of[8];
+    size_t first[9], member[8];
+    assert_int_equal(jd_inlet_groups(8, 4, pair, parent, group_of, first, member), 2);
+    const int32_t want_of[8] = {-1, 0, 1, 0, -1, 1, 1, 0};
+    for (int p = 0; p < 8; p++) assert_int_equal(group_of[p], want_of[p]);
+    const size_t want_first[3] = {0, 3, 6}, want_member[6] = {1, 3, 7, 2, 5, 6};
+    for (int g = 0; g < 3; g++) assert_int_equal(first[g], want_first[g]);
+    for (int m = 0; m < 6; m++) assert_int_equal(member[m], want_member[m]);
+    double rel[24] = {0};
+    const double radius[8] = {0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01};
+    const int32_t species[8] = {0};
+    for (int p = 0; p < 8; p++) rel[3 * p] = -0.03 * p; /* a row along the belt, 1 cm gaps */
+    jd_inlet_spec s = one_sphere(rel, radius, species);
+    s.n = 8;
+    s.max_sections = 1;
+    s.n_groups = 2;
+    s.group_first = first;
+    s.group_member = member;
+    s.group_of = group_of;
+    char msg[256];
+    assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_OK);
+    assert_int_equal(jd_inlet_groups(8, 0, pair, parent, group_of, first, member), 0);
+    for (int p = 0; p < 8; p++) assert_int_equal(group_of[p], -1);
+}
+
 int run_inlet_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(crossing_step_of_each_copy),
@@ -483,6 +515,7 @@ int run_inlet_tests(void) {
         cmocka_unit_test(record_line_round_trip),
         cmocka_unit_test(bonded_block_starts_with_its_first_sphere),
         cmocka_unit_test(stream_inserts_a_group_whole),
+        cmocka_unit_test(groups_are_the_bond_components),
     };
     return cmocka_run_group_tests_name("inlet", tests, NULL, NULL);
 }
