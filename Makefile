@@ -227,6 +227,16 @@ mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),bu
 	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
 	    $(if $(DT)$(NP),--) $(if $(DT),--dt $(DT)) $(if $(NP),--ranks $(NP))
 
+# Jiang's Chapter 5 bonded-block campaign (docs/mixing.md §11): the 18 fills of
+# reference_runs/mixing/ch5/models.yaml (Groups 1-3 x Models 1-6) in both engines, the resumable
+# units of scripts/mixing/plan_ch5.py.  outputs: out/mixing/ch5/ENGINE/groupG_modelM/fill.h5
+#   make mixing-bonded [MODEL=group2_model3] [ENGINE=jdem|liggghts-jdem] [UNIT=...] [NP=2] [LIST=1]
+.PHONY: mixing-bonded
+mixing-bonded: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,build/liggghts-jdem build/jdem)
+	$(PY) scripts/campaign.py scripts/mixing/plan_ch5.py $(if $(MODEL),--model $(MODEL)) \
+	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
+	    $(if $(NP),-- --ranks $(NP))
+
 # The tables of the finished units, seed | jdem | liggghts-jdem (Tables 4-3...4-5, the mixing
 # parameters, run times) and Figs 4-11/4-12: out/mixing/ch4/report.md, summary.json and
 # fig4-1N_ENGINE.png, and the committed copy in reference_runs/mixing/ch4/results/; a result not
