@@ -40,7 +40,8 @@ SUITES += [("inlet", [PY, "tests/inlet/test_inlet.py"], "lines", {})]
 # the long axis, and the sanitizer build on the same scene.
 SUITES += [("inlet-bonded", [PY, "tests/inlet/test_bonded_section.py"], "lines", {})]
 # The bonded section in liggghts-jdem (fix jdem/inlet's section bonds) against jdem, 1 and 2
-# ranks: the same stream, bonds and breaks, states within 1e-10; the guard; bad section lines.
+# ranks: the same stream, bonds and breaks, states within 1e-10; restart continuation bit for bit;
+# the guard; bad section lines.
 SUITES += [("inlet-bonded-cross-engine", [PY, "tests/inlet/test_bonded_inlet_liggghts.py"], "lines", {})]
 # The inlet in both engines: the same insertion stream bit for bit on 1 and 2 ranks, the same
 # particles and states at every frame, the inflow energy, fix jdem/inlet's bad arguments.

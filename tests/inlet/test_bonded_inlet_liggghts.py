@@ -16,6 +16,9 @@ and a big sphere, falling onto a floor where bonds break); the deck is the gener
 * trajectories: every frame holds the same particles, and positions, velocities and spins agree
   with jdem's within the cross-engine tolerance 1e-10 (scaled by R, v and v/R): sphere-sphere
   contacts are not bitwise across the engines (docs/liggghts.md);
+* restart: the run killed (SIGKILL) once its LIGGGHTS restart file of step 9000 exists, and
+  continued from the file of step 8000 (after the first breaks) with scripts/liggghts_run.py --resume equals the uninterrupted
+  run with the same restart cadence bit for bit (every dataset but /h5md), on 1 and 2 ranks;
 * guard: with bonds stiff enough to set the time step, fix jdem/guard refuses the deck with
   build/jdem's message (the same fastest bond period, from the section's future bonds);
 * bad input: a section bond line naming a particle that does not exist, and a bond type without
@@ -24,9 +27,11 @@ One PASS/FAIL line per check.
 """
 import os
 import re
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 import h5py
 import numpy as np
@@ -83,6 +88,58 @@ def compare(c, jd, lg, ranks, scales):
         worst = scaled_difference(jd, lg, scales)
         c.check("trajectories: states within %g of jdem's, scaled (largest %.2g; %s)" % (TOL, worst, tag),
                 worst <= TOL)
+
+
+RESTART_EVERY, KILL_AFTER = 1000, 9000   # it continues from step 8000, after the first breaks (7184)
+
+
+def restart_steps(deck_dir):
+    names = os.listdir(deck_dir) if os.path.isdir(deck_dir) else []
+    return sorted(int(n.split(".")[1]) for n in names if n.startswith("restart.") and n.split(".")[1].isdigit())
+
+
+def datasets(path):
+    found = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda n, o: found.__setitem__(n, o[()]) if isinstance(o, h5py.Dataset)
+                     and not n.startswith("h5md") else None)
+    return found
+
+
+def same_bits(a, b):
+    if isinstance(a, np.ndarray) and a.dtype.kind == "f":
+        return a.shape == b.shape and np.array_equal(a, b, equal_nan=True)
+    return np.array_equal(a, b)
+
+
+def check_restart(c, tmp, ranks):
+    runner = [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), SCENE, "--np", str(ranks),
+              "--checkpoint-every", str(RESTART_EVERY)]
+    ref = os.path.join(tmp, "restart_ref_np%d.h5" % ranks)
+    r = subprocess.run(runner + ["-o", ref], capture_output=True, text=True)
+    if not c.check("restart: the uninterrupted run with restart files (%d rank(s))" % ranks, r.returncode == 0,
+                   r.stderr[-800:]):
+        return
+    out = os.path.join(tmp, "restart_cont_np%d.h5" % ranks)
+    deck = out[:-3] + ".deck"
+    proc = subprocess.Popen(runner + ["-o", out], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+    deadline = time.time() + 300
+    while proc.poll() is None and time.time() < deadline and max(restart_steps(deck) or [0]) < KILL_AFTER:
+        time.sleep(0.001)
+    subprocess.run(["pkill", "-KILL", "-s", str(proc.pid)])
+    rc = proc.wait()
+    r = subprocess.run(runner + ["-o", out, "--resume"], capture_output=True, text=True)
+    if not c.check("restart: killed after step %d (exit %s), continued from step %d (%d rank(s))" % (KILL_AFTER, rc, KILL_AFTER - RESTART_EVERY, ranks),
+                   rc == -signal.SIGKILL and r.returncode == 0 and
+                   "--resume: continuing from %s/restart.%d" % (deck, KILL_AFTER - RESTART_EVERY) in r.stderr,
+                   r.stderr[-800:]):
+        return
+    a, b = datasets(ref), datasets(out)
+    differ = sorted(n for n in a if n not in b or not same_bits(a[n], b[n]))
+    c.check("restart: the continued run equals the uninterrupted one bit for bit (%d datasets, bonds "
+            "and breaks included; %d rank(s))" % (len(a), ranks),
+            not differ and sorted(a) == sorted(b) and "connectivity/broken_bonds" in a, differ[:8])
 
 
 def check_guard(c, tmp):
@@ -158,6 +215,8 @@ def main():
             c.check("stream: the insertion record equals jdem's (%d lines; %d rank(s))" % (rec.count("\n"), ranks),
                     rec == open(jd_rec).read())
             compare(c, jd, read(lg_h5), ranks, scales)
+        for ranks in (1, 2):
+            check_restart(c, tmp, ranks)
         check_guard(c, tmp)
         check_bad_sections(c, tmp)
     return 1 if c.failed else 0
