@@ -44,6 +44,12 @@ static const char *const jd_bond_observable_names[JD_N_BOND_OBSERVABLES] = {
     "bond_breakage_energy"};
 static const int jd_bond_observable_is_energy[JD_N_BOND_OBSERVABLES] = {0, 0, 1, 1, 1};
 
+/* A scene with inlets also writes INLET_ENERGY [J]: the kinetic and gravitational energy the
+ * inserted particles brought, 1/2 m v^2 - m g.x summed over them in insertion order (the input
+ * side of the energy balance; with several inlets the LIGGGHTS fixes add their sums in fix
+ * order, equal to the stepper's one running sum to round-off). */
+static const char *const jd_obs_inlet_energy = "inlet_energy";
+
 /* The wall observables of a scene with a servo wall (docs/scenes.md "Servo walls"), each a
  * scalar series: for every wall WALL_FORCE/NAME/{x,y,z} [N], the particles' total force on it;
  * for every servo wall SERVO_STRESS/NAME [Pa] (its measured stress, jd_servo_stress) and

@@ -16,6 +16,7 @@
 #include "output.h"
 #include "update.h"
 
+#include "fix_jdem_inlet.h"
 #include "fix_wall_jiang.h"
 #include "fix_wall_jiang_mesh.h"
 #include "h5md.h"
@@ -426,6 +427,15 @@ int DumpH5mdJdem::write_contact_observables(const double all_obs[JDO_N], bigint 
                                  errlen) != 0)
       return -1;
   }
+  bool inlets = false; /* the inflow, as the stepper writes it with inlets */
+  double inflow = 0.0;
+  for (int k = 0; k < modify->nfix; k++) {
+    const FixJdemInlet *in = dynamic_cast<FixJdemInlet *>(modify->fix[k]);
+    if (in) inflow += in->inflow_energy(), inlets = true;
+  }
+  if (inlets && jd_h5md_write_observable(h5, jd_obs_inlet_energy, (int64_t)step, time, inflow, err,
+                                         errlen) != 0)
+    return -1;
   for (size_t k = 0; k < wall_names.size(); k++)
     if (jd_h5md_write_observable(h5, wall_names[k].c_str(), (int64_t)step, time, wall_values[k],
                                  err, errlen) != 0)

@@ -379,7 +379,7 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
             jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->run.dt,
                                      val[k], err, errlen) != 0)
             return JD_RUN_OUTPUT;
-    if (h && s->inlets && jd_h5md_write_observable(h, "inlet_energy", s->step,
+    if (h && s->inlets && jd_h5md_write_observable(h, jd_obs_inlet_energy, s->step,
                                                    (double)s->step * s->run.dt,
                                                    sim_inlets_energy(s), err, errlen) != 0)
         return JD_RUN_OUTPUT;

@@ -19,6 +19,9 @@ and a big sphere, falling onto a floor where bonds break); the deck is the gener
 * restart: the run killed (SIGKILL) once its LIGGGHTS restart file of step 9000 exists, and
   continued from the file of step 8000 (after the first breaks) with scripts/liggghts_run.py --resume equals the uninterrupted
   run with the same restart cadence bit for bit (every dataset but /h5md), on 1 and 2 ranks;
+* energy: both engines write the inflow (observables/inlet_energy) alike (1e-12), and in each the
+  balance, with the bonds' elastic, damping and breakage energy booked, closes to 1e-3 of the
+  inflow (the time discretisation of the floor impacts; some breakage energy is booked);
 * guard: with bonds stiff enough to set the time step, fix jdem/guard refuses the deck with
   build/jdem's message (the same fastest bond period, from the section's future bonds);
 * bad input: a section bond line naming a particle that does not exist, and a bond type without
@@ -71,6 +74,34 @@ def scaled_difference(a, b, scales):
         if both.any():
             worst = max(worst, float(np.max(np.abs(x[both] - y[both])) / s))
     return worst
+
+
+BOOKED = ("kinetic_energy", "rotational_energy", "elastic_energy", "gravitational_energy",
+          "damping_dissipation", "friction_dissipation", "bond_elastic_energy",
+          "bond_damping_dissipation", "bond_breakage_energy")
+
+
+def energy(path):
+    """(inflow, the balance's largest residual over the inflow, the breakage energy) at the end."""
+    with h5py.File(path, "r") as f:
+        o = {k: f["observables/%s/value" % k][()] for k in BOOKED + ("wall_work", "inlet_energy")
+             if "observables/%s/value" % k in f}
+    if "inlet_energy" not in o:
+        return None, None, None
+    total = sum(o[k] for k in BOOKED) - o["wall_work"]
+    inflow = o["inlet_energy"]
+    return inflow, float(np.max(np.abs(total - inflow)) / np.max(np.abs(inflow))), float(o["bond_breakage_energy"][-1])
+
+
+def check_energy(c, jd_path, lg_path, ranks):
+    (a, ra, ba), (b, rb, bb) = energy(jd_path), energy(lg_path)
+    if not c.check("energy: liggghts-jdem writes observables/inlet_energy (%d rank(s))" % ranks, b is not None):
+        return
+    c.check("energy: the same inflow, %.12g J against jdem's %.12g J (%d rank(s))" % (b[-1], a[-1], ranks),
+            a.shape == b.shape and np.allclose(a, b, rtol=1e-12, atol=0.0))
+    c.check("energy: the balance closes with the bonds' energies booked, largest residual %.2g (jdem) "
+            "and %.2g (liggghts-jdem) of the inflow <= 1e-3; breakage %.3g J (%d rank(s))" % (ra, rb, bb, ranks),
+            ra <= 1e-3 and rb <= 1e-3 and ba > 0.0 and bb > 0.0)
 
 
 def compare(c, jd, lg, ranks, scales):
@@ -215,6 +246,7 @@ def main():
             c.check("stream: the insertion record equals jdem's (%d lines; %d rank(s))" % (rec.count("\n"), ranks),
                     rec == open(jd_rec).read())
             compare(c, jd, read(lg_h5), ranks, scales)
+            check_energy(c, jd_h5, lg_h5, ranks)
         for ranks in (1, 2):
             check_restart(c, tmp, ranks)
         check_guard(c, tmp)
