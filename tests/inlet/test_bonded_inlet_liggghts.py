@@ -22,6 +22,10 @@ and a big sphere, falling onto a floor where bonds break); the deck is the gener
 * energy: both engines write the inflow (observables/inlet_energy) alike (1e-12), and in each the
   balance, with the bonds' elastic, damping and breakage energy booked, closes to 1e-3 of the
   inflow (the time discretisation of the floor impacts; some breakage energy is booked);
+* breakage diagnostics: scripts/mixing/breakage.py, from the trajectory's bond records alone
+  (formed and broken, with steps), gives the intact bonds and the fragments (connected components
+  of the intact bonds, scipy) that each engine's own `bonds` and `fragments` observables count
+  from its live state, at every 250th sample;
 * guard: with bonds stiff enough to set the time step, fix jdem/guard refuses the deck with
   build/jdem's message (the same fastest bond period, from the section's future bonds);
 * bad input: a section bond line naming a particle that does not exist, and a bond type without
@@ -42,6 +46,7 @@ import yaml
 
 from scripts import engines
 from scripts.engines import JDEM, LIGGGHTS_JDEM, ROOT
+from scripts.mixing import breakage
 from tests.engine.engine_common import Checks
 
 SCENE = os.path.join(ROOT, "tests", "inlet", "bonded_section.yaml")
@@ -102,6 +107,22 @@ def check_energy(c, jd_path, lg_path, ranks):
     c.check("energy: the balance closes with the bonds' energies booked, largest residual %.2g (jdem) "
             "and %.2g (liggghts-jdem) of the inflow <= 1e-3; breakage %.3g J (%d rank(s))" % (ra, rb, bb, ranks),
             ra <= 1e-3 and rb <= 1e-3 and ba > 0.0 and bb > 0.0)
+
+
+def check_breakage_records(c, path, who):
+    rec = breakage.read_bonds(path)
+    with h5py.File(path, "r") as f:
+        steps = f["observables/fragments/step"][()]
+        fragments, bonds = f["observables/fragments/value"][()], f["observables/bonds/value"][()]
+    picked = range(0, len(steps), 250)
+    wrong = [int(steps[k]) for k in picked
+             if len(breakage.fragment_sizes(rec, int(steps[k]))) != fragments[k]
+             or len(breakage.intact_at(rec, int(steps[k]))) != bonds[k]]
+    end = breakage.broken_fraction(rec, int(steps[-1]))
+    c.check("breakage diagnostics from the records equal %s's bonds and fragments observables at %d "
+            "samples (at the end %d fragments, %d of %d bonds broken: %.3f tension, %.3f shear)"
+            % (who, len(picked), fragments[-1], end["broken"], end["formed"], end["tension"], end["shear"]),
+            not wrong and end["broken"] > 0, "differ at steps %s" % wrong[:5])
 
 
 def compare(c, jd, lg, ranks, scales):
@@ -233,6 +254,7 @@ def main():
         if not c.check("jdem runs the bonded section", r.returncode == 0, r.stderr):
             return 1
         jd = read(jd_h5)
+        check_breakage_records(c, jd_h5, "jdem")
         for ranks in (1, 2):
             lg_h5 = os.path.join(tmp, "lig_np%d.h5" % ranks)
             # 2 ranks split along the belt: the falling blocks cross the subdomain boundary, so
@@ -247,6 +269,8 @@ def main():
                     rec == open(jd_rec).read())
             compare(c, jd, read(lg_h5), ranks, scales)
             check_energy(c, jd_h5, lg_h5, ranks)
+            if ranks == 2:
+                check_breakage_records(c, lg_h5, "liggghts-jdem on 2 ranks")
         for ranks in (1, 2):
             check_restart(c, tmp, ranks)
         check_guard(c, tmp)
