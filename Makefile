@@ -237,6 +237,12 @@ mixing-bonded: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,build/liggghts-jd
 	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
 	    $(if $(NP),-- --ranks $(NP))
 
+# Table 5-3 (phi_v at the middle clip) and the breakage of the finished Ch. 5 fills, seed | jdem |
+# liggghts-jdem: out/mixing/ch5/report.md and reference_runs/mixing/ch5/results/.
+.PHONY: mixing-bonded-report
+mixing-bonded-report:
+	$(PY) -m scripts.mixing.report_ch5
+
 # The tables of the finished units, seed | jdem | liggghts-jdem (Tables 4-3...4-5, the mixing
 # parameters, run times) and Figs 4-11/4-12: out/mixing/ch4/report.md, summary.json and
 # fig4-1N_ENGINE.png, and the committed copy in reference_runs/mixing/ch4/results/; a result not
