@@ -35,6 +35,13 @@ class Checks:
         err = abs(got - want) / abs(want)
         return self.check(name, err <= rel, f"got {got:.12g}, want {want:.12g} (rel. error {err:.3g} > {rel:g})")
 
+    def built(self, *binaries):
+        """True when every binary is built; else one FAIL line naming the make target."""
+        for b in binaries:
+            if not os.access(b, os.X_OK):
+                return self.check("%s exists" % b, False, "make %s" % os.path.relpath(b, ROOT))
+        return True
+
     def exit(self):
         sys.exit(1 if self.failed else 0)
 

@@ -48,6 +48,7 @@ from scripts import engines
 from scripts.engines import JDEM, LIGGGHTS_JDEM, ROOT
 from scripts.mixing import breakage
 from tests.engine.engine_common import Checks
+from tests.liggghts.check_runner_resume import datasets, restart_steps, same_bits
 
 SCENE = os.path.join(ROOT, "tests", "inlet", "bonded_section.yaml")
 PY = "/usr/bin/python3"
@@ -145,25 +146,6 @@ def compare(c, jd, lg, ranks, scales):
 RESTART_EVERY, KILL_AFTER = 1000, 9000   # it continues from step 8000, after the first breaks (7184)
 
 
-def restart_steps(deck_dir):
-    names = os.listdir(deck_dir) if os.path.isdir(deck_dir) else []
-    return sorted(int(n.split(".")[1]) for n in names if n.startswith("restart.") and n.split(".")[1].isdigit())
-
-
-def datasets(path):
-    found = {}
-    with h5py.File(path, "r") as f:
-        f.visititems(lambda n, o: found.__setitem__(n, o[()]) if isinstance(o, h5py.Dataset)
-                     and not n.startswith("h5md") else None)
-    return found
-
-
-def same_bits(a, b):
-    if isinstance(a, np.ndarray) and a.dtype.kind == "f":
-        return a.shape == b.shape and np.array_equal(a, b, equal_nan=True)
-    return np.array_equal(a, b)
-
-
 def check_restart(c, tmp, ranks):
     runner = [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), SCENE, "--np", str(ranks),
               "--checkpoint-every", str(RESTART_EVERY)]
@@ -238,10 +220,8 @@ def check_bad_sections(c, tmp):
 
 def main():
     c = Checks()
-    for b in (JDEM, LIGGGHTS_JDEM):
-        if not os.access(b, os.X_OK):
-            c.check("%s exists" % b, False, "make %s" % os.path.relpath(b, ROOT))
-            return 1
+    if not c.built(JDEM, LIGGGHTS_JDEM):
+        return 1
     sc = yaml.safe_load(engines.resolve(SCENE, check=True).stdout)
     inlet = sc["inlets"][0]
     R = max(p["radius"] for p in inlet["section"]["particles"])

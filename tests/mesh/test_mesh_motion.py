@@ -233,10 +233,8 @@ def check_belt(c, tmp):
 
 def main():
     c = Checks()
-    for b in (engines.JDEM, engines.LIGGGHTS_JDEM):
-        if not os.access(b, os.X_OK):
-            c.check("%s exists" % b, False, "make %s" % os.path.relpath(b, ROOT))
-            return 1
+    if not c.built(engines.JDEM, engines.LIGGGHTS_JDEM):
+        return 1
     with tempfile.TemporaryDirectory() as tmp:
         check_drum(c, tmp)
         check_piston(c, tmp)
