@@ -103,14 +103,41 @@ void jd_mesh_motion_velocity(const jd_mesh_motion *m, size_t n, const double (*c
     }
 }
 
-void jd_mesh_conveyor_velocity(const double u[3], const double t[3][3], double v[3][3]) {
-    double e[3][3], n[3];
+/* The triangle's unit normal as LIGGGHTS' TriMesh stores it: (t1 - t0)/|t1 - t0| x
+ * (t2 - t1)/|t2 - t1|, normalised. */
+static void face_normal(const double t[3][3], double n[3]) {
+    double e[2][3];
     for (int i = 0; i < 2; i++) {
         for (int k = 0; k < 3; k++) e[i][k] = t[(i + 1) % 3][k] - t[i][k];
         scale_inv3(e[i], mag3(e[i]));
     }
     cross3(e[0], e[1], n);
     scale_inv3(n, mag3(n));
+}
+
+void jd_mesh_spin_velocity(const double origin[3], const double axis[3], double omega,
+                           const double t[3][3], double v[3][3]) {
+    double n[3], unit[3] = {axis[0], axis[1], axis[2]};
+    face_normal(t, n);
+    scale_inv3(unit, mag3(unit));
+    for (int c = 0; c < 3; c++) {
+        const double arm[3] = {t[c][0] - origin[0], t[c][1] - origin[1], t[c][2] - origin[2]};
+        double tang[3];
+        cross3(arm, unit, tang);
+        for (int k = 0; k < 3; k++) tang[k] = -omega * tang[k];
+        const double along = tang[0] * n[0] + tang[1] * n[1] + tang[2] * n[2];
+        for (int k = 0; k < 3; k++) v[c][k] = tang[k] - along * n[k];
+        const double speed = mag3(tang), left = mag3(v[c]);
+        if (left > 0.0) {
+            scale_inv3(v[c], left);
+            for (int k = 0; k < 3; k++) v[c][k] = speed * v[c][k];
+        }
+    }
+}
+
+void jd_mesh_conveyor_velocity(const double u[3], const double t[3][3], double v[3][3]) {
+    double n[3];
+    face_normal(t, n);
     const double speed = mag3(u), along = u[0] * n[0] + u[1] * n[1] + u[2] * n[2];
     double tang[3];
     for (int k = 0; k < 3; k++) tang[k] = u[k] - along * n[k];

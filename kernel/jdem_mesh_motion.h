@@ -13,6 +13,8 @@
  *     subtraction and addition are skipped when the origin is (0, 0, 0), as LIGGGHTS skips them);
  *   - the corners' velocities after the step: the translation velocity, or (omega axis) x
  *     (corner - origin) at the moved corner;
+ *   - a spinning surface's corner velocity (surface_ang_vel): omega axis x (corner - origin),
+ *     its normal part removed and rescaled as a conveyor's;
  *   - a conveyor's corner velocity: the surface velocity's component tangential to the
  *     triangle, rescaled to the surface velocity's magnitude.  Where the surface velocity is
  *     normal to a triangle (its tangential part below 1e-12 of it) the triangle is at rest;
@@ -70,6 +72,15 @@ void jd_mesh_motion_velocity(const jd_mesh_motion *m, size_t n, const double (*c
  * ((t1 - t0)/|t1 - t0| x (t2 - t1)/|t2 - t1|, normalised), rescaled to |u|, or zero when that
  * remainder is below 1e-12 |u|; the same at the three corners. */
 void jd_mesh_conveyor_velocity(const double u[3], const double t[3][3], double v[3][3]);
+
+/* The velocity [m/s] of the three corners of triangle t[3][3] [m] of a surface spinning at
+ * omega [rad/s] about the axis through origin [m] along axis (any length > 0), the triangles
+ * staying in place (LIGGGHTS' fix mesh/surface surface_ang_vel, operation for operation): at
+ * corner c, w = -omega (t_c - origin) x axis/|axis|, minus its component along the triangle's
+ * unit normal (jd_mesh_conveyor_velocity's), rescaled to |w| (left as it is when nothing
+ * remains).  For a surface of revolution about the axis, w is tangential already. */
+void jd_mesh_spin_velocity(const double origin[3], const double axis[3], double omega,
+                           const double t[3][3], double v[3][3]);
 
 #ifdef __cplusplus
 }

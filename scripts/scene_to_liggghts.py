@@ -188,10 +188,13 @@ def mesh_lines(meshes, tid, taken):
         scale = float(w.get("scale", 1.0))
         mid = identifier(w["name"], "m_", taken)
         belt = [float(c) for c in w.get("surface_velocity", [0, 0, 0])]
-        L.append("fix %s all mesh/surface file %s type %d%s%s\n" % (
+        spin = w.get("surface_angular_velocity")
+        L.append("fix %s all mesh/surface file %s type %d%s%s%s\n" % (
             mid, word(w["file"], "mesh file"), tid[w["material"]],
             "" if scale == 1.0 else " scale %s" % num(scale),
-            " surface_vel %s" % vec(belt) if any(belt) else ""))
+            " surface_vel %s" % vec(belt) if any(belt) else "",
+            " surface_ang_vel origin %s axis %s omega %s" % (vec(spin["origin"]), vec(spin["axis"]),
+                                                             num(spin["omega"])) if spin else ""))
         L.extend(mesh_motion_lines(w, mid, taken))
         L.append("fix %s all wall/jiang mesh n_meshes 1 meshes %s\n" % (fid, mid))
     return L

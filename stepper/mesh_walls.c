@@ -12,14 +12,18 @@
 
 static int nonzero3(const double v[3]) { return v[0] != 0.0 || v[1] != 0.0 || v[2] != 0.0; }
 
-/* The wall's velocity at the corners of a moving or conveyor mesh. */
-static void corner_velocities(jd_sim_mesh *m, const double surface_velocity[3]) {
+/* The wall's velocity at the corners of a moving, conveyor or spinning mesh. */
+static void corner_velocities(jd_sim_mesh *m, const jd_mesh_wall *in) {
     if (m->motion.kind != JD_MESH_STILL)
         jd_mesh_motion_velocity(&m->motion, 3 * m->topo.ntri, (const double(*)[3])m->corner,
                                 (double(*)[3])m->vnode);
+    else if (in->spinning)
+        for (size_t t = 0; t < m->topo.ntri; t++)
+            jd_mesh_spin_velocity(in->spin_origin, in->spin_axis, in->spin_omega,
+                                  (const double(*)[3])m->corner[t], m->vnode[t]);
     else
         for (size_t t = 0; t < m->topo.ntri; t++)
-            jd_mesh_conveyor_velocity(surface_velocity, (const double(*)[3])m->corner[t], m->vnode[t]);
+            jd_mesh_conveyor_velocity(in->surface_velocity, (const double(*)[3])m->corner[t], m->vnode[t]);
 }
 
 /* The corners, motion and topology of scene wall `in` into m (the scene reader has run the
@@ -29,10 +33,11 @@ static int mesh_init(jd_sim_mesh *m, const jd_mesh_wall *in, size_t stride, char
     const int moving = in->motion.kind != JD_MESH_STILL;
     m->motion = in->motion;
     m->corner = malloc(n * sizeof *m->corner);
-    if (moving || nonzero3(in->surface_velocity)) m->vnode = malloc(n * sizeof *m->vnode);
+    const int surface = nonzero3(in->surface_velocity) || in->spinning;
+    if (moving || surface) m->vnode = malloc(n * sizeof *m->vnode);
     if (moving) m->corner_at_build = malloc(n * sizeof *m->corner_at_build);
     if (!m->corner || (moving && (!m->vnode || !m->corner_at_build)) ||
-        (nonzero3(in->surface_velocity) && !m->vnode)) {
+        (surface && !m->vnode)) {
         snprintf(err, errlen, "out of memory for the corners of mesh wall '%s'", in->name);
         return -1;
     }
@@ -57,7 +62,7 @@ static int mesh_init(jd_sim_mesh *m, const jd_mesh_wall *in, size_t stride, char
         snprintf(err, errlen, "mesh wall '%s': triangle %zu is degenerate", in->name, bad);
         return -1;
     }
-    if (m->vnode) corner_velocities(m, in->surface_velocity);
+    if (m->vnode) corner_velocities(m, in);
     return 0;
 }
 

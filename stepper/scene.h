@@ -68,6 +68,10 @@ typedef struct jd_mesh_wall {
     double rotation_period;   /* rotation: the period as given [s] (0 when not rotating) */
     double rotation_axis[3];  /* rotation: the axis as given */
     double surface_velocity[3]; /* a conveyor surface's velocity [m/s]; (0, 0, 0): none */
+    int spinning;             /* surface_angular_velocity given: the surface spins in place */
+    double spin_origin[3];    /* a point of its axis [m] */
+    double spin_axis[3];      /* its axis, as given (any length > 0) */
+    double spin_omega;        /* its angular velocity, right-handed about spin_axis [rad/s] */
 } jd_mesh_wall;
 
 /* Run-time watchdog (docs/scenes.md "Watchdog"): limits that stop a run that goes wrong. */

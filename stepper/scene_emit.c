@@ -241,6 +241,10 @@ static int emit_mesh_wall(yaml_emitter_t *e, const jd_scene *s, const jd_mesh_wa
          key_vec(e, "axis", w->rotation_axis) || key_num(e, "period", w->rotation_period) ||
          map_end(e)))
         return 1;
+    if (w->spinning &&
+        (str(e, "surface_angular_velocity") || map_start(e, 1) || key_vec(e, "origin", w->spin_origin) ||
+         key_vec(e, "axis", w->spin_axis) || key_num(e, "omega", w->spin_omega) || map_end(e)))
+        return 1;
     return map_end(e);
 }
 

@@ -129,8 +129,29 @@ static int read_rotation(loader *L, const yaml_node_t *w, const char *path, jd_m
     return 0;
 }
 
-/* velocity, rotation and surface_velocity: at most one motion, and a conveyor surface only on
- * a mesh that stays (LIGGGHTS' move/mesh replaces the surface's velocity by the motion's). */
+static const char *const SPIN_KEYS[] = {"origin", "axis", "omega", NULL};
+
+/* walls.K.surface_angular_velocity: {origin, axis, omega} (fix mesh/surface surface_ang_vel). */
+static int read_spin(loader *L, const yaml_node_t *w, const char *path, jd_mesh_wall *mw) {
+    const yaml_node_t *r = sd_get(&L->c, w, "surface_angular_velocity");
+    char sub[SD_PATH_MAX], key[SD_PATH_MAX];
+    sd_join(sub, path, "surface_angular_velocity");
+    if (sd_keys(&L->c, r, sub, SPIN_KEYS) || sd_req_vec3(&L->c, r, sub, "origin", mw->spin_origin) ||
+        sd_req_vec3(&L->c, r, sub, "axis", mw->spin_axis) ||
+        sd_req_num(&L->c, r, sub, "omega", SD_ANY, &mw->spin_omega))
+        return -1;
+    if (!nonzero3(mw->spin_axis)) {
+        sd_join(key, sub, "axis");
+        return sd_fail(&L->c, sd_get(&L->c, r, "axis"), key, "the spin axis is (0, 0, 0); valid: "
+                       "a non-zero direction (any length)");
+    }
+    mw->spinning = 1;
+    return 0;
+}
+
+/* velocity, rotation, surface_velocity and surface_angular_velocity: at most one motion, and a
+ * conveyor or spinning surface only on a mesh that stays (LIGGGHTS' move/mesh replaces the
+ * surface's velocity by the motion's), and not both. */
 static int read_motion(loader *L, const yaml_node_t *w, const char *path, jd_mesh_wall *mw) {
     double v[3] = {0.0, 0.0, 0.0};
     char sub[SD_PATH_MAX];
@@ -152,7 +173,13 @@ static int read_motion(loader *L, const yaml_node_t *w, const char *path, jd_mes
                        "on a moving mesh; valid: surface_velocity on a mesh wall without "
                        "velocity or rotation");
     }
-    return 0;
+    if (!sd_get(&L->c, w, "surface_angular_velocity")) return 0;
+    sd_join(sub, path, "surface_angular_velocity");
+    if (mw->motion.kind != JD_MESH_STILL || nonzero3(mw->surface_velocity))
+        return sd_fail(&L->c, sd_get(&L->c, w, "surface_angular_velocity"), sub, "a spinning "
+                       "surface on a moving or conveyor mesh; valid: surface_angular_velocity on a "
+                       "mesh wall without velocity, rotation or surface_velocity");
+    return read_spin(L, w, path, mw);
 }
 
 int scene_read_mesh_wall(loader *L, const yaml_node_t *w, const char *path, jd_mesh_wall *mw) {

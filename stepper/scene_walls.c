@@ -20,7 +20,7 @@ static const char *const CYLINDER_KEYS[] = {"name",     "type",     "axis",    "
                                             "angular_velocity", NULL};
 static const char *const MESH_KEYS[] = {"name",     "type",     "file",     "material",
                                         "scale",    "velocity", "rotation", "surface_velocity",
-                                        NULL};
+                                        "surface_angular_velocity", NULL};
 static const char *const BOOLEANS[] = {"false", "true", NULL};
 
 /* Enum spellings, indexed by the kernel's enum values. */
