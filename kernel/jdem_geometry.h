@@ -193,16 +193,19 @@ static inline int jd_geom_cylinder(const jd_cylinder *c, const double x[3], doub
     return 1;
 }
 
-/* The velocity out [m/s] of the point p [m] on the surface of cylinder c when the cylinder
+/* The velocity out [m/s] of cylinder c's surface at the contact point p = x + ra of a sphere
+ * centred at x [m] (ra [m]: jd_geom_cylinder's, centre to contact point) when the cylinder
  * translates at v [m/s] and spins at omega [rad/s] about its axis (right-handed about a1 - a0;
  * the shape does not change, so the geometry above does not see the spin):
  * v + omega u x (p - a0), u = (a1 - a0)/|a1 - a0|; exactly v when omega = 0. */
 static inline void jd_cylinder_surface_velocity(const jd_cylinder *c, const double v[3], double omega,
-                                                const double p[3], double out[3]) {
+                                                const double x[3], const double ra[3],
+                                                double out[3]) {
     if (omega == 0.0) {
         for (int k = 0; k < 3; k++) out[k] = v[k];
         return;
     }
+    const double p[3] = {x[0] + ra[0], x[1] + ra[1], x[2] + ra[2]};
     const double ab[3] = {c->a1[0] - c->a0[0], c->a1[1] - c->a0[1], c->a1[2] - c->a0[2]};
     const double s = omega / sqrt(jd_dot(ab, ab));
     const double w[3] = {s * ab[0], s * ab[1], s * ab[2]};

@@ -332,12 +332,10 @@ void FixWallJiang::loop(bool commit) {
     jd_kinematics k;
     jd_copy3(k.va, v[i]);
     jd_copy3(k.wa, omega[i]);
-    if (shape == 1) { /* the surface's velocity where the sphere touches it */
-      const double p[3] = {x[i][0] + g.ra[0], x[i][1] + g.ra[1], x[i][2] + g.ra[2]};
-      jd_cylinder_surface_velocity(&cyl, vel, spin, p, k.vb);
-    } else {
+    if (shape == 1) /* the surface's velocity where the sphere touches it */
+      jd_cylinder_surface_velocity(&cyl, vel, spin, x[i], g.ra, k.vb);
+    else
       jd_copy3(k.vb, vel);
-    }
     k.wb[0] = k.wb[1] = k.wb[2] = 0.0;
     JdHistory<F> hs(h, roll_at, commit);
     jd_contact_result out;

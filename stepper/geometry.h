@@ -76,8 +76,7 @@ static inline void wall_point_velocity(const jd_sim_wall *w, const double x[3], 
         for (int d = 0; d < 3; d++) vb[d] = w->v[d];
         return;
     }
-    const double p[3] = {x[0] + ra[0], x[1] + ra[1], x[2] + ra[2]};
-    jd_cylinder_surface_velocity(&w->cyl, w->v, w->spin, p, vb);
+    jd_cylinder_surface_velocity(&w->cyl, w->v, w->spin, x, ra, vb);
 }
 
 #endif /* JDEM_GEOMETRY_H */
