@@ -1,8 +1,9 @@
 /*
  * scene_deposit.c — the particles_from section (docs/scenes.md "particles_from"): the particles
  * of one frame of an H5MD trajectory, optionally only those whose centre lies in a region, moved
- * by a translation.  They become ordinary particles of the resolved scene, so `jdem resolve` (and
- * the LIGGGHTS deck made from it) lists them explicitly.
+ * by a translation, and the bonds intact between them.  They become ordinary particles and bonds
+ * of the resolved scene, so `jdem resolve` (and the LIGGGHTS deck made from it) lists them
+ * explicitly.
  *
  * The region messages use the wording and number format of scripts/mixing/deposit.py (Python's
  * repr of a float), so that a cut refused by the generators and by the engines reads the same.
@@ -16,13 +17,14 @@
 #include "scene_internal.h"
 
 static const char *const ENTRY_KEYS[] = {"file", "frame", "region", "dilate", "translate",
-                                         "velocities", "ids", NULL};
+                                         "velocities", "ids", "bonds", NULL};
 /* A dilation spreads a cut that was under the deposit's pressure until its overlaps are gone;
  * past 2 the cut is no longer the packing it was taken from. */
 static const sd_range DILATION = {1.0, 2.0, 0, 0};
 static const char *const REGION_KEYS[] = {"lo", "hi", NULL};
 static const char *const VELOCITIES[] = {"zero", "keep", NULL};
 static const char *const IDS[] = {"keep", "renumber", NULL};
+static const char *const BONDS[] = {"keep", "none", NULL};
 
 /* x as Python's repr(float) writes it: the shortest digits that read back as x, in fixed
  * notation for decimal exponents -4 to 15 (with ".0" if integral), else d.ddde+XX. */
@@ -88,6 +90,8 @@ typedef struct deposit_entry {
     double lo[3], hi[3], shift[3];
     double dilate; /* positions scaled by this about the region's centre, before the shift */
     int velocities, renumber;
+    int no_bonds;  /* bonds: none (default keep: the frame's intact bonds between kept particles) */
+    int section;   /* an inlet section's from_deposit, whose bonds are not carried over */
 } deposit_entry;
 
 static int read_region(loader *L, deposit_entry *d) {
@@ -124,7 +128,7 @@ static int read_entry(loader *L, const yaml_node_t *map, const char *list_path, 
     d->dilate = 1.0;
     sd_join_index(d->path, list_path, k);
     if (sd_mapping(&L->c, map, d->path,
-                   "{file, frame, region, dilate, translate, velocities, ids}") ||
+                   "{file, frame, region, dilate, translate, velocities, ids, bonds}") ||
         sd_keys(&L->c, map, d->path, ENTRY_KEYS))
         return -1;
     d->file_node = sd_get(&L->c, map, "file");
@@ -141,7 +145,8 @@ static int read_entry(loader *L, const yaml_node_t *map, const char *list_path, 
                    read_region(L, d) || read_dilation(L, d) ||
                    sd_opt_vec3(&L->c, map, d->path, "translate", d->shift) ||
                    sd_opt_enum(&L->c, map, d->path, "velocities", VELOCITIES, &d->velocities) ||
-                   sd_opt_enum(&L->c, map, d->path, "ids", IDS, &d->renumber)
+                   sd_opt_enum(&L->c, map, d->path, "ids", IDS, &d->renumber) ||
+                   sd_opt_enum(&L->c, map, d->path, "bonds", BONDS, &d->no_bonds)
                ? -1
                : 0;
 }
@@ -213,16 +218,19 @@ static int deposit_material(loader *L, const deposit_entry *d, const dep_frame *
                    "poisson_ratio and density in materials", d->file, fr->materials[sp]);
 }
 
+/* Add the kept particles; new_id[j] is the id slot j got (-1: not kept). */
 static int add_kept(loader *L, const deposit_entry *d, const dep_frame *fr, int32_t src,
-                    int64_t *next_id) {
+                    int64_t *next_id, int64_t *new_id) {
     jd_scene *s = L->s;
     size_t count = 0;
     for (size_t j = 0; j < fr->n; j++) {
+        new_id[j] = -1;
         if (fr->id[j] < 0 || !kept(d, &fr->position[3 * j])) continue;
         int mat = deposit_material(L, d, fr, fr->species[j]);
         long i = mat < 0 ? -1 : scene_add_particle(L, d->map, src);
         if (i < 0) return -1;
         s->id[i] = d->renumber ? (*next_id)++ : fr->id[j];
+        new_id[j] = s->id[i];
         s->material[i] = mat;
         s->radius[i] = fr->radius[j];
         s->settled[i] = 1;
@@ -249,37 +257,76 @@ static int add_kept(loader *L, const deposit_entry *d, const dep_frame *fr, int3
                    "valid: a region holding at least one particle centre", lo, hi);
 }
 
+/* This scene's bond type for the deposit's type t, or -1 after reporting. */
+static int deposit_bond_type(loader *L, const deposit_entry *d, const dep_frame *fr, int32_t t) {
+    const jd_scene *s = L->s;
+    for (size_t i = 0; i < s->n_bond_types; i++)
+        if (strcmp(s->bond_types[i].name, fr->bond_types[t]) == 0) return (int)i;
+    char sub[SD_PATH_MAX];
+    sd_join(sub, d->path, "file");
+    return sd_fail(&L->c, d->file_node, sub, "%s: the deposit's bond type '%s' is not a bond type "
+                   "of this scene; valid: a bond type of that name under bond_types, or bonds: "
+                   "none", d->file, fr->bond_types[t]);
+}
+
+/* The bonds intact at the frame between two kept particles become explicit bonds of the scene,
+ * formed at step 0 with zero force where the particles now are (the deposit's bond forces, like
+ * its tangential contact history, are not carried over). */
+static int add_kept_bonds(loader *L, const deposit_entry *d, const dep_frame *fr,
+                          const int64_t *new_id) {
+    size_t carried = 0;
+    for (size_t l = 0; l < fr->n_lines; l++) {
+        const int64_t a = new_id[fr->line_row[2 * l]], b = new_id[fr->line_row[2 * l + 1]];
+        if (a < 0 || b < 0) continue;
+        if (d->section) {
+            carried++;
+            continue;
+        }
+        const int type = deposit_bond_type(L, d, fr, fr->line_type[l]);
+        if (type < 0 || scene_add_bond(L, d->map, a, b, type)) return -1;
+    }
+    if (!carried) return 0;
+    return sd_fail(&L->c, d->map, d->path, "%s: %zu bonds intact between the kept particles, "
+                   "which an inlet section does not carry over; valid: bonds: none (the section "
+                   "unbonded), or the section's blocks and bonds", d->file, carried);
+}
+
 static int read_deposit(loader *L, const yaml_node_t *map, const char *list_path, size_t k,
-                        int64_t *next_id) {
+                        int section, int64_t *next_id) {
     deposit_entry d;
     if (read_entry(L, map, list_path, k, &d)) return -1;
+    d.section = section;
     dep_frame fr;
     char msg[1024];
-    if (dep_read_frame(d.file, d.frame, d.velocities, &fr, msg, sizeof msg)) {
+    if (dep_read_frame(d.file, d.frame, d.velocities, !d.no_bonds, &fr, msg, sizeof msg)) {
         char sub[SD_PATH_MAX];
         int frame_error = strstr(msg, "does not exist") != NULL && d.frame_node;
         sd_join(sub, d.path, frame_error ? "frame" : "file");
         return sd_fail(&L->c, frame_error ? d.frame_node : d.file_node, sub, "%s", msg);
     }
-    int rc = (d.has_region && check_region(L, &d, &fr)) ||
-             add_kept(L, &d, &fr, PSRC_DEPOSIT(k), next_id);
+    int64_t *new_id = malloc((fr.n ? fr.n : 1) * sizeof *new_id);
+    int rc = !new_id ? sd_no_memory(&L->c, map, d.path)
+                     : (d.has_region && check_region(L, &d, &fr)) ||
+                           add_kept(L, &d, &fr, PSRC_DEPOSIT(k), next_id, new_id) ||
+                           add_kept_bonds(L, &d, &fr, new_id);
+    free(new_id);
     dep_free_frame(&fr);
     return rc ? -1 : 0;
 }
 
-int scene_read_deposit_list(loader *L, const yaml_node_t *list, const char *path) {
-    if (sd_sequence(&L->c, list, path, "a list of {file, frame, region, translate, velocities, "
-                    "ids}"))
+int scene_read_deposit_list(loader *L, const yaml_node_t *list, const char *path, int section) {
+    if (sd_sequence(&L->c, list, path, "a list of {file, frame, region, dilate, translate, "
+                    "velocities, ids, bonds}"))
         return -1;
     int64_t next_id = 1;
     for (size_t i = 0; i < L->s->n_particles; i++)
         next_id = L->s->id[i] >= next_id ? L->s->id[i] + 1 : next_id;
     for (size_t k = 0; k < sd_len(list); k++)
-        if (read_deposit(L, sd_item(&L->c, list, k), path, k, &next_id)) return -1;
+        if (read_deposit(L, sd_item(&L->c, list, k), path, k, section, &next_id)) return -1;
     return 0;
 }
 
 int scene_read_deposits(loader *L) {
     const yaml_node_t *list = sd_get(&L->c, L->root, "particles_from");
-    return list ? scene_read_deposit_list(L, list, "particles_from") : 0;
+    return list ? scene_read_deposit_list(L, list, "particles_from", 0) : 0;
 }

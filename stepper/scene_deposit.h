@@ -19,12 +19,19 @@ typedef struct dep_frame {
     double *angular_velocity;  /* [3n] [rad/s], NULL unless asked for                    */
     char **materials;          /* [n_materials] the source scene's material names, in order */
     size_t n_materials;
+    /* The bonds intact at the frame (/jdem/bond_lines), read only when asked for: */
+    size_t n_lines;            /* bonds                                                  */
+    int64_t *line_row;         /* [2 n_lines] the slots of their two particles           */
+    int32_t *line_type;        /* [n_lines] index into bond_types                        */
+    char **bond_types;         /* [n_bond_types] the source scene's bond type names, in order */
+    size_t n_bond_types;
 } dep_frame;
 
-/* Read frame `frame` (Python-style: -1 is the last) of FILE, with the velocities if asked.
- * Returns 0, or -1 with a one-line message naming the file and what would be valid in msg. */
-int dep_read_frame(const char *file, int64_t frame, int velocities, dep_frame *fr, char *msg,
-                   size_t len);
+/* Read frame `frame` (Python-style: -1 is the last) of FILE, with the velocities and the intact
+ * bonds if asked (a trajectory without bonds has none).  Returns 0, or -1 with a one-line
+ * message naming the file and what would be valid in msg. */
+int dep_read_frame(const char *file, int64_t frame, int velocities, int bonds, dep_frame *fr,
+                   char *msg, size_t len);
 void dep_free_frame(dep_frame *fr);
 
 #endif

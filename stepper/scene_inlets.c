@@ -100,7 +100,7 @@ static int read_section(loader *L, const yaml_node_t *m, const char *path, jd_in
         if (section_particle(L, sd_item(&L->c, parts, k), pp)) return -1;
     }
     sd_join(item, sub, "from_deposit");
-    if (deposits && scene_read_deposit_list(L, deposits, item)) return -1;
+    if (deposits && scene_read_deposit_list(L, deposits, item, 1)) return -1;
     return take_section(L, from, in, sec, sub) || scene_read_section_bonds(L, sec, sub, in, *blocks);
 }
 

@@ -113,8 +113,10 @@ int scene_check_inlets(loader *L);
 #define PSRC_IS_DEPOSIT(src) ((src) < INT32_MIN / 2)
 int scene_read_deposits(loader *L);
 /* The deposit entries of `list` (at `path`, e.g. an inlet's section.from_deposit) appended to
- * the scene's particles, each marked settled. */
-int scene_read_deposit_list(loader *L, const yaml_node_t *list, const char *path);
+ * the scene's particles, each marked settled, with the bonds intact between them (bonds: keep,
+ * the default; `section`: an inlet's section, which refuses a deposit whose kept particles are
+ * bonded unless bonds: none). */
+int scene_read_deposit_list(loader *L, const yaml_node_t *list, const char *path, int section);
 
 /* scene_walls.c */
 int scene_read_walls(loader *L);

@@ -8,8 +8,11 @@ x Models 1-6): the fill, `ENGINE/groupG_modelM/fill` into out/mixing/ch5/ENGINE/
 the seed's dt = 1e-4 s, which the guard accepts for Table 5-1's softer small spheres (largest
 safe dt 1.28e-4 s; Chapter 4's needs --force, docs/mixing.md §6).  Each fill is resumable the way plan_ch4's are (jdem's checkpoints,
 LIGGGHTS' restart files), and writes its scene first: `jdem resolve` of the case, the one scene
-both engines run.  --ranks N runs each liggghts-jdem fill on N MPI ranks.  The Ch. 5
-measurements (the 27 points, the cubes of the middle clip under 5 kPa) are not units yet.
+both engines run.  --ranks N runs each liggghts-jdem fill on N MPI ranks.  After each fill:
+`ENGINE/CASE/cubes`, the 9 cube scenes of the middle clip (reference_runs/mixing/ch5/generate.py:
+points 10-18 of Table 5-2 under 5 kPa, each with its own copy of the deposit and its intact
+bonds), and `ENGINE/CASE/cubeK`, K = 10..18, their compressions, into
+out/mixing/ch5/ENGINE/CASE/cubeK.h5 (the 27 points' phi_v are read from the fill itself).
 """
 import os
 import shlex
@@ -17,10 +20,13 @@ import shlex
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 from scripts.campaign import Unit
-from scripts.mixing.plan_ch4 import (ENGINES, FILL_PARTICLES, FILL_TIME, SEED_DT, fill_command,
-                                     fill_ranks, jdem, resumable, valid_trajectory)
+from scripts.mixing.plan_ch4 import (CUBE_PARTICLES, CUBE_TIME, ENGINES, FILL_PARTICLES, FILL_TIME,
+                                     PY, SCENE_COST, SEED_DT, fill_command, fill_ranks, jdem,
+                                     resumable, run_command, valid_scene, valid_trajectory)
 
 SCENE = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "models.yaml")
+GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "generate.py")
+CUBES = range(10, 19)     # Table 5-2's middle clip
 OUT = os.path.join(ROOT, "out", "mixing", "ch5")
 CASES = [f"group{g}_model{m}" for g in range(1, 4) for m in range(1, 7)]
 
@@ -33,6 +39,22 @@ def fill_unit(engine, case, ranks):
                 resumes=resumable(engine), ranks=fill_ranks(engine, ranks))
 
 
+def cube_units(engine, case):
+    """The middle clip's 9 cube scenes of the fill's deposit, and their compressions."""
+    base = os.path.join(OUT, engine, case)
+    scenes = [os.path.join(base, "cubes", f"cube{k}.yaml") for k in CUBES]
+    units = [Unit(f"{engine}/{case}/cubes", scenes,
+                  [PY, GENERATE, "cubes", os.path.join(base, "fill.h5"), "--case", case,
+                   "-o", "{dir}"], case, engine, needs=[f"{engine}/{case}/fill"],
+                  validate=valid_scene, cost=SCENE_COST)]
+    for k, scene in zip(CUBES, scenes):
+        units.append(Unit(f"{engine}/{case}/cube{k}", [os.path.join(base, f"cube{k}.h5")],
+                          run_command(engine, scene, "{out0}", False), case, engine,
+                          needs=[f"{engine}/{case}/cubes"], validate=valid_trajectory,
+                          cost=CUBE_PARTICLES * CUBE_TIME / SEED_DT))
+    return units
+
+
 def units(argv):
     import argparse
     ap = argparse.ArgumentParser(prog="plan_ch5.py")
@@ -41,4 +63,5 @@ def units(argv):
     a = ap.parse_args(argv)
     if a.ranks < 1:
         ap.error("--ranks %d: valid: a positive number of MPI ranks" % a.ranks)
-    return [fill_unit(engine, case, a.ranks) for engine in ENGINES for case in CASES]
+    return [u for engine in ENGINES for case in CASES
+            for u in [fill_unit(engine, case, a.ranks)] + cube_units(engine, case)]

@@ -7,7 +7,10 @@ fills of `make mixing-bonded` (docs/mixing.md §11).
 Reads OUT/ENGINE/groupG_modelM/fill.h5: phi_v at the 27 points of Table 5-2 from the last frame
 (Table 5-3 is the middle clip, points 10-18, y = 0.5 m; the trimmed mean and std of
 scripts/mixing/stats.py), and the breakage of the whole fill (scripts/mixing/breakage.py: the
-bonds formed and broken per mode, the fragments at the end); the run times from the campaign's
+bonds formed and broken per mode, the fragments at the end), and when all 9 compressions of the
+middle clip are done (OUT/ENGINE/CASE/cubeK.h5, K = 10..18) Tables 5-4 and 5-5 (E, nu_xy, nu_xz of
+the orthotropic fit on the best-fit particle strain) and the unambiguous M and K0
+(report_ch4.cube_result, the Ch. 4 analysis); the run times from the campaign's
 .campaign_times.json.  Writes OUT/report.md and OUT/summary.json, and with --results (default
 reference_runs/mixing/ch5/results for the default OUT) also there; a fill not under OUT is
 taken from the committed summary.json, with the commit it came from.  The seed reports no
@@ -20,7 +23,7 @@ import os
 import numpy as np
 
 from scripts.mixing import breakage, deposit, params, stats
-from scripts.mixing.report_ch4 import commit, write_atomic
+from scripts.mixing.report_ch4 import commit, cube_result, write_atomic
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_OUT = os.path.join(ROOT, "out", "mixing", "ch5")
@@ -39,6 +42,21 @@ SEED_PHI_V = {1: [(0.0575, 0.0933), (0.0186, 0.0319), (0.4658, 0.2712), (0.4507,
                   (0.3771, 0.1441), (0.3225, 0.3449)],
               3: [(0.0434, 0.0663), (0.0501, 0.0671), (0.2417, 0.1927), (0.2846, 0.1744),
                   (0.1331, 0.0540), (0.3163, 0.4352)]}
+
+
+# spec §3.6-3.7, Tables 5-4 and 5-5: (mean, std) per group, Models 1-6
+SEED_ELASTIC = {
+    "E": {1: [(4483, 2860), (5702, 3050), (4753, 1317), (8195, 3396), (5970, 2801), (5427, 2893)],
+          2: [(6522, 1781), (4189, 742), (3157, 697), (3072, 1081), (6759, 2122), (4618, 857)],
+          3: [(5838, 1350), (4764, 1317), (4880, 1415), (5136, 1959), (4803, 820), (4827, 1394)]},
+    "nu_xy": {1: [(0.513, 0.074), (0.549, 0.076), (0.519, 0.122), (0.661, 0.117), (0.554, 0.080), (0.559, 0.118)],
+              2: [(0.578, 0.085), (0.470, 0.061), (0.451, 0.079), (0.495, 0.061), (0.554, 0.081), (0.509, 0.056)],
+              3: [(0.515, 0.066), (0.484, 0.055), (0.505, 0.091), (0.582, 0.071), (0.485, 0.049), (0.523, 0.084)]},
+    "nu_xz": {1: [(0.441, 0.068), (0.412, 0.067), (0.411, 0.071), (0.298, 0.113), (0.386, 0.068), (0.387, 0.088)],
+              2: [(0.371, 0.063), (0.460, 0.034), (0.465, 0.045), (0.454, 0.029), (0.374, 0.060), (0.418, 0.029)],
+              3: [(0.426, 0.043), (0.452, 0.041), (0.428, 0.058), (0.386, 0.058), (0.442, 0.032), (0.419, 0.058)]},
+}
+CUBES = range(10, 19)
 
 
 def case(g, m):
@@ -79,6 +97,12 @@ def collect(out, committed, rev):
                 path = os.path.join(out, engine, case(g, m), "fill.h5")
                 if os.path.exists(path):
                     entry = dict(fill_result(path), source=rev)
+                    cubes = [os.path.join(out, engine, case(g, m), "cube%d.h5" % k) for k in CUBES]
+                    if all(os.path.exists(c) for c in cubes):
+                        entry["cubes"] = [cube_result(c) for c in cubes]
+                        took = [spent.get("%s/cube%d" % (name, k), {}).get("seconds") for k in CUBES]
+                        if all(t is not None for t in took):
+                            entry["cube_seconds"] = float(sum(took))
                     if name + "/fill" in spent:
                         entry["seconds"] = spent[name + "/fill"].get("seconds")
                     found[name] = entry
@@ -92,6 +116,40 @@ def cell(entry, fmt="%.4f"):
         return "—"
     s = entry["middle_clip"]
     return (fmt + " ± " + fmt) % (s["mean"], s["std"])
+
+
+def elastic_cell(entry, key, fmt):
+    if not entry or "cubes" not in entry:
+        return "—"
+    s = stats.summary([c[key] for c in entry["cubes"]])
+    return (fmt + " ± " + fmt) % (s["mean"], s["std"])
+
+
+def elastic_tables(found):
+    """Tables 5-4 and 5-5 (the orthotropic fit) and M, K0 (unambiguous), seed | jdem | liggghts-jdem."""
+    lines = ["### Tables 5-4 and 5-5: E and the Poisson ratios at the middle clip (σzz = 5 kPa)", "",
+             "mean ± std over the 9 cubes of points 10–18, the highest and lowest dropped; the fit of a "
+             "laterally confined cube is ill-posed (spec §2.4, docs/model.md §10): compare M and K0", "",
+             "| group | model | E seed [Pa] | E jdem | E liggghts-jdem | νxy seed | νxy jdem | νxy liggghts-jdem "
+             "| νxz seed | νxz jdem | νxz liggghts-jdem | M (wall strain) jdem / liggghts-jdem [Pa] | K0 jdem / liggghts-jdem "
+             "| 9 cubes' run time jdem / liggghts-jdem [s] |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for g in GROUPS:
+        for m in MODELS:
+            es = [found.get("%s/%s" % (e, case(g, m))) for e in ENGINES]
+            if not any(e and "cubes" in e for e in es):
+                continue
+            cols = []
+            for key, fmt in (("E", "%.0f"), ("nu_xy", "%.3f"), ("nu_xz", "%.3f")):
+                cols.append(fmt % SEED_ELASTIC[key][g][m - 1][0] + " ± " + fmt % SEED_ELASTIC[key][g][m - 1][1])
+                cols += [elastic_cell(e, key, fmt) for e in es]
+            cols.append(" / ".join(elastic_cell(e, "M_wall", "%.0f") for e in es))
+            cols.append(" / ".join(elastic_cell(e, "K0", "%.3f") for e in es))
+            cols.append(" / ".join("%.0f" % e["cube_seconds"] if e and e.get("cube_seconds") else "—" for e in es))
+            lines.append("| %d | %d | %s |" % (g, m, " | ".join(cols)))
+    if len(lines) == 6:
+        lines.append("(no case has all 9 compressions yet)")
+    return lines
 
 
 def report(found, rev):
@@ -117,6 +175,7 @@ def report(found, rev):
             lines.append("| %s | %s | %d | %d | %.3f | %.3f | %d | %d | %d |" % (
                 *name.split("/"), k["formed"], k["broken"], k["tension"], k["shear"],
                 k["fragments"], k["whole_blocks"], k["singles"]))
+    lines += [""] + elastic_tables(found)
     sources = sorted({(n, e["source"]) for n, e in found.items() if e.get("source") != rev})
     lines += ["", "From earlier commits: " + (", ".join("%s (%s)" % s for s in sources) if sources else "none"),
               "", "Not run: %d of %d fills." % (2 * 18 - len(found), 2 * 18), ""]

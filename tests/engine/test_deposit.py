@@ -11,6 +11,12 @@ of this test are made from its last frame.  Checks:
   - empty slots: a trajectory whose id is a time series with -1 for empty slots (a changing
     particle set) gives only the occupied slots of the frame;
   - ids: renumber gives the kept particles consecutive ids after the scene's own particles;
+  - bonds: from a bonded block that broke on a plate (tests/liggghts/bond_scenes/block_drop.yaml),
+    the resolved scene's bonds are exactly those intact at the frame between two kept particles,
+    as scripts/mixing/breakage.py computes them from the bond and break tables (formed by the
+    frame's step, not broken by then), with their type by name; bonds: none keeps none; a bond
+    type the scene lacks, and a bonded deposit fed to an inlet section (which does not carry
+    bonds), are refused with their exact messages;
   - the other engine: the LIGGGHTS deck made from the resolved scene (scene_to_liggghts.py) runs
     the same particles, and its trajectory matches build/jdem's (compare_trajectories.py); a
     scene started from liggghts-jdem's trajectory gets its last frame bit for bit;
@@ -179,6 +185,94 @@ def check_liggghts(c, work, path, jdem_h5):
                 "the particles differ from liggghts-jdem's last frame")
 
 
+BONDED_SCENE = """jdem_scene: 1
+name: %s
+time: {dt: 1.0e-7, steps: 10}
+gravity: [0, 0, -9.81]
+materials:
+  clay: {youngs_modulus: 1.0e9, poisson_ratio: 0.25, density: 2500, restitution: 0.5, friction: 0.5}
+  plate: {restitution: 0.5, friction: 0.5}
+%swalls:
+  - {name: floor, type: plane, corners: [[-0.05,-0.05,0],[0.05,-0.05,0],[0.05,0.05,0],[-0.05,0.05,0]], material: plate}
+particles_from:
+  - %s
+"""
+CEMENT = ("bond_types:\n  %s: {normal_stiffness: 1.0e12, shear_stiffness: 5.0e11, tensile_strength: 1.5e6, "
+          "shear_strength: 1.0e6, radius_multiplier: 1.0}\n")
+
+
+def bonded_scene(work, name, entry, bond_type="cement"):
+    path = os.path.join(work, name + ".yaml")
+    with open(path, "w") as f:
+        f.write(BONDED_SCENE % (name, CEMENT % bond_type, entry))
+    return path
+
+
+INLET = """inlets:
+  - {name: belt, section: {from_deposit: [%s]}, origin: [0.0, 0.0, 0.02], velocity: [1, 0, 0],
+     plane: {point: [0.01, 0, 0], normal: [1, 0, 0]}, period: 0.1, stop: {sections: 1}}
+"""
+
+
+def check_inlet_refuses_bonds(c, work, src, intact):
+    text = BONDED_SCENE.replace("particles_from:\n  - %s\n", "")
+    for name, entry in (("inlet_bonded", "{file: %s}" % src), ("inlet_unbonded", "{file: %s, bonds: none}" % src)):
+        path = os.path.join(work, name + ".yaml")
+        with open(path, "w") as f:
+            f.write(text % (name, CEMENT % "cement") + INLET % entry)
+        rc, _, err = resolve(path)
+        if name == "inlet_unbonded":
+            c.check("deposit_bonds_inlet_none", rc == 0, err)
+            continue
+        want = ("key 'inlets.0.section.from_deposit.0': %s: %d bonds intact between the kept particles, "
+                "which an inlet section does not carry over; valid: bonds: none (the section unbonded), "
+                "or the section's blocks and bonds" % (src, intact))
+        got = err.split(": ", 2)[-1]
+        c.check("deposit_bonds_inlet_refused", rc == 2 and got == want, "rc %d, got %r, want %r" % (rc, got, want))
+
+
+def check_bonds(c, work):
+    """The bonds intact at the frame between kept particles come along (bonds: keep, the
+    default), against breakage.py's reading of the source's tables."""
+    from scripts.mixing import breakage
+    src = os.path.join(work, "block_drop.h5")
+    drop = os.path.join(engines.ROOT, "tests", "liggghts", "bond_scenes", "block_drop.yaml")
+    p = engines.jdem("run", drop, "-o", src, "--quiet", binary=JDEM)
+    if not c.check("deposit_bonds_source_run", p.returncode == 0, p.stderr.strip()):
+        return
+    rec = breakage.read_bonds(src)
+    with h5py.File(src, "r") as f:
+        step = int(f["particles/all/position/step"][-1])
+        pos, ids = f["particles/all/position/value"][-1], f["particles/all/id"][()]
+    lo, hi = pos.min(axis=0) - 1e-6, pos.max(axis=0) + 1e-6
+    hi[0] = np.median(pos[:, 0])                       # about half of the block
+    kept = set(ids[np.all((pos >= lo) & (pos < hi), axis=1)].tolist())
+    intact = breakage.intact_at(rec, step)
+    want = sorted(tuple(sorted(b)) for b in intact.tolist() if b[0] in kept and b[1] in kept)
+    broken_kept = sum(1 for a, b in rec["broken"][rec["broken_step"] <= step].tolist() if a in kept and b in kept)
+    c.check("deposit_bonds_source_broke", broken_kept > 0 and len(want) > 0,
+            "%d intact and %d broken bonds among the kept particles: the check needs both" % (len(want), broken_kept))
+    entry = "{file: %s, region: {lo: %s, hi: %s}}" % (src, lo.tolist(), hi.tolist())
+    rc, out, err = resolve(bonded_scene(work, "bonds_keep", entry))
+    if c.check("deposit_bonds_resolve", rc == 0, err):
+        doc = yaml.load(out, Loader=yaml.CSafeLoader)
+        got = sorted(tuple(sorted(b["ids"])) for b in doc.get("bonds", []))
+        c.check("deposit_bonds_intact_kept", got == want,
+                "%d bonds, want %d (first differences %s)" % (len(got), len(want), sorted(set(got) ^ set(want))[:4]))
+        c.check("deposit_bonds_type_by_name", all(b["type"] == "cement" for b in doc.get("bonds", [])),
+                "a bond type other than cement")
+    rc, out, err = resolve(bonded_scene(work, "bonds_none", entry[:-1] + ", bonds: none}"))
+    if c.check("deposit_bonds_none_resolve", rc == 0, err):
+        c.check("deposit_bonds_none", not yaml.load(out, Loader=yaml.CSafeLoader).get("bonds"),
+                "bonds: none kept bonds")
+    rc, _, err = resolve(bonded_scene(work, "bonds_bad_type", entry, bond_type="glue"))
+    want_msg = ("key 'particles_from.0.file': %s: the deposit's bond type 'cement' is not a bond type "
+                "of this scene; valid: a bond type of that name under bond_types, or bonds: none" % src)
+    got = err.split(": ", 2)[-1]
+    c.check("deposit_bonds_bad_type", rc == 2 and got == want_msg, "rc %d, got %r, want %r" % (rc, got, want_msg))
+    check_inlet_refuses_bonds(c, work, src, len(intact))
+
+
 def bad_cases(work, src):
     """(name, entry, extra scene text, materials, expected message after 'FILE:LINE: ')."""
     dep = deposit.read_frame(src)
@@ -255,6 +349,7 @@ def main():
     check_dilation(c, work, src)
     check_empty_slots(c, work, src)
     check_bad(c, work, src)
+    check_bonds(c, work)
     if done:
         check_liggghts(c, work, *done)
     c.exit()

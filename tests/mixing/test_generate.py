@@ -1,6 +1,9 @@
 #!/usr/bin/python3
 """reference_runs/mixing/ch4/generate.py on a synthetic deposit: the second pass's 8 cells
-(regions, order, queue on the belt) and the 9 cubes (regions, walls, servo), and its messages."""
+(regions, order, queue on the belt) and the 9 cubes (regions, walls, servo), and its messages;
+reference_runs/mixing/ch5/generate.py's 9 middle-clip cubes (spec §2.3-2.4: points 10-18 of
+Table 5-2, overlapping in z, each its own scene; 5 kPa; wall friction 0.2; the case's bond
+types, the deposit's bonds kept)."""
 import math
 import os
 import subprocess
@@ -14,6 +17,7 @@ import yaml
 from tests.mixing.common import ROOT, check, finish
 
 GEN = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "generate.py")
+GEN5 = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "generate.py")
 
 
 def write_deposit(path, top):
@@ -33,8 +37,8 @@ def write_deposit(path, top):
         p["position/time"] = np.array([0.0])
 
 
-def gen(*args):
-    return subprocess.run([sys.executable, GEN, *args], capture_output=True, text=True)
+def gen(*args, script=GEN):
+    return subprocess.run([sys.executable, script, *args], capture_output=True, text=True)
 
 
 tmp = tempfile.mkdtemp()
@@ -73,6 +77,23 @@ normal = np.cross(np.subtract(top["corners"][1], top["corners"][0]),
                   np.subtract(top["corners"][2], top["corners"][0]))
 check("cube_servo_top_faces_down", top["name"] == "top" and normal[2] < 0
       and top["servo"]["target"] == 1000.0 and top["servo"]["tolerance"] == 10.0, f"{top}")
+r = gen("cubes", dep, "--case", "group3_model2", "-o", os.path.join(tmp, "cubes5"), script=GEN5)
+check("ch5_cubes_run", r.returncode == 0, r.stderr)
+names = sorted(os.listdir(os.path.join(tmp, "cubes5"))) if r.returncode == 0 else []
+check("ch5_cubes_middle_clip", names == ["cube%d.yaml" % k for k in range(10, 19)], f"{names}")
+docs = {k: yaml.safe_load(open(os.path.join(tmp, "cubes5", "cube%d.yaml" % k))) for k in (10, 14, 18)} \
+    if names else {}
+regions = {k: d["particles_from"][0]["region"] for k, d in docs.items()}
+check("ch5_cube_regions", regions == {10: {"lo": [0.15, 0.4, 0.1], "hi": [0.35, 0.6, 0.3]},
+                                      14: {"lo": [0.4, 0.4, 0.2], "hi": [0.6, 0.6, 0.4]},
+                                      18: {"lo": [0.65, 0.4, 0.3], "hi": [0.85, 0.6, 0.5]}}, f"{regions}")
+d14 = docs.get(14, {"walls": [{}], "materials": {}})
+check("ch5_cube_servo_5kPa", d14["walls"][-1].get("servo", {}).get("target") == 5000.0
+      and d14["walls"][-1]["servo"]["tolerance"] == 50.0, f"{d14['walls'][-1]}")
+check("ch5_cube_wall_friction", d14["materials"].get("wall", {}).get("friction") == 0.2, f"{d14['materials']}")
+check("ch5_cube_bonds_from_deposit", "strong" in d14.get("bond_types", {}) and "bonds" not in d14
+      and d14.get("particles_from", [{}])[0].get("bonds", "keep") == "keep" and "inlets" not in d14,
+      f"{sorted(d14)}")
 shallow = os.path.join(tmp, "shallow.h5")
 write_deposit(shallow, 0.5)
 r = gen("second-pass", shallow, "--case", "model1", "-o", os.path.join(tmp, "x.yaml"))

@@ -29,10 +29,8 @@ plane, so spheres that touch (or overlap, as a cut from under the deposit's pres
 rammed by their neighbours still on the belt (the undilated fill stops on the watchdog's
 overlap limit within 0.1 s, a fill dilated only to touching within 0.3 s).  The cells are `from_deposit`
 entries (region + dilation + translation), so the scene names the deposit, not its particles.
-cubes: a 0.2 m cube at each Table 4-2 point keeps the particles whose centres lie inside; five
-fixed walls and a servo top wall (1000 Pa +- 10 Pa) at the outline of the kept particles, so
-that none starts inside a wall.  The kept particles are `settled`: their contact overlaps are
-allowed at the start (docs/scenes.md).
+cubes: a 0.2 m cube at each Table 4-2 point (scripts/mixing/cube_scene.py: the particles whose
+centres lie inside, five fixed walls and a servo top wall at 1000 Pa +- 10 Pa).
 Both check every region against the deposit (scripts/mixing/deposit.py) before writing.
 """
 import argparse
@@ -43,7 +41,7 @@ import numpy as np
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-from scripts.mixing import deposit, params
+from scripts.mixing import cube_scene, deposit, params
 from scripts.stability_scenes import set_path  # the sweep's dotted-path override
 
 MODELS = os.path.join(HERE, "models.yaml")
@@ -51,9 +49,7 @@ JITTER = 1.0e-6           # [m] one step of --jitter: far below every length of 
 CELL = (1.0, 0.5, 0.25)   # [RECON] orientation, spec §1.7
 DEPTH = 1.0               # [TEXT] L1539
 FEED_PITCH = 1.1          # [RECON] the first pass's lattice pitch over the sphere diameter
-CUBE = 0.2                # [TEXT] spec §2.4
-SEED_DT = 1.0e-4          # [TEXT] Table 4-1
-SERVO = {"target": 1000.0, "gain": 1.0e-4, "tolerance": 10.0, "max_speed": 0.02, "hold": 0.05}
+SERVO_TARGET = 1000.0     # [TEXT] spec §2.4: sigma_zz 1000 Pa, tolerance 10 Pa
 
 
 def case_scene(case, dt=None):
@@ -150,48 +146,14 @@ def second_pass(args):
     write(args.out, doc, f"second pass of {args.deposit} ({args.case}), gap {args.gap} m")
 
 
-def outline(cut):
-    """The box that touches the kept particles (min(x - R)..max(x + R)): the cube's walls
-    stand there, so that no particle of the cut starts inside a wall [RECON]."""
-    r = cut.radius[:, None]
-    return ((cut.position - r).min(axis=0).round(12).tolist(),
-            (cut.position + r).max(axis=0).round(12).tolist())
-
-
-def cube_walls(lo, hi):
-    """Five fixed walls and the servo top, corners counter-clockwise seen from inside."""
-    (x0, y0, z0), (x1, y1, z1) = lo, hi
-    quad = {
-        "floor": [[x0, y0, z0], [x1, y0, z0], [x1, y1, z0], [x0, y1, z0]],
-        "left": [[x0, y0, z0], [x0, y1, z0], [x0, y1, z1], [x0, y0, z1]],
-        "right": [[x1, y0, z0], [x1, y0, z1], [x1, y1, z1], [x1, y1, z0]],
-        "front": [[x0, y0, z0], [x0, y0, z1], [x1, y0, z1], [x1, y0, z0]],
-        "back": [[x0, y1, z0], [x1, y1, z0], [x1, y1, z1], [x0, y1, z1]],
-        "top": [[x0, y0, z1], [x0, y1, z1], [x1, y1, z1], [x1, y0, z1]],
-    }
-    walls = [{"name": n, "type": "plane", "corners": c, "material": "wall"} for n, c in quad.items()]
-    walls[-1]["servo"] = dict(SERVO)
-    return walls
-
-
 def cubes(args):
     dep = deposit.read_frame(args.deposit)
     os.makedirs(args.out, exist_ok=True)
     for k, c in enumerate(params.POINTS_TABLE_4_2, start=1):
-        lo, hi = (c - CUBE / 2).round(12).tolist(), (c + CUBE / 2).round(12).tolist()
-        cut = deposit.keep_box(dep, lo, hi, source=args.deposit)
-        doc = case_scene(args.case, args.dt)
+        doc = cube_scene.cube_doc(case_scene(args.case, args.dt), dep, args.deposit, c,
+                                  SERVO_TARGET, set_dt)
         doc["name"] = f"mixing_ch4_cube{k}"
         doc["description"] = f"Jiang (2021) Ch. 4 compression test, cube {k} (Table 4-2)"
-        doc.pop("inlets")
-        doc["walls"] = cube_walls(*outline(cut))
-        doc["particles_from"] = [{"file": os.path.abspath(args.deposit), "frame": -1,
-                                  "region": {"lo": lo, "hi": hi}}]
-        dt = doc["time"]["dt"]
-        doc["time"] = {"dt": SEED_DT, "end_time": 10.0,
-                       "max_impact_speed": doc["time"]["max_impact_speed"]}
-        doc["output"] = {"every": 1000, "observables_every": 100}   # 0.1 s, 0.01 s
-        set_dt(doc, dt)
         write(os.path.join(args.out, f"cube{k}.yaml"), doc,
               f"compression cube {k} at {c.tolist()} of {args.deposit} ({args.case})")
 
