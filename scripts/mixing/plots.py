@@ -7,6 +7,8 @@ the box and the cylinders drawn; `clip` keeps only the spheres cut by the middle
 strip_plot: one parameter at the points per model (Figs 4-11, 4-12): the values as dark
 symbols on one vertical line per model, the seed's mean as a red square and its standard
 deviation as a grey bar (stats.py), and the ideal phi_v as a red dashed line.
+break_map: where the bonds of a bonded fill broke (Ch. 5; the seed shows none): the break
+positions in the front view (x-z), tension and shear apart, with the box and the cylinders.
 mixing_figure: the seed's Fig. 4-11 (pass 1) or 4-12 (pass 2) of one engine from the results of
 report_ch4.py (summary.json): its six panels (a)-(f), phi_v, phi_m, e, n, rho_b and Z, each a
 strip plot over the models with a finished fill of that pass.
@@ -65,6 +67,31 @@ def deposit_view(dep, path, view="front", box=((0, 0, 0), (1, 1, 2)), cylinders=
     fig.savefig(path)
     plt.close(fig)
     return int(len(d))
+
+
+def break_map(position, mode, path, box=((0, 0, 0), (1, 1, 2)), cylinders=(), title=None):
+    """Write the front view of the break positions [K][3] (m) as PNG, mode 1 tension (orange),
+    2 shear (purple), with the box and the cylinders (x, z, radius) along y."""
+    lo, hi = box
+    fig, ax = plt.subplots(figsize=(4, 7), dpi=100)
+    for m, name, colour in ((1, "tension", "#ff7f0e"), (2, "shear", "#7b3294")):
+        at = position[mode == m]
+        ax.scatter(at[:, 0], at[:, 2], s=2, c=colour, alpha=0.4, linewidths=0,
+                   label=f"{name} ({len(at)})")
+    ax.add_patch(Rectangle((lo[0], lo[2]), hi[0] - lo[0], hi[2] - lo[2], fill=False, lw=1.5,
+                           color="k"))
+    for x, z, rc in cylinders:
+        ax.add_patch(Circle((x, z), rc, color="0.4"))
+    ax.set_xlim(lo[0] - 0.05, hi[0] + 0.05)
+    ax.set_ylim(lo[2] - 0.05, hi[2] + 0.05)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("z [m]")
+    ax.legend(loc="lower left", markerscale=4, fontsize=8)
+    ax.set_title(title or "bond breaks")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
 
 
 def draw_strip(ax, values_by_model, name, ideal=None):

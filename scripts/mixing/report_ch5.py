@@ -22,7 +22,8 @@ import os
 
 import numpy as np
 
-from scripts.mixing import breakage, deposit, params, stats
+from scripts.mixing import breakage, deposit, params, plots, stats
+from scripts.mixing_views import scene_geometry
 from scripts.mixing.report_ch4 import commit, cube_result, write_atomic
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -57,6 +58,9 @@ SEED_ELASTIC = {
               3: [(0.426, 0.043), (0.452, 0.041), (0.428, 0.058), (0.386, 0.058), (0.442, 0.032), (0.419, 0.058)]},
 }
 CUBES = range(10, 19)
+SNAPSHOTS = (1.0, 3.0, 9.0)   # [s] the seed's snapshot times (Figs 5-5 to 5-22), then the end
+# fragment sizes (spheres) counted over time: single spheres, pieces, half blocks, whole blocks
+FRAGMENT_BINS = ((1, 1), (2, 7), (8, 15), (16, 31), (32, 32))
 
 
 def case(g, m):
@@ -77,7 +81,27 @@ def fill_result(path):
     out["breakage"] = dict(breakage.broken_fraction(rec, end), fragments=int(len(sizes)),
                            whole_blocks=int(np.count_nonzero(sizes == 32)),
                            singles=int(np.count_nonzero(sizes == 1)))
+    steps = [round(t / rec["dt"]) for t in SNAPSHOTS] + [end]
+    out["breakage_over_time"] = [dict(b, fragments=fragment_histogram(breakage.fragment_sizes(rec, b["step"])))
+                                 for b in breakage.over_time(rec, steps)]
+    out["_breaks"] = (rec["broken_at"], rec["mode"])   # for the map; not in summary.json
     return out
+
+
+def fragment_histogram(sizes):
+    """The number of fragments in each FRAGMENT_BINS range of sizes."""
+    return [int(np.count_nonzero((sizes >= a) & (sizes <= b))) for a, b in FRAGMENT_BINS]
+
+
+def write_break_map(entry, name, path, directory):
+    """The front view of where the fill's bonds broke, as DIR/ENGINE_CASE_breaks.png."""
+    position, mode = entry.pop("_breaks")
+    if not len(mode):
+        return None
+    box, cylinders, _ = scene_geometry(path)
+    png = os.path.join(directory, name.replace("/", "_") + "_breaks.png")
+    plots.break_map(position, mode, png, box, cylinders, title=f"{name}: bond breaks")
+    return os.path.basename(png)
 
 
 def times(out):
@@ -88,7 +112,7 @@ def times(out):
         return {}
 
 
-def collect(out, committed, rev):
+def collect(out, committed, rev, directory):
     found, spent = {}, times(out)
     for engine in ENGINES:
         for g in GROUPS:
@@ -97,6 +121,8 @@ def collect(out, committed, rev):
                 path = os.path.join(out, engine, case(g, m), "fill.h5")
                 if os.path.exists(path):
                     entry = dict(fill_result(path), source=rev)
+                    if "_breaks" in entry:
+                        entry["break_map"] = write_break_map(entry, name, path, directory)
                     cubes = [os.path.join(out, engine, case(g, m), "cube%d.h5" % k) for k in CUBES]
                     if all(os.path.exists(c) for c in cubes):
                         entry["cubes"] = [cube_result(c) for c in cubes]
@@ -175,6 +201,21 @@ def report(found, rev):
             lines.append("| %s | %s | %d | %d | %.3f | %.3f | %d | %d | %d |" % (
                 *name.split("/"), k["formed"], k["broken"], k["tension"], k["shear"],
                 k["fragments"], k["whole_blocks"], k["singles"]))
+    lines += ["", "### Breakage over time: broken fraction (tension + shear) and fragments by size", "",
+              "at the seed's snapshot times and the end; fragments: connected components of the intact "
+              "bonds, counted by size in spheres (%s); the seed reports none" %
+              ", ".join("%d" % a if a == b else "%d–%d" % (a, b) for a, b in FRAGMENT_BINS), "",
+              "| engine | case | t [s] | broken | tension | shear | fragments by size |",
+              "|---|---|---|---|---|---|---|"]
+    for name, e in sorted(found.items()):
+        for b in e.get("breakage_over_time", []):
+            lines.append("| %s | %s | %.1f | %.3f | %.3f | %.3f | %s |" % (
+                *name.split("/"), b["time"], b["total"], b["tension"], b["shear"],
+                " / ".join(str(n) for n in b["fragments"])))
+    maps = [(n, e["break_map"]) for n, e in sorted(found.items()) if e.get("break_map")]
+    if maps:
+        lines += ["", "Where the bonds broke (front view, the obstacles grey):", ""]
+        lines += ["![%s](%s)" % m for m in maps]
     lines += [""] + elastic_tables(found)
     sources = sorted({(n, e["source"]) for n, e in found.items() if e.get("source") != rev})
     lines += ["", "From earlier commits: " + (", ".join("%s (%s)" % s for s in sources) if sources else "none"),
@@ -193,7 +234,13 @@ def main():
         with open(os.path.join(results, "summary.json")) as f:
             committed = json.load(f).get("results", {})
     rev = commit()
-    found = collect(a.out, committed, rev)
+    os.makedirs(a.out, exist_ok=True)
+    found = collect(a.out, committed, rev, results or a.out)
+    if results and results != a.out:   # the maps beside both reports
+        import shutil
+        for e in found.values():
+            if e.get("break_map") and os.path.exists(os.path.join(results, e["break_map"])):
+                shutil.copy(os.path.join(results, e["break_map"]), os.path.join(a.out, e["break_map"]))
     for d in [a.out] + ([results] if results else []):
         os.makedirs(d, exist_ok=True)
         write_atomic(os.path.join(d, "report.md"), report(found, rev))
