@@ -153,7 +153,8 @@ SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py
                                 f"{PY} tests/mixing/test_generate.py; c=$?; "
                                 f"{PY} tests/mixing/test_claims.py; d=$?; "
                                 f"{PY} tests/mixing/test_report.py; e=$?; "
-                                f"{PY} tests/mixing/test_horizon.py; f=$?; exit $((a | b | c | d | e | f))"],
+                                f"{PY} tests/mixing/test_horizon.py; f=$?; "
+                                f"{PY} tests/mixing/test_outflow.py; g=$?; exit $((a | b | c | d | e | f | g))"],
             "lines", {})]
 # The campaign driver (scripts/campaign.py) with dummy units, a killed run resumed.
 SUITES += [("campaign", [PY, "tests/mixing/test_campaign.py"], "lines", {})]
