@@ -95,25 +95,34 @@ def check_needs(units, chosen):
 
 
 class Times:
-    """Measured seconds per unit, kept across runs (written atomically)."""
+    """Measured seconds per unit, kept across runs.  Campaign processes running at once share
+    the file: each add re-reads it under an exclusive lock and merges its own entry, so that
+    none drops another's (written atomically)."""
 
     def __init__(self, path):
         self.path = path
+        self.seconds = self.read()
+
+    def read(self):
         try:
-            with open(path) as f:
-                self.seconds = json.load(f)
+            with open(self.path) as f:
+                return json.load(f)
         except (OSError, ValueError):
-            self.seconds = {}
+            return {}
 
     def add(self, unit, seconds, cpu_seconds):
-        self.seconds[unit.name] = {"seconds": seconds, "cpu_seconds": cpu_seconds, "cost": unit.cost,
-                                   "ranks": unit.ranks}
+        import fcntl
+        entry = {"seconds": seconds, "cpu_seconds": cpu_seconds, "cost": unit.cost,
+                 "ranks": unit.ranks}
         # beside the plan's first output, whose directory a selection without that unit never made
         os.makedirs(os.path.dirname(self.path), exist_ok=True)
-        tmp = self.path + ".tmp"
-        with open(tmp, "w") as f:
-            json.dump(self.seconds, f, indent=1)
-        os.replace(tmp, self.path)
+        with open(self.path + ".lock", "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            self.seconds = dict(self.read(), **{unit.name: entry})
+            tmp = "%s.%d.tmp" % (self.path, os.getpid())
+            with open(tmp, "w") as f:
+                json.dump(self.seconds, f, indent=1)
+            os.replace(tmp, self.path)
 
     def eta(self, remaining):
         done = list(self.seconds.values())

@@ -193,6 +193,21 @@ def test_times_beside_unrun_first_unit():
           f"exit {r.returncode}, ran {runs(here)}: {r.stderr[-400:]}")
 
 
+def test_times_shared_by_campaigns_at_once():
+    """Two campaign processes that loaded the times file before either finished a unit (as two
+    `make mixing-bonded UNIT=...` started together do) keep both units' times: each add merges
+    into the file as it is then, not as it was loaded."""
+    from scripts.campaign import Times, Unit
+    path = os.path.join(tempfile.mkdtemp(), "out", ".campaign_times.json")
+    a, b = Times(path), Times(path)
+    a.add(Unit("a", ["x"], ["true"]), 1.0, 1.0)
+    b.add(Unit("b", ["y"], ["true"]), 2.0, 2.0)
+    a.add(Unit("c", ["z"], ["true"]), 3.0, 3.0)
+    got = json.load(open(path))
+    check("times_shared_by_campaigns_at_once", sorted(got) == ["a", "b", "c"]
+          and got["b"]["seconds"] == 2.0, f"{got}")
+
+
 def test_ch4_plan():
     """The plan of make mixing (docs/mixing.md §4): 2 engines x 6 models x (2 fills, 1 second-
     pass scene, 2 x (1 cube-scene unit + 9 compressions)) = 276 units, plus per engine the
@@ -295,6 +310,7 @@ def test_ch4_ranks():
 test_validation_and_selection()
 test_not_yet_runnable()
 test_times_beside_unrun_first_unit()
+test_times_shared_by_campaigns_at_once()
 test_ch4_dt_variants()
 test_ch4_ranks()
 test_ch4_plan()
