@@ -19,24 +19,24 @@ MIN_FALL_SPEED = 0.5   # [m/s]
 
 def spread(path, cylinders):
     """[{"x", "z", "n", "mean", "std"}] (deg) per cylinder (x, z, radius) of the fill at path."""
+    theta = [[] for _ in cylinders]
     with h5py.File(path, "r") as f:
         p = f["particles/all"]
-        ids = p["id"]
-        x, v = p["position/value"], p["velocity/value"]
-        frames = x.shape[0]
+        ids, x, v = p["id"], p["position/value"], p["velocity/value"]
         series = isinstance(ids, h5py.Group)
-        out = []
-        for cx, cz, rc in cylinders:
-            theta = []
-            for k in range(frames):
-                live = (ids["value"][k] if series else ids[()]) >= 0
-                xk, vk = x[k][live], v[k][live]
+        for k in range(x.shape[0]):   # each frame read once, for every cylinder
+            live = (ids["value"][k] if series else ids[()]) >= 0
+            xk, vk = x[k][live], v[k][live]
+            falling = -vk[:, 2] > MIN_FALL_SPEED
+            for t, (cx, cz, rc) in zip(theta, cylinders):
                 below = cz - xk[:, 2]
-                band = ((np.abs(xk[:, 0] - cx) < BAND_X) & (below > BAND_Z[0] * rc) &
-                        (below < BAND_Z[1] * rc) & (-vk[:, 2] > MIN_FALL_SPEED))
-                theta.append(np.degrees(np.arctan2(vk[band, 0], -vk[band, 2])))
-            t = np.concatenate(theta) if theta else np.zeros(0)
-            out.append({"x": cx, "z": cz, "n": int(len(t)),
-                        "mean": float(np.mean(t)) if len(t) else float("nan"),
-                        "std": float(np.std(t, ddof=1)) if len(t) > 1 else float("nan")})
+                band = (falling & (np.abs(xk[:, 0] - cx) < BAND_X) & (below > BAND_Z[0] * rc) &
+                        (below < BAND_Z[1] * rc))
+                t.append(np.degrees(np.arctan2(vk[band, 0], -vk[band, 2])))
+    out = []
+    for t, (cx, cz, _) in zip(theta, cylinders):
+        t = np.concatenate(t) if t else np.zeros(0)
+        out.append({"x": cx, "z": cz, "n": int(len(t)),
+                    "mean": float(np.mean(t)) if len(t) else float("nan"),
+                    "std": float(np.std(t, ddof=1)) if len(t) > 1 else float("nan")})
     return out
