@@ -105,6 +105,47 @@ static int32_t component_root(int32_t *parent, int32_t x) {
     return x;
 }
 
+/* Bond a before bond b in the (smaller, larger) order. */
+static int bond_before(const int32_t *pair, size_t a, size_t b) {
+    return pair[2 * a] != pair[2 * b] ? pair[2 * a] < pair[2 * b] : pair[2 * a + 1] < pair[2 * b + 1];
+}
+
+static void swap_bonds(int32_t *pair, int32_t *type, size_t a, size_t b) {
+    const int32_t i = pair[2 * a], j = pair[2 * a + 1], t = type[a];
+    pair[2 * a] = pair[2 * b];
+    pair[2 * a + 1] = pair[2 * b + 1];
+    type[a] = type[b];
+    pair[2 * b] = i;
+    pair[2 * b + 1] = j;
+    type[b] = t;
+}
+
+/* Restore the max-heap below node `root` of the first n bonds. */
+static void sift_down(int32_t *pair, int32_t *type, size_t root, size_t n) {
+    for (size_t child; (child = 2 * root + 1) < n; root = child) {
+        if (child + 1 < n && bond_before(pair, child, child + 1)) child++;
+        if (!bond_before(pair, root, child)) return;
+        swap_bonds(pair, type, root, child);
+    }
+}
+
+size_t jd_inlet_sort_bonds(size_t n_bonds, int32_t *pair, int32_t *type) {
+    for (size_t k = 0; k < n_bonds; k++)
+        if (pair[2 * k] > pair[2 * k + 1]) {
+            const int32_t i = pair[2 * k];
+            pair[2 * k] = pair[2 * k + 1];
+            pair[2 * k + 1] = i;
+        }
+    for (size_t k = n_bonds / 2; k-- > 0;) sift_down(pair, type, k, n_bonds);
+    for (size_t end = n_bonds; end > 1; end--) {
+        swap_bonds(pair, type, 0, end - 1);
+        sift_down(pair, type, 0, end - 1);
+    }
+    for (size_t k = 1; k < n_bonds; k++)
+        if (pair[2 * k] == pair[2 * k - 2] && pair[2 * k + 1] == pair[2 * k - 1]) return k;
+    return n_bonds;
+}
+
 size_t jd_inlet_groups(size_t n, size_t n_bonds, const int32_t *pair, int32_t *parent,
                        int32_t *group_of, size_t *group_first, size_t *group_member) {
     for (size_t p = 0; p < n; p++) {

@@ -165,6 +165,13 @@ int64_t jd_inlet_group_start(const jd_inlet_spec *s, int64_t copy, const size_t 
  * (the order of the resolved `bonds:` entries): first_id + c n + min(i, j), then the larger. */
 void jd_inlet_bond_ids(const jd_inlet_spec *s, int64_t copy, size_t i, size_t j, int64_t ids[2]);
 
+/* The section's bonds in the one order both engines resolve them to: each pair [2 n_bonds] of
+ * section indices turned smaller first, and the bonds sorted by (smaller, larger) in place, their
+ * types [n_bonds] moved with them (heap sort: no allocation; the order of equal pairs is
+ * unspecified, and equal pairs are an error).  Returns the index k > 0 of the first bond whose
+ * pair repeats bond k - 1's, or n_bonds when every pair is bonded once.  O(n_bonds log n_bonds). */
+size_t jd_inlet_sort_bonds(size_t n_bonds, int32_t *pair, int32_t *type);
+
 /* The groups of a section from its bonds (pairs [2 n_bonds] of section indices < n): the
  * connected components of the bond graph, numbered in the order of their smallest member; a
  * particle in no bond is in no group.  Fills group_of [n] (-1: none), group_first [n_groups + 1]

@@ -4,7 +4,6 @@
 #include <mpi.h>
 
 #include <algorithm>
-#include <array>
 #include <cerrno>
 #include <climits>
 #include <cmath>
@@ -259,23 +258,19 @@ void FixJdemInlet::read_section(const char *path) {
   make_groups();
 }
 
-/* The section's bonds, smaller index first, sorted by (I, J) as build/jdem resolves them. */
+/* The section's bonds in the kernel's order (jd_inlet_sort_bonds), as build/jdem resolves them. */
 void FixJdemInlet::sort_bonds(const std::vector<int> &bonds, const char *path) {
-  std::vector<std::array<int, 3> > b;
-  for (size_t k = 0; k < bonds.size(); k += 3)
-    b.push_back({std::min(bonds[k], bonds[k + 1]), std::max(bonds[k], bonds[k + 1]), bonds[k + 2]});
-  std::sort(b.begin(), b.end(), [](const std::array<int, 3> &x, const std::array<int, 3> &y) {
-    return x[0] != y[0] ? x[0] < y[0] : x[1] < y[1];
-  });
-  for (size_t k = 0; k < b.size(); k++) {
-    if (k > 0 && b[k][0] == b[k - 1][0] && b[k][1] == b[k - 1][1]) {
-      char msg[400];
-      std::snprintf(msg, sizeof msg, "fix jdem/inlet: section file %s: section particles %d and %d "
-                    "are bonded twice; valid: at most one bond per pair", path, b[k][0], b[k][1]);
-      error->all(FLERR, msg);
-    }
-    bond_pair.insert(bond_pair.end(), {b[k][0], b[k][1]});
-    bond_type.push_back(b[k][2]);
+  for (size_t k = 0; k < bonds.size(); k += 3) {
+    bond_pair.insert(bond_pair.end(), {bonds[k], bonds[k + 1]});
+    bond_type.push_back(bonds[k + 2]);
+  }
+  const size_t k = jd_inlet_sort_bonds(bond_type.size(), bond_pair.data(), bond_type.data());
+  if (k < bond_type.size()) {
+    char msg[400];
+    std::snprintf(msg, sizeof msg, "fix jdem/inlet: section file %s: section particles %d and %d "
+                  "are bonded twice; valid: at most one bond per pair", path, bond_pair[2 * k],
+                  bond_pair[2 * k + 1]);
+    error->all(FLERR, msg);
   }
 }
 

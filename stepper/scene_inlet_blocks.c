@@ -180,13 +180,6 @@ static int read_section_bond(loader *L, const yaml_node_t *e, const char *path, 
     return add_pair(b, p[0], p[1], type) ? sd_no_memory(&L->c, e, path) : 0;
 }
 
-static const int32_t *sort_pairs_of;
-static int by_pair(const void *x, const void *y) {
-    const int32_t *p = &sort_pairs_of[2 * *(const size_t *)x], *q = &sort_pairs_of[2 * *(const size_t *)y];
-    if (p[0] != q[0]) return p[0] < q[0] ? -1 : 1;
-    return p[1] < q[1] ? -1 : p[1] > q[1];
-}
-
 /* The connected components of the bonds (the kernel's rule, jd_inlet_groups). */
 static int make_groups(jd_inlet *in) {
     int32_t *parent = malloc(in->n * sizeof *parent);
@@ -216,30 +209,20 @@ int scene_read_section_bonds(loader *L, const yaml_node_t *sec, const char *path
         rc = read_section_bond(L, sd_item(&L->c, list, k), item, in->n, b);
     }
     const size_t n = b->n_bonds;
-    size_t *perm = rc == 0 && n ? malloc(n * sizeof *perm) : NULL;
-    if (rc == 0 && n && (!perm || !(in->bond_pair = malloc(2 * n * sizeof *in->bond_pair)) ||
+    if (rc == 0 && n && (!(in->bond_pair = malloc(2 * n * sizeof *in->bond_pair)) ||
                          !(in->bond_type = malloc(n * sizeof *in->bond_type))))
         rc = sd_no_memory(&L->c, sec, path);
     if (rc == 0 && n) {
-        for (size_t k = 0; k < n; k++) perm[k] = k;
-        sort_pairs_of = b->pair;
-        qsort(perm, n, sizeof *perm, by_pair);
-        for (size_t k = 0; k < n; k++) {
-            in->bond_pair[2 * k] = b->pair[2 * perm[k]];
-            in->bond_pair[2 * k + 1] = b->pair[2 * perm[k] + 1];
-            in->bond_type[k] = b->type[perm[k]];
-            if (k > 0 && in->bond_pair[2 * k] == in->bond_pair[2 * k - 2] &&
-                in->bond_pair[2 * k + 1] == in->bond_pair[2 * k - 1]) {
-                rc = sd_fail(&L->c, list ? list : sec, list ? sub : path, "section particles %d "
-                             "and %d are bonded twice; valid: at most one bond per pair",
-                             in->bond_pair[2 * k], in->bond_pair[2 * k + 1]);
-                break;
-            }
-        }
+        memcpy(in->bond_pair, b->pair, 2 * n * sizeof *in->bond_pair);
+        memcpy(in->bond_type, b->type, n * sizeof *in->bond_type);
+        const size_t k = jd_inlet_sort_bonds(n, in->bond_pair, in->bond_type);
+        if (k < n)
+            rc = sd_fail(&L->c, list ? list : sec, list ? sub : path, "section particles %d "
+                         "and %d are bonded twice; valid: at most one bond per pair",
+                         in->bond_pair[2 * k], in->bond_pair[2 * k + 1]);
         in->n_bonds = n;
         if (rc == 0 && make_groups(in)) rc = sd_no_memory(&L->c, sec, path);
     }
-    free(perm);
     if (b == &none) {
         free(none.pair);
         free(none.type);

@@ -499,6 +499,25 @@ static void groups_are_the_bond_components(void **state) {
     for (int p = 0; p < 8; p++) assert_int_equal(group_of[p], -1);
 }
 
+/* jd_inlet_sort_bonds: 7 bonds given out of order, two with the larger index first, come back
+ * smaller first in the (smaller, larger) order with their types; the same list with a pair
+ * repeated (reversed) reports the repeat at its sorted index. */
+static void section_bonds_sort_into_the_resolved_order(void **state) {
+    (void)state;
+    int32_t pair[14] = {5, 6, 1, 3, 6, 2, 3, 7, 0, 9, 1, 2, 4, 0};
+    int32_t type[7] = {10, 11, 12, 13, 14, 15, 16};
+    assert_int_equal(jd_inlet_sort_bonds(7, pair, type), 7);
+    const int32_t want_pair[14] = {0, 4, 0, 9, 1, 2, 1, 3, 2, 6, 3, 7, 5, 6};
+    const int32_t want_type[7] = {16, 14, 15, 11, 12, 13, 10};
+    for (int k = 0; k < 14; k++) assert_int_equal(pair[k], want_pair[k]);
+    for (int k = 0; k < 7; k++) assert_int_equal(type[k], want_type[k]);
+    int32_t twice[8] = {3, 1, 0, 2, 1, 3, 0, 1}, t2[4] = {0, 1, 2, 3};
+    assert_int_equal(jd_inlet_sort_bonds(4, twice, t2), 3); /* 0-1, 0-2, 1-3, 1-3 */
+    assert_int_equal(twice[4], 1);
+    assert_int_equal(twice[7], 3);
+    assert_int_equal(jd_inlet_sort_bonds(0, twice, t2), 0);
+}
+
 int run_inlet_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(crossing_step_of_each_copy),
@@ -516,6 +535,7 @@ int run_inlet_tests(void) {
         cmocka_unit_test(bonded_block_starts_with_its_first_sphere),
         cmocka_unit_test(stream_inserts_a_group_whole),
         cmocka_unit_test(groups_are_the_bond_components),
+        cmocka_unit_test(section_bonds_sort_into_the_resolved_order),
     };
     return cmocka_run_group_tests_name("inlet", tests, NULL, NULL);
 }
