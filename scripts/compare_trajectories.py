@@ -8,7 +8,9 @@ The tolerance is the scene's `output.compare_tolerance` (stored in A's /paramete
 default there is 1e-10), unless --tol overrides it.
 
 Particles are matched by id and frames by step (only steps present in both are compared; the
-frames of each file are listed if they differ).  For every common frame the largest difference
+frames of each file are listed if they differ).  A growing particle set (an inlet's run: ids
+per frame, -1 in the empty slots) is compared over the particles present, which must be the
+same in both files at each common frame.  For every common frame the largest difference
 of each field is scaled by the scene's scale of that field:
 
     position          max radius R
@@ -41,7 +43,11 @@ SHORT = {"position": "x", "velocity": "v", "angular_velocity": "w", "force": "f"
 def load(path):
     f = h5py.File(path, "r")
     p = f["particles/all"]
-    out = {"file": f, "id": p["id"][()], "radius": p["radius"][()], "fields": {}}
+    out = {"file": f, "radius": p["radius"][()], "fields": {}}
+    if isinstance(p["id"], h5py.Group):   # a growing particle set: ids per frame, -1 empty
+        out["id_steps"], out["id_frames"] = p["id/step"][()], p["id/value"][()]
+    else:
+        out["id_steps"], out["id_frames"] = None, p["id"][()]
     for k in FIELDS:
         if k in p:
             out["fields"][k] = (p[k]["step"][()], p[k]["value"])
@@ -69,6 +75,24 @@ class Unusable(Exception):
     """The two trajectories cannot be compared (message says why)."""
 
 
+def ids_at(X, step):
+    """The ids of X's slots at `step` (-1: an empty slot of a growing set)."""
+    if X["id_steps"] is None:
+        return X["id_frames"]
+    at = np.flatnonzero(X["id_steps"] == step)
+    if not len(at):
+        raise Unusable("no ids at step %d" % step)
+    return X["id_frames"][at[0]]
+
+
+def live_order(X, step):
+    """The slots of X's particles at `step`, ordered by id, and their ids."""
+    ids = ids_at(X, step)
+    slots = np.flatnonzero(ids >= 0)
+    slots = slots[np.argsort(ids[slots], kind="stable")]
+    return slots, ids[slots]
+
+
 def frame_index(X, field, common):
     """Indices of the common steps in X's frames of one field, and the field's dataset."""
     steps, val = X["fields"][field]
@@ -78,11 +102,12 @@ def frame_index(X, field, common):
 
 def scales(A, B, fields, common):
     """The scale of each field (see the module docstring)."""
-    R = float(max(A["radius"].max(), 1e-300))
+    R = float(max(np.nanmax(A["radius"]), 1e-300))
     vscale = 0.0
     if "velocity" in fields:
         fa, va = frame_index(A, "velocity", common)
-        vscale = float(np.max(np.linalg.norm(va[fa[0]], axis=1)))
+        slots, _ = live_order(A, common[0])
+        vscale = float(np.max(np.linalg.norm(va[fa[0]][slots], axis=1), initial=0.0))
     if vscale == 0.0:
         gabs = float(np.linalg.norm(A["gravity"]))
         vscale = np.sqrt(gabs * R) if gabs > 0 else 1.0
@@ -92,8 +117,8 @@ def scales(A, B, fields, common):
             m = 0.0
             for X in (A, B):
                 val = X["fields"][k][1][()]
-                if val.size:
-                    m = max(m, float(np.max(np.linalg.norm(val, axis=2))))
+                if val.size and np.isfinite(val).any():
+                    m = max(m, float(np.nanmax(np.linalg.norm(val, axis=2))))
             scale[k] = m
     if scale.get("force", 0.0) == 0.0:
         scale["force"] = 1.0
@@ -104,13 +129,19 @@ def scales(A, B, fields, common):
 
 def field_differences(A, B, fields, common, scale):
     """table[frame, field]: the largest scaled difference of the field in that frame."""
-    ia, ib = np.argsort(A["id"]), np.argsort(B["id"])
+    order = []
+    for step in common:
+        (ia, ida), (ib, idb) = live_order(A, step), live_order(B, step)
+        if not np.array_equal(ida, idb):
+            raise Unusable("the particle ids differ at step %d (%d vs %d particles)" % (
+                step, len(ida), len(idb)))
+        order.append((ia, ib))
     table = np.zeros((len(common), len(fields)))
     for c, k in enumerate(fields):
         fa, va = frame_index(A, k, common)
         fb, vb = frame_index(B, k, common)
         va_all, vb_all = va[()], vb[()]
-        for n in range(len(common)):
+        for n, (ia, ib) in enumerate(order):
             xa = va_all[fa[n]][ia]
             xb = vb_all[fb[n]][ib]
             table[n, c] = float(np.max(np.abs(xa - xb))) / scale[k] if xa.size else 0.0
@@ -172,8 +203,10 @@ def compare(path_a, path_b, observables=True, until=None):
         A, B = load(path_a), load(path_b)
     except (OSError, KeyError) as e:
         raise Unusable("cannot read the trajectories: %s" % e)
-    if sorted(A["id"].tolist()) != sorted(B["id"].tolist()):
-        raise Unusable("the particle ids differ (%d vs %d particles)" % (len(A["id"]), len(B["id"])))
+    if A["id_steps"] is None and B["id_steps"] is None and \
+            sorted(A["id_frames"].tolist()) != sorted(B["id_frames"].tolist()):
+        raise Unusable("the particle ids differ (%d vs %d particles)" % (len(A["id_frames"]),
+                                                                         len(B["id_frames"])))
     fields = [k for k in FIELDS if k in A["fields"] and k in B["fields"]]
     if "position" not in fields:
         raise Unusable("no common position data")

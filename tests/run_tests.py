@@ -154,7 +154,8 @@ SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py
                                 f"{PY} tests/mixing/test_claims.py; d=$?; "
                                 f"{PY} tests/mixing/test_report.py; e=$?; "
                                 f"{PY} tests/mixing/test_horizon.py; f=$?; "
-                                f"{PY} tests/mixing/test_outflow.py; g=$?; exit $((a | b | c | d | e | f | g))"],
+                                f"{PY} tests/mixing/test_outflow.py; g=$?; "
+                                f"{PY} tests/mixing/test_fill_ch5.py; h=$?; exit $((a | b | c | d | e | f | g | h))"],
             "lines", {})]
 # The campaign driver (scripts/campaign.py) with dummy units, a killed run resumed.
 SUITES += [("campaign", [PY, "tests/mixing/test_campaign.py"], "lines", {})]

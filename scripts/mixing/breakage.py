@@ -45,22 +45,35 @@ def intact_at(rec, step):
     return np.array([p for p in formed.tolist() if tuple(p) not in gone], dtype=np.int64).reshape(-1, 2)
 
 
-def fragment_sizes(rec, step):
-    """The sizes of the fragments at `step`: connected components of the intact bonds among the
-    particles of the bonds formed by then, largest first."""
+def components(rec, step):
+    """(ids, label): the particles of the bonds formed by `step`, sorted by id, and the fragment
+    each one belongs to, a connected component of the intact bonds (labels 0..n-1)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
-    formed = rec["bonds"][rec["formed"] <= step]
-    ids = np.unique(formed)
+    ids = np.unique(rec["bonds"][rec["formed"] <= step]).astype(np.int64)
     if len(ids) == 0:
-        return np.zeros(0, dtype=np.int64)
-    index = {int(i): k for k, i in enumerate(ids)}
+        return ids, np.zeros(0, dtype=np.int64)
     intact = intact_at(rec, step)
-    rows = np.array([index[int(a)] for a in intact[:, 0]], dtype=np.int64)
-    cols = np.array([index[int(b)] for b in intact[:, 1]], dtype=np.int64)
+    rows, cols = np.searchsorted(ids, intact[:, 0]), np.searchsorted(ids, intact[:, 1])
     graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(len(ids), len(ids)))
-    _, label = connected_components(graph, directed=False)
-    return np.sort(np.bincount(label))[::-1]
+    return ids, connected_components(graph, directed=False)[1]
+
+
+def fragment_sizes(rec, step):
+    """The sizes of the fragments at `step`, largest first."""
+    return np.sort(np.bincount(components(rec, step)[1]))[::-1]
+
+
+def fragment_of(rec, step, ids):
+    """The size of the fragment each particle of `ids` belongs to at `step`; 0 for a particle
+    never bonded by then."""
+    bonded, label = components(rec, step)
+    out = np.zeros(len(ids), dtype=np.int64)
+    if len(bonded):
+        at = np.minimum(np.searchsorted(bonded, ids), len(bonded) - 1)
+        hit = bonded[at] == ids
+        out[hit] = np.bincount(label)[label[at[hit]]]
+    return out
 
 
 def broken_fraction(rec, step):

@@ -13,6 +13,8 @@ both engines run.  --ranks N runs each liggghts-jdem fill on N MPI ranks.  After
 points 10-18 of Table 5-2 under 5 kPa, each with its own copy of the deposit and its intact
 bonds), and `ENGINE/CASE/cubeK`, K = 10..18, their compressions, into
 out/mixing/ch5/ENGINE/CASE/cubeK.h5 (the 27 points' phi_v are read from the fill itself).
+Chapter 6's rigid cements add two fills per engine, rigid_model1 and rigid_model3 (Figs 6-1 and
+6-2), drawn but not compressed (the seed measures nothing in them).
 """
 import os
 import shlex
@@ -29,6 +31,7 @@ GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "generate.py")
 CUBES = range(10, 19)     # Table 5-2's middle clip
 OUT = os.path.join(ROOT, "out", "mixing", "ch5")
 CASES = [f"group{g}_model{m}" for g in range(1, 4) for m in range(1, 7)]
+RIGID_CASES = ["rigid_model1", "rigid_model3"]   # Ch. 6, Figs 6-1 and 6-2: pictures, no cubes
 
 
 def fill_unit(engine, case, ranks):
@@ -63,5 +66,6 @@ def units(argv):
     a = ap.parse_args(argv)
     if a.ranks < 1:
         ap.error("--ranks %d: valid: a positive number of MPI ranks" % a.ranks)
-    return [u for engine in ENGINES for case in CASES
-            for u in [fill_unit(engine, case, a.ranks)] + cube_units(engine, case)]
+    return [u for engine in ENGINES for case in CASES + RIGID_CASES
+            for u in [fill_unit(engine, case, a.ranks)] +
+            (cube_units(engine, case) if case in CASES else [])]

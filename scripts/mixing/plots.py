@@ -4,6 +4,8 @@ deposit_view: the front (x-z, looking along +y) or side (y-z, looking along -x) 
 deposit, spheres to scale as circles coloured by cohort (the seed's red = big, blue = small),
 the box and the cylinders drawn; `clip` keeps only the spheres cut by the middle plane y = 0.5
 (the seed's "middle clip") or x = 0.5 for a side view.
+snapshot_sheet: front and side views of several frames in one picture, spheres in the colours
+the caller gives (Ch. 5: big spheres, whole blocks, fragments and single spheres apart).
 strip_plot: one parameter at the points per model (Figs 4-11, 4-12): the values as dark
 symbols on one vertical line per model, the seed's mean as a red square and its standard
 deviation as a grey bar (stats.py), and the ideal phi_v as a red dashed line.
@@ -30,26 +32,25 @@ BIG_COLOUR, SMALL_COLOUR = "#d62728", "#1f4fb4"
 VIEWS = {"front": (0, 2, 1), "side": (1, 2, 0)}  # (horizontal axis, vertical axis, depth axis)
 
 
-def deposit_view(dep, path, view="front", box=((0, 0, 0), (1, 1, 2)), cylinders=(),
-                 clip=None, title=None, threshold=None):
-    """Write the view as PNG; returns the number of spheres drawn.  cylinders: (x, z, radius)
-    of horizontal cylinders along y [m]; clip: half-thickness of the slab around the middle
-    plane to keep (None: all spheres)."""
+def draw_deposit(ax, dep, view="front", box=((0, 0, 0), (1, 1, 2)), cylinders=(), clip=None,
+                 colours=None, threshold=None):
+    """Draw the view on `ax`; returns the number of spheres drawn.  cylinders: (x, z, radius) of
+    horizontal cylinders along y [m]; clip: half-thickness of the slab around the middle plane to
+    keep (None: all spheres); colours: one colour per particle (default: red big, blue small)."""
     h, v, depth = VIEWS[view]
     keep = np.ones(len(dep.radius), bool)
     if clip is not None:
         mid = 0.5 * (box[0][depth] + box[1][depth])
         keep = np.abs(dep.position[:, depth] - mid) <= dep.radius + clip
-    big = big_mask(dep.radius, threshold)
+    if colours is None:
+        colours = np.where(big_mask(dep.radius, threshold), BIG_COLOUR, SMALL_COLOUR)
     order = np.argsort(-dep.position[keep][:, depth] if view == "front" else dep.position[keep][:, depth])
     xy = dep.position[keep][:, [h, v]][order]
     d = 2.0 * dep.radius[keep][order]
-    colours = np.where(big[keep][order], BIG_COLOUR, SMALL_COLOUR)
     lo, hi = box
-    fig, ax = plt.subplots(figsize=(4, 7), dpi=100)
     ax.add_collection(EllipseCollection(d, d, np.zeros(len(d)), units="xy", offsets=xy,
-                                        offset_transform=ax.transData, facecolors=colours,
-                                        edgecolors="none"))
+                                        offset_transform=ax.transData,
+                                        facecolors=np.asarray(colours)[keep][order], edgecolors="none"))
     ax.add_patch(Rectangle((lo[h], lo[v]), hi[h] - lo[h], hi[v] - lo[v], fill=False, lw=1.5,
                            color="k"))
     for x, z, rc in cylinders:
@@ -62,11 +63,42 @@ def deposit_view(dep, path, view="front", box=((0, 0, 0), (1, 1, 2)), cylinders=
     ax.set_aspect("equal")
     ax.set_xlabel("xyz"[h] + " [m]")
     ax.set_ylabel("z [m]")
+    return int(len(d))
+
+
+def deposit_view(dep, path, view="front", box=((0, 0, 0), (1, 1, 2)), cylinders=(),
+                 clip=None, title=None, threshold=None, colours=None):
+    """Write the view (draw_deposit) as PNG; returns the number of spheres drawn."""
+    fig, ax = plt.subplots(figsize=(4, 7), dpi=100)
+    n = draw_deposit(ax, dep, view, box, cylinders, clip, colours, threshold)
     ax.set_title(title or f"{view} view, t = {dep.time:g} s")
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
-    return int(len(d))
+    return n
+
+
+def snapshot_sheet(frames, path, box=((0, 0, 0), (1, 1, 2)), cylinders=(), legend=(), title=None):
+    """The seed's Figs 5-5 to 5-22 as one PNG: the front view (top row) and the side view (bottom
+    row) of each of `frames`, a list of (deposit, colours per particle); legend: (label, colour)
+    pairs.  Returns the number of spheres drawn per frame."""
+    fig, axes = plt.subplots(2, len(frames), figsize=(2.6 * len(frames), 9.5), dpi=100,
+                             squeeze=False)
+    drawn = []
+    for k, (dep, colours) in enumerate(frames):
+        for row, view in enumerate(("front", "side")):
+            n = draw_deposit(axes[row][k], dep, view, box, cylinders, colours=colours)
+            axes[row][k].set_title(f"{view}, t = {dep.time:g} s", fontsize=9)
+        drawn.append(n)
+    if legend:
+        fig.legend(handles=[Rectangle((0, 0), 1, 1, color=c, label=l) for l, c in legend],
+                   loc="lower center", ncol=len(legend) if len(frames) > 2 else 2, fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout(rect=(0, 0.04 if legend else 0, 1, 0.97 if title else 1))
+    fig.savefig(path)
+    plt.close(fig)
+    return drawn
 
 
 def break_map(position, mode, path, box=((0, 0, 0), (1, 1, 2)), cylinders=(), title=None):

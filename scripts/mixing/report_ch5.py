@@ -4,16 +4,17 @@ fills of `make mixing-bonded` (docs/mixing.md §11).
 
     /usr/bin/python3 -m scripts.mixing.report_ch5 [--out out/mixing/ch5] [--results DIR]
 
-Reads OUT/ENGINE/groupG_modelM/fill.h5: phi_v at the 27 points of Table 5-2 from the last frame
-(Table 5-3 is the middle clip, points 10-18, y = 0.5 m; the trimmed mean and std of
-scripts/mixing/stats.py), and the breakage of the whole fill (scripts/mixing/breakage.py: the
-bonds formed and broken per mode, the fragments at the end), and when all 9 compressions of the
-middle clip are done (OUT/ENGINE/CASE/cubeK.h5, K = 10..18) Tables 5-4 and 5-5 (E, nu_xy, nu_xz of
-the orthotropic fit on the best-fit particle strain) and the unambiguous M and K0
-(report_ch4.cube_result, the Ch. 4 analysis); the run times from the campaign's
-.campaign_times.json.  Writes OUT/report.md and OUT/summary.json, and with --results (default
-reference_runs/mixing/ch5/results for the default OUT) also there; a fill not under OUT is
-taken from the committed summary.json, with the commit it came from.  The seed reports no
+Reads OUT/ENGINE/groupG_modelM/fill.h5 and measures it with scripts/mixing/fill_ch5.py: Table
+5-3 (phi_v at the middle clip, points 10-18 of Table 5-2, y = 0.5 m; the trimmed mean and std of
+scripts/mixing/stats.py), the breakage over time, the free surface and packing, the energy
+balance and the bond-steps, its pictures (the break map and the snapshot sheet); the outflow
+below each obstacle (outflow.py); and when all 9 compressions of the middle clip are done
+(OUT/ENGINE/CASE/cubeK.h5, K = 10..18) Tables 5-4 and 5-5 (E, nu_xy, nu_xz of the orthotropic
+fit on the best-fit particle strain) and the unambiguous M and K0 (report_ch4.cube_result, the
+Ch. 4 analysis); the run times from the campaign's .campaign_times.json.  Then the seed's claims
+that the finished fills decide.  Writes OUT/report.md and OUT/summary.json, and with --results
+(default reference_runs/mixing/ch5/results for the default OUT) also there; a fill not under OUT
+is taken from the committed summary.json, with the commit it came from.  The seed reports no
 breakage at all (spec §4.3): those columns have no seed value.
 """
 import argparse
@@ -22,7 +23,9 @@ import os
 
 import numpy as np
 
-from scripts.mixing import breakage, deposit, outflow, params, plots, stats
+from scripts.mixing import fill_ch5, outflow, params, stats, structure
+from scripts.mixing.fill_ch5 import FRAGMENT_BINS
+from scripts.mixing.plan_ch5 import CASES, RIGID_CASES
 from scripts.mixing_views import scene_geometry
 from scripts.mixing.report_ch4 import commit, cube_result, write_atomic
 
@@ -32,10 +35,6 @@ DEFAULT_RESULTS = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "results
 ENGINES = ("jdem", "liggghts-jdem")
 GROUPS = (1, 2, 3)
 MODELS = tuple(range(1, 7))
-# Table 5-2: points 1-27, y = 0.25 (1-9), 0.5 (10-18, the middle clip), 0.75 (19-27)
-POINTS_TABLE_5_2 = np.array([[x, y, z] for y in (0.25, 0.5, 0.75) for z in (0.2, 0.3, 0.4)
-                             for x in (0.25, 0.5, 0.75)])
-MIDDLE_CLIP = slice(9, 18)
 # spec §3.5, Table 5-3: (mean, std) of phi_v at the middle clip, per group and model
 SEED_PHI_V = {1: [(0.0575, 0.0933), (0.0186, 0.0319), (0.4658, 0.2712), (0.4507, 0.2039),
                   (0.3197, 0.1548), (0.3214, 0.3750)],
@@ -58,50 +57,10 @@ SEED_ELASTIC = {
               3: [(0.426, 0.043), (0.452, 0.041), (0.428, 0.058), (0.386, 0.058), (0.442, 0.032), (0.419, 0.058)]},
 }
 CUBES = range(10, 19)
-SNAPSHOTS = (1.0, 3.0, 9.0)   # [s] the seed's snapshot times (Figs 5-5 to 5-22), then the end
-# fragment sizes (spheres) counted over time: single spheres, pieces, half blocks, whole blocks
-FRAGMENT_BINS = ((1, 1), (2, 7), (8, 15), (16, 31), (32, 32))
 
 
 def case(g, m):
     return "group%d_model%d" % (g, m)
-
-
-def fill_result(path):
-    dep = deposit.read_frame(path)
-    phi = [float(p["phi_v"]) for p in params.at_points(dep, POINTS_TABLE_5_2)]
-    out = {"particles": int(len(dep.radius)), "time": dep.time, "phi_v": phi,
-           "middle_clip": stats.summary(phi[MIDDLE_CLIP])}
-    try:
-        rec = breakage.read_bonds(path)
-    except breakage.BreakageError:
-        return out   # Group 1: no bonds
-    end = int(max(rec["formed"].max(initial=0), rec["broken_step"].max(initial=0), dep.step))
-    sizes = breakage.fragment_sizes(rec, end)
-    out["breakage"] = dict(breakage.broken_fraction(rec, end), fragments=int(len(sizes)),
-                           whole_blocks=int(np.count_nonzero(sizes == 32)),
-                           singles=int(np.count_nonzero(sizes == 1)))
-    steps = [round(t / rec["dt"]) for t in SNAPSHOTS] + [end]
-    out["breakage_over_time"] = [dict(b, fragments=fragment_histogram(breakage.fragment_sizes(rec, b["step"])))
-                                 for b in breakage.over_time(rec, steps)]
-    out["_breaks"] = (rec["broken_at"], rec["mode"])   # for the map; not in summary.json
-    return out
-
-
-def fragment_histogram(sizes):
-    """The number of fragments in each FRAGMENT_BINS range of sizes."""
-    return [int(np.count_nonzero((sizes >= a) & (sizes <= b))) for a, b in FRAGMENT_BINS]
-
-
-def write_break_map(entry, name, path, directory):
-    """The front view of where the fill's bonds broke, as DIR/ENGINE_CASE_breaks.png."""
-    position, mode = entry.pop("_breaks")
-    if not len(mode):
-        return None
-    box, cylinders, _ = scene_geometry(path)
-    png = os.path.join(directory, name.replace("/", "_") + "_breaks.png")
-    plots.break_map(position, mode, png, box, cylinders, title=f"{name}: bond breaks")
-    return os.path.basename(png)
 
 
 def times(out):
@@ -112,29 +71,32 @@ def times(out):
         return {}
 
 
+def measure(path, name, out, spent, directory, rev):
+    """The summary entry of the finished fill at path, with its cubes when all 9 are done."""
+    entry = dict(fill_ch5.result(path), source=rev)
+    entry["outflow"] = outflow.spread(path, scene_geometry(path)[1])
+    fill_ch5.write_pictures(entry, name, path, directory)
+    cubes = [os.path.join(out, name, "cube%d.h5" % k) for k in CUBES]
+    if all(os.path.exists(c) for c in cubes):
+        entry["cubes"] = [cube_result(c) for c in cubes]
+        took = [spent.get("%s/cube%d" % (name, k), {}).get("seconds") for k in CUBES]
+        if all(t is not None for t in took):
+            entry["cube_seconds"] = float(sum(took))
+    if name + "/fill" in spent:
+        entry["seconds"] = spent[name + "/fill"].get("seconds")
+    return entry
+
+
 def collect(out, committed, rev, directory):
     found, spent = {}, times(out)
     for engine in ENGINES:
-        for g in GROUPS:
-            for m in MODELS:
-                name = "%s/%s" % (engine, case(g, m))
-                path = os.path.join(out, engine, case(g, m), "fill.h5")
-                if os.path.exists(path):
-                    entry = dict(fill_result(path), source=rev)
-                    entry["outflow"] = outflow.spread(path, scene_geometry(path)[1])
-                    if "_breaks" in entry:
-                        entry["break_map"] = write_break_map(entry, name, path, directory)
-                    cubes = [os.path.join(out, engine, case(g, m), "cube%d.h5" % k) for k in CUBES]
-                    if all(os.path.exists(c) for c in cubes):
-                        entry["cubes"] = [cube_result(c) for c in cubes]
-                        took = [spent.get("%s/cube%d" % (name, k), {}).get("seconds") for k in CUBES]
-                        if all(t is not None for t in took):
-                            entry["cube_seconds"] = float(sum(took))
-                    if name + "/fill" in spent:
-                        entry["seconds"] = spent[name + "/fill"].get("seconds")
-                    found[name] = entry
-                elif name in committed:
-                    found[name] = committed[name]
+        for c in CASES + RIGID_CASES:
+            name = "%s/%s" % (engine, c)
+            path = os.path.join(out, name, "fill.h5")
+            if os.path.exists(path):
+                found[name] = measure(path, name, out, spent, directory, rev)
+            elif name in committed:
+                found[name] = committed[name]
     return found
 
 
@@ -213,8 +175,97 @@ def claims(found):
                 lines.append("- %s Model %d: stiffness falls as bond strength rises (M %.0f, %.0f, %.0f Pa "
                              "for Groups 1-3): **%s**" % (engine, m, *ms,
                                                          "held" if ms[0] > ms[1] > ms[2] else "not held"))
+                ratio = [stats.summary([c["nu_xy"] for c in e["cubes"]])["mean"] /
+                         stats.summary([c["nu_xz"] for c in e["cubes"]])["mean"] for e in (g1, g2, g3)]
+                lines.append("- %s Model %d: the anisotropy νxy/νxz falls with bond strength (%.3f, %.3f, "
+                             "%.3f for Groups 1-3; the fit is ill-posed, docs/model.md §10): **%s**" % (
+                                 engine, m, *ratio, "held" if ratio[0] > ratio[1] > ratio[2] else "not held"))
+            lines += surface_claim(engine, m, g1, g3)
     if len(lines) == 2:
         lines.append("(none yet: each needs a Group 1 fill and a bonded fill of the same model)")
+    return lines
+
+
+def structure_table(found):
+    lines = ["### Free surface and packing of the deposit (scripts/mixing/structure.py; the seed shows "
+             "pictures only)", "",
+             "the plane fitted to the height map (0.05 m columns, %.2f m from the walls out): its "
+             "inclination and slope along x; the solid fraction within %.2f m of the side walls and "
+             "farther than %.2f m from them, %.2f m over the floor to %.2f m under the lowest column" % (
+                 structure.WALL_BAND, structure.WALL_BAND, structure.INTERIOR, structure.FLOOR_BAND,
+                 structure.SURFACE_BAND), "",
+             "| engine | case | inclination [deg] | slope along x [deg] | surface lowest–highest [m] "
+             "| solid fraction near the walls | in the interior | wall − interior |",
+             "|---|---|---|---|---|---|---|---|"]
+    for name, e in sorted(found.items()):
+        s, p = e.get("surface"), e.get("packing")
+        if s and p:
+            lines.append("| %s | %s | %.1f | %+.1f | %.3f–%.3f | %.4f | %.4f | %+.4f |" % (
+                *name.split("/"), s["inclination"], s["slope_x"], s["lowest"], s["highest"],
+                p["wall"], p["interior"], p["wall"] - p["interior"]))
+    if len(lines) == 5:
+        lines.append("(no fill measured since these measures were added)")
+    return lines
+
+
+def energy_table(found):
+    """The energy balance of each fill and the worst one; the bonds' speed."""
+    lines = ["### Energy balance and speed of the fills (scripts/mixing/energy.py)", "",
+             "largest residual of KE + RE + elastic + gravitational + dissipated (the bonds' stored, "
+             "damped and breakage energy included) − wall work − inflow, over the energy in play and "
+             "over the inflow; the stability suite holds 1e-3 of the energy in play", "",
+             "| engine | case | residual / in play | residual / inflow | breakage [J] | inflow [J] "
+             "| bond-steps | run time [s] | bond-steps/s |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    worst = None
+    for name, e in sorted(found.items()):
+        b = e.get("energy")
+        if not b:
+            continue
+        rate = e["bond_steps"] / e["seconds"] if e.get("seconds") and e.get("bond_steps") else None
+        lines.append("| %s | %s | %.2e | %.2e | %.3g | %.4g | %.3g | %s | %s |" % (
+            *name.split("/"), b["residual_in_play"], b["residual_inflow"], b["breakage"], b["inflow"],
+            e.get("bond_steps", 0.0), "%.0f" % e["seconds"] if e.get("seconds") else "—",
+            "%.3g" % rate if rate else "—"))
+        if worst is None or b["residual_in_play"] > worst[1]:
+            worst = (name, b["residual_in_play"])
+    if worst:
+        lines += ["", "Worst fill: %s, %.2e of the energy in play (%s the stability suite's 1e-3)." % (
+            worst[0], worst[1], "within" if worst[1] <= 1e-3 else "**beyond**")]
+    else:
+        lines.append("(no fill measured since the balance was added)")
+    return lines
+
+
+def surface_claim(engine, m, g1, g3):
+    """Strong bonds leave an inclined free surface and more voids near the walls (Group 3 against
+    Group 1 of the same model)."""
+    if not (g3 and g1.get("surface") and g3.get("surface")):
+        return []
+    s1, s3 = g1["surface"]["inclination"], g3["surface"]["inclination"]
+    v1, v3 = ((e["packing"]["interior"] - e["packing"]["wall"]) for e in (g1, g3))
+    return ["- %s Model %d: strong bonds leave a more inclined free surface (%.1f° against Group 1's "
+            "%.1f°): **%s**" % (engine, m, s3, s1, "held" if s3 > s1 else "not held"),
+            "- %s Model %d: strong bonds leave more voids near the walls (solid fraction interior − wall "
+            "%.4f against Group 1's %.4f): **%s**" % (engine, m, v3, v1, "held" if v3 > v1 else "not held")]
+
+
+def rigid_section(found):
+    """Chapter 6's rigid cements (Figs 6-1, 6-2; the seed shows pictures only)."""
+    lines = ["### Chapter 6: rigid cements (Figs 6-1 and 6-2, unbreakable bonds)", "",
+             "| engine | case | φv at the middle clip | bonds formed | broken | fragments at the end "
+             "| whole blocks | run time [s] |", "|---|---|---|---|---|---|---|---|"]
+    rigid = [(n, e) for n, e in sorted(found.items()) if n.split("/")[1] in RIGID_CASES]
+    for name, e in rigid:
+        k = e.get("breakage", {})
+        lines.append("| %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            *name.split("/"), cell(e), k.get("formed", "—"), k.get("broken", "—"),
+            k.get("fragments", "—"), k.get("whole_blocks", "—"),
+            "%.0f" % e["seconds"] if e.get("seconds") else "—"))
+    if not rigid:
+        lines.append("(not run yet: `make mixing-bonded MODEL=rigid_model1`, `MODEL=rigid_model3`)")
+    lines += ["", "Final middle clips (the spheres cut by y = 0.5 m):", ""]
+    lines += ["![%s](%s)" % (n, e["clip"]) for n, e in sorted(found.items()) if e.get("clip")]
     return lines
 
 
@@ -272,10 +323,19 @@ def report(found, rev):
     if maps:
         lines += ["", "Where the bonds broke (front view, the obstacles grey):", ""]
         lines += ["![%s](%s)" % m for m in maps]
-    lines += [""] + elastic_tables(found) + [""] + claims(found)
+    lines += [""] + structure_table(found) + [""] + energy_table(found) + [""] + elastic_tables(found)
+    lines += [""] + claims(found)
+    lines += [""] + rigid_section(found)
+    views = [(n, e["views"]) for n, e in sorted(found.items()) if e.get("views")]
+    if views:
+        lines += ["", "### Snapshots (Figs 5-5 to 5-22): front and side views at t = 1, 3, 9 s and the end", "",
+                  "big spheres red, the small ones in whole blocks blue, in fragments of 2–31 green, "
+                  "alone orange (Group 1: all small blue)", ""]
+        lines += ["![%s](%s)" % v for v in views]
     sources = sorted({(n, e["source"]) for n, e in found.items() if e.get("source") != rev})
     lines += ["", "From earlier commits: " + (", ".join("%s (%s)" % s for s in sources) if sources else "none"),
-              "", "Not run: %d of %d fills." % (2 * 18 - len(found), 2 * 18), ""]
+              "", "Not run: %d of %d fills." % (2 * len(CASES + RIGID_CASES) - len(found),
+                                                2 * len(CASES + RIGID_CASES)), ""]
     return "\n".join(lines)
 
 
@@ -295,8 +355,9 @@ def main():
     if results and results != a.out:   # the maps beside both reports
         import shutil
         for e in found.values():
-            if e.get("break_map") and os.path.exists(os.path.join(results, e["break_map"])):
-                shutil.copy(os.path.join(results, e["break_map"]), os.path.join(a.out, e["break_map"]))
+            for png in (e.get("break_map"), e.get("views"), e.get("clip")):
+                if png and os.path.exists(os.path.join(results, png)):
+                    shutil.copy(os.path.join(results, png), os.path.join(a.out, png))
     for d in [a.out] + ([results] if results else []):
         os.makedirs(d, exist_ok=True)
         write_atomic(os.path.join(d, "report.md"), report(found, rev))

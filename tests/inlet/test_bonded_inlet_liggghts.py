@@ -218,6 +218,30 @@ def check_bad_sections(c, tmp):
         f.write(good)
 
 
+def check_rigid(c, tmp):
+    """Ch. 6's rigid cements (.inf strengths): every bond intact in both engines, and the two
+    trajectories, a growing particle set, within the tolerance (scripts/compare_trajectories.py)."""
+    doc = yaml.safe_load(open(SCENE))
+    doc["bond_types"]["weak"].update(tensile_strength=float("inf"), shear_strength=float("inf"))
+    doc["watchdog"] = {"max_overlap_fraction": 1.5}   # the Ch. 5 scene's: a big sphere lands on a block
+    scene = os.path.join(tmp, "rigid.yaml")
+    with open(scene, "w") as f:
+        yaml.safe_dump(doc, f)
+    jd_h5, lg_h5 = os.path.join(tmp, "rigid_jdem.h5"), os.path.join(tmp, "rigid_lig.h5")
+    r = subprocess.run([JDEM, "run", scene, "-o", jd_h5, "--quiet"], capture_output=True, text=True)
+    rc, log = run_liggghts(scene, lg_h5, 1)
+    if not c.check("rigid: both engines run the section with unbreakable bonds",
+                   r.returncode == 0 and rc == 0, r.stderr + log[-1500:]):
+        return
+    for name, path in (("jdem", jd_h5), ("liggghts-jdem", lg_h5)):
+        d = read(path)
+        c.check("rigid: all %d bonds formed and none broken in %s" % (len(d["bonds"]), name),
+                len(d["bonds"]) == 120 and len(d["broken"]) == 0, "%d broken" % len(d["broken"]))
+    p = engines.run(engines.script("compare_trajectories", jd_h5, lg_h5))
+    c.check("rigid: the trajectories agree (compare_trajectories.py on a growing set: %s)" %
+            p.stdout.strip().splitlines()[-1], p.returncode == 0, p.stdout[-1500:] + p.stderr[-800:])
+
+
 def main():
     c = Checks()
     if not c.built(JDEM, LIGGGHTS_JDEM):
@@ -255,6 +279,7 @@ def main():
             check_restart(c, tmp, ranks)
         check_guard(c, tmp)
         check_bad_sections(c, tmp)
+        check_rigid(c, tmp)
     return 1 if c.failed else 0
 
 

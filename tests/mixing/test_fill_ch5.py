@@ -1,0 +1,197 @@
+#!/usr/bin/python3
+"""What report_ch5.py measures in a Chapter 5 fill (scripts/mixing/{structure,energy,breakage,
+fill_ch5}.py), on hand-made trajectories whose answers follow in closed form:
+
+* free surface: a simple-cubic bed whose columns rise 0.03 m per 0.09 m along x has the fitted
+  plane's slope atan(1/3) = 18.43 deg (the height map's 0.05 m columns sample the steps);
+* packing: the same lattice fills pi/6 of every region that spans whole lattice periods, near the
+  walls and in the interior alike; with the layer of spheres against the side walls removed, the
+  wall band keeps pi/6 (0.93^2 - 0.87^2) / (0.99^2 - 0.87^2) of its volume;
+* energy: a planted residual of 0.5 J over a known energy in play;
+* fragments: two chains of bonds, one broken at step 10, and an unbonded particle;
+* bond-steps: intact bonds held between the samples of observables/bonds;
+* the snapshot colours: big, whole block, fragment and single sphere apart;
+* the report: a bonded fill and a Ch. 6 rigid fill under --out appear in the new tables (the
+  worst fill named, the rigid fill's bonds all intact) with the numbers measured above.
+"""
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+import h5py
+import numpy as np
+import yaml
+
+from tests.mixing.common import ROOT, check, close, finish
+from scripts.mixing import breakage, deposit, energy, fill_ch5, plots, structure
+
+R, PITCH, SIDE = 0.015, 0.03, 0.99          # 33 lattice periods across the box
+LO, HI = (0.0, 0.0, 0.0), (SIDE, SIDE, 2.0)
+CUBIC = math.pi / 6
+
+
+def bed(layers_of, skip_walls=False):
+    """A simple-cubic bed: the column at (x, y) holds layers_of(x) spheres."""
+    g = np.arange(R, SIDE, PITCH)
+    pts = [[x, y, R + PITCH * k] for x in g for y in g for k in range(layers_of(x))
+           if not (skip_walls and min(x, y, SIDE - x, SIDE - y) < PITCH)]
+    x = np.array(pts)
+    n = len(x)
+    return deposit.Deposit(np.arange(n), np.zeros(n, np.int32), np.full(n, R),
+                           np.full(n, 4000 * 4 / 3 * math.pi * R ** 3), x, step=100, time=27.0)
+
+
+def test_structure():
+    steps = bed(lambda x: 10 + int(x / (3 * PITCH)))
+    s = structure.free_surface(steps, LO, HI)
+    close("surface: the stepped bed's fitted slope along x is atan(1/3)", s["slope_x"],
+          math.degrees(math.atan(1 / 3)), 0.5)
+    close("surface: the inclination equals the slope along x (no slope along y)",
+          s["inclination"], s["slope_x"], 1e-6)
+    flat = bed(lambda x: 12)
+    p = structure.packing(flat, LO, HI)
+    close("packing: the simple-cubic bed fills pi/6 near the walls", p["wall"], CUBIC, 5e-3)
+    close("packing: and pi/6 in the interior", p["interior"], CUBIC, 5e-3)
+    close("packing: the layer's top is 0.06 m under the surface", p["top"], 12 * PITCH - 0.06, 1e-12)
+    hollow = structure.packing(bed(lambda x: 12, skip_walls=True), LO, HI)
+    want = CUBIC * (0.93 ** 2 - 0.87 ** 2) / (0.99 ** 2 - 0.87 ** 2)
+    close("packing: without the spheres against the walls the band keeps %.4f" % want,
+          hollow["wall"], want, 5e-3)
+    close("packing: the interior is untouched", hollow["interior"], CUBIC, 5e-3)
+    close("surface: a flat bed is level", structure.free_surface(flat, LO, HI)["inclination"], 0.0, 1e-9)
+
+
+def observables(f, series):
+    for name, value in series.items():
+        g = f.create_group("observables/" + name)
+        g["value"] = np.asarray(value, float)
+        g["step"] = np.arange(len(value)) * 100
+        g["time"] = np.arange(len(value)) * 0.01
+
+
+def test_energy(tmp):
+    path = os.path.join(tmp, "energy.h5")
+    inflow = np.array([0.0, 10.0, 20.0, 20.0])
+    ke = np.array([0.0, 6.0, 8.0, 2.0])
+    damping = np.array([0.0, 3.0, 9.0, 14.0])
+    bond = np.array([0.0, 1.0, 2.5, 3.0])      # bond elastic + breakage below
+    with h5py.File(path, "w") as f:
+        observables(f, {"kinetic_energy": ke, "damping_dissipation": damping,
+                        "bond_elastic_energy": bond - np.array([0, 0, 0.5, 1.0]),
+                        "bond_breakage_energy": np.array([0, 0, 0.5, 1.0]) + np.array([0, 0, 0, 0.5]),
+                        "gravitational_energy": inflow - ke - damping - bond,
+                        "wall_work": np.zeros(4), "inlet_energy": inflow})
+    b = energy.balance(path)
+    in_play = max(ke + damping + bond + np.array([0, 0, 0, 0.5]))
+    close("energy: the planted 0.5 J residual over the energy in play", b["residual_in_play"],
+          0.5 / in_play, 1e-12)
+    close("energy: and over the inflow", b["residual_inflow"], 0.5 / 20.0, 1e-12)
+    close("energy: the breakage booked at the end", b["breakage"], 1.5, 1e-12)
+    with h5py.File(os.path.join(tmp, "no_inlet.h5"), "w") as f:
+        observables(f, {"kinetic_energy": ke})
+    check("energy: a run without an inlet has no balance", energy.balance(os.path.join(tmp, "no_inlet.h5")) is None)
+
+
+def bonds_record():
+    """Chains 1-2-3 and 4-5 formed at step 0 and 4, 2-3 broken at step 10 (tension)."""
+    return {"bonds": np.array([[1, 2], [2, 3], [4, 5]]), "formed": np.array([0, 0, 4]),
+            "broken": np.array([[2, 3]]), "broken_step": np.array([10]), "mode": np.array([1]),
+            "broken_at": np.array([[0.5, 0.5, 0.5]]), "dt": 1e-4}
+
+
+def test_fragments():
+    rec = bonds_record()
+    ids = np.array([1, 2, 3, 4, 5, 9])
+    check("fragments: before the break 3, 3, 3, 2, 2 and 0 (unbonded)",
+          breakage.fragment_of(rec, 5, ids).tolist() == [3, 3, 3, 2, 2, 0],
+          str(breakage.fragment_of(rec, 5, ids)))
+    check("fragments: before 4-5 forms, 4 and 5 are not bonded",
+          breakage.fragment_of(rec, 2, ids).tolist() == [3, 3, 3, 0, 0, 0])
+    check("fragments: after the break 2, 2, 1, 2, 2, 0",
+          breakage.fragment_of(rec, 20, ids).tolist() == [2, 2, 1, 2, 2, 0])
+    check("fragments: sizes largest first", breakage.fragment_sizes(rec, 20).tolist() == [2, 2, 1])
+    r = 0.015 * np.ones(5)
+    r[0] = 0.03
+    dep = deposit.Deposit(np.array([6, 1, 3, 9, 40]), np.zeros(5, np.int32), r, np.ones(5),
+                          np.zeros((5, 3)), step=20)
+    whole = dict(rec, bonds=np.array([[40, 40 + k] for k in range(1, fill_ch5.BLOCK)]),
+                 formed=np.zeros(fill_ch5.BLOCK - 1, np.int64))
+    got = fill_ch5.colours(dep, dict(rec, bonds=np.vstack([rec["bonds"], whole["bonds"]]),
+                                     formed=np.concatenate([rec["formed"], whole["formed"]])))
+    want = [c for _, c in fill_ch5.CATEGORIES]
+    check("colours: big, fragment, single, never bonded (single), whole block",
+          got.tolist() == [want[0], want[2], want[3], want[3], want[1]], str(got))
+    check("colours: an unbonded fill draws every small sphere as the seed's blue",
+          fill_ch5.colours(dep, None).tolist() == [want[0]] + [plots.SMALL_COLOUR] * 4)
+
+
+def test_bond_steps(tmp):
+    path = os.path.join(tmp, "bonds.h5")
+    with h5py.File(path, "w") as f:
+        g = f.create_group("observables/bonds")
+        g["value"], g["step"] = np.array([10, 8, 8]), np.array([0, 100, 300])
+    close("bond-steps: 10 x 100 + 8 x 200", fill_ch5.bond_steps(path), 2600.0, 0.0)
+
+
+def scene_text():
+    walls = [{"name": n, "type": "plane", "corners": c} for n, c in (
+        ("floor", [[0, 0, 0], [SIDE, 0, 0], [SIDE, SIDE, 0], [0, SIDE, 0]]),
+        ("top", [[0, 0, 2], [0, SIDE, 2], [SIDE, SIDE, 2], [SIDE, 0, 2]]))]
+    walls.append({"name": "upper_mixer", "type": "cylinder", "axis": [[0.3, 0, 1.5], [0.3, SIDE, 1.5]],
+                  "radius": 0.05})
+    return yaml.safe_dump({"name": "mixing_ch5", "walls": walls})
+
+
+def write_fill(path, dep, rec, residual):
+    """A one-frame trajectory of dep with the bonds of rec and a balance off by `residual` J."""
+    with h5py.File(path, "w") as f:
+        f["parameters/scene"] = scene_text().encode()
+        f["parameters"].attrs["dt"] = rec["dt"]
+        p = f.create_group("particles/all")
+        p["id"], p["species"], p["radius"], p["mass"] = dep.id, dep.species, dep.radius, dep.mass
+        p["position/value"], p["velocity/value"] = dep.position[None], np.zeros((1,) + dep.position.shape)
+        p["position/step"], p["position/time"] = np.array([dep.step]), np.array([dep.time])
+        f["connectivity/bonds"], f["jdem/bonds/formed_step"] = rec["bonds"], rec["formed"]
+        if len(rec["broken"]):
+            f["connectivity/broken_bonds"], f["jdem/broken_bonds/step"] = rec["broken"], rec["broken_step"]
+            f["jdem/broken_bonds/mode"], f["jdem/broken_bonds/position"] = rec["mode"], rec["broken_at"]
+        observables(f, {"kinetic_energy": [0.0, 4.0], "inlet_energy": [0.0, 10.0],
+                        "gravitational_energy": [0.0, 6.0 + residual], "bonds": [3, 2]})
+
+
+def test_report(tmp):
+    out = os.path.join(tmp, "out")
+    dep = bed(lambda x: 10 + int(x / (3 * PITCH)))
+    rec = bonds_record()
+    rec_rigid = dict(rec, broken=np.zeros((0, 2), np.int64), broken_step=np.zeros(0, np.int64))
+    for case, r, residual in (("group2_model3", rec, 0.25), ("rigid_model3", rec_rigid, 0.01)):
+        os.makedirs(os.path.join(out, "jdem", case))
+        write_fill(os.path.join(out, "jdem", case, "fill.h5"), dep, r, residual)
+    run = subprocess.run([sys.executable, "-m", "scripts.mixing.report_ch5", "--out", out],
+                         cwd=ROOT, capture_output=True, text=True)
+    check("report: runs on a bonded and a rigid fill", run.returncode == 0, run.stderr[-800:])
+    if run.returncode:
+        return
+    text = open(os.path.join(out, "report.md")).read()
+    slope = structure.free_surface(dep, LO, HI)
+    check("report: the bonded fill's surface row", "| jdem | group2_model3 | %.1f | %+.1f |" % (
+        slope["inclination"], slope["slope_x"]) in text)
+    check("report: the worst fill is the bonded one, 0.25 J of its 4 J in play",
+          "Worst fill: jdem/group2_model3, 6.25e-02 of the energy in play (**beyond**" in text)
+    check("report: the rigid fill's bonds all intact (3 formed, 0 broken, 2 fragments)",
+          re.search(r"\| jdem \| rigid_model3 \| [^|]+ \| 3 \| 0 \| 2 \| 0 \| — \|", text) is not None)
+    check("report: the bond-steps, 3 x 100", "| 300 |" in text)
+    for png in ("jdem_group2_model3_views.png", "jdem_rigid_model3_clip.png", "jdem_group2_model3_breaks.png"):
+        check("report: draws %s" % png, os.path.exists(os.path.join(out, png)) and "(%s)" % png in text)
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    test_structure()
+    test_energy(tmp)
+    test_fragments()
+    test_bond_steps(tmp)
+    test_report(tmp)
+finish()
