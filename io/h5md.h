@@ -1,7 +1,7 @@
 /*
  * h5md.h — the trajectory writer shared by both engines (the standalone stepper and the
  * LIGGGHTS dump style `h5md/jdem`).  C11 on top of the HDF5 C library; it writes the H5MD 1.1
- * layout fixed in DESIGN.md plus an XDMF sidecar so that ParaView opens the file directly.
+ * layout of docs/output.md plus an XDMF sidecar so that ParaView opens the file directly.
  *
  * Layout (all floating-point data float64, SI units; N particles sorted by id; F frames;
  * docs/output.md describes it for readers):

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""accuracy.py — error against run time (work-precision study) of issue 6: `make accuracy`.
+"""accuracy.py — error against run time (work-precision study): `make accuracy`.
 
     scripts/accuracy.py run     [--out out/accuracy] [--items a,b] [--engines jdem,...] [--repeats 3]
     scripts/accuracy.py analyse [--out out/accuracy]

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""bench.py — the performance benchmark of issue 6 (`make bench`).
+"""bench.py — the performance benchmark (`make bench`).
 
     scripts/bench.py [--sizes 5k,20k] [--variants all] [--engines jdem,liggghts-jdem,liggghts]
                      [--repeats 3] [--ranks-size 20k] [--out out/bench] [--fresh] [--report-only]
@@ -93,8 +93,8 @@ def main():
                     help="OpenMP thread counts of the jdem runs (default 1,2)")
     ap.add_argument("--threads-variants", default=os.environ.get("BENCH_THREADS_VARIANTS", "soft_mono"),
                     help="variants whose jdem runs use every --threads count ('all' for every variant); "
-                         "the others run on 1 thread (default soft_mono: the beds issue 6 sets the "
-                         "thread target on; keeps make bench short)")
+                         "the others run on 1 thread (default soft_mono: the beds the "
+                         "thread target is set on; keeps make bench short)")
     ap.add_argument("--timeout", type=float, default=RUN_TIMEOUT_S,
                     help="seconds after which one engine run is killed and recorded as failed")
     ap.add_argument("--keep-files", action="store_true",

@@ -40,7 +40,7 @@ BOND_MAX_GAP = 1.0e-9
 # A single engine run that takes longer than this is reported as failed (and the bench goes on)
 RUN_TIMEOUT_S = 3600.0
 PROFILE_MAX_SIZE = "20k"          # the callgrind profile runs on the smallest size, if not above this
-FLATNESS_TARGET = 1.25            # issue 6: jdem's cost per particle-step within 1.25x from 5k to 1M
+FLATNESS_TARGET = 1.25            # jdem's cost per particle-step within 1.25x from 5k to 1M (flat in N)
 
 
 def is_bonded(variant):

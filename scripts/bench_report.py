@@ -162,7 +162,7 @@ def flatness_section(flat):
         return []
     L = ["## Cost per particle-step against N (jdem)\n\n",
          "Nanoseconds per particle-step of jdem at each size run, and the flatness ratio max / min over the "
-         "sizes (issue 6: <= %.2f from 5k to 1M), from three measures of the loop: wall time by jdem's loop "
+         "sizes (target: <= %.2f from 5k to 1M), from three measures of the loop: wall time by jdem's loop "
          "timer less its output (the throughput tables' measure), the sum of the loop's `--timing` parts but "
          "the output (the same less the per-step checks), and CPU time as run(S) - run(1) (1 thread; its set-up, scene parsing, "
          "varies by more than the loop takes from 80k up). On a loaded "

@@ -134,7 +134,7 @@ bond_rules:
 
 
 def feature_check(out, size, steps, repeats, timeout=RUN_TIMEOUT_S):
-    """The scene-specialisation check of issue 6: the soft monodisperse bed without damping,
+    """The scene-specialisation check: the soft monodisperse bed without damping,
     rolling resistance and bonds (restitution 1, rolling friction 0), run by the loop
     specialised for it, against the same scene with those laws enabled at zero coefficients:
     the general contact loop (--all-laws: damping, rolling and mu_R evaluated with zero

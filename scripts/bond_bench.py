@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""bond_bench.py — nanoseconds per bond per step (issue 4), next to the LAMMPS bpm/rotational
+"""bond_bench.py — nanoseconds per bond per step, next to the LAMMPS bpm/rotational
 anchor of about 228 ns per bond-step on one core (shared/spec/anchors.md §2.1).
 
     scripts/bond_bench.py [--engines jdem] [--counts 20,20,20] [--steps 400] [--repeats 3]

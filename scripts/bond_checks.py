@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""bond_checks.py — the parallel-bond checks of issue 4, engine-agnostic.
+"""bond_checks.py — the parallel-bond checks, engine-agnostic.
 
     scripts/bond_checks.py [--engines jdem,liggghts-jdem] [--quick] [--np N] [--out out/bonds]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""stability_scenes.py — write the scenes of reference_runs/stability/ (issue 5).
+"""stability_scenes.py — write the scenes of reference_runs/stability/.
 
     scripts/stability_scenes.py [--jdem build/jdem] [--out reference_runs/stability]
 

@@ -1,5 +1,5 @@
 """agreement_ch4.py — the two engines' deposits against the run-to-run spread (report_ch4.py;
-issue 23: "deposit statistics agree within the measured run-to-run spread").
+the deposit statistics must agree within the measured run-to-run spread).
 
 Past the cross-engine horizon (under a second of the fill) jdem and liggghts-jdem are two
 realisations of the same chaotic fill, so their deposits can differ by what two realisations of

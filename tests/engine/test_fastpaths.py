@@ -253,7 +253,7 @@ c.check("specialised_vs_general_identical", identical(spec, general),
         "the specialised loop differs from the general one at zero coefficients: "
         f"position {rel_diff(spec, general, 'position'):.3g}")
 c.check("plain_scene_differs_from_base", not identical(spec, srt), "the variant changed nothing")
-# Bonds enabled at zero coefficients as well (issue 6's general scene): springs of zero stiffness
+# Bonds enabled at zero coefficients as well (the general scene): springs of zero stiffness
 # between the pairs within half a radius at the start carry no load, so the trajectory is still the
 # specialised loop's bit for bit, no bond breaks, and the bonds hold no energy (0, not 0/0).
 assert plain.count("\nwalls:\n") == 1
