@@ -49,10 +49,12 @@ extern "C" {
     JD_LAW_SETS_TANGENTIAL(X, JD_F_MINDLIN)                                    \
     JD_LAW_SETS_TANGENTIAL(X, JD_F_ENERGY | JD_F_MINDLIN)
 
-/* The laws a force loop takes as a run-time part of its law set rather than compiling a copy
- * for: Mindlin's K_t changes one scalar per contact (jd_tangential_stiffness), so a branch on
- * the bit costs less than doubling the tangential copies (docs/performance.md, "Build time").
- * JD_LAW_LOOPS holds every law set without these bits. */
+/* The laws no compiled loop is specialised for: Mindlin's K_t changes one scalar per contact
+ * (jd_tangential_stiffness), so compiling the tangential copies twice is not worth it
+ * (docs/performance.md, "Build time").  The plugin's scalar loops take the bit as a branch
+ * (jd_law_set_of_loop); the stepper's SIMD lanes would turn it into a select that every run
+ * pays, so a run with it takes the stepper's reference loops.  JD_LAW_LOOPS holds every law set
+ * without these bits. */
 #define JD_F_RUN_TIME JD_F_MINDLIN
 
 /* The compiled loop that runs law set bits: a dispatcher switches on this and expands

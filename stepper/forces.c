@@ -2,8 +2,9 @@
  * forces.c — force loops.  The scene's law set (JD_F_* bits, kernel/jdem_laws.h) is fixed for a
  * run; the loop body is instantiated once per compiled law set of the kernel's list
  * (JD_LAW_LOOPS) with the bits as a constant, so that jd_contact() compiles away every law the
- * scene does not use (a scene pays only for what it uses); the run-time laws (JD_F_RUN_TIME)
- * are a branch inside.  The sets with energy bookkeeping are compiled in forces_energy.c.  Order as LIGGGHTS: pair forces in list order (the candidates that
+ * scene does not use (a scene pays only for what it uses).  A run with a run-time law
+ * (JD_F_RUN_TIME: Mindlin's K_t) takes the reference loops, which keep its bit as a value: a
+ * branch in the compiled copies would be a select in every SIMD lane of every run.  The sets with energy bookkeeping are compiled in forces_energy.c.  Order as LIGGGHTS: pair forces in list order (the candidates that
  * touched at the build, then the others: sim.h, jd_contact_list), wall forces, mesh walls, gravity.
  *
  * Threads (sim.h, "Threads"): each thread zeroes the forces of the particles it owns, evaluates
@@ -715,8 +716,7 @@ static double plain_contact_loops(jd_sim *s, int tid, double *t_pairs_end) {
 
 #endif
 
-/* This thread's share of the contact loops under law set F (jd_law_set_of_loop: constant but
- * for the run-time laws); returns its wall work.  *t_pairs_end: when thread 0 finished its
+/* This thread's share of the contact loops under the constant law set F; returns its wall work.  *t_pairs_end: when thread 0 finished its
  * share of the pairs (with threads, the split of the timing is thread 0's). */
 static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int tid,
                                              double *t_pairs_end) {
@@ -741,11 +741,10 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
 }
 
 /* One instantiation per compiled law set (the kernel's list, jdem_laws.h: JD_LAW_LOOPS): the
- * switch maps the run's bits to a constant law set, and the loop passes the run-time laws
- * (JD_F_RUN_TIME) of the run's bits on to the kernel. */
+ * switch maps the run's bits to a constant law set.  Bits with a run-time law match no case. */
 #define JD_FORCE_CASE(loop)                                                                   \
     case (loop):                                                                              \
-        *work = contact_loops(s, jd_law_set_of_loop((loop), s->run.features), tid, t_pairs_end);  \
+        *work = contact_loops(s, (loop), tid, t_pairs_end);                                   \
         return 1;
 
 /* The compiled law sets with energy bookkeeping are instantiated in a translation unit of their
@@ -755,7 +754,7 @@ static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int ti
 int sim_force_loops_energy(jd_sim *s, int tid, double *work, double *t_pairs_end);
 #ifdef JD_FORCE_LOOPS_ENERGY
 int sim_force_loops_energy(jd_sim *s, int tid, double *work, double *t_pairs_end) {
-    switch (jd_law_set_loop(s->run.features)) {
+    switch (s->run.features) {
         JD_LAW_SETS_WITH(JD_FORCE_CASE, JD_F_ENERGY)
     default:
         return 0;
@@ -764,7 +763,7 @@ int sim_force_loops_energy(jd_sim *s, int tid, double *work, double *t_pairs_end
 #else
 #ifndef JD_ONE_FORCE_LOOP
 static int force_loops_without_energy(jd_sim *s, int tid, double *work, double *t_pairs_end) {
-    switch (jd_law_set_loop(s->run.features)) {
+    switch (s->run.features) {
         JD_LAW_SETS_WITH(JD_FORCE_CASE, 0u)
     default:
         return 0;
@@ -787,7 +786,7 @@ static double dispatch(jd_sim *s, int tid, double *t_pairs_end_out) {
 #else
     if (!force_loops_without_energy(s, tid, &work, &t_pairs_end) &&
         !sim_force_loops_energy(s, tid, &work, &t_pairs_end))
-        /* not a law set (jd_law_set_select never returns one): the reference path */
+        /* a run-time law (Mindlin's K_t): the reference path */
         work = plain_contact_loops(s, tid, &t_pairs_end);
 #endif
     if (tid == 0) *t_pairs_end_out = t_pairs_end;
