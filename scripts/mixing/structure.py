@@ -2,8 +2,11 @@
 strong bonds "leave an inclined free surface and more voids near the walls" (spec §3.8).  The
 seed shows this in pictures only; these measures are ours [RECON].
 
-free_surface: the deposit's top as a height map, the highest particle top (z + R) in each
-SURFACE_CELL x SURFACE_CELL column of the box, and the plane z = a + b x + c y fitted to it by
+free_surface: the deposit's top as a height map, the top (z + R) of the bed in each
+SURFACE_CELL x SURFACE_CELL column of the box: the highest particle that the column's particles
+reach from the bottom up without a vertical gap of more than BED_GAP between one particle's top
+and the next one's bottom (spheres resting on an obstacle above the bed are not its surface),
+and the plane z = a + b x + c y fitted to it by
 least squares; its inclination atan(sqrt(b^2 + c^2)) in degrees and the slope along x (the
 feed direction), from the columns inside the walls by more than WALL_BAND (a heap against a
 wall is not the free surface).
@@ -19,17 +22,35 @@ WALL_BAND = 0.06      # [m] two small diameters, one big one
 INTERIOR = 0.15       # [m]
 FLOOR_BAND = 0.06     # [m]
 SURFACE_BAND = 0.06   # [m]
+BED_GAP = 0.06        # [m] a big diameter: more than any gap inside a settled bed
 SAMPLES = 200000      # random points per region: the fraction's standard error ~ 1e-3
 SEED = 20211
 
 
+def bed_top(bottom, top):
+    """The top [m] of the stack of a column's particles (bottoms and tops [m]) reached from the
+    lowest without a gap of more than BED_GAP."""
+    order = np.argsort(bottom, kind="stable")
+    bottom, top = bottom[order], np.maximum.accumulate(top[order])
+    gaps = np.nonzero(bottom[1:] - top[:-1] > BED_GAP)[0]
+    return float(top[gaps[0]] if len(gaps) else top[-1])
+
+
 def height_map(dep, lo, hi, cell=SURFACE_CELL):
-    """(x, y, h) of the columns' centres [m] and heights [m], the columns without particles out."""
+    """(x, y, h) of the columns' centres [m] and the bed's heights [m] (bed_top), the columns
+    without particles out."""
     nx, ny = (int(round((hi[k] - lo[k]) / cell)) for k in (0, 1))
     i = np.clip(((dep.position[:, 0] - lo[0]) / cell).astype(int), 0, nx - 1)
     j = np.clip(((dep.position[:, 1] - lo[1]) / cell).astype(int), 0, ny - 1)
+    column = i * ny + j
+    z, r = dep.position[:, 2], dep.radius
     h = np.full(nx * ny, -np.inf)
-    np.maximum.at(h, i * ny + j, dep.position[:, 2] + dep.radius)
+    order = np.argsort(column, kind="stable")
+    starts = np.searchsorted(column[order], np.arange(nx * ny + 1))
+    for c in range(nx * ny):
+        members = order[starts[c]:starts[c + 1]]
+        if len(members):
+            h[c] = bed_top(z[members] - r[members], z[members] + r[members])
     cx, cy = np.meshgrid(lo[0] + cell * (np.arange(nx) + 0.5), lo[1] + cell * (np.arange(ny) + 0.5),
                          indexing="ij")
     ok = np.isfinite(h)

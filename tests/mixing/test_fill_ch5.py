@@ -3,7 +3,8 @@
 fill_ch5}.py), on hand-made trajectories whose answers follow in closed form:
 
 * free surface: a simple-cubic bed whose columns rise 0.03 m per 0.09 m along x has the fitted
-  plane's slope atan(1/3) = 18.43 deg (the height map's 0.05 m columns sample the steps);
+  plane's slope atan(1/3) = 18.43 deg (the height map's 0.05 m columns sample the steps); a
+  level bed with spheres resting 0.5 m above part of it (as on a mixer) stays level;
 * packing: the same lattice fills pi/6 of every region that spans whole lattice periods, near the
   walls and in the interior alike; with the layer of spheres against the side walls removed, the
   wall band keeps pi/6 (0.93^2 - 0.87^2) / (0.99^2 - 0.87^2) of its volume;
@@ -62,6 +63,22 @@ def test_structure():
           hollow["wall"], want, 5e-3)
     close("packing: the interior is untouched", hollow["interior"], CUBIC, 5e-3)
     close("surface: a flat bed is level", structure.free_surface(flat, LO, HI)["inclination"], 0.0, 1e-9)
+    # spheres resting 0.5 m above the bed's top over x < 0.4 m (as on a mixer) are not its surface
+    perched = bed(lambda x: 12)
+    over = perched.position[:, 0] < 0.4
+    top = perched.position[over & (perched.position[:, 2] > 11 * PITCH)]
+    lifted = deposit.Deposit(np.arange(len(perched.radius) + len(top)),
+                             np.zeros(len(perched.radius) + len(top), np.int32),
+                             np.full(len(perched.radius) + len(top), R),
+                             np.full(len(perched.radius) + len(top), perched.mass[0]),
+                             np.vstack([perched.position, top + [0.0, 0.0, 0.5]]), step=100, time=27.0)
+    s = structure.free_surface(lifted, LO, HI)
+    close("surface: spheres resting 0.5 m over the bed leave it level", s["inclination"], 0.0, 1e-9)
+    close("surface: and its top at 12 layers", s["highest"], 12 * PITCH, 1e-12)
+    close("surface: a gap of BED_GAP or less still joins the stack",
+          structure.bed_top(np.array([0.0, 0.08]), np.array([0.03, 0.11])), 0.11, 1e-15)
+    close("surface: a wider gap ends it",
+          structure.bed_top(np.array([0.0, 0.1]), np.array([0.03, 0.13])), 0.03, 1e-15)
 
 
 def observables(f, series):
