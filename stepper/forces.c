@@ -4,8 +4,10 @@
  * (JD_LAW_LOOPS) with the bits as a constant, so that jd_contact() compiles away every law the
  * scene does not use (a scene pays only for what it uses).  A run with a run-time law
  * (JD_F_RUN_TIME: Mindlin's K_t) takes the reference loops, which keep its bit as a value: a
- * branch in the compiled copies would be a select in every SIMD lane of every run.  The sets with energy bookkeeping are compiled in forces_energy.c.  Order as LIGGGHTS: pair forces in list order (the candidates that
- * touched at the build, then the others: sim.h, jd_contact_list), wall forces, mesh walls, gravity.
+ * branch in the compiled copies would be a select in every SIMD lane of every run.  The sets
+ * with energy bookkeeping are compiled in forces_energy.c.  Order as LIGGGHTS: pair forces in
+ * list order (the candidates that touched at the build, then the others: sim.h,
+ * jd_contact_list), wall forces, mesh walls, gravity.
  *
  * Threads (sim.h, "Threads"): each thread zeroes the forces of the particles it owns, evaluates
  * their entries and adds into f and torque, and into its overflow buffer for partners beyond its
@@ -716,8 +718,9 @@ static double plain_contact_loops(jd_sim *s, int tid, double *t_pairs_end) {
 
 #endif
 
-/* This thread's share of the contact loops under the constant law set F; returns its wall work.  *t_pairs_end: when thread 0 finished its
- * share of the pairs (with threads, the split of the timing is thread 0's). */
+/* This thread's share of the contact loops under the constant law set F; returns its wall
+ * work.  *t_pairs_end: when thread 0 finished its share of the pairs (with threads, the split
+ * of the timing is thread 0's). */
 static JD_ALWAYS_INLINE double contact_loops(jd_sim *s, const unsigned F, int tid,
                                              double *t_pairs_end) {
     const jd_particles *ps = &s->particles;

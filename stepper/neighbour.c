@@ -295,50 +295,36 @@ static int sort_into_cells(jd_sim *s, char *err, size_t errlen) {
     return sim_reorder(s, s->lists.cell_items, err, errlen);
 }
 
-/* Push the pairs (i, j > i) of the particles j at [q0, q1) of the cell arrays whose surfaces
- * are closer than the skin. */
-static int push_near(const jd_particles *ps, const jd_neighbour_lists *lists, unsigned kind,
-                     size_t i, int32_t q0, int32_t q1, jd_contact_list *l) {
-    const double *xi = ps->x + 3 * i;
-    const double ri = ps->radius[i];
-    for (int32_t q = q0; q < q1; q++) {
-        const int32_t j = lists->cell_items[q];
-        if ((size_t)j <= i) continue;
-        const double *xj = ps->x + 3 * (size_t)j;
-        const double d[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
-        const double range = ri + ps->radius[j] + lists->skin;
-        if (jd_dot(d, d) < range * range && list_push(l, (int32_t)i, j, kind) != 0) return -1;
-    }
-    return 0;
-}
-
-/* push_near for the particles j in [j0, j1), all > i (numbered in cell order): the tests of a
- * block of JD_NEAR_BLOCK at a time first, in SIMD lanes, then the pushes in order. */
+/* Push the pairs (i, j) of the partners j > i at [q0, q1) of the cell arrays whose surfaces are
+ * closer than the skin: j = items[q], or j = q when items is NULL (particles numbered in cell
+ * order).  The tests of a block of JD_NEAR_BLOCK partners first, in SIMD lanes, then the pushes
+ * in order. */
 #define JD_NEAR_BLOCK 32
-static int push_near_run(const jd_particles *ps, double skin, unsigned kind, size_t i,
-                         int32_t j0, int32_t j1, jd_contact_list *l) {
+static int push_near(const jd_particles *ps, double skin, unsigned kind, size_t i,
+                     const int32_t *items, int32_t q0, int32_t q1, jd_contact_list *l) {
     const double *restrict x = ps->x, *restrict rad = ps->radius;
     const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i];
-    for (int32_t b = j0; b < j1; b += JD_NEAR_BLOCK) {
-        const int nb = j1 - b < JD_NEAR_BLOCK ? (int)(j1 - b) : JD_NEAR_BLOCK;
+    for (int32_t b = q0; b < q1; b += JD_NEAR_BLOCK) {
+        const int nb = q1 - b < JD_NEAR_BLOCK ? (int)(q1 - b) : JD_NEAR_BLOCK;
         int near[JD_NEAR_BLOCK];
         for (int k = 0; k < nb; k++) {
-            const size_t j = (size_t)(b + k);
+            const size_t j = (size_t)(items ? items[b + k] : b + k);
             const double d0 = x[3 * j] - xi0, d1 = x[3 * j + 1] - xi1, d2 = x[3 * j + 2] - xi2;
-            const double range = ri + rad[j] + skin; /* the sum in push_near's order */
-            near[k] = d0 * d0 + d1 * d1 + d2 * d2 < range * range;
+            const double range = ri + rad[j] + skin;
+            near[k] = j > i && d0 * d0 + d1 * d1 + d2 * d2 < range * range;
         }
         for (int k = 0; k < nb; k++)
-            if (near[k] && list_push(l, (int32_t)i, b + k, kind) != 0) return -1;
+            if (near[k] && list_push(l, (int32_t)i, items ? items[b + k] : b + k, kind) != 0)
+                return -1;
     }
     return 0;
 }
 
 /* The pairs within the skin, from the cell grid (lists' cell arrays), into l; step: for a
- * message.  sorted: the particles are numbered in the grid's cell order (sort_into_cells), so
- * a cell numbered before i's holds only j < i, and the three cells of a row along the fast axis
- * hold one run of consecutive j: each of the 9 rows around i's cell is one range of j, from
- * i + 1 on.  The list is the same either way (each row sorted by j). */
+ * message.  The three cells of a row along the fast axis are one run of the cell arrays, so each
+ * of the 9 rows around i's cell is one call of push_near.  sorted: the particles are numbered in
+ * the grid's cell order (sort_into_cells), so that run is the partners j themselves, and those
+ * before i + 1 are skipped unread.  The list is the same either way (each row sorted by j). */
 static int build_pair_list_cells(const jd_particles *ps, jd_neighbour_lists *lists, unsigned kind,
                                  int sorted, int64_t step, jd_contact_list *l, char *err,
                                  size_t errlen) {
@@ -355,6 +341,8 @@ static int build_pair_list_cells(const jd_particles *ps, jd_neighbour_lists *lis
         c[ax[2]] = ci % nc[ax[2]];
         c[ax[1]] = (ci / nc[ax[2]]) % nc[ax[1]];
         c[ax[0]] = ci / (nc[ax[2]] * nc[ax[1]]);
+        const int f0 = c[ax[2]] > 0 ? c[ax[2]] - 1 : 0;   /* the row's cells along the fast axis */
+        const int f1 = c[ax[2]] + 1 < nc[ax[2]] ? c[ax[2]] + 1 : nc[ax[2]] - 1;
         const size_t first = l->n;
         for (int ds = -1; ds <= 1; ds++) {
             int nb[3];
@@ -363,22 +351,14 @@ static int build_pair_list_cells(const jd_particles *ps, jd_neighbour_lists *lis
             for (int dm = -1; dm <= 1; dm++) {
                 nb[ax[1]] = c[ax[1]] + dm;
                 if (nb[ax[1]] < 0 || nb[ax[1]] >= nc[ax[1]]) continue;
-                const int f0 = c[ax[2]] > 0 ? c[ax[2]] - 1 : 0;
-                const int f1 = c[ax[2]] + 1 < nc[ax[2]] ? c[ax[2]] + 1 : nc[ax[2]] - 1;
                 nb[ax[2]] = f0;
-                const size_t row = cell_number(nb, nc, ax);
-                const size_t end = row + (size_t)(f1 - f0) + 1;
-                if (sorted) {
-                    const int32_t q1 = lists->cell_start[end];
-                    const int32_t q0 = lists->cell_start[row] > (int32_t)i ? lists->cell_start[row]
-                                                                          : (int32_t)i + 1;
-                    if (q0 < q1 && push_near_run(ps, lists->skin, kind, i, q0, q1, l) != 0) goto oom;
-                    continue;
-                }
-                for (size_t cell = row; cell < end; cell++)
-                    if (push_near(ps, lists, kind, i, lists->cell_start[cell],
-                                  lists->cell_start[cell + 1], l) != 0)
-                        goto oom;
+                const size_t row = cell_number(nb, nc, ax), end = row + (size_t)(f1 - f0) + 1;
+                int32_t q0 = lists->cell_start[row];
+                const int32_t q1 = lists->cell_start[end];
+                if (sorted && q0 <= (int32_t)i) q0 = (int32_t)i + 1;
+                if (q0 < q1 && push_near(ps, lists->skin, kind, i, sorted ? NULL : lists->cell_items,
+                                         q0, q1, l) != 0)
+                    goto oom;
             }
         }
         sort_segment(l->j + first, l->n - first);

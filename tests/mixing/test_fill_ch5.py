@@ -64,14 +64,11 @@ def test_structure():
     close("packing: the interior is untouched", hollow["interior"], CUBIC, 5e-3)
     close("surface: a flat bed is level", structure.free_surface(flat, LO, HI)["inclination"], 0.0, 1e-9)
     # spheres resting 0.5 m above the bed's top over x < 0.4 m (as on a mixer) are not its surface
-    perched = bed(lambda x: 12)
-    over = perched.position[:, 0] < 0.4
-    top = perched.position[over & (perched.position[:, 2] > 11 * PITCH)]
-    lifted = deposit.Deposit(np.arange(len(perched.radius) + len(top)),
-                             np.zeros(len(perched.radius) + len(top), np.int32),
-                             np.full(len(perched.radius) + len(top), R),
-                             np.full(len(perched.radius) + len(top), perched.mass[0]),
-                             np.vstack([perched.position, top + [0.0, 0.0, 0.5]]), step=100, time=27.0)
+    top = flat.position[(flat.position[:, 0] < 0.4) & (flat.position[:, 2] > 11 * PITCH)]
+    n = len(flat.radius) + len(top)
+    lifted = deposit.Deposit(np.arange(n), np.zeros(n, np.int32), np.full(n, R),
+                             np.full(n, flat.mass[0]), np.vstack([flat.position, top + [0, 0, 0.5]]),
+                             step=100, time=27.0)
     s = structure.free_surface(lifted, LO, HI)
     close("surface: spheres resting 0.5 m over the bed leave it level", s["inclination"], 0.0, 1e-9)
     close("surface: and its top at 12 layers", s["highest"], 12 * PITCH, 1e-12)
