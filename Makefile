@@ -253,7 +253,7 @@ mixing-bonded-report:
 # one run: out/mixing/speed/report.md and summary.json (docs/mixing.md §10).
 .PHONY: mixing-speed
 mixing-speed: all
-	$(PY) -m scripts.mixing.speed_ch4 $(if $(SPEED_TIME),--end-time $(SPEED_TIME))
+	$(PY) -m scripts.mixing.speed_ch4 $(if $(SPEED_TIME),--end-time $(SPEED_TIME)) $(if $(SPEED_ROUNDS),--rounds $(SPEED_ROUNDS))
 
 .PHONY: mixing-report
 mixing-report:

@@ -277,6 +277,13 @@ static JD_ALWAYS_INLINE void sphere_test(const double *restrict x, const double 
     }
 }
 
+/* Whether GCC vectorises a lane loop that reads the history records at a constant stride: it
+ * can for a group of 1, 2, 4, ... or 3 doubles. */
+static JD_ALWAYS_INLINE int record_widths_vectorise(const unsigned F) {
+    const int hw = HW(F), rw = RW(F);
+    return (hw == 3 || (hw & (hw - 1)) == 0) && (rw == 3 || (rw & (rw - 1)) == 0);
+}
+
 /* Geometry and law for the pair entries [c0, c0 + nb), one SIMD lane per candidate; returns
  * the number of lanes.  Entries that touched at the build (packed = 0): every entry is a lane,
  * the sphere test (LIGGGHTS' rsq < radsum^2, then jd_geom_spheres_fill's) a lane mask rather
@@ -307,6 +314,12 @@ static JD_ALWAYS_INLINE int batch_evaluate(const jd_particles *ps, const jd_run_
     const jd_pair_const_roll pcr1 = fast->pcr_alike;
     const double r1 = fast->r_alike;
     int m = nb;
+    /* Records of an odd width (the energy sets': 11 and 6 doubles) are no group of loads the
+     * vectoriser can permute, and it does not fall back to one load per lane for a constant
+     * stride: read through an index instead, which it gathers. */
+    const int indexed = packed || !record_widths_vectorise(F);
+    if (indexed && !packed)
+        for (int b = 0; b < nb; b++) B->c[b] = b;
     if (packed) {
         /* this copy serves any particles; a bed of alike ones still takes the radius sum from
          * the scene rather than from two gathers per entry */
@@ -323,7 +336,7 @@ static JD_ALWAYS_INLINE int batch_evaluate(const jd_particles *ps, const jd_run_
     }
     for (int q = 0; q < m; q++) {
         /* int indices (vectorisable arithmetic; 3 n < 2^31 is checked at set-up) */
-        const int32_t b = packed ? B->c[q] : q, c = (int32_t)c0 + b, i = li[b], j = lj[b];
+        const int32_t b = indexed ? B->c[q] : q, c = (int32_t)c0 + b, i = li[b], j = lj[b];
         const double dx[3] = {x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]};
         const double ri = alike ? r1 : rad[i], rj = alike ? r1 : rad[j];
         const double rsq = jd_dot(dx, dx), radsum = ri + rj;

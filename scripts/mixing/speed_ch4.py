@@ -1,13 +1,15 @@
 """speed_ch4.py — the Chapter 4 fill's speed in the three engines, measured in one run
 (`make mixing-speed`; docs/mixing.md §9).
 
-    python3 -m scripts.mixing.speed_ch4 [--case model1] [--end-time 5] [--out out/mixing/speed]
+    python3 -m scripts.mixing.speed_ch4 [--case model1] [--end-time 5] [--rounds 3] [--out out/mixing/speed]
 
 The first END_TIME seconds of the case's fill at the seed's dt (--force: the guard refuses it),
 run by jdem on 1 and 2 threads, by liggghts-jdem (our law and walls, fix jdem/inlet) on 1 and 2
 ranks, and by LIGGGHTS' own hertz/history pair and primitive walls (the deck generator's
 --builtin mode) with our inlet on 1 and 2 ranks.  The engines are run in turn, so they see the
-same spell of the shared machine.  Each engine's time is its time loop without output (jdem's
+same spell of the shared machine, in ROUNDS rounds, every other one in the reverse order, so that
+no engine always runs first or last in a spell; the report gives each configuration's median and
+range, and the ratios of the medians.  Each engine's time is its time loop without output (jdem's
 `loop - output` of --timing, LIGGGHTS' Loop time less its Outpt share): every engine writes the
 same H5MD frames.  The work is the particle-steps of the growing set, the sum over the inserted
 particles of the steps after their insertion step (jdem's --inlet-record; the stream is the same
@@ -18,6 +20,7 @@ import csv
 import json
 import os
 import re
+import statistics
 import subprocess
 
 from scripts import engines
@@ -62,18 +65,22 @@ def run_liggghts(resolved, d, engine, ranks):
 
 
 def report(summary):
-    rows = ["| engine | cores | loop without output [s] | particle-steps/s | jdem (same cores) is faster by |",
+    rows = ["| engine | cores | loop without output, median (range) [s] | particle-steps/s | "
+            "jdem (same cores) is faster by |",
             "|---|---:|---:|---:|---:|"]
     for r in summary["runs"]:
         ref = next(q for q in summary["runs"] if q["engine"] == "jdem" and q["cores"] == r["cores"])
-        rows.append(f"| {r['engine']} | {r['cores']} | {r['loop_s']:.1f} | {r['rate']:.3g} | "
+        rows.append(f"| {r['engine']} | {r['cores']} | {r['loop_s']:.1f} "
+                    f"({min(r['loop_all']):.1f}–{max(r['loop_all']):.1f}) | {r['rate']:.3g} | "
                     f"{r['loop_s'] / ref['loop_s']:.2f}x |")
     return (f"# Chapter 4 fill: speed of the three engines\n\n"
             f"Case {summary['case']}, the first {summary['end_time']} s of the fill at dt = "
             f"{summary['dt']} s ({summary['steps']} steps, {summary['inserted']} spheres inserted, "
-            f"{summary['particle_steps']:.4g} particle-steps); load average before the runs "
-            f"{summary['load_before']:.2f}, after {summary['load_after']:.2f}.  `liggghts` is "
-            f"LIGGGHTS' own hertz/history pair and primitive walls with our inlet.\n\n"
+            f"{summary['particle_steps']:.4g} particle-steps); {summary['rounds']} rounds, every "
+            f"other one in the reverse order; load average before the runs "
+            f"{summary['load_before']:.2f}, after {summary['load_after']:.2f}; commit "
+            f"{summary['commit']}.  `liggghts` is LIGGGHTS' own hertz/history pair and primitive "
+            f"walls with our inlet.\n\n"
             + "\n".join(rows) + "\n")
 
 
@@ -81,6 +88,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--case", default="model1")
     ap.add_argument("--end-time", type=float, default=5.0, help="simulated time [s]")
+    ap.add_argument("--rounds", type=int, default=3, help="runs of each configuration")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "mixing", "speed"))
     a = ap.parse_args()
     d = os.path.abspath(a.out)
@@ -91,12 +99,20 @@ def main():
     with open(resolved, "w") as f:
         f.write(engines.resolve(scene, check=True).stdout)
     load_before = os.getloadavg()[0]
+    if a.rounds < 1:
+        raise SystemExit(f"speed_ch4: --rounds {a.rounds}: need at least 1")
+    times = {run: [] for run in RUNS}
+    for k in range(a.rounds):
+        for engine, cores in (RUNS if k % 2 == 0 else RUNS[::-1]):
+            r = run_jdem(resolved, d, cores) if engine == "jdem" else run_liggghts(resolved, d, engine, cores)
+            times[(engine, cores)].append(r)
+            print(f"speed_ch4: round {k + 1}/{a.rounds}, {engine} on {cores}: {r['loop_s']:.1f} s",
+                  flush=True)
     runs = []
-    for engine, cores in RUNS:
-        r = run_jdem(resolved, d, cores) if engine == "jdem" else run_liggghts(resolved, d, engine, cores)
-        r.update(engine=engine, cores=cores)
-        runs.append(r)
-        print(f"speed_ch4: {engine} on {cores}: {r['loop_s']:.1f} s", flush=True)
+    for (engine, cores), rs in times.items():
+        loops = [r["loop_s"] for r in rs]
+        runs.append(dict(rs[0], engine=engine, cores=cores, loop_s=statistics.median(loops),
+                         loop_all=loops))
     steps = runs[0]["steps"]
     if any(r["steps"] != steps for r in runs):
         raise SystemExit("speed_ch4: the engines ran different numbers of steps: "
@@ -108,7 +124,8 @@ def main():
         r.pop("record", None)
         r["rate"] = work / r["loop_s"]
     summary = {"case": a.case, "end_time": a.end_time, "dt": 1e-4, "steps": steps,
-               "inserted": inserted, "particle_steps": work, "load_before": load_before,
+               "inserted": inserted, "particle_steps": work, "rounds": a.rounds,
+               "load_before": load_before,
                "load_after": os.getloadavg()[0], "runs": runs,
                "commit": subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
                                         capture_output=True, text=True).stdout.strip()}
