@@ -227,9 +227,9 @@ static int bin_particles(jd_neighbour_lists *lists, const jd_particles *ps, doub
     memset(lists->cell_start, 0, (ncell + 1) * sizeof *lists->cell_start);
     for (size_t i = 0; i < ps->n; i++) {
         int c[3];
-        for (int d = 0; d < 3; d++) {
-            c[d] = (int)((ps->x[3 * i + d] - lo[d]) / h);
-            c[d] = c[d] < 0 ? 0 : c[d] >= nc[d] ? nc[d] - 1 : c[d];
+        for (int d = 0; d < 3; d++) { /* a particle outside the grid goes to its edge cell */
+            const double t = floor((ps->x[3 * i + d] - lo[d]) / h);
+            c[d] = t < 0.0 ? 0 : t >= (double)nc[d] ? nc[d] - 1 : (int)t;
         }
         lists->cell_of[i] = (int32_t)cell_number(c, nc, ax);
         lists->cell_start[lists->cell_of[i] + 1]++;
@@ -247,9 +247,56 @@ static double grid_cells(const double lo[3], const double hi[3], double h) {
     return cells;
 }
 
+/* The k-th smallest (from 0) of a[0, n), n > k, reordering a (Hoare's selection). */
+static double kth_smallest(double *a, ptrdiff_t n, ptrdiff_t k) {
+    ptrdiff_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        const double pivot = a[lo + (hi - lo) / 2];
+        ptrdiff_t i = lo, j = hi;
+        while (i <= j) {
+            while (a[i] < pivot) i++;
+            while (a[j] > pivot) j--;
+            if (i <= j) {
+                const double t = a[i];
+                a[i++] = a[j];
+                a[j--] = t;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            return a[k];
+    }
+    return a[k];
+}
+
+/* A grid over the box that holds all particles but the JD_GRID_TRIM-th part lowest and highest
+ * along each axis, from JD_GRID_TRIM_MIN_N particles: a few that left the bulk (a sphere thrown
+ * out of a container and falling) would otherwise stretch the box, and with it the cells, by
+ * orders of magnitude.  The few outside are binned into the edge cells (bin_particles), which
+ * keeps the list exact: a partner within range of such a particle lies in its edge cell or the
+ * next one along every axis (LAMMPS bins the same way). */
+#define JD_GRID_TRIM 1000
+#define JD_GRID_TRIM_MIN_N 1024
+static int core_box(const jd_particles *ps, double lo[3], double hi[3]) {
+    const ptrdiff_t n = (ptrdiff_t)ps->n, k = n / JD_GRID_TRIM;
+    double *a = malloc((size_t)n * sizeof *a);
+    if (!a) return -1;
+    for (int d = 0; d < 3; d++) {
+        for (ptrdiff_t i = 0; i < n; i++) a[i] = ps->x[3 * i + d];
+        lo[d] = kth_smallest(a, n, k);
+        hi[d] = kth_smallest(a, n, n - 1 - k);
+    }
+    free(a);
+    return 0;
+}
+
 /* The cell grid over the particles' bounding box: cell edge h >= the largest interaction
- * range, grown if the box would need more than about 8 cells per particle (sparse or scattered
- * systems).  Fails on a non-finite position. */
+ * range; over the core box (core_box) instead if the whole box would need more than about 8
+ * cells per particle and the core box would not; the edge grown if even that needs more
+ * (sparse or scattered systems).  Fails on a non-finite position or out of memory. */
 static int cell_grid(const jd_particles *ps, double skin, int64_t step, double *h_out, double lo[3],
                      int nc[3], char *err, size_t errlen) {
     double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -270,7 +317,19 @@ static int cell_grid(const jd_particles *ps, double skin, int64_t step, double *
     }
     double h = 2.0 * rmax + skin;
     const double max_cells = 8.0 * (double)ps->n + 64.0;
-    const double cells = grid_cells(lo, hi, h);
+    double cells = grid_cells(lo, hi, h);
+    if (cells > max_cells && ps->n >= JD_GRID_TRIM_MIN_N) {
+        double core_lo[3], core_hi[3];
+        if (core_box(ps, core_lo, core_hi) != 0) {
+            snprintf(err, errlen, "out of memory for the cell grid of %zu particles", ps->n);
+            return -1;
+        }
+        if (grid_cells(core_lo, core_hi, h) <= max_cells) {
+            memcpy(lo, core_lo, sizeof core_lo);
+            memcpy(hi, core_hi, sizeof core_hi);
+            cells = grid_cells(lo, hi, h);
+        }
+    }
     if (cells > max_cells) h *= cbrt(cells / max_cells) * 1.01;
     /* the cube root fits a box spread in three dimensions; a flat one (one particle far away
      * along one axis) can keep far more cells than that, without bound: cap them at 8x */
