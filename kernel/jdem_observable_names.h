@@ -50,6 +50,12 @@ static const int jd_bond_observable_is_energy[JD_N_BOND_OBSERVABLES] = {0, 0, 1,
  * order, equal to the stepper's one running sum to round-off). */
 static const char *const jd_obs_inlet_energy = "inlet_energy";
 
+/* A scene with a domain (kernel/jdem_domain.h) also writes LOST_PARTICLES [-], the particles
+ * deleted outside it so far, and LOST_ENERGY [J], the energy they took (jd_lost_energy summed;
+ * the output side of the balance). */
+static const char *const jd_obs_lost_particles = "lost_particles";
+static const char *const jd_obs_lost_energy = "lost_energy";
+
 /* The wall observables of a scene with a servo wall (docs/scenes.md "Servo walls"), each a
  * scalar series: for every wall WALL_FORCE/NAME/{x,y,z} [N], the particles' total force on it;
  * for every servo wall SERVO_STRESS/NAME [Pa] (its measured stress, jd_servo_stress) and

@@ -16,6 +16,7 @@
 #include "output.h"
 #include "update.h"
 
+#include "fix_jdem_domain.h"
 #include "fix_jdem_inlet.h"
 #include "fix_wall_jiang.h"
 #include "fix_wall_jiang_mesh.h"
@@ -236,12 +237,14 @@ void DumpH5mdJdem::write() {
   }
 }
 
-/* A fix that adds atoms during the run: LIGGGHTS' insertion fixes (insert/pack, insert/stream,
- * insert/rate/region, ...) and jdem's inlet.  With one, the dump writes a growing set. */
+/* A fix that adds or deletes atoms during the run: LIGGGHTS' insertion fixes (insert/pack,
+ * insert/stream, insert/rate/region, ...), jdem's inlet and jdem's domain.  With one, the dump
+ * writes a growing set (a deleted atom's row is empty). */
 bool DumpH5mdJdem::insertion_fix() const {
   for (int k = 0; k < modify->nfix; k++) {
     const char *style = modify->fix[k]->style;
-    if (std::strncmp(style, "insert/", 7) == 0 || std::strcmp(style, "jdem/inlet") == 0)
+    if (std::strncmp(style, "insert/", 7) == 0 || std::strcmp(style, "jdem/inlet") == 0 ||
+        std::strcmp(style, "jdem/domain") == 0)
       return true;
   }
   return false;
@@ -436,6 +439,13 @@ int DumpH5mdJdem::write_contact_observables(const double all_obs[JDO_N], bigint 
   if (inlets && jd_h5md_write_observable(h5, jd_obs_inlet_energy, (int64_t)step, time, inflow, err,
                                          errlen) != 0)
     return -1;
+  for (int k = 0; k < modify->nfix; k++) /* the outflow, as the stepper writes it with a domain */
+    if (const FixJdemDomain *d = dynamic_cast<FixJdemDomain *>(modify->fix[k]))
+      if (jd_h5md_write_observable(h5, jd_obs_lost_particles, (int64_t)step, time,
+                                   d->lost_particles(), err, errlen) != 0 ||
+          jd_h5md_write_observable(h5, jd_obs_lost_energy, (int64_t)step, time, d->lost_energy(),
+                                   err, errlen) != 0)
+        return -1;
   for (size_t k = 0; k < wall_names.size(); k++)
     if (jd_h5md_write_observable(h5, wall_names[k].c_str(), (int64_t)step, time, wall_values[k],
                                  err, errlen) != 0)

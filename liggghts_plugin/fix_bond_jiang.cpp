@@ -572,6 +572,36 @@ void FixBondJiang::local_bonds(std::vector<int> &pairs) const {
     }
 }
 
+double FixBondJiang::held_elastic(int i) {
+  double e = 0.0;
+  for (int k = 0; k < nbond[i] && (features & JD_B_ENERGY); k++) {
+    jd_bond_state st;
+    std::memcpy(&st, state(i, k), sizeof st);
+    e += st.u_prev;
+  }
+  return e;
+}
+
+double FixBondJiang::drop_partners(const std::vector<int> &gone) {
+  double e = 0.0;
+  for (int i = 0; i < atom->nlocal; i++)
+    for (int k = 0; k < nbond[i];) {
+      if (!std::binary_search(gone.begin(), gone.end(), partner[i][k])) {
+        k++;
+        continue;
+      }
+      jd_bond_state st;
+      std::memcpy(&st, state(i, k), sizeof st);
+      if (features & JD_B_ENERGY) e += st.u_prev;
+      for (int m = k + 1; m < nbond[i]; m++) { /* the others keep their order */
+        partner[i][m - 1] = partner[i][m];
+        std::memcpy(state(i, m - 1), state(i, m), REC_LEN * sizeof(double));
+      }
+      nbond[i]--;
+    }
+  return e;
+}
+
 int FixBondJiang::local_count() const {
   int n = 0;
   for (int i = 0; i < atom->nlocal; i++) n += nbond[i];

@@ -121,6 +121,13 @@ class FixBondJiang : public Fix {
   /* The bond type's parameters (fix jdem/guard bounds the inlets' future bonds with them). */
   const jd_bond_params &bond_params() const { return params; }
 
+  /* fix jdem/domain deletes the atoms that left the box (kernel/jdem_domain.h): the elastic
+   * energy [J] of the bonds local atom i holds, which go with it; then, once every rank has
+   * deleted its atoms, the bonds whose partner id is in `gone` (sorted) are removed, and the
+   * elastic energy they held is returned.  Their dashpots were harvested at their last step. */
+  double held_elastic(int i);
+  double drop_partners(const std::vector<int> &gone);
+
   /* This rank's intact bonds as (lower id, higher id) pairs. */
   void local_bonds(std::vector<int> &pairs) const;
   int local_count() const;

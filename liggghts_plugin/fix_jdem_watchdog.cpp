@@ -22,6 +22,7 @@
 #include "fix_insert.h"
 
 #include "dump_h5md_jdem.h"
+#include "fix_jdem_domain.h"
 #include "fix_jdem_inlet.h"
 #include "fix_wall_jiang.h"
 #include "jdem_observables.h"
@@ -317,10 +318,13 @@ bool FixJdemWatchdog::energy(std::string &msg) {
   bond[JD_OBS_BOND_DAMPING] = sum[JDO_BOND_DAMPING];
   bond[JD_OBS_BOND_BREAKAGE] = sum[JDO_BOND_BREAKAGE];
   jd_energy_terms now = jd_energy_terms_of(sum, bond);
-  /* the energy the inlets brought in is input, as the stepper books it (stepper/watchdog.c) */
+  /* the energy the inlets brought in is input, and the energy the atoms deleted outside the
+   * domain took is output, as the stepper books them (stepper/watchdog.c) */
   for (int k = 0; k < modify->nfix; k++) {
     const FixJdemInlet *in = dynamic_cast<const FixJdemInlet *>(modify->fix[k]);
     if (in) now.wall_work += in->inflow_energy();
+    const FixJdemDomain *dom = dynamic_cast<const FixJdemDomain *>(modify->fix[k]);
+    if (dom) now.wall_work -= dom->lost_energy();
   }
   now.wall_work += inserted_energy;
   const double jump = has_ref ? jd_energy_jump(&ref, &now) : 0.0;

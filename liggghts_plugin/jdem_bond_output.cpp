@@ -8,6 +8,7 @@
 #include "modify.h"
 
 #include "fix_bond_jiang.h"
+#include "fix_jdem_domain.h"
 #include "h5md.h"
 
 namespace LAMMPS_NS {
@@ -127,7 +128,7 @@ int JdemBondOutput::write(LAMMPS *lmp, jd_h5md *h, char *err, size_t errlen) {
     formed_pairs.push_back((double)b.id[0]);
     formed_pairs.push_back((double)b.id[1]);
   }
-  count_intact(formed_pairs, intact);
+  count_intact(lmp, formed_pairs, intact);
   return 0;
 }
 
@@ -153,7 +154,7 @@ void JdemBondOutput::count(LAMMPS *lmp) {
   MPI_Comm_rank(world, &me);
   if (me != 0) return;
   mark_restored(lmp);
-  count_intact(formed_pairs, intact);
+  count_intact(lmp, formed_pairs, intact);
 }
 
 void JdemBondOutput::mark_restored(LAMMPS *lmp) {
@@ -174,8 +175,9 @@ std::vector<int> JdemBondOutput::ever_bonded_ids() const {
   return ids;
 }
 
-/* fragments: union-find over the ever-bonded particles along the intact bonds */
-void JdemBondOutput::count_intact(const std::vector<double> &formed_pairs,
+/* fragments: union-find over the ever-bonded particles along the intact bonds; a particle
+ * deleted outside the domain (fix jdem/domain) is no longer one, as build/jdem counts them */
+void JdemBondOutput::count_intact(LAMMPS *lmp, const std::vector<double> &formed_pairs,
                                   const std::vector<double> &intact) {
   for (const std::vector<double> *pairs : {&formed_pairs, &intact})
     for (double t : *pairs) {
@@ -183,6 +185,10 @@ void JdemBondOutput::count_intact(const std::vector<double> &formed_pairs,
       if (id >= ever_bonded_.size()) ever_bonded_.resize(id + 1, 0);
       ever_bonded_[id] = 1;
     }
+  for (int k = 0; k < lmp->modify->nfix; k++)
+    if (const FixJdemDomain *d = dynamic_cast<FixJdemDomain *>(lmp->modify->fix[k]))
+      for (int id : d->gone_ids())
+        if ((size_t)id < ever_bonded_.size()) ever_bonded_[id] = 0;
   std::vector<int> parent(ever_bonded_.size());
   for (size_t i = 0; i < parent.size(); i++) parent[i] = (int)i;
   for (size_t p = 0; p + 1 < intact.size(); p += 2) {

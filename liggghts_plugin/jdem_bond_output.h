@@ -39,9 +39,11 @@ class JdemBondOutput {
   std::vector<int> ever_bonded_ids() const;
 
  private:
-  /* Marks the atoms of both lists of (lower id, higher id) pairs as ever bonded, then counts the intact bonds
-   * and the fragments over the concatenated (lower id, higher id) pairs (rank 0). */
-  void count_intact(const std::vector<double> &formed_pairs, const std::vector<double> &intact);
+  /* Marks the atoms of both lists of (lower id, higher id) pairs as ever bonded (and those fix
+   * jdem/domain deleted as no longer), then counts the intact bonds and the fragments over the
+   * concatenated (lower id, higher id) pairs (rank 0). */
+  void count_intact(LAMMPS *lmp, const std::vector<double> &formed_pairs,
+                    const std::vector<double> &intact);
   /* Marks the particles a restart file lists as ever bonded (FixBondJiang, rank 0). */
   void mark_restored(LAMMPS *lmp);
   bool active_ = false;

@@ -10,6 +10,7 @@
  *   fix jdem/guard          idem
  *   fix jdem/observables    idem
  *   fix jdem/inlet          idem
+ *   fix jdem/domain         idem
  *   fix jdem/restart        idem (defined by pair_style gran/jiang itself: fix_jdem_restart.h)
  *   dump h5md/jdem          LIGGGHTS 3.8 has no dump map: Output::add_dump() is an if-else chain
  *                           over style_dump.h.  We interpose Output::add_dump (libliggghts.so
@@ -44,6 +45,7 @@
 #include "fix_bond_jiang.h"
 #include "fix_jdem_loads.h"
 #include "fix_jdem_guard.h"
+#include "fix_jdem_domain.h"
 #include "fix_jdem_inlet.h"
 #include "fix_jdem_observables.h"
 #include "fix_jdem_restart.h"
@@ -100,6 +102,10 @@ static Fix *create_fix_jdem_inlet(LAMMPS *lmp, int narg, char **arg) {
   return new FixJdemInlet(lmp, narg, arg);
 }
 
+static Fix *create_fix_jdem_domain(LAMMPS *lmp, int narg, char **arg) {
+  return new FixJdemDomain(lmp, narg, arg);
+}
+
 static Fix *create_fix_jdem_restart(LAMMPS *lmp, int narg, char **arg) {
   return new FixJdemRestart(lmp, narg, arg);
 }
@@ -115,6 +121,7 @@ static void register_jdem_styles(LAMMPS *lmp) {
   (*fix_map)["jdem/observables"] = &create_fix_jdem_observables;
   (*fix_map)["jdem/inlet"] = &create_fix_jdem_inlet;
   (*fix_map)["jdem/restart"] = &create_fix_jdem_restart;
+  (*fix_map)["jdem/domain"] = &create_fix_jdem_domain;
 }
 
 /* ---- dump h5md/jdem: interposed Output::add_dump ---- */

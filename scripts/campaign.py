@@ -186,8 +186,14 @@ def run(units, times, everything=None, log=sys.stderr):
     todo = [u for u in todo if u not in blocked]
     for u in blocked:
         print(f"campaign: skip {u.name}: not yet runnable: {memo[u.name]}", file=log, flush=True)
-    failed = 0
+    failed = skipped = 0
     for i, u in enumerate(todo):
+        unmet = [n for n in u.needs if n in by_name and not is_done(by_name[n])]
+        if unmet:  # a need failed earlier in this run: this unit would only fail after it
+            skipped += 1
+            print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: skipped: needs {unmet[0]}, which did "
+                  f"not finish", file=log, flush=True)
+            continue
         eta = times.eta(todo[i:])
         print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: "
               + ("continuing its interrupted run" if resuming(u) else "running")
@@ -204,8 +210,10 @@ def run(units, times, everything=None, log=sys.stderr):
         eta = times.eta(todo[i + 1:])
         print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: done in {fmt_seconds(took)}; "
               f"{len(todo) - i - 1} left, ETA {fmt_seconds(eta)}", file=log, flush=True)
-    print(f"campaign: {len(todo) - failed} run, {failed} failed, {len(blocked)} not yet runnable, "
-          f"{len(units) - len(todo) - len(blocked)} already done", file=log, flush=True)
+    print(f"campaign: {len(todo) - failed - skipped} run, {failed} failed, "
+          + (f"{skipped} skipped after a failure, " if skipped else "")
+          + f"{len(blocked)} not yet runnable, {len(units) - len(todo) - len(blocked)} already done",
+          file=log, flush=True)
     return failed, len(blocked)
 
 

@@ -111,7 +111,12 @@ def interaction_table(scene, names):
 
 
 def bounding_box(scene, particles):
-    """The simulation box: around the particles' (PARTICLES.lo, .hi) and the walls' extent."""
+    """The simulation box: the scene's domain when it has one (fix jdem/domain deletes the atoms
+    that leave it, so LIGGGHTS loses none); else around the particles' (PARTICLES.lo, .hi) and
+    the walls' extent."""
+    if scene.get("domain"):
+        d = scene["domain"]
+        return [float(c) for c in d["lo"]], [float(c) for c in d["hi"]]
     lo, hi = list(particles.lo), list(particles.hi)
     rmax = particles.rmax
 
@@ -639,6 +644,10 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         particles.write_loads(os.path.join(deck_dir, "loads.txt"))
         L.append("fix loads all jdem/loads file loads.txt   # last of the forces, as build/jdem\n")
     L.extend(inlet_lines(scene, tid, deck_dir, inlet_record))
+    if scene.get("domain"):  # after the inlets: build/jdem inserts, then deletes
+        d = scene["domain"]
+        L.append("fix domain all jdem/domain lo %s hi %s gravity %s   # kernel/jdem_domain.h\n"
+                 % (vec(d["lo"]), vec(d["hi"]), vec(g)))
     L.append("fix integr all nve/sphere\n")
     L.extend(watchdog_lines(scene, builtin))
     L.extend(guard_lines(scene, builtin, force))

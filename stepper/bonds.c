@@ -586,6 +586,29 @@ void sim_bonds_permute(jd_bonds *b, const int32_t *new_index, size_t n) {
     b->ever = ever;
 }
 
+double sim_bonds_drop_from(jd_bonds *b, size_t keep) {
+    if (!b) return 0.0;
+    double elastic = 0.0;
+    size_t w = 0;
+    for (size_t k = 0; k < b->n; k++) {
+        jd_bond_state st = state_get(b, b->sw, k);
+        if ((size_t)b->i[k] >= keep || (size_t)b->j[k] >= keep) {
+            jd_bond_harvest(&st, &b->e_damp_dropped, &b->e_break_dropped);
+            elastic += st.u_prev;
+            continue;
+        }
+        if (w != k) {
+            b->i[w] = b->i[k];
+            b->j[w] = b->j[k];
+            b->type[w] = b->type[k];
+            state_set(b, b->sw, w, &st);
+        }
+        w++;
+    }
+    b->n = w;
+    return elastic;
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* Guard                                                                                     */
 

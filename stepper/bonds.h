@@ -126,6 +126,10 @@ void sim_bonds_observables(const jd_bonds *b, size_t n_particles, jd_bond_observ
 
 /* Remap the particle indices after a re-sort (reorder.c): particle k < n is now new_index[k]. */
 void sim_bonds_permute(jd_bonds *b, const int32_t *new_index, size_t n);
+/* Remove the bonds of the particles at indices >= keep (deleted, stepper/domain.c), keeping the
+ * order of the others; their dissipation goes to the totals.  Returns the elastic energy they
+ * held [J], which leaves the run with them (0 for NULL). */
+double sim_bonds_drop_from(jd_bonds *b, size_t keep);
 
 /* Time-step guard input (jd_guard_input.bond_omega2): the largest over the particles of the sum
  * of its bonds' squared frequency bounds (jd_bond_omega2_bound; Gershgorin) [rad^2/s^2]; 0

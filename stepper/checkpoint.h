@@ -76,6 +76,8 @@ int jd_checkpoint_read(jd_sim *s, jd_checkpointer *ck, const char *path, char *e
 /* What the checkpoint needs of the modules whose state is private to their files. */
 /* loads.c: the loaded particles (n), their indices and the 6 n forces of the last evaluation */
 size_t sim_loads_state(jd_loads *l, int32_t **index, double **f_prev);
+/* A checkpoint's count of loaded particles, n <= the current one (the domain deletes some). */
+void sim_loads_set_count(jd_loads *l, size_t n);
 /* bonds.c: room for need bonds (0 or -1) */
 int sim_bonds_reserve(jd_bonds *b, size_t need);
 /* inlet.c: the streams' state (n_inlets of them) */
@@ -83,6 +85,8 @@ typedef struct jd_inlet_state_view {
     size_t n_inlets;
     int64_t *next_step;        /* the smallest next_step of the streams */
     double *energy_in, *seconds;
+    int64_t *lost;             /* particles deleted outside the domain (domain.c) */
+    double *energy_lost;       /* the energy they took [J] */
     int64_t *id;               /* [capacity] id of each scene index */
     int32_t *slot;             /* [capacity] its trajectory row */
 } jd_inlet_state_view;

@@ -19,6 +19,10 @@
  * step over the inlets); only at a step where particles are due does it pop them, append them
  * and rebuild the neighbour list.
  *
+ * Deleted particles.  A scene with a domain (domain.c) has these rows too, with or without
+ * inlets: a deleted particle's row goes back to id -1, and the scene indices close up over it
+ * (sim_inlets_close_up), so the next inserted particle's scene index is still the count n.
+ *
  * Bonded blocks.  The kernel inserts a bonded group whole at its start step; the section's bonds
  * of the copies inserted at a step are formed right after their particles are appended
  * (form_block_bonds), unstressed, and written to /connectivity at that step.
@@ -58,6 +62,8 @@ struct jd_sim_inlets {
     size_t buf_cap;
     int64_t next_step;     /* the smallest next_step of the streams */
     double energy_in;      /* kinetic + gravitational energy the inserted particles brought [J] */
+    int64_t lost;          /* particles deleted outside the domain (domain.c) */
+    double energy_lost;    /* the energy they took (kernel/jdem_domain.h) [J] */
     double seconds;        /* wall time spent inserting [s] */
     FILE *log;             /* the insertion record (sim_inlets_log), or NULL */
 };
@@ -127,14 +133,14 @@ size_t sim_inlets_capacity(const jd_scene *sc) {
 
 int sim_inlets_init(jd_sim *s, char *err, size_t errlen) {
     const jd_scene *sc = s->run.scene;
-    if (!sc->n_inlets) return 0;
+    if (!sc->n_inlets && !sc->has_domain) return 0;
     jd_sim_inlets *in = calloc(1, sizeof *in);
     if (!in) goto oom;
     s->inlets = in;
     in->n_inlets = sc->n_inlets;
     in->n_scene = sc->n_particles;
     in->cap = sim_inlets_capacity(sc);
-    in->run = calloc(sc->n_inlets, sizeof *in->run);
+    in->run = calloc(sc->n_inlets ? sc->n_inlets : 1, sizeof *in->run);
     in->id = malloc((in->cap ? in->cap : 1) * sizeof *in->id);
     in->slot = malloc((in->cap ? in->cap : 1) * sizeof *in->slot);
     in->rows = malloc((in->cap ? in->cap : 1) * sizeof *in->rows);
@@ -152,7 +158,7 @@ int sim_inlets_init(jd_sim *s, char *err, size_t errlen) {
         in->next_step = r->st.next_step < in->next_step ? r->st.next_step : in->next_step;
         if (r->spec.n > in->buf_cap) in->buf_cap = r->spec.n;
     }
-    in->buf = malloc(in->buf_cap * sizeof *in->buf);
+    in->buf = malloc((in->buf_cap ? in->buf_cap : 1) * sizeof *in->buf);
     if (!in->buf) goto oom;
     make_rows(in, sc);
     s->particles.ids = in->id;
@@ -285,25 +291,44 @@ static int insert_due(jd_sim *s, char *err, size_t errlen) {
     int rc = 0;
     if (added) {
         sim_particle_kinds(&s->fast, &s->particles, s->run.n_materials, s->opt.plain_loops);
-        rc = sim_neighbour_build(s, err, errlen);
+        rc = sim_domain_delete(s, 0, err, errlen) || sim_neighbour_build(s, err, errlen);
     }
     in->seconds += sim_clock() - t0;
     return rc;
 }
 
 int sim_inlets_step(jd_sim *s, char *err, size_t errlen) {
+    if (!s->inlets->n_inlets) return 0;
     const int rc = insert_due(s, err, errlen);
     for (size_t k = 0; rc == 0 && k < s->inlets->n_inlets; k++) check_height(s, k);
     return rc;
 }
 
 int64_t sim_inlets_inserted(const jd_sim *s) {
-    return s->inlets ? (int64_t)(s->particles.n - s->inlets->n_scene) : 0;
+    return s->inlets ? (int64_t)s->particles.n + s->inlets->lost - (int64_t)s->inlets->n_scene : 0;
 }
 
 double sim_inlets_seconds(const jd_sim *s) { return s->inlets ? s->inlets->seconds : 0.0; }
 
 double sim_inlets_energy(const jd_sim *s) { return s->inlets ? s->inlets->energy_in : 0.0; }
+
+int64_t sim_lost_particles(const jd_sim *s) { return s->inlets ? s->inlets->lost : 0; }
+
+double sim_lost_energy(const jd_sim *s) { return s->inlets ? s->inlets->energy_lost : 0.0; }
+
+void sim_inlets_close_up(jd_sim *s, const unsigned char *gone_scene, size_t n, size_t gone,
+                         double energy) {
+    jd_sim_inlets *in = s->inlets;
+    size_t w = 0;
+    for (size_t p = 0; p < n; p++) {
+        if (gone_scene[p]) continue;
+        in->id[w] = in->id[p];
+        in->slot[w] = in->slot[p];
+        w++;
+    }
+    in->lost += (int64_t)gone;
+    in->energy_lost += energy;
+}
 
 /* The trajectory's particle set: every row the run can hold. */
 int sim_inlets_particles(const jd_sim *s, int64_t *id, int32_t *species, double *radius,
@@ -340,6 +365,7 @@ void sim_inlets_state(jd_sim *s, jd_inlet_state_view *v) {
     jd_sim_inlets *in = s->inlets;
     *v = (jd_inlet_state_view){.n_inlets = in->n_inlets, .next_step = &in->next_step,
                                .energy_in = &in->energy_in, .seconds = &in->seconds,
+                               .lost = &in->lost, .energy_lost = &in->energy_lost,
                                .id = in->id, .slot = in->slot};
 }
 

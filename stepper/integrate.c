@@ -312,7 +312,7 @@ int sim_step(jd_sim *s, int seen, char *err, size_t errlen) {
     if (s->meshes) sim_mesh_walls_move(s->meshes, s->run.dt, s->lists.skin);
     const double t1 = sim_clock();
     if ((moved || sim_neighbour_walls_moved(&s->walls, s->lists.skin)) &&
-        sim_neighbour_build(s, err, errlen) != 0)
+        (sim_domain_delete(s, 1, err, errlen) != 0 || sim_neighbour_build(s, err, errlen) != 0))
         return -1;
     const double t2 = sim_clock();
     sim_compute_forces(s);

@@ -65,6 +65,18 @@ void sim_loads_permute(jd_loads *l, const int32_t *new_index) {
     for (size_t k = 0; k < l->n; k++) l->index[k] = new_index[l->index[k]];
 }
 
+void sim_loads_drop_from(jd_loads *l, size_t keep) {
+    if (!l) return;
+    size_t w = 0;
+    for (size_t k = 0; k < l->n; k++) {
+        if ((size_t)l->index[k] >= keep) continue;
+        l->index[w] = l->index[k];
+        memmove(&l->f_prev[6 * w], &l->f_prev[6 * k], 6 * sizeof *l->f_prev);
+        w++;
+    }
+    l->n = w;
+}
+
 void sim_loads_apply(jd_loads *l, jd_particles *ps, const jd_run_constants *run,
                      jd_accounts *accounts, int in_setup) {
     const jd_scene *sc = run->scene;
@@ -91,4 +103,8 @@ size_t sim_loads_state(jd_loads *l, int32_t **index, double **f_prev) {
     *index = l->index;
     *f_prev = l->f_prev;
     return l->n;
+}
+
+void sim_loads_set_count(jd_loads *l, size_t n) {
+    if (n <= l->n) l->n = n;
 }

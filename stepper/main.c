@@ -592,6 +592,10 @@ static int run_and_close(const cli *c, jd_sim *sim, jd_h5md *h, const char *out,
     if (!c->quiet)
         fprintf(stderr, "jdem: wrote %s (%lld steps, %lld neighbour builds)\n", out,
                 (long long)sim->step, (long long)sim->lists.n_builds);
+    if (sim_lost_particles(sim) > 0) /* never silent: the deposit is short of them */
+        fprintf(stderr, "jdem: %lld particles left the domain and were deleted (they took %.6g J; "
+                "observables lost_particles, lost_energy)\n", (long long)sim_lost_particles(sim),
+                sim_lost_energy(sim));
     if (ck->path) unlink(ck->path); /* a complete run has nothing to resume */
     return 0;
 }

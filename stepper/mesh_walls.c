@@ -146,6 +146,24 @@ static void history_drop(jd_mesh_walls *mw, jd_mesh_history *h, size_t o, unsign
     memset(slot, 0, JD_MESH_SLOTS * h->stride * sizeof *slot);
 }
 
+void sim_mesh_walls_close_up(jd_mesh_walls *mw, const unsigned char *gone_scene, size_t n,
+                             unsigned F) {
+    for (size_t k = 0; k < mw->n; k++) {
+        jd_mesh_history *h = &mw->mesh[k].hist;
+        const size_t per = JD_MESH_SLOTS * h->stride, top = n < h->n ? n : h->n;
+        size_t w = 0;
+        for (size_t o = 0; o < top; o++) {
+            if (gone_scene[o]) {
+                history_drop(mw, h, o, F);
+                continue;
+            }
+            if (w != o) memcpy(h->slots + w * per, h->slots + o * per, per * sizeof *h->slots);
+            w++;
+        }
+        if (top > w) memset(h->slots + w * per, 0, (top - w) * per * sizeof *h->slots);
+    }
+}
+
 int sim_mesh_history_resize(jd_mesh_history *h, size_t n) {
     free(h->slots);
     h->slots = NULL;

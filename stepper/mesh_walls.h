@@ -96,6 +96,12 @@ int sim_mesh_walls_moving(const jd_mesh_walls *mw, size_t k);
 /* The triangles [ntri][3][3] of mesh wall k where they are now [m]. */
 const double (*sim_mesh_walls_corners(const jd_mesh_walls *mw, size_t k))[3][3];
 
+/* After domain.c deleted the particles of scene indices p < n with gone_scene[p]: their history
+ * is dropped (dissipation booked; F: the run's features) and the others close up over it, as
+ * the scene indices do. */
+void sim_mesh_walls_close_up(jd_mesh_walls *mw, const unsigned char *gone_scene, size_t n,
+                             unsigned F);
+
 /* What a checkpoint needs (checkpoint_state.c stores the corners, the corners at the
  * candidates' build, the histories, the candidate lists and the dissipation of ended contacts
  * as they are, so that a resumed run evaluates the same candidates in the same order):

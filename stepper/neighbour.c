@@ -111,6 +111,36 @@ static void drop_entry(jd_accounts *accounts, const jd_contact_list *l, size_t c
     jd_contact_harvest(&st, 1.0, &accounts->e_damp_dropped, &accounts->e_fric_dropped);
 }
 
+static void copy_entry(const jd_contact_list *from, size_t c, jd_contact_list *to, size_t d) {
+    const size_t hw = (size_t)from->hw, rw = (size_t)from->rw;
+    to->i[d] = from->i[c];
+    to->j[d] = from->j[c];
+    memcpy(to->hist + hw * d, from->hist + hw * c, hw * sizeof *to->hist);
+    if (rw) memcpy(to->rhist + rw * d, from->rhist + rw * c, rw * sizeof *to->rhist);
+}
+
+/* Entries of l with an index >= keep (a deleted particle; `pairs`: j too) are dropped, their
+ * dissipation harvested; the others keep their order within each of the two runs. */
+static void drop_from(jd_accounts *accounts, jd_contact_list *l, int pairs, size_t keep) {
+    size_t w = 0, touch = 0;
+    for (size_t c = 0; c < l->n; c++) {
+        if ((size_t)l->i[c] >= keep || (pairs && (size_t)l->j[c] >= keep)) {
+            drop_entry(accounts, l, c);
+            continue;
+        }
+        if (w != c) copy_entry(l, c, l, w);
+        touch += c < l->n_touch;
+        w++;
+    }
+    l->n = w;
+    l->n_touch = touch;
+}
+
+void sim_lists_drop_from(jd_sim *s, size_t keep) {
+    drop_from(&s->accounts, &s->lists.pairs, 1, keep);
+    drop_from(&s->accounts, &s->lists.wall_pairs, 0, keep);
+}
+
 /* Give every entry of nw (one sorted run) the history of the same (i, j) in old, or a fresh
  * (zero) history: one merge with each of old's two sorted runs (jd_contact_list). */
 static void carry_over(jd_accounts *accounts, const jd_contact_list *old, jd_contact_list *nw) {
@@ -147,13 +177,6 @@ static unsigned list_kind(unsigned features) {
 }
 
 /* Entry c of `from` into entry d of `to` (same kind of list). */
-static void copy_entry(const jd_contact_list *from, size_t c, jd_contact_list *to, size_t d) {
-    const size_t hw = (size_t)from->hw, rw = (size_t)from->rw;
-    to->i[d] = from->i[c];
-    to->j[d] = from->j[c];
-    memcpy(to->hist + hw * d, from->hist + hw * c, hw * sizeof *to->hist);
-    if (rw) memcpy(to->rhist + rw * d, from->rhist + rw * c, rw * sizeof *to->rhist);
-}
 
 /* The pair list `in` (one sorted run) into `out` as two sorted runs: the candidates whose
  * spheres touch now (LIGGGHTS' rsq < radsum^2), then the others (jd_contact_list). */

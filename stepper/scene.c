@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "jdem_domain.h"
 #include "jdem_guard.h"
 #include "scene_internal.h"
 #include "sim.h"
@@ -21,7 +22,8 @@ static const char *const TOP_KEYS[] = {"jdem_scene", "name", "case", "descriptio
                                        "output", "gravity", "model", "materials", "interactions",
                                        "particles", "generate", "walls", "watchdog", "sweep",
                                        "bond_types", "bonds", "bond_rules", "particles_from",
-                                       "inlets", NULL};
+                                       "inlets", "domain", NULL};
+static const char *const DOMAIN_KEYS[] = {"lo", "hi", NULL};
 static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_speed",
                                          "coordination_number", NULL};
 static const char *const OUTPUT_KEYS[] = {"every", "observables_every", "compare_tolerance",
@@ -342,6 +344,37 @@ static int default_impact_speed(loader *L) {
     return 0;
 }
 
+/* The optional domain: lo and hi, with lo < hi along every axis. */
+static int read_domain(loader *L) {
+    int rc;
+    const yaml_node_t *d = section(L, "domain", DOMAIN_KEYS, &rc);
+    if (!d || rc) return rc;
+    jd_scene *s = L->s;
+    if (sd_req_vec3(&L->c, d, "domain", "lo", s->domain_lo) ||
+        sd_req_vec3(&L->c, d, "domain", "hi", s->domain_hi))
+        return -1;
+    for (int k = 0; k < 3; k++)
+        if (!(s->domain_lo[k] < s->domain_hi[k]))
+            return sd_fail(&L->c, sd_get(&L->c, d, "hi"), "domain.hi", "%c is %g, not above "
+                           "domain.lo's %g; valid: hi > lo along every axis", "xyz"[k],
+                           s->domain_hi[k], s->domain_lo[k]);
+    s->has_domain = 1;
+    return 0;
+}
+
+/* Every scene particle starts inside the domain (a particle outside it would be deleted at the
+ * first neighbour build, which is never what the scene meant). */
+static int check_domain(loader *L) {
+    const jd_scene *s = L->s;
+    for (size_t i = 0; s->has_domain && i < s->n_particles; i++)
+        if (!jd_inside_domain(s->domain_lo, s->domain_hi, &s->position[3 * i]))
+            return sd_fail(&L->c, sd_get(&L->c, L->root, "domain"), "domain", "particle id %lld "
+                           "at (%g, %g, %g) m lies outside [lo, hi); valid: a domain that holds "
+                           "every particle's centre", (long long)s->id[i], s->position[3 * i],
+                           s->position[3 * i + 1], s->position[3 * i + 2]);
+    return 0;
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* Loading                                                                                   */
 
@@ -351,6 +384,7 @@ static int read_scene(loader *L) {
      * file; interactions come last because their defaults depend on which materials meet. */
     if (sd_keys(&L->c, L->root, NULL, TOP_KEYS) || read_header(L) || read_time(L) ||
         read_output(L) || sd_opt_vec3(&L->c, L->root, NULL, "gravity", s->gravity) ||
+        read_domain(L) ||
         read_model(L) || read_watchdog(L) || scene_read_materials(L) ||
         scene_read_bond_types(L) || scene_read_particles(L) || scene_read_generators(L) ||
         scene_read_deposits(L) ||
@@ -366,7 +400,8 @@ static int read_scene(loader *L) {
                        "particle in particles or generate");
     }
     if (scene_read_interactions(L) || scene_sort_particles(L) || scene_check_overlaps(L) ||
-        scene_check_wall_overlaps(L) || scene_check_plane_winding(L) || scene_resolve_bonds(L))
+        scene_check_wall_overlaps(L) || scene_check_plane_winding(L) || check_domain(L) ||
+        scene_resolve_bonds(L))
         return -1;
     if (!L->max_impact_given && default_impact_speed(L)) return -1;
     return (L->s->dt_auto && auto_dt(L)) || scene_check_inlets(L);

@@ -165,6 +165,12 @@ typedef struct jd_scene {
 
     double gravity[3];        /* [m/s^2] */
 
+    /* domain (docs/scenes.md "Domain"): with has_domain, a particle whose centre is outside
+     * [domain_lo, domain_hi) along some axis at a neighbour build is deleted, as LIGGGHTS does
+     * with `boundary f f f` and `thermo_modify lost ignore` at a reneighbouring step */
+    int has_domain;
+    double domain_lo[3], domain_hi[3]; /* [m] */
+
     jd_watchdog_limits watchdog;
 
     /* model options (kernel enums) */

@@ -125,6 +125,12 @@ static int emit_watchdog(yaml_emitter_t *e, const jd_watchdog_limits *w) {
            key_num(e, "max_energy_jump", w->max_energy_jump) || map_end(e);
 }
 
+static int emit_domain(yaml_emitter_t *e, const jd_scene *s) {
+    return s->has_domain && (str(e, "domain") || map_start(e, 0) ||
+                             key_vec(e, "lo", s->domain_lo) || key_vec(e, "hi", s->domain_hi) ||
+                             map_end(e));
+}
+
 static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
     return key_int(e, "jdem_scene", 1) || key_str(e, "name", s->name) ||
            key_str(e, "case", s->case_name) || key_str(e, "description", s->description) ||
@@ -136,7 +142,8 @@ static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
            key_int(e, "observables_every", s->observables_every) ||
            key_num(e, "compare_tolerance", s->compare_tolerance) || str(e, "energy") ||
            scalar(e, s->energy ? "true" : "false", YAML_PLAIN_SCALAR_STYLE) || map_end(e) ||
-           key_vec(e, "gravity", s->gravity) || str(e, "model") || map_start(e, 0) ||
+           key_vec(e, "gravity", s->gravity) || emit_domain(e, s) || str(e, "model") ||
+           map_start(e, 0) ||
            key_str(e, "wall_rule", WALL_RULES[s->wall_rule]) ||
            key_str(e, "damping", DAMPING_MAPS[s->damping_map]) ||
            key_str(e, "tangential_limit", XI_LIMITS[s->xi_limit]) || key_num(e, "mu_r", s->mu_r) ||

@@ -379,9 +379,16 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
             jd_h5md_write_observable(h, jd_observable_names[k], s->step, (double)s->step * s->run.dt,
                                      val[k], err, errlen) != 0)
             return JD_RUN_OUTPUT;
-    if (h && s->inlets && jd_h5md_write_observable(h, jd_obs_inlet_energy, s->step,
-                                                   (double)s->step * s->run.dt,
-                                                   sim_inlets_energy(s), err, errlen) != 0)
+    const double t = (double)s->step * s->run.dt;
+    if (h && s->run.scene->n_inlets &&
+        jd_h5md_write_observable(h, jd_obs_inlet_energy, s->step, t, sim_inlets_energy(s), err,
+                                 errlen) != 0)
+        return JD_RUN_OUTPUT;
+    if (h && s->run.scene->has_domain &&
+        (jd_h5md_write_observable(h, jd_obs_lost_particles, s->step, t,
+                                  (double)sim_lost_particles(s), err, errlen) != 0 ||
+         jd_h5md_write_observable(h, jd_obs_lost_energy, s->step, t, sim_lost_energy(s), err,
+                                  errlen) != 0))
         return JD_RUN_OUTPUT;
     if (h && s->walls.forces && sim_walls_write_observables(&s->walls, &s->run, s->step, h, err, errlen) != 0)
         return JD_RUN_OUTPUT;
@@ -397,8 +404,8 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
                                          (double)s->step * s->run.dt, bv[k], err, errlen) != 0)
                 return JD_RUN_OUTPUT;
     }
-    return sim_watchdog_energy(&s->watch, &s->particles, &s->run, s->step, sim_inlets_energy(s), &o,
-                               err, errlen);
+    return sim_watchdog_energy(&s->watch, &s->particles, &s->run, s->step,
+                               sim_inlets_energy(s) - sim_lost_energy(s), &o, err, errlen);
 }
 
 static int due(int64_t step, int64_t every, int64_t last) {

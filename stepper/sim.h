@@ -397,11 +397,21 @@ int sim_inlets_particles(const jd_sim *s, int64_t *id, int32_t *species, double 
 /* Vector k of a frame (3 per active particle, scene order) spread onto the rows, NaN for the
  * particles not inserted (yet). */
 double *sim_inlets_frame_rows(const jd_sim *s, int k, const double *scene_ordered);
-/* The id of each row at this frame: -1 for the particles not inserted (yet). */
+/* The id of each row at this frame: -1 for the particles not inserted (yet) or deleted. */
 const int64_t *sim_inlets_frame_ids(const jd_sim *s);
+/* The rows also serve a scene with a domain and no inlets (its particle set shrinks).  After
+ * domain.c deleted `gone` particles (gone_scene[p]: scene index p of the n before), close the
+ * scene indices up and book them with the energy they took [J]. */
+void sim_inlets_close_up(jd_sim *s, const unsigned char *gone_scene, size_t n, size_t gone,
+                         double energy);
+int64_t sim_lost_particles(const jd_sim *s);
+double sim_lost_energy(const jd_sim *s); /* [J] */
 
 /* neighbour.c */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
+/* Drop the pair and wall entries of the particles at indices >= keep (deleted, domain.c),
+ * booking what they dissipated. */
+void sim_lists_drop_from(jd_sim *s, size_t keep);
 /* 1 when some wall moved more than skin/2 [m] since the last build (the particles' part of the
  * rebuild criterion rides in the drift, integrate.c) */
 int sim_neighbour_walls_moved(const jd_walls *walls, double skin);
@@ -470,6 +480,14 @@ void sim_loads_apply(jd_loads *l, jd_particles *ps, const jd_run_constants *run,
                      jd_accounts *accounts, int in_setup);
 /* Remap the loaded particles after a re-sort (reorder.c): particle k is now new_index[k]. */
 void sim_loads_permute(jd_loads *l, const int32_t *new_index);
+/* Forget the loaded particles at indices >= keep (deleted, domain.c). */
+void sim_loads_drop_from(jd_loads *l, size_t keep);
+
+/* domain.c: the scene's domain (kernel/jdem_domain.h).  Before a neighbour build: delete the
+ * particles whose centre is outside it, booking what they take (sim_inlets_close_up).
+ * half_step: called inside sim_step, where v and omega are half-step values.  0, or -1 with err
+ * (out of memory; nothing changed). */
+int sim_domain_delete(jd_sim *s, int half_step, char *err, size_t errlen);
 
 /* integrate.c: one full step.  seen: the state at the step's end is looked at (frame,
  * observables); else the step's final half kick is left pending (s->kick_pending) and done in

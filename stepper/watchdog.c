@@ -60,8 +60,9 @@ int sim_watchdog_step(const jd_watch *watch, const jd_particles *ps, const jd_ru
 }
 
 /* The balance's terms by the kernel's rule (jd_energy_terms_of). */
-/* The energy the inlets brought in is booked as work done on the particles, so the balance
- * closes while the set grows. */
+/* The net energy the particle set gained at its boundary (what the inlets brought in, less what
+ * the particles deleted outside the domain took) is booked as work done on the particles, so
+ * the balance closes while the set grows and shrinks. */
 static void energy_terms(double inlet_energy, const jd_observables *o, jd_energy_terms *e) {
     double v[JD_N_OBSERVABLES], b[JD_N_BOND_OBSERVABLES];
     sim_observables_values(o, v);

@@ -20,7 +20,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 ENGINE_TESTS = ["neighbour", "fastpaths", "free_flight", "hertz_impact", "energy_balance", "guard",
                 "guard_coordination", "dt_auto", "watchdog",
-                "signals", "bench_tiling", "deposit", "servo"]
+                "signals", "bench_tiling", "deposit", "servo", "domain"]
 SANITIZED = {"JDEM": "build/san/jdem"}
 
 # name, command, output style, extra environment.  Sanitizer builds run the same checks.

@@ -3,7 +3,8 @@ and resumed from it equals the uninterrupted run bit for bit (every dataset of t
 tests/checkpoint/compare_h5.py), on 1 and 2 threads, for a settling bed with walls, friction
 and rolling, a servo compression, an inlet stream, a bonded beam and an inlet of bonded blocks
 (the checkpoint between two copies' insertions), a bed in a turning meshed drum and spheres
-on a meshed conveyor (the mesh's moved corners, its contact history and candidates); SIGTERM writes a
+on a meshed conveyor (the mesh's moved corners, its contact history and candidates), spheres
+leaving the domain (the shrinking set, its bonds and loads); SIGTERM writes a
 checkpoint and exits 143; bad checkpoints are refused with their messages; a failed
 checkpoint write keeps the previous checkpoint and stops the run (exit 3)."""
 import math
@@ -34,6 +35,8 @@ CASES = [  # scene, case, checkpoint every N steps
     ("reference_runs/stability/bonded_beam.yaml", "tip_load", 20000),
     # a checkpoint between the two copies' block insertions (steps 1330 and 2730)
     ("tests/inlet/bonded_section.yaml", None, 2500),
+    # a checkpoint between deletions outside the domain (steps 47, 124 and 200)
+    ("tests/engine/scenes/domain_exit.yaml", None, 100),
 ]
 
 

@@ -63,7 +63,9 @@ def load(path):
     """The trajectory as plain numpy arrays: particles, per-frame groups and observables."""
     with h5py.File(path, "r") as f:
         part = f["particles/all"]
-        t = {k: part[k][()] for k in ("id", "species", "radius", "mass")}
+        # a growing or shrinking set (inlets, domain) has per-frame ids: id[frame, row], -1 empty
+        t = {k: part[k]["value"][()] if isinstance(part[k], h5py.Group) else part[k][()]
+             for k in ("id", "species", "radius", "mass")}
         for k in ("position", "velocity", "angular_velocity", "force", "torque"):
             g = part[k]
             t[k] = g["value"][()]

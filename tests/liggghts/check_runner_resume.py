@@ -5,7 +5,8 @@ restart files (--checkpoint-every N --resume; docs/liggghts.md "Restarts").
     tests/liggghts/check_runner_resume.py [--keep]
 
 The case is the conveyor fill of tests/checkpoint/scenes/inlet_stream.yaml (12 sections on a
-belt, 120,000 steps, a frame every 5000 and observables every 1000 steps), with a restart file
+belt, 120,000 steps, a frame every 5000 and observables every 1000 steps; its domain deletes 76
+spheres from step 44500 on, so the files resumed from carry deletions), with a restart file
 every 6000 steps, so that a run resumes between two frames.  The reference of every check is the same run uninterrupted: a continued run
 must equal it bit for bit (==, NaN == NaN in the empty rows of the growing set) in every dataset
 of its trajectory but /h5md (the file's author and creator), on 1 and 2 MPI ranks:

@@ -148,6 +148,12 @@ def test_validation_and_selection():
           and "output a.txt does not validate: content 'garbage', expected 'ok'" in r.stderr,
           r.stderr)
     check("invalid_output_not_final", not os.path.exists(final(here, "a")), "a.txt exists")
+    reset_log(here)
+    r = campaign(here, "--model", "m1", env={"CONTENT_a": "garbage"})
+    check("need_failed_skips", r.returncode == 1 and runs(here) == ["a"]
+          and "[2/2] b: skipped: needs a, which did not finish" in r.stderr
+          and "campaign: 0 run, 1 failed, 1 skipped after a failure," in r.stderr,
+          f"ran {runs(here)}: {r.stderr}")
     r = campaign(here, "--engine", "e2")
     check("needs_unfinished", r.returncode == 2 and "campaign: unit b needs a, which is neither "
           "done nor selected" in r.stderr, r.stderr)
