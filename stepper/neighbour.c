@@ -13,6 +13,7 @@
  * the run's totals, so the dissipation observables lose nothing at a rebuild.
  */
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -193,18 +194,6 @@ static int split_touching(const jd_particles *ps, unsigned kind, const jd_contac
     return 0;
 }
 
-/* The (particle, wall) candidates within the skin into l; allpairs: every particle with every
- * wall. */
-static int build_wall_list(const jd_particles *ps, const jd_walls *walls, double skin, int allpairs,
-                           unsigned kind, jd_contact_list *l) {
-    for (size_t i = 0; i < ps->n; i++)
-        for (size_t w = 0; w < walls->n; w++)
-            if ((allpairs || wall_candidate(&walls->wall[w], ps->x + 3 * i, ps->radius[i], skin)) &&
-                list_push(l, (int32_t)i, (int32_t)w, kind) != 0)
-                return -1;
-    return 0;
-}
-
 static void sort_segment(int32_t *j, size_t n) { /* insertion sort: a few dozen entries */
     for (size_t a = 1; a < n; a++) {
         const int32_t v = j[a];
@@ -377,13 +366,27 @@ static int sort_into_cells(jd_sim *s, char *err, size_t errlen) {
     return sim_reorder(s, s->lists.cell_items, err, errlen);
 }
 
+/* Room for one more entry in part p (its arrays grow by half, from 1024).  0 or -1. */
+static int part_room(jd_pair_part *p) {
+    if (p->n < p->cap) return 0;
+    const size_t cap = p->cap ? p->cap + p->cap / 2 : 1024;
+    int32_t *a = realloc(p->i, cap * sizeof *a);
+    if (!a) return -1;
+    p->i = a;
+    int32_t *b = realloc(p->j, cap * sizeof *b);
+    if (!b) return -1;
+    p->j = b;
+    p->cap = cap;
+    return 0;
+}
+
 /* Push the pairs (i, j) of the partners j > i at [q0, q1) of the cell arrays whose surfaces are
- * closer than the skin: j = items[q], or j = q when items is NULL (particles numbered in cell
- * order).  The tests of a block of JD_NEAR_BLOCK partners first, in SIMD lanes, then the pushes
- * in order. */
+ * closer than the skin into part p: j = items[q], or j = q when items is NULL (particles
+ * numbered in cell order).  The tests of a block of JD_NEAR_BLOCK partners first, in SIMD
+ * lanes, then the pushes in order. */
 #define JD_NEAR_BLOCK 32
-static int push_near(const jd_particles *ps, double skin, unsigned kind, size_t i,
-                     const int32_t *items, int32_t q0, int32_t q1, jd_contact_list *l) {
+static int push_near(const jd_particles *ps, double skin, size_t i, const int32_t *items,
+                     int32_t q0, int32_t q1, jd_pair_part *p) {
     const double *restrict x = ps->x, *restrict rad = ps->radius;
     const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i];
     for (int32_t b = q0; b < q1; b += JD_NEAR_BLOCK) {
@@ -395,60 +398,153 @@ static int push_near(const jd_particles *ps, double skin, unsigned kind, size_t 
             const double range = ri + rad[j] + skin;
             near[k] = j > i && d0 * d0 + d1 * d1 + d2 * d2 < range * range;
         }
-        for (int k = 0; k < nb; k++)
-            if (near[k] && list_push(l, (int32_t)i, items ? items[b + k] : b + k, kind) != 0)
-                return -1;
+        for (int k = 0; k < nb; k++) {
+            if (!near[k]) continue;
+            if (part_room(p) != 0) return -1;
+            p->i[p->n] = (int32_t)i;
+            p->j[p->n++] = items ? items[b + k] : b + k;
+        }
     }
     return 0;
 }
 
-/* The pairs within the skin, from the cell grid (lists' cell arrays), into l; step: for a
- * message.  The three cells of a row along the fast axis are one run of the cell arrays, so each
- * of the 9 rows around i's cell is one call of push_near.  sorted: the particles are numbered in
- * the grid's cell order (sort_into_cells), so that run is the partners j themselves, and those
- * before i + 1 are skipped unread.  The list is the same either way (each row sorted by j). */
-static int build_pair_list_cells(const jd_particles *ps, jd_neighbour_lists *lists, unsigned kind,
-                                 int sorted, int64_t step, jd_contact_list *l, char *err,
-                                 size_t errlen) {
-    if (ps->n < 2) return 0;
-    double h, lo[3];
+/* The cell grid a build searches (cell_grid, cell_axes) and how the particles are numbered. */
+typedef struct cell_search {
+    const jd_particles *ps;
+    const jd_neighbour_lists *lists; /* its cell arrays, binned */
     int nc[3], ax[3];
-    if (cell_grid(ps, lists->skin, step, &h, lo, nc, err, errlen) != 0) return -1;
-    cell_axes(nc, ax);
-    if (bin_particles(lists, ps, h, lo, nc, ax) != 0) goto oom;
+    int sorted;  /* particles numbered in cell order (sort_into_cells) */
+} cell_search;
 
-    for (size_t i = 0; i < ps->n; i++) {
-        const int32_t ci = lists->cell_of[i];
-        int c[3];
-        c[ax[2]] = ci % nc[ax[2]];
-        c[ax[1]] = (ci / nc[ax[2]]) % nc[ax[1]];
-        c[ax[0]] = ci / (nc[ax[2]] * nc[ax[1]]);
-        const int f0 = c[ax[2]] > 0 ? c[ax[2]] - 1 : 0;   /* the row's cells along the fast axis */
-        const int f1 = c[ax[2]] + 1 < nc[ax[2]] ? c[ax[2]] + 1 : nc[ax[2]] - 1;
-        const size_t first = l->n;
-        for (int ds = -1; ds <= 1; ds++) {
-            int nb[3];
-            nb[ax[0]] = c[ax[0]] + ds;
-            if (nb[ax[0]] < 0 || nb[ax[0]] >= nc[ax[0]]) continue;
-            for (int dm = -1; dm <= 1; dm++) {
-                nb[ax[1]] = c[ax[1]] + dm;
-                if (nb[ax[1]] < 0 || nb[ax[1]] >= nc[ax[1]]) continue;
-                nb[ax[2]] = f0;
-                const size_t row = cell_number(nb, nc, ax), end = row + (size_t)(f1 - f0) + 1;
-                int32_t q0 = lists->cell_start[row];
-                const int32_t q1 = lists->cell_start[end];
-                if (sorted && q0 <= (int32_t)i) q0 = (int32_t)i + 1;
-                if (q0 < q1 && push_near(ps, lists->skin, kind, i, sorted ? NULL : lists->cell_items,
-                                         q0, q1, l) != 0)
-                    goto oom;
-            }
+/* Particle i's pairs (i, j > i) within the skin into part p, sorted by j: the 9 rows of cells
+ * around i's cell, each one run of the cell arrays (its three cells along the fast axis).
+ * With the particles in cell order that run is the partners themselves, and those before i + 1
+ * are skipped unread; the entries are the same either way. */
+static int pairs_of(const void *ctx, size_t i, jd_pair_part *p) {
+    const cell_search *g = ctx;
+    const jd_particles *ps = g->ps;
+    const jd_neighbour_lists *lists = g->lists;
+    const int *nc = g->nc, *ax = g->ax;
+    const int32_t ci = lists->cell_of[i];
+    int c[3];
+    c[ax[2]] = ci % nc[ax[2]];
+    c[ax[1]] = (ci / nc[ax[2]]) % nc[ax[1]];
+    c[ax[0]] = ci / (nc[ax[2]] * nc[ax[1]]);
+    const int f0 = c[ax[2]] > 0 ? c[ax[2]] - 1 : 0; /* the row's cells along the fast axis */
+    const int f1 = c[ax[2]] + 1 < nc[ax[2]] ? c[ax[2]] + 1 : nc[ax[2]] - 1;
+    const size_t first = p->n;
+    for (int ds = -1; ds <= 1; ds++) {
+        int nb[3];
+        nb[ax[0]] = c[ax[0]] + ds;
+        if (nb[ax[0]] < 0 || nb[ax[0]] >= nc[ax[0]]) continue;
+        for (int dm = -1; dm <= 1; dm++) {
+            nb[ax[1]] = c[ax[1]] + dm;
+            if (nb[ax[1]] < 0 || nb[ax[1]] >= nc[ax[1]]) continue;
+            nb[ax[2]] = f0;
+            const size_t row = cell_number(nb, nc, ax), end = row + (size_t)(f1 - f0) + 1;
+            int32_t q0 = lists->cell_start[row];
+            const int32_t q1 = lists->cell_start[end];
+            if (g->sorted && q0 <= (int32_t)i) q0 = (int32_t)i + 1;
+            if (q0 < q1 && push_near(ps, lists->skin, i, g->sorted ? NULL : lists->cell_items, q0,
+                                     q1, p) != 0)
+                return -1;
         }
-        sort_segment(l->j + first, l->n - first);
+    }
+    sort_segment(p->j + first, p->n - first);
+    return 0;
+}
+
+/* What a wall-list build searches. */
+typedef struct wall_search {
+    const jd_particles *ps;
+    const jd_walls *walls;
+    double skin;  /* [m] */
+    int allpairs; /* every particle with every wall */
+} wall_search;
+
+/* Particle i's (particle, wall) candidates within the skin into part p, by wall. */
+static int walls_of(const void *ctx, size_t i, jd_pair_part *p) {
+    const wall_search *q = ctx;
+    for (size_t w = 0; w < q->walls->n; w++) {
+        if (!q->allpairs &&
+            !wall_candidate(&q->walls->wall[w], q->ps->x + 3 * i, q->ps->radius[i], q->skin))
+            continue;
+        if (part_room(p) != 0) return -1;
+        p->i[p->n] = (int32_t)i;
+        p->j[p->n++] = (int32_t)w;
     }
     return 0;
-oom:
-    snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", l->n);
-    return -1;
+}
+
+/* Room for the parts of `threads` threads (kept from one build to the next).  0 or -1. */
+static int parts_reserve(jd_neighbour_lists *lists, int threads) {
+    if (lists->n_parts >= threads) return 0;
+    jd_pair_part *p = realloc(lists->parts, (size_t)threads * sizeof *p);
+    if (!p) return -1;
+    memset(p + lists->n_parts, 0, (size_t)(threads - lists->n_parts) * sizeof *p);
+    lists->parts = p;
+    lists->n_parts = threads;
+    return 0;
+}
+
+/* The entries of particles 0 .. n - 1, entries_of(ctx, i, part) each, appended to l (of this
+ * kind) in ascending i: each of `threads` threads takes one equal range of i into its part, and
+ * the parts are joined in thread order, so the list is the same for every thread count.  0, or
+ * -1 when out of memory. */
+typedef int (*entries_fn)(const void *ctx, size_t i, jd_pair_part *p);
+static int build_in_parts(jd_neighbour_lists *lists, size_t n, int threads, entries_fn entries_of,
+                          const void *ctx, unsigned kind, jd_contact_list *l) {
+    if (parts_reserve(lists, threads) != 0) return -1;
+    for (int t = 0; t < threads; t++) lists->parts[t].n = 0; /* also of a thread OpenMP withholds */
+    int failed = 0;
+#pragma omp parallel num_threads(threads) if (threads > 1) reduction(| : failed)
+    {
+        const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        jd_pair_part p = lists->parts[t]; /* a copy: the parts share cache lines */
+        for (size_t i = n * (size_t)t / (size_t)nt; i < n * (size_t)(t + 1) / (size_t)nt && !failed; i++)
+            failed |= entries_of(ctx, i, &p) != 0;
+        lists->parts[t] = p;
+    }
+    size_t total = l->n;
+    for (int t = 0; t < threads; t++) total += lists->parts[t].n;
+    if (failed || sim_list_reserve(l, total, kind) != 0) return -1;
+    for (int t = 0; t < threads; t++) {
+        const jd_pair_part *p = &lists->parts[t];
+        if (!p->n) continue; /* its arrays may not exist yet */
+        memcpy(l->i + l->n, p->i, p->n * sizeof *l->i);
+        memcpy(l->j + l->n, p->j, p->n * sizeof *l->j);
+        l->n += p->n;
+    }
+    return 0;
+}
+
+void sim_neighbour_parts_free(jd_neighbour_lists *lists) {
+    for (int t = 0; t < lists->n_parts; t++) {
+        free(lists->parts[t].i);
+        free(lists->parts[t].j);
+    }
+    free(lists->parts);
+    lists->parts = NULL;
+    lists->n_parts = 0;
+}
+
+/* The pairs within the skin, from the cell grid (lists' cell arrays), into l, on `threads`
+ * threads (build_in_parts); step: for a message; sorted: the particles are numbered in the
+ * grid's cell order (sort_into_cells). */
+static int build_pair_list_cells(const jd_particles *ps, jd_neighbour_lists *lists, unsigned kind,
+                                 int sorted, int threads, int64_t step, jd_contact_list *l,
+                                 char *err, size_t errlen) {
+    if (ps->n < 2) return 0;
+    double h, lo[3];
+    cell_search g = {.ps = ps, .lists = lists, .sorted = sorted};
+    if (cell_grid(ps, lists->skin, step, &h, lo, g.nc, err, errlen) != 0) return -1;
+    cell_axes(g.nc, g.ax);
+    if (bin_particles(lists, ps, h, lo, g.nc, g.ax) != 0 ||
+        build_in_parts(lists, ps->n, threads, pairs_of, &g, kind, l) != 0) {
+        snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", l->n);
+        return -1;
+    }
+    return 0;
 }
 
 static int build_pair_list_all(size_t n, unsigned kind, jd_contact_list *l) {
@@ -477,8 +573,8 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
                      s->particles.n);
             return -1;
         }
-    } else if (build_pair_list_cells(&s->particles, &s->lists, kind, sorted, s->step, nw, err,
-                                     errlen) != 0) {
+    } else if (build_pair_list_cells(&s->particles, &s->lists, kind, sorted, s->threads.n, s->step,
+                                     nw, err, errlen) != 0) {
         return -1;
     }
     nw->n_touch = nw->n;
@@ -493,7 +589,10 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
 
     jd_contact_list *wn = &s->lists.wall_spare;
     wn->n = 0;
-    if (build_wall_list(&s->particles, &s->walls, s->lists.skin, s->opt.allpairs, kind, wn) != 0) {
+    const wall_search ws = {.ps = &s->particles, .walls = &s->walls, .skin = s->lists.skin,
+                            .allpairs = s->opt.allpairs};
+    if (s->walls.n &&
+        build_in_parts(&s->lists, s->particles.n, s->threads.n, walls_of, &ws, kind, wn) != 0) {
         snprintf(err, errlen, "out of memory building the wall candidate list");
         return -1;
     }

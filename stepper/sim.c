@@ -299,6 +299,7 @@ void sim_free(jd_sim *s) {
     sim_walls_free(&s->walls);
     sim_mesh_walls_free(s->meshes);
     free(s->lists.cell_start);
+    sim_neighbour_parts_free(&s->lists);
     sim_contact_list_free(&s->lists.pairs);
     sim_contact_list_free(&s->lists.wall_pairs);
     sim_contact_list_free(&s->lists.spare);

@@ -258,6 +258,13 @@ typedef struct jd_thread_layout {
     jd_overlap_trip *trips;  /* one per thread, merged into jd_watch.overlap_trip */
 } jd_thread_layout;
 
+/* One thread's part of a pair list being built (neighbour.c): the entries (i, j) of its range of
+ * i, joined in thread order. */
+typedef struct jd_pair_part {
+    int32_t *i, *j;
+    size_t n, cap;
+} jd_pair_part;
+
 /* The contact lists and the neighbour search that builds them (neighbour.c). */
 typedef struct jd_neighbour_lists {
     jd_contact_list pairs, wall_pairs;
@@ -273,6 +280,8 @@ typedef struct jd_neighbour_lists {
     int32_t *cell_of, *cell_items, *cell_start; /* cell of each particle, particles by cell, and
                                                    each cell's first item (cell_cap + 1) */
     size_t cell_cap;   /* capacity of cell_start */
+    jd_pair_part *parts; /* one per thread of the pair search, kept from one build to the next */
+    int n_parts;
 } jd_neighbour_lists;
 
 /* The walls (walls.c). */
@@ -412,6 +421,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen);
 /* Drop the pair and wall entries of the particles at indices >= keep (deleted, domain.c),
  * booking what they dissipated. */
 void sim_lists_drop_from(jd_sim *s, size_t keep);
+void sim_neighbour_parts_free(jd_neighbour_lists *lists);
 /* 1 when some wall moved more than skin/2 [m] since the last build (the particles' part of the
  * rebuild criterion rides in the drift, integrate.c) */
 int sim_neighbour_walls_moved(const jd_walls *walls, double skin);
