@@ -4,7 +4,10 @@ against the energy the inlet brought in (observables/inlet_energy, kinetic and g
 insertion), the way scripts/stability.py folds the bonds' terms.
 
     residual(t) = KE + RE + elastic + gravitational + damping + friction + bond elastic
-                  + bond damping + bond breakage - wall_work - inflow
+                  + bond damping + bond breakage + lost - wall_work - inflow
+
+(lost: observables/lost_energy, what the spheres deleted outside the scene's domain took;
+docs/scenes.md "Domain").
 
 The residual is reported over the energy in play, the largest over the samples of KE + RE +
 elastic + the dissipated energies + |wall_work| (stability.py's measure: the gravitational
@@ -24,7 +27,8 @@ def balance(path):
     or the energy observables."""
     with h5py.File(path, "r") as f:
         o = {k: f["observables/%s/value" % k][()] for k in
-             STORED + DISSIPATED + ("gravitational_energy", "wall_work", "inlet_energy")
+             STORED + DISSIPATED + ("gravitational_energy", "wall_work", "inlet_energy",
+                                           "lost_energy")
              if "observables/%s/value" % k in f}
     if "inlet_energy" not in o or "kinetic_energy" not in o:
         return None
@@ -32,7 +36,8 @@ def balance(path):
     get = lambda k: o.get(k, zero)
     stored = sum(get(k) for k in STORED)
     dissipated = sum(get(k) for k in DISSIPATED)
-    residual = stored + dissipated + get("gravitational_energy") - get("wall_work") - o["inlet_energy"]
+    residual = (stored + dissipated + get("gravitational_energy") + get("lost_energy")
+                - get("wall_work") - o["inlet_energy"])
     in_play = float(np.max(stored + dissipated + np.abs(get("wall_work"))))
     worst = float(np.max(np.abs(residual)))
     return {"in_play": in_play, "inflow": float(np.max(np.abs(o["inlet_energy"]))),
@@ -40,4 +45,5 @@ def balance(path):
             "residual_inflow": worst / float(np.max(np.abs(o["inlet_energy"]))),
             "breakage": float(get("bond_breakage_energy")[-1]),
             "damping": float(get("damping_dissipation")[-1] + get("bond_damping_dissipation")[-1]),
-            "friction": float(get("friction_dissipation")[-1]), "samples": int(len(residual))}
+            "friction": float(get("friction_dissipation")[-1]), "samples": int(len(residual)),
+            "lost": float(get("lost_energy")[-1])}
