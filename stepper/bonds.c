@@ -5,6 +5,7 @@
  */
 #include <math.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -430,13 +431,17 @@ static size_t bond_breaks(jd_bonds *b, const jd_particles *ps, double dt, int in
     return broke;
 }
 
-/* Drop broken bonds, keeping the order of the others; their energies go to the totals. */
-static void compact(jd_bonds *b) {
+/* Drop the bonds that broke, and those of the particles at indices >= keep, keeping the order of
+ * the others; their dissipation goes to the totals.  Returns the elastic energy the removed bonds
+ * held at their last evaluation [J]. */
+static double remove_bonds(jd_bonds *b, size_t keep) {
+    double elastic = 0.0;
     size_t w = 0;
     for (size_t k = 0; k < b->n; k++) {
         jd_bond_state st = state_get(b, b->sw, k);
-        if (!jd_bond_intact(&st)) {
+        if (!jd_bond_intact(&st) || (size_t)b->i[k] >= keep || (size_t)b->j[k] >= keep) {
             jd_bond_harvest(&st, &b->e_damp_dropped, &b->e_break_dropped);
+            elastic += st.u_prev;
             continue;
         }
         if (w != k) {
@@ -448,6 +453,7 @@ static void compact(jd_bonds *b) {
         w++;
     }
     b->n = w;
+    return elastic;
 }
 
 void sim_bonds_forces(jd_bonds *b, jd_particles *ps, const jd_run_constants *run,
@@ -498,7 +504,7 @@ void sim_bonds_forces(jd_bonds *b, jd_particles *ps, const jd_run_constants *run
         }
 #undef JD_BOND_LOOP
     }
-    if (broke && !in_setup) compact(b);
+    if (broke && !in_setup) remove_bonds(b, SIZE_MAX);
 }
 
 /* ---------------------------------------------------------------------------------------- */
@@ -586,28 +592,7 @@ void sim_bonds_permute(jd_bonds *b, const int32_t *new_index, size_t n) {
     b->ever = ever;
 }
 
-double sim_bonds_drop_from(jd_bonds *b, size_t keep) {
-    if (!b) return 0.0;
-    double elastic = 0.0;
-    size_t w = 0;
-    for (size_t k = 0; k < b->n; k++) {
-        jd_bond_state st = state_get(b, b->sw, k);
-        if ((size_t)b->i[k] >= keep || (size_t)b->j[k] >= keep) {
-            jd_bond_harvest(&st, &b->e_damp_dropped, &b->e_break_dropped);
-            elastic += st.u_prev;
-            continue;
-        }
-        if (w != k) {
-            b->i[w] = b->i[k];
-            b->j[w] = b->j[k];
-            b->type[w] = b->type[k];
-            state_set(b, b->sw, w, &st);
-        }
-        w++;
-    }
-    b->n = w;
-    return elastic;
-}
+double sim_bonds_drop_from(jd_bonds *b, size_t keep) { return b ? remove_bonds(b, keep) : 0.0; }
 
 /* ---------------------------------------------------------------------------------------- */
 /* Guard                                                                                     */
