@@ -75,7 +75,7 @@ int jd_checkpoint_read(jd_sim *s, jd_checkpointer *ck, const char *path, char *e
 
 /* What the checkpoint needs of the modules whose state is private to their files. */
 /* loads.c: the loaded particles (n), their indices and the 6 n forces of the last evaluation */
-size_t sim_loads_state(jd_loads *l, int32_t **index, double **f_prev);
+size_t sim_loads_state(jd_loads *l, int32_t **index, int32_t **scene, double **f_prev);
 /* A checkpoint's count of loaded particles, n <= the current one (the domain deletes some). */
 void sim_loads_set_count(jd_loads *l, size_t n);
 /* bonds.c: room for need bonds (0 or -1) */

@@ -164,14 +164,15 @@ static void ck_bonds(ck_io *io, jd_bonds *b, size_t n_particles) {
     ck_double(io, "bonds/breakage_dropped", &b->e_break_dropped);
 }
 
-static void ck_loads(ck_io *io, jd_loads *l) {
-    int32_t *index;
+static void ck_loads(ck_io *io, jd_loads *l, int has_domain) {
+    int32_t *index, *scene;
     double *f_prev;
-    const size_t have = sim_loads_state(l, &index, &f_prev);
+    const size_t have = sim_loads_state(l, &index, &scene, &f_prev);
     size_t n = have;
     ck_count(io, "loads/n", &n, have); /* fewer when the domain deleted some */
     if (io->reading && !io->failed) sim_loads_set_count(l, n);
     ck_int32s(io, "loads/index", n, index);
+    if (has_domain) ck_int32s(io, "loads/scene", n, scene); /* which ones are left */
     ck_doubles(io, "loads/previous_force", 6 * n, f_prev);
 }
 
@@ -288,7 +289,7 @@ void ck_state(ck_io *io, jd_sim *s) {
     ck_walls(io, &s->walls);
     ck_accounts_and_watch(io, &s->accounts, &s->watch);
     if (s->bonds) ck_bonds(io, s->bonds, s->particles.n);
-    if (s->loads) ck_loads(io, s->loads);
+    if (s->loads) ck_loads(io, s->loads, s->run.scene->has_domain);
     if (s->inlets) ck_inlets(io, s);
     if (s->meshes) ck_meshes(io, s->meshes, sim_inlets_capacity(s->run.scene));
 }

@@ -19,6 +19,8 @@ struct jd_loads {
     size_t n;
     int32_t *index;   /* loaded particles (engine indices; set up in scene order, before the
                          first renumbering, and remapped by sim_loads_permute) */
+    int32_t *scene;   /* their index in the scene's arrays (force, fixed): the scene index at
+                         the start, which a deletion outside the domain does not change */
     double *f_prev;   /* 6 per loaded particle: force and torque applied at the previous
                          evaluation (external force, or the constraint's reaction) */
 };
@@ -33,11 +35,13 @@ int sim_loads_init(jd_loads **loads, const jd_scene *sc, char *err, size_t errle
     }
     if (l) {
         l->index = malloc((n ? n : 1) * sizeof *l->index);
+        l->scene = malloc((n ? n : 1) * sizeof *l->scene);
         l->f_prev = calloc(6 * (n ? n : 1), sizeof *l->f_prev);
     }
-    if (!l || !l->index || !l->f_prev) {
+    if (!l || !l->index || !l->scene || !l->f_prev) {
         if (l) {
             free(l->index);
+            free(l->scene);
             free(l->f_prev);
         }
         free(l);
@@ -46,7 +50,10 @@ int sim_loads_init(jd_loads **loads, const jd_scene *sc, char *err, size_t errle
     }
     for (size_t i = 0; i < sc->n_particles; i++) {
         const double *F = &sc->force[3 * i];
-        if (sc->fixed[i] || F[0] != 0.0 || F[1] != 0.0 || F[2] != 0.0) l->index[l->n++] = (int32_t)i;
+        if (sc->fixed[i] || F[0] != 0.0 || F[1] != 0.0 || F[2] != 0.0) {
+            l->scene[l->n] = (int32_t)i;
+            l->index[l->n++] = (int32_t)i;
+        }
     }
     *loads = l;
     return 0;
@@ -55,6 +62,7 @@ int sim_loads_init(jd_loads **loads, const jd_scene *sc, char *err, size_t errle
 void sim_loads_free(jd_loads **loads) {
     if (!*loads) return;
     free((*loads)->index);
+    free((*loads)->scene);
     free((*loads)->f_prev);
     free(*loads);
     *loads = NULL;
@@ -71,6 +79,7 @@ void sim_loads_drop_from(jd_loads *l, size_t keep) {
     for (size_t k = 0; k < l->n; k++) {
         if ((size_t)l->index[k] >= keep) continue;
         l->index[w] = l->index[k];
+        l->scene[w] = l->scene[k];
         memmove(&l->f_prev[6 * w], &l->f_prev[6 * k], 6 * sizeof *l->f_prev);
         w++;
     }
@@ -82,7 +91,7 @@ void sim_loads_apply(jd_loads *l, jd_particles *ps, const jd_run_constants *run,
     const jd_scene *sc = run->scene;
     double work = 0.0;
     for (size_t k = 0; k < l->n; k++) {
-        const size_t i = (size_t)l->index[k], p = (size_t)ps->orig[i]; /* engine, scene index */
+        const size_t i = (size_t)l->index[k], p = (size_t)l->scene[k]; /* engine, scene arrays */
         double *f = ps->f + 3 * i, *t = ps->torque + 3 * i, *prev = l->f_prev + 6 * k;
         double applied[6];
         for (int d = 0; d < 3; d++) {
@@ -99,8 +108,9 @@ void sim_loads_apply(jd_loads *l, jd_particles *ps, const jd_run_constants *run,
     if (!in_setup) accounts->wall_work += work;
 }
 
-size_t sim_loads_state(jd_loads *l, int32_t **index, double **f_prev) {
+size_t sim_loads_state(jd_loads *l, int32_t **index, int32_t **scene, double **f_prev) {
     *index = l->index;
+    *scene = l->scene;
     *f_prev = l->f_prev;
     return l->n;
 }

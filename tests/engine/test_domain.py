@@ -79,6 +79,11 @@ for pid in FLIERS:
     gone = frame_ids[:, row[pid]] == -1
     c.check(f"domain_row_{pid}_empty_after_deletion", np.array_equal(gone, frame_steps >= k),
             f"rows empty at frames {frame_steps[gone].tolist()}, deleted at step {k}")
+# E (id 1005), held at rest, keeps its load when the deletions move its scene index
+e_row = row[1005]
+e_moved = np.max(np.abs(t["position"][:, e_row] - t["position"][0, e_row]))
+c.check("domain_held_particle_keeps_its_load", e_moved == 0.0 and frame_ids[-1, e_row] == 1005,
+        f"the held sphere moved by {e_moved:.3g} m")
 c.check("domain_bond_went_with_its_particles", obs["bonds"][0] == 1 and obs["bonds"][-1] == 0,
         f"bonds {obs['bonds'][0]:g} at the start, {obs['bonds'][-1]:g} at the end")
 total = energy_total(obs) + obs["bond_elastic_energy"] + obs["bond_damping_dissipation"] \
