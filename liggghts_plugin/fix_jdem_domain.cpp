@@ -62,6 +62,14 @@ FixJdemDomain::FixJdemDomain(LAMMPS *lmp, int narg, char **arg)
 
 int FixJdemDomain::setmask() { return PRE_EXCHANGE; }
 
+/* The bond fixes whose bonds a deleted atom takes with it, found once per run, not at every
+ * reneighbouring step. */
+void FixJdemDomain::init() {
+  bonds.clear();
+  for (int k = 0; k < modify->nfix; k++)
+    if (FixBondJiang *b = dynamic_cast<FixBondJiang *>(modify->fix[k])) bonds.push_back(b);
+}
+
 /* Delete this rank's atoms outside the domain (swapping the last atom in, as LAMMPS does), then,
  * collectively, the bonds to them held on other atoms, and book the counts on every rank. */
 void FixJdemDomain::pre_exchange() {
@@ -69,9 +77,6 @@ void FixJdemDomain::pre_exchange() {
          **torque = atom->torque;
   double *rmass = atom->rmass, *radius = atom->radius;
   const double dtf = 0.5 * update->dt * force->ftm2v;
-  std::vector<FixBondJiang *> bonds;
-  for (int k = 0; k < modify->nfix; k++)
-    if (FixBondJiang *b = dynamic_cast<FixBondJiang *>(modify->fix[k])) bonds.push_back(b);
   std::vector<int> mine;
   double e = 0.0;
   int nlocal = atom->nlocal;

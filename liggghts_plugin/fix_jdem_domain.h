@@ -23,6 +23,7 @@ class FixJdemDomain : public Fix {
  public:
   FixJdemDomain(class LAMMPS *, int, char **);
   int setmask();
+  void init();
   void pre_exchange();
   void write_restart(FILE *);
   void restart(char *);
@@ -37,6 +38,7 @@ class FixJdemDomain : public Fix {
   double lo[3], hi[3], g[3];
   double lost, energy;
   std::vector<int> gone_all;
+  std::vector<class FixBondJiang *> bonds; /* set by init() */
 };
 
 }  // namespace LAMMPS_NS
