@@ -259,6 +259,12 @@ static jd_inlet_status check_values(const jd_inlet_spec *s, int allow_unbounded,
                  s->overlap_tol);
         return JD_INLET_BAD_VALUE;
     }
+    if (!(s->max_insert_overlap >= 0.0)) {
+        snprintf(msg, len, "max_insert_overlap %g is not valid; valid: a number >= 0 (a fraction "
+                           "of the smaller radius) or inf",
+                 s->max_insert_overlap);
+        return JD_INLET_BAD_VALUE;
+    }
     if (!(s->offset >= 0.0) || !isfinite(s->offset)) {
         snprintf(msg, len, "offset %g is not valid; valid: a number >= 0", s->offset);
         return JD_INLET_BAD_VALUE;
@@ -433,6 +439,7 @@ void jd_inlet_stream_init(const jd_inlet_spec *s, jd_inlet_stream *st, jd_inlet_
     st->started = 0;
     st->stop_step = s->stop_step;
     st->inserted = 0;
+    st->skipped = 0;
     for (size_t p = 0; p < s->n; p++)
         aim(s, &cursor[p], 0, p);
     update_next(s, st);
@@ -475,6 +482,66 @@ size_t jd_inlet_pop(const jd_inlet_spec *s, jd_inlet_stream *st, int64_t step,
     }
     update_next(s, st);
     return count;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Insertion into an occupied place                                                          */
+/* ---------------------------------------------------------------------------------------- */
+
+double jd_inlet_overlap_fraction(const double a[3], double ra, const double b[3], double rb) {
+    const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    const double dist = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    return (ra + rb - dist) / (ra < rb ? ra : rb);
+}
+
+void jd_inlet_worst_overlaps(const jd_inlet_particle *due, size_t n_due, size_t n, const double *x,
+                             const double *radius, double *worst, size_t *with) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t q = 0; q < n_due; q++) {
+        worst[q] = -INFINITY;
+        with[q] = SIZE_MAX;
+        for (int d = 0; d < 3; d++) {
+            lo[d] = fmin(lo[d], due[q].position[d] - due[q].radius);
+            hi[d] = fmax(hi[d], due[q].position[d] + due[q].radius);
+        }
+    }
+    for (size_t i = 0; i < n; i++) {
+        const double *xi = &x[3 * i];
+        const double r = radius[i];
+        if (xi[0] + r < lo[0] || xi[0] - r > hi[0] || xi[1] + r < lo[1] || xi[1] - r > hi[1] ||
+            xi[2] + r < lo[2] || xi[2] - r > hi[2])
+            continue;
+        for (size_t q = 0; q < n_due; q++) {
+            const double f = jd_inlet_overlap_fraction(due[q].position, due[q].radius, xi, r);
+            if (f > worst[q]) {
+                worst[q] = f;
+                with[q] = i;
+            }
+        }
+    }
+}
+
+size_t jd_inlet_skip_groups(const jd_inlet_spec *s, const jd_inlet_particle *due, size_t n_due,
+                            const double *worst, unsigned char *skip) {
+    for (size_t q = 0; q < n_due; q++)
+        skip[q] = worst[q] > s->max_insert_overlap;
+    for (size_t q = 0; q < n_due; q++) {
+        const int32_t g = s->n_groups ? s->group_of[due[q].index] : -1;
+        if (!skip[q] || g < 0)
+            continue;
+        for (size_t r = 0; r < n_due; r++)
+            if (due[r].copy == due[q].copy && s->group_of[due[r].index] == g)
+                skip[r] = 1;
+    }
+    size_t count = 0;
+    for (size_t q = 0; q < n_due; q++)
+        count += skip[q];
+    return count;
+}
+
+void jd_inlet_book_skipped(jd_inlet_stream *st, size_t n_skipped) {
+    st->inserted -= (int64_t)n_skipped;
+    st->skipped += (int64_t)n_skipped;
 }
 
 /* ---------------------------------------------------------------------------------------- */

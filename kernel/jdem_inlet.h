@@ -61,6 +61,10 @@ extern "C" {
  * scene reader's start-overlap rule (docs/scenes.md "Start overlaps"). */
 #define JD_INLET_OVERLAP_TOL 1e-6
 
+/* The default max_insert_overlap: any overlap with a particle already in the domain skips the
+ * insertion, as LIGGGHTS' insertion fixes do with `overlapcheck yes` (their default). */
+#define JD_INLET_MAX_INSERT_OVERLAP 0.0
+
 /* The description of one inlet, fixed for a run (the resolved scene's `inlets:` entry). */
 typedef struct jd_inlet_spec {
     size_t n;               /* particles per section, >= 1                                 [-]   */
@@ -81,6 +85,10 @@ typedef struct jd_inlet_spec {
                                neighbouring copies), fraction of the smaller radius, >= 0:
                                JD_INLET_OVERLAP_TOL, or for cells cut from a deposit the largest
                                contact overlap it may hold (the watchdog's limit)      [-]   */
+    double max_insert_overlap; /* the insertion rule of "Insertion into an occupied place"
+                               below: the largest overlap, fraction of the smaller radius, with a
+                               particle already in the domain at which a particle is still
+                               inserted, >= 0; INFINITY: always inserted             [-]   */
     /* Bonded groups (see "Bonded groups of a section" below); n_groups = 0 (and NULL arrays):
      * none, every particle is inserted at its own crossing step. */
     size_t n_groups;             /* groups of the section                              [-]   */
@@ -207,6 +215,7 @@ typedef struct jd_inlet_stream {
     int64_t stop_step;       /* copy of the spec's; the engine lowers it to stop by height [-] */
     int64_t next_step;       /* the smallest cursor step: nothing to do before it     [-] */
     int64_t inserted;        /* particles inserted so far                             [-] */
+    int64_t skipped;         /* particles not inserted: their place was occupied      [-] */
 } jd_inlet_stream;
 
 /* Initialise a stream (cursor: an array of s->n entries). */
@@ -218,6 +227,47 @@ void jd_inlet_stream_init(const jd_inlet_spec *s, jd_inlet_stream *st, jd_inlet_
  * step).  Updates st->next_step. */
 size_t jd_inlet_pop(const jd_inlet_spec *s, jd_inlet_stream *st, int64_t step,
                     jd_inlet_particle *out, size_t cap);
+
+/* ---- Insertion into an occupied place ----
+ *
+ * The pending stream is rigid and takes part in nothing, so a particle already in the domain can
+ * sit where a pending one is about to cross: one knocked back against the belt, or one that lags
+ * behind the belt as its block tips over the plane (docs/mixing.md 1.1).  Inserting the pending
+ * particle there would start a contact at an arbitrary overlap, with the elastic energy of it.
+ * Rule (LIGGGHTS' overlap check of its insertion fixes): a particle due at a step whose position
+ * overlaps a particle already in the domain by more than spec.max_insert_overlap times the
+ * smaller radius is not inserted, and neither is any other member of its bonded group in that
+ * copy.  It is skipped for good: the stream goes on with its next copy, and the skipped particles
+ * are counted (jd_inlet_stream.skipped).  The engine calls, at every step with particles due:
+ *   jd_inlet_worst_overlaps on all of the step's due particles (of one inlet) against the
+ *   particles in the domain before the step's insertions, jd_inlet_skip_groups, then
+ *   jd_inlet_book_skipped, and inserts the rest. */
+
+/* The overlap of spheres (a, ra) and (b, rb) as a fraction of the smaller radius:
+ * (ra + rb - |a - b|) / min(ra, rb); <= 0 when they are apart.  Positions [m], radii [m]. */
+double jd_inlet_overlap_fraction(const double a[3], double ra, const double b[3], double rb);
+
+/* For each due particle q (n_due of them), the largest overlap fraction worst[q] with the n
+ * particles (x [3n] [m], radius [n] [m]) and the index with[q] of that particle (the first of
+ * equal ones); worst[q] = -INFINITY and with[q] = SIZE_MAX when none is within reach.  Only
+ * the particles in the box of the due particles (widened by each one's own radius) are
+ * compared.  O(n + candidates n_due). */
+void jd_inlet_worst_overlaps(const jd_inlet_particle *due, size_t n_due, size_t n, const double *x,
+                             const double *radius, double *worst, size_t *with);
+
+/* The skip decision of the due particles (in pop order: increasing id): skip[q] = 1 when
+ * worst[q] > s->max_insert_overlap or when another due member of q's bonded group in the same
+ * copy has it; 0 otherwise.  Returns the number skipped.  O(n_due) without groups, O(n_due^2)
+ * at worst with them. */
+size_t jd_inlet_skip_groups(const jd_inlet_spec *s, const jd_inlet_particle *due, size_t n_due,
+                            const double *worst, unsigned char *skip);
+
+/* The engines report the first JD_INLET_REPORTED skips of a run on their error stream, then
+ * count the rest (observable skipped_particles). */
+#define JD_INLET_REPORTED 10
+
+/* Book n_skipped particles that jd_inlet_pop returned but the engine did not insert. */
+void jd_inlet_book_skipped(jd_inlet_stream *st, size_t n_skipped);
 
 /* ---- The stop rules both engines apply, and the insertion record ---- */
 

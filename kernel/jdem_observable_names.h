@@ -50,6 +50,10 @@ static const int jd_bond_observable_is_energy[JD_N_BOND_OBSERVABLES] = {0, 0, 1,
  * order, equal to the stepper's one running sum to round-off). */
 static const char *const jd_obs_inlet_energy = "inlet_energy";
 
+/* ... and SKIPPED_PARTICLES [-]: the particles its inlets did not insert because their place
+ * was occupied (kernel/jdem_inlet.h "Insertion into an occupied place"), so far. */
+static const char *const jd_obs_skipped_particles = "skipped_particles";
+
 /* A scene with a domain (kernel/jdem_domain.h) also writes LOST_PARTICLES [-], the particles
  * deleted outside it so far, and LOST_ENERGY [J], the energy they took (jd_lost_energy summed;
  * the output side of the balance). */

@@ -431,13 +431,15 @@ int DumpH5mdJdem::write_contact_observables(const double all_obs[JDO_N], bigint 
       return -1;
   }
   bool inlets = false; /* the inflow, as the stepper writes it with inlets */
-  double inflow = 0.0;
+  double inflow = 0.0, skipped = 0.0;
   for (int k = 0; k < modify->nfix; k++) {
     const FixJdemInlet *in = dynamic_cast<FixJdemInlet *>(modify->fix[k]);
-    if (in) inflow += in->inflow_energy(), inlets = true;
+    if (in) inflow += in->inflow_energy(), skipped += (double)in->skipped(), inlets = true;
   }
-  if (inlets && jd_h5md_write_observable(h5, jd_obs_inlet_energy, (int64_t)step, time, inflow, err,
-                                         errlen) != 0)
+  if (inlets && (jd_h5md_write_observable(h5, jd_obs_inlet_energy, (int64_t)step, time, inflow,
+                                          err, errlen) != 0 ||
+                 jd_h5md_write_observable(h5, jd_obs_skipped_particles, (int64_t)step, time,
+                                          skipped, err, errlen) != 0))
     return -1;
   for (int k = 0; k < modify->nfix; k++) /* the outflow, as the stepper writes it with a domain */
     if (const FixJdemDomain *d = dynamic_cast<FixJdemDomain *>(modify->fix[k]))

@@ -32,7 +32,7 @@ using namespace FixConst;
 static const char *USAGE =
     "fix ID group jdem/inlet file SECTION origin X Y Z velocity VX VY VZ plane PX PY PZ NX NY NZ "
     "period L [offset D] first_id ID stop sections N|time T|height H [below_speed V] [every N] "
-    "[overlap_tol F] [record FILE|append_record FILE]";
+    "[overlap_tol F] [max_insert_overlap F|inf] [record FILE|append_record FILE]";
 
 FixJdemInlet::FixJdemInlet(LAMMPS *lmp, int narg, char **arg)
     : Fix(lmp, narg, arg), spec(), stream(), started(false), stop_time(-1.0), height(-1.0),
@@ -42,6 +42,7 @@ FixJdemInlet::FixJdemInlet(LAMMPS *lmp, int narg, char **arg)
   if (!atom->tag_enable || atom->map_style == 0)
     error->all(FLERR, "fix jdem/inlet needs atom IDs and `atom_modify map array` (or hash)");
   spec.overlap_tol = JD_INLET_OVERLAP_TOL;
+  spec.max_insert_overlap = JD_INLET_MAX_INSERT_OVERLAP;
   parse(narg, arg);
   force_reneighbor = 1;
   next_reneighbor = -1; /* set by init() once dt is known */
@@ -131,6 +132,16 @@ void FixJdemInlet::parse(int narg, char **arg) {
     } else if (key == "overlap_tol") { /* a section cut from a settled deposit keeps its contacts */
       spec.overlap_tol = positive(error, narg, arg, i, "overlap_tol");
       i += 2;
+    } else if (key == "max_insert_overlap") { /* a fraction of the smaller radius, or inf */
+      if (i + 1 < narg && !std::strcmp(arg[i + 1], "inf")) {
+        spec.max_insert_overlap = INFINITY;
+      } else {
+        numbers(error, narg, arg, i, 1, &spec.max_insert_overlap);
+        if (!(spec.max_insert_overlap >= 0.0))
+          error->all(FLERR, "fix jdem/inlet: max_insert_overlap must be a number >= 0 (a fraction "
+                            "of the smaller radius) or inf");
+      }
+      i += 2;
     } else if (key == "first_id") {
       spec.first_id = integer(error, narg, arg, i, 1, "first_id");
       have[4] = true;
@@ -157,7 +168,7 @@ void FixJdemInlet::parse(int narg, char **arg) {
     } else {
       const std::string msg = "fix jdem/inlet: unknown keyword '" + key.substr(0, 64) +
                               "'; valid: file, origin, velocity, plane, period, offset, first_id, "
-                              "stop, overlap_tol, record, append_record";
+                              "stop, overlap_tol, max_insert_overlap, record, append_record";
       error->all(FLERR, msg.c_str());
     }
   }
@@ -418,6 +429,56 @@ void FixJdemInlet::check_created(const std::vector<jd_inlet_particle> &due, int 
     }
 }
 
+/* The due particles whose place is free (kernel/jdem_inlet.h "Insertion into an occupied
+ * place"): the owner of each position measures its worst overlap with the atoms at this step
+ * (the ghosts brought up to date first), one reduction shares them, and every rank applies the
+ * kernel's rule to the same numbers. */
+std::vector<jd_inlet_particle> FixJdemInlet::kept_of(const std::vector<jd_inlet_particle> &due) {
+  if (std::isinf(spec.max_insert_overlap)) return due;
+  comm->forward_comm();
+  const size_t n = due.size();
+  std::vector<double> mine(n), worst(n);
+  std::vector<size_t> with(n);
+  std::vector<int> mine_tag(n, -1), with_tag(n, -1);
+  const int nall = atom->nlocal + atom->nghost;
+  jd_inlet_worst_overlaps(due.data(), n, (size_t)nall, nall ? atom->x[0] : NULL, atom->radius,
+                          mine.data(), with.data());
+  for (size_t q = 0; q < n; q++) {
+    if (!domain->is_in_subdomain(const_cast<double *>(due[q].position))) mine[q] = -INFINITY;
+    else if (with[q] != SIZE_MAX) mine_tag[q] = atom->tag[with[q]];
+  }
+  MPI_Allreduce(mine.data(), worst.data(), (int)n, MPI_DOUBLE, MPI_MAX, world);
+  MPI_Allreduce(mine_tag.data(), with_tag.data(), (int)n, MPI_INT, MPI_MAX, world);
+  std::vector<unsigned char> skip(n);
+  if (!jd_inlet_skip_groups(&spec, due.data(), n, worst.data(), skip.data())) return due;
+  std::vector<jd_inlet_particle> kept;
+  for (size_t q = 0; q < n; q++) {
+    if (!skip[q]) {
+      kept.push_back(due[q]);
+      continue;
+    }
+    report_skip(due[q], worst[q], with_tag[q]);
+    jd_inlet_book_skipped(&stream, 1);
+  }
+  return kept;
+}
+
+/* Rank 0 reports the first JD_INLET_REPORTED skips of the run, in build/jdem's words. */
+void FixJdemInlet::report_skip(const jd_inlet_particle &p, double worst, int with_tag) {
+  const long long nth = skipped() + 1;
+  if (comm->me != 0 || nth > JD_INLET_REPORTED) return;
+  char why[160] = "with its bonded block", line[400];
+  if (worst > spec.max_insert_overlap)
+    std::snprintf(why, sizeof why, "particle id %d overlaps its place by %.6g of the smaller radius",
+                  with_tag, worst);
+  std::snprintf(line, sizeof line, "fix %s jdem/inlet: step %lld: skips particle id %lld: %s "
+                "(max_insert_overlap %g)%s\n", id, (long long)update->ntimestep, (long long)p.id,
+                why, spec.max_insert_overlap,
+                nth == JD_INLET_REPORTED ? "; further skips are counted, not reported" : "");
+  if (screen) std::fputs(line, screen);
+  if (logfile) std::fputs(line, logfile);
+}
+
 /* The particles due at this step (after the contact histories were saved by atom id: LIGGGHTS
  * runs fix contacthistory's pre_exchange first, so the new atoms may overwrite ghosts). */
 void FixJdemInlet::pre_exchange() {
@@ -434,6 +495,7 @@ void FixJdemInlet::pre_exchange() {
   if (due.empty()) return;
   if (due.back().id > INT_MAX)
     error->all(FLERR, "fix jdem/inlet: the stream's ids pass 2147483647, LIGGGHTS' largest atom id");
+  due = kept_of(due);
   int created = 0;
   for (size_t q = 0; q < due.size(); q++) {
     const jd_inlet_particle &p = due[q];
@@ -453,7 +515,7 @@ void FixJdemInlet::pre_exchange() {
   atom->nghost = 0; /* the ghosts are rebuilt by this step's borders() */
   atom->map_init();
   atom->map_set();
-  form_block_bonds(due);
+  if (!due.empty()) form_block_bonds(due);
   insert_seconds += MPI_Wtime() - t0;
 }
 
@@ -517,9 +579,9 @@ void FixJdemInlet::post_run() {
   if (comm->me != 0) return;
   const long long n = inserted();
   char line[320];
-  std::snprintf(line, sizeof line, "fix %s jdem/inlet: inserted %lld particles, inflow energy %.17g J, "
-                "insertion %.6f s, %.1f ns per particle\n", id, n, energy_in, slowest,
-                n ? 1e9 * slowest / (double)n : 0.0);
+  std::snprintf(line, sizeof line, "fix %s jdem/inlet: inserted %lld particles, skipped %lld, "
+                "inflow energy %.17g J, insertion %.6f s, %.1f ns per particle\n", id, n,
+                skipped(), energy_in, slowest, n ? 1e9 * slowest / (double)n : 0.0);
   if (screen) std::fputs(line, screen);
   if (logfile) std::fputs(line, logfile);
 }
@@ -527,7 +589,7 @@ void FixJdemInlet::post_run() {
 /* ---- restart files: the position in the stream (every rank computes the whole stream) ---- */
 
 namespace {
-enum { INLET_SHARED_HEAD = 9 }; /* then 2 per section particle: its cursor */
+enum { INLET_SHARED_HEAD = 10 }; /* then 2 per section particle: its cursor */
 }
 
 void FixJdemInlet::write_restart(FILE *fp) {
@@ -535,7 +597,8 @@ void FixJdemInlet::write_restart(FILE *fp) {
   const double head[INLET_SHARED_HEAD] = {
       started ? 1.0 : 0.0, spec.dt, jdem_restart_pack_i64(spec.stop_step), (double)spec.n,
       jdem_restart_pack_i64(stream.started), jdem_restart_pack_i64(stream.stop_step),
-      jdem_restart_pack_i64(stream.next_step), jdem_restart_pack_i64(stream.inserted), energy_in};
+      jdem_restart_pack_i64(stream.next_step), jdem_restart_pack_i64(stream.inserted), energy_in,
+      jdem_restart_pack_i64(stream.skipped)};
   st.shared.assign(head, head + INLET_SHARED_HEAD);
   for (size_t p = 0; p < spec.n; p++) {
     st.shared.push_back(jdem_restart_pack_i64(started ? cursor[p].copy : 0));
@@ -567,6 +630,7 @@ void FixJdemInlet::restart(char *buf) {
   stream.next_step = jdem_restart_unpack_i64(s[6]);
   stream.inserted = jdem_restart_unpack_i64(s[7]);
   energy_in = s[8];
+  stream.skipped = jdem_restart_unpack_i64(s[9]);
   next_reneighbor = stream.next_step == JD_INLET_NEVER ? -1 : stream.next_step;
   started = true;
 }

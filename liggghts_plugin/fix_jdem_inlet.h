@@ -1,7 +1,7 @@
 /* fix_jdem_inlet.h — `fix ID group jdem/inlet file SECTION origin X Y Z velocity VX VY VZ
  *                     plane PX PY PZ NX NY NZ period L [offset D] first_id ID
  *                     stop sections N | stop time T | stop height H [below_speed V] [every N]
- *                     [record FILE | append_record FILE]`:
+ *                     [max_insert_overlap F | inf] [record FILE | append_record FILE]`:
  * the conveyor inlet of docs/mixing.md 2.1 in LIGGGHTS, the stream of kernel/jdem_inlet.h (the
  * same function calls as build/jdem's stepper/inlet.c, so the particles, ids, steps, positions and
  * velocities are the stepper's bit for bit).
@@ -34,6 +34,17 @@
  * particle is created by the rank whose subdomain holds it, with LIGGGHTS' own atom creation
  * (AtomVec::create_atom, the create_attribute fixes' set_arrays, natoms, the atom map), as fix
  * insert/pack and insert/stream do.  A particle outside every subdomain (outside the box) stops the run.
+ *
+ * Occupied places (kernel/jdem_inlet.h "Insertion into an occupied place").  Before creating
+ * the step's particles, the ghosts' positions are brought to this step (a forward
+ * communication: pre_exchange runs before the step's own); the rank that owns a due particle's
+ * position measures its worst overlap with its local and ghost atoms (a ghost cutoff of twice
+ * the largest radius and more covers every atom that can touch it), the ranks share those
+ * (one reduction), and every rank applies the kernel's rule (jd_inlet_skip_groups): a particle
+ * (with its bonded block) whose place is occupied beyond max_insert_overlap (a fraction of the
+ * smaller radius; default JD_INLET_MAX_INSERT_OVERLAP, inf: never skip) is not created, and is
+ * counted (skipped(), the observable skipped_particles); rank 0 reports the first
+ * JD_INLET_REPORTED, as build/jdem does.
  *
  * Cost.  The fix asks for a re-neighbouring at the next due step only (force_reneighbor,
  * next_reneighbor); at any other step pre_exchange and end_of_step compare the step with one
@@ -83,6 +94,8 @@ class FixJdemInlet : public Fix {
   double inflow_energy() const { return energy_in; }
   /* particles inserted so far (all ranks) and the wall time this rank spent inserting [s] */
   long long inserted() const { return (long long)stream.inserted; }
+  /* particles not inserted because their place was occupied (all ranks) */
+  long long skipped() const { return (long long)stream.skipped; }
   double seconds() const { return insert_seconds; }
   /* the section: its particles' atom types - 1, radii [m] and densities [kg/m^3] (fix jdem/guard
    * counts them as the stepper's guard does, once each) */
@@ -100,6 +113,8 @@ class FixJdemInlet : public Fix {
   void start_stream();
   void create(const jd_inlet_particle &p, const double g[3]);
   void check_created(const std::vector<jd_inlet_particle> &due, int created_here);
+  std::vector<jd_inlet_particle> kept_of(const std::vector<jd_inlet_particle> &due);
+  void report_skip(const jd_inlet_particle &p, double worst, int with_tag);
   void settle_new_particles();
   void height_rule();
   void sort_bonds(const std::vector<int> &bonds, const char *path);

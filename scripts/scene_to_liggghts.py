@@ -452,6 +452,8 @@ def inlet_lines(scene, tid, deck_dir, record):
         if any(p.get("settled") for p in inlet["section"]["particles"]):
             # cells cut from a settled deposit keep their contacts (the scene reader's rule)
             words += " overlap_tol %s" % num(scene["watchdog"]["max_overlap_fraction"])
+        limit = inlet["max_insert_overlap"]  # the resolved scene's: a number, or .inf
+        words += " max_insert_overlap %s" % ("inf" if math.isinf(limit) else num(limit))
         if record:
             words += " %s %s" % ("record" if k == 0 else "append_record", word(os.path.abspath(record), "record path"))
         L.append("fix %s all jdem/inlet %s\n" % (ident, words))

@@ -276,6 +276,7 @@ static void ck_inlets(ck_io *io, jd_sim *s) {
         ck_int64(io, NAME(p, "inlets/%zu/stop_step", k), &st->stop_step);
         ck_int64(io, NAME(p, "inlets/%zu/next_step", k), &st->next_step);
         ck_int64(io, NAME(p, "inlets/%zu/inserted", k), &st->inserted);
+        ck_int64(io, NAME(p, "inlets/%zu/skipped", k), &st->skipped);
         ck_array(io, NAME(p, "inlets/%zu/cursors", k), H5T_NATIVE_INT64, 2 * nc, st->cursor);
     }
 }

@@ -58,7 +58,10 @@ struct jd_sim_inlets {
     jd_row *rows;          /* [cap] the trajectory's rows, sorted by id */
     double *frame;         /* [5 x 3 cap] the vectors of a frame in row order */
     int64_t *frame_id;     /* [cap] the ids of a frame in row order, -1: not inserted */
-    jd_inlet_particle *buf;
+    jd_inlet_particle *buf; /* the particles due at a step, with their insertion checks: */
+    double *worst;          /* the largest overlap of each with a particle in the domain [-] */
+    size_t *with;           /* the index of that particle */
+    unsigned char *skip;    /* 1: not inserted (kernel/jdem_inlet.h "occupied place") */
     size_t buf_cap;
     int64_t next_step;     /* the smallest next_step of the streams */
     double energy_in;      /* kinetic + gravitational energy the inserted particles brought [J] */
@@ -131,6 +134,23 @@ size_t sim_inlets_capacity(const jd_scene *sc) {
     return cap;
 }
 
+/* Room for `need` due particles and their checks (a step can have more than a section due:
+ * copies overlap in crossing time).  On failure the old buffers stay valid. */
+static int grow_due(jd_sim_inlets *in, size_t need) {
+    if (need <= in->buf_cap && in->buf) return 0;
+    jd_inlet_particle *buf = realloc(in->buf, need * sizeof *buf);
+    if (buf) in->buf = buf;
+    double *worst = realloc(in->worst, need * sizeof *worst);
+    if (worst) in->worst = worst;
+    size_t *with = realloc(in->with, need * sizeof *with);
+    if (with) in->with = with;
+    unsigned char *skip = realloc(in->skip, need * sizeof *skip);
+    if (skip) in->skip = skip;
+    if (!buf || !worst || !with || !skip) return -1;
+    in->buf_cap = need;
+    return 0;
+}
+
 int sim_inlets_init(jd_sim *s, char *err, size_t errlen) {
     const jd_scene *sc = s->run.scene;
     if (!sc->n_inlets && !sc->has_domain) return 0;
@@ -158,8 +178,7 @@ int sim_inlets_init(jd_sim *s, char *err, size_t errlen) {
         in->next_step = r->st.next_step < in->next_step ? r->st.next_step : in->next_step;
         if (r->spec.n > in->buf_cap) in->buf_cap = r->spec.n;
     }
-    in->buf = malloc((in->buf_cap ? in->buf_cap : 1) * sizeof *in->buf);
-    if (!in->buf) goto oom;
+    if (grow_due(in, in->buf_cap ? in->buf_cap : 1) != 0) goto oom;
     make_rows(in, sc);
     s->particles.ids = in->id;
     return 0;
@@ -179,6 +198,9 @@ void sim_inlets_free(jd_sim *s) {
     free(in->frame);
     free(in->frame_id);
     free(in->buf);
+    free(in->worst);
+    free(in->with);
+    free(in->skip);
     free(in);
     s->inlets = NULL;
 }
@@ -264,6 +286,45 @@ static int form_block_bonds(jd_sim *s, size_t k, size_t n0, size_t n1) {
     return 0;
 }
 
+/* Every particle of inlet r due at `step` into in->buf[0, *due), in pop order. */
+static int pop_due(jd_sim_inlets *in, inlet_run *r, int64_t step, size_t *due) {
+    size_t got;
+    while (r->st.next_step == step) {
+        if (*due == in->buf_cap && grow_due(in, 2 * in->buf_cap) != 0) return -1;
+        got = jd_inlet_pop(&r->spec, &r->st, step, in->buf + *due, in->buf_cap - *due);
+        if (got == 0) break;
+        *due += got;
+    }
+    return 0;
+}
+
+/* The insertion check (kernel/jdem_inlet.h "Insertion into an occupied place") of inlet k's
+ * due particles against the particles in the domain: in->skip[q] set, the first skips
+ * reported, the count booked in the stream. */
+static void skip_occupied(jd_sim *s, size_t k, size_t due) {
+    jd_sim_inlets *in = s->inlets;
+    inlet_run *r = &in->run[k];
+    const jd_particles *ps = &s->particles;
+    jd_inlet_worst_overlaps(in->buf, due, ps->n, ps->x, ps->radius, in->worst, in->with);
+    const size_t skipped = jd_inlet_skip_groups(&r->spec, in->buf, due, in->worst, in->skip);
+    for (size_t q = 0; q < due && skipped; q++) {
+        if (!in->skip[q]) continue;
+        const int64_t nth = sim_skipped_particles(s) + 1;
+        if (nth <= JD_INLET_REPORTED) {
+            char why[160] = "with its bonded block";
+            if (in->worst[q] > r->spec.max_insert_overlap)
+                snprintf(why, sizeof why, "particle id %lld overlaps its place by %.6g of the "
+                         "smaller radius", (long long)sim_particle_id(ps, in->with[q]), in->worst[q]);
+            fprintf(stderr, "jdem: step %lld: inlet '%s' skips particle id %lld: %s "
+                    "(max_insert_overlap %g)%s\n", (long long)s->step,
+                    s->run.scene->inlets[k].name, (long long)in->buf[q].id, why,
+                    r->spec.max_insert_overlap,
+                    nth == JD_INLET_REPORTED ? "; further skips are counted, not reported" : "");
+        }
+        jd_inlet_book_skipped(&r->st, 1);
+    }
+}
+
 static int insert_due(jd_sim *s, char *err, size_t errlen) {
     jd_sim_inlets *in = s->inlets;
     if (s->step != in->next_step) return 0;
@@ -274,12 +335,16 @@ static int insert_due(jd_sim *s, char *err, size_t errlen) {
     for (size_t k = 0; k < in->n_inlets; k++) {
         inlet_run *r = &in->run[k];
         const size_t n0 = s->particles.n;
-        size_t got;
-        while (r->st.next_step == s->step &&
-               (got = jd_inlet_pop(&r->spec, &r->st, s->step, in->buf, in->buf_cap)) > 0) {
-            for (size_t q = 0; q < got && s->particles.n < in->cap; q++) append(s, &in->buf[q]);
-            added += got;
+        size_t due = 0;
+        if (pop_due(in, r, s->step, &due) != 0) {
+            snprintf(err, errlen, "out of memory for the particles due at step %lld",
+                     (long long)s->step);
+            return -1;
         }
+        skip_occupied(s, k, due);
+        for (size_t q = 0; q < due && s->particles.n < in->cap; q++)
+            if (!in->skip[q]) append(s, &in->buf[q]);
+        added += s->particles.n - n0;
         if (form_block_bonds(s, k, n0, s->particles.n) != 0) {
             snprintf(err, errlen, "step %lld: a bond of inlet '%s' joins a particle not inserted "
                      "with its block, or memory ran out", (long long)s->step,
@@ -311,6 +376,12 @@ int64_t sim_inlets_inserted(const jd_sim *s) {
 double sim_inlets_seconds(const jd_sim *s) { return s->inlets ? s->inlets->seconds : 0.0; }
 
 double sim_inlets_energy(const jd_sim *s) { return s->inlets ? s->inlets->energy_in : 0.0; }
+
+int64_t sim_skipped_particles(const jd_sim *s) {
+    int64_t n = 0;
+    for (size_t k = 0; s->inlets && k < s->inlets->n_inlets; k++) n += s->inlets->run[k].st.skipped;
+    return n;
+}
 
 int64_t sim_lost_particles(const jd_sim *s) { return s->inlets ? s->inlets->lost : 0; }
 

@@ -596,6 +596,9 @@ static int run_and_close(const cli *c, jd_sim *sim, jd_h5md *h, const char *out,
         fprintf(stderr, "jdem: %lld particles left the domain and were deleted (they took %.6g J; "
                 "observables lost_particles, lost_energy)\n", (long long)sim_lost_particles(sim),
                 sim_lost_energy(sim));
+    if (sim_skipped_particles(sim) > 0) /* never silent: the stream is short of them */
+        fprintf(stderr, "jdem: the inlets skipped %lld particles whose place was occupied "
+                "(observable skipped_particles)\n", (long long)sim_skipped_particles(sim));
     if (ck->path) unlink(ck->path); /* a complete run has nothing to resume */
     return 0;
 }

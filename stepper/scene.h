@@ -119,6 +119,9 @@ typedef struct jd_inlet {
     double period;            /* L [m] */
     double offset;            /* copy 0 set back along the belt [m] */
     int64_t first_id;         /* id of particle 0 of copy 0 */
+    double max_insert_overlap; /* a particle whose place is occupied beyond this overlap (fraction
+                                 of the smaller radius) is skipped (kernel/jdem_inlet.h); INFINITY:
+                                 never */
     int stop;                 /* jd_inlet_stop */
     int64_t sections;         /* JD_INLET_STOP_SECTIONS: copies, >= 1 */
     double stop_time;         /* JD_INLET_STOP_TIME: no copy starts at or after ceil(time/dt) [s] */

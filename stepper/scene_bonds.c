@@ -5,7 +5,6 @@
  */
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #include "scene_internal.h"
 
@@ -27,22 +26,9 @@ _Static_assert(JD_BOND_BEND_I == 0 && JD_BOND_BEND_J_LITERAL == 1, "BENDINGS ord
 /* A strength: a number > 0, or .inf (that failure mode is off). */
 static int read_strength(loader *L, const yaml_node_t *m, const char *path, const char *key,
                          double *out) {
-    const yaml_node_t *n = sd_get(&L->c, m, key);
-    char sub[SD_PATH_MAX];
-    sd_join(sub, path, key);
-    if (!n) return sd_missing(&L->c, m, path, key, "a number > 0 [Pa], or .inf");
-    const char *s = sd_scalar(n);
-    if (s && (strcasecmp(s, ".inf") == 0 || strcasecmp(s, "+.inf") == 0)) {
-        *out = INFINITY;
-        return 0;
-    }
-    char *end = NULL;
-    const double v = s ? strtod(s, &end) : NAN;
-    if (!s || end == s || *end != '\0' || !isfinite(v) || !(v > 0.0))
-        return sd_fail(&L->c, n, sub, SD_QUOTE " is not a strength; valid: a number > 0 [Pa], "
-                       "or .inf", s ? s : sd_kind(n));
-    *out = v;
-    return 0;
+    if (!sd_get(&L->c, m, key)) return sd_missing(&L->c, m, path, key, "a number > 0 [Pa], or .inf");
+    return sd_opt_num_or_inf(&L->c, m, path, key, SD_POSITIVE, "a strength",
+                             "a number > 0 [Pa], or .inf", out);
 }
 
 static int read_type(loader *L, const yaml_node_pair_t *p, jd_bond_type *t) {

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 #include "scene.h"
@@ -301,6 +302,11 @@ int sd_missing(sd_ctx *c, const yaml_node_t *map, const char *path, const char *
 /* Typed values                                                                              */
 
 /* YAML 1.1/1.2 spellings of infinity and NaN (.inf, -.Inf, .NaN, ...). */
+int sd_is_inf(const yaml_node_t *n) {
+    const char *s = n ? sd_scalar(n) : NULL;
+    return s && (strcasecmp(s, ".inf") == 0 || strcasecmp(s, "+.inf") == 0);
+}
+
 static int yaml_nonfinite(const char *s) {
     if (*s == '+' || *s == '-') s++;
     static const char *const spell[] = {".inf", ".Inf", ".INF", ".nan", ".NaN", ".NAN", NULL};
@@ -463,6 +469,25 @@ int sd_opt_num(sd_ctx *c, const yaml_node_t *map, const char *path, const char *
     char sub[SD_PATH_MAX];
     sd_join(sub, path, key);
     return sd_num(c, n, sub, r, out);
+}
+
+int sd_opt_num_or_inf(sd_ctx *c, const yaml_node_t *map, const char *path, const char *key,
+                      sd_range r, const char *what, const char *valid, double *out) {
+    const yaml_node_t *n = sd_get(c, map, key);
+    if (!n) return 0;
+    if (sd_is_inf(n)) {
+        *out = INFINITY;
+        return 0;
+    }
+    char sub[SD_PATH_MAX];
+    sd_join(sub, path, key);
+    const char *s = sd_scalar(n);
+    char *end = NULL;
+    const double v = s ? strtod(s, &end) : NAN;
+    if (!s || end == s || *end != '\0' || !isfinite(v) || !in_range(v, r))
+        return sd_fail(c, n, sub, SD_QUOTE " is not %s; valid: %s", s ? s : sd_kind(n), what, valid);
+    *out = v;
+    return 0;
 }
 
 int sd_req_num(sd_ctx *c, const yaml_node_t *map, const char *path, const char *key, sd_range r,

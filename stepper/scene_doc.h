@@ -58,6 +58,7 @@ yaml_node_t *sd_get(const sd_ctx *c, const yaml_node_t *map, const char *key);
 size_t sd_len(const yaml_node_t *seq);
 yaml_node_t *sd_item(const sd_ctx *c, const yaml_node_t *seq, size_t i);
 const char *sd_scalar(const yaml_node_t *n); /* NULL unless a scalar */
+int sd_is_inf(const yaml_node_t *n);         /* 1 for the scalar .inf or +.inf (any case) */
 
 /* Structure checks.  sd_keys: `map` must be a mapping whose keys are distinct scalars from the
  * NULL-terminated `allowed` list. */
@@ -84,6 +85,10 @@ int sd_enum(sd_ctx *c, const yaml_node_t *n, const char *path, const char *const
 /* Optional / required members of a mapping: absent optional members keep *out. */
 int sd_opt_num(sd_ctx *c, const yaml_node_t *map, const char *path, const char *key, sd_range r,
                double *out);
+/* An optional number in r, or .inf (INFINITY); a failure says "'<text>' is not <what>; valid:
+ * <valid>". */
+int sd_opt_num_or_inf(sd_ctx *c, const yaml_node_t *map, const char *path, const char *key,
+                      sd_range r, const char *what, const char *valid, double *out);
 int sd_req_num(sd_ctx *c, const yaml_node_t *map, const char *path, const char *key, sd_range r,
                double *out);
 int sd_opt_vec3(sd_ctx *c, const yaml_node_t *map, const char *path, const char *key,

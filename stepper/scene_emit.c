@@ -345,7 +345,8 @@ static int emit_inlets(yaml_emitter_t *e, const jd_scene *s) {
             key_vec(e, "velocity", in->velocity) || str(e, "plane") || map_start(e, 1) ||
             key_vec(e, "point", in->plane_point) || key_vec(e, "normal", in->plane_normal) ||
             map_end(e) || key_num(e, "period", in->period) || key_num(e, "offset", in->offset) ||
-            key_int(e, "first_id", in->first_id) || emit_inlet_stop(e, in) || map_end(e))
+            key_int(e, "first_id", in->first_id) || str(e, "max_insert_overlap") ||
+            num_or_inf(e, in->max_insert_overlap) || emit_inlet_stop(e, in) || map_end(e))
             return 1;
     }
     return seq_end(e);

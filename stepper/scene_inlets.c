@@ -9,6 +9,7 @@
  * lattice is exactly the lattice the generate section would make.  Section particles carry no
  * velocity: every inserted particle moves at the belt velocity.
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,7 +17,8 @@
 #include "scene_internal.h"
 
 static const char *const INLET_KEYS[] = {"name", "section", "origin", "velocity", "plane",
-                                         "period", "offset", "first_id", "stop", NULL};
+                                         "period", "offset", "first_id", "stop",
+                                         "max_insert_overlap", NULL};
 static const char *const SECTION_KEYS[] = {"blocks", "generate", "particles", "from_deposit",
                                             "bonds", NULL};
 static const char *const SECTION_PARTICLE_KEYS[] = {"material", "radius", "position", "settled",
@@ -168,6 +170,17 @@ static int read_first_id(loader *L, const yaml_node_t *m, const char *path, jd_i
     return -1;
 }
 
+/* max_insert_overlap: a fraction >= 0 of the smaller radius, or .inf (every particle is
+ * inserted, whatever occupies its place). */
+/* max_insert_overlap: a fraction >= 0 of the smaller radius, or .inf (every particle is
+ * inserted, whatever occupies its place). */
+static int read_max_insert_overlap(loader *L, const yaml_node_t *m, const char *path, jd_inlet *in) {
+    in->max_insert_overlap = JD_INLET_MAX_INSERT_OVERLAP;
+    return sd_opt_num_or_inf(&L->c, m, path, "max_insert_overlap", SD_NONNEGATIVE,
+                             "an overlap fraction", "a number >= 0 (a fraction of the smaller radius), or .inf (never "
+                             "skip a particle)", &in->max_insert_overlap);
+}
+
 static int read_inlet(loader *L, const yaml_node_t *m, const char *path, jd_inlet *in) {
     char sub[SD_PATH_MAX];
     if (sd_keys(&L->c, m, path, INLET_KEYS)) return -1;
@@ -186,6 +199,7 @@ static int read_inlet(loader *L, const yaml_node_t *m, const char *path, jd_inle
                    read_plane(L, m, path, in) ||
                    sd_req_num(&L->c, m, path, "period", SD_POSITIVE, &in->period) ||
                    sd_opt_num(&L->c, m, path, "offset", SD_NONNEGATIVE, &in->offset) ||
+                   read_max_insert_overlap(L, m, path, in) ||
                    read_first_id(L, m, path, in) || read_stop(L, m, path, in) ||
                    scene_check_section_blocks(L, path, in, blocks);
     scene_free_section_blocks(blocks);
@@ -220,6 +234,7 @@ void scene_inlet_spec(const jd_scene *sc, size_t k, jd_inlet_spec *out) {
                            .dt = sc->dt, .first_id = in->first_id,
                            .max_sections = in->stop == JD_INLET_STOP_SECTIONS ? in->sections : 0,
                            .stop_step = JD_INLET_NO_STOP,
+                           .max_insert_overlap = in->max_insert_overlap,
                            .overlap_tol = in->settled ? sc->watchdog.max_overlap_fraction
                                                       : JD_INLET_OVERLAP_TOL,
                            .n_groups = in->n_groups, .group_first = in->group_first,

@@ -4,7 +4,6 @@
  */
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #include "jdem_geometry.h"
 #include "scene_internal.h"
@@ -108,9 +107,7 @@ static int read_cylinder(loader *L, const yaml_node_t *w, const char *path, jd_w
 
 /* max_speed: a number (the kernel checks its sign), or .inf (no cap). */
 static int read_max_speed(loader *L, const yaml_node_t *m, const char *path, double *out) {
-    const yaml_node_t *n = sd_get(&L->c, m, "max_speed");
-    const char *text = n ? sd_scalar(n) : NULL;
-    if (text && (strcasecmp(text, ".inf") == 0 || strcasecmp(text, "+.inf") == 0)) {
+    if (sd_is_inf(sd_get(&L->c, m, "max_speed"))) {
         *out = INFINITY;
         return 0;
     }

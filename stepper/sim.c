@@ -382,8 +382,10 @@ static int sample_observables(jd_sim *s, jd_h5md *h, char *err, size_t errlen) {
             return JD_RUN_OUTPUT;
     const double t = (double)s->step * s->run.dt;
     if (h && s->run.scene->n_inlets &&
-        jd_h5md_write_observable(h, jd_obs_inlet_energy, s->step, t, sim_inlets_energy(s), err,
-                                 errlen) != 0)
+        (jd_h5md_write_observable(h, jd_obs_inlet_energy, s->step, t, sim_inlets_energy(s), err,
+                                  errlen) != 0 ||
+         jd_h5md_write_observable(h, jd_obs_skipped_particles, s->step, t,
+                                  (double)sim_skipped_particles(s), err, errlen) != 0))
         return JD_RUN_OUTPUT;
     if (h && s->run.scene->has_domain &&
         (jd_h5md_write_observable(h, jd_obs_lost_particles, s->step, t,

@@ -414,6 +414,8 @@ const int64_t *sim_inlets_frame_ids(const jd_sim *s);
 void sim_inlets_close_up(jd_sim *s, const unsigned char *gone_scene, size_t n, size_t gone,
                          double energy);
 int64_t sim_lost_particles(const jd_sim *s);
+/* Particles the inlets skipped: their place was occupied (kernel/jdem_inlet.h). */
+int64_t sim_skipped_particles(const jd_sim *s);
 double sim_lost_energy(const jd_sim *s); /* [J] */
 
 /* neighbour.c */

@@ -46,6 +46,9 @@ SUITES += [("inlet-bonded-cross-engine", [PY, "tests/inlet/test_bonded_inlet_lig
 # The inlet in both engines: the same insertion stream bit for bit on 1 and 2 ranks, the same
 # particles and states at every frame, the inflow energy, fix jdem/inlet's bad arguments.
 SUITES += [("inlet-cross-engine", [PY, "tests/inlet/test_inlet_liggghts.py"], "lines", {})]
+# Insertion into an occupied place: which particles the inlet skips (closed form), the literal
+# rule's ram, both engines' records and skip counts on 1 and 2 ranks.
+SUITES += [("inlet-occupied", [PY, "tests/inlet/test_occupied.py"], "lines", {})]
 # The two engines on the same scenes (bitwise or 1e-10), and LIGGGHTS on 1 vs 2 MPI ranks.
 SUITES += [("cross-engine", [PY, "tests/liggghts/check_liggghts.py"], "lines", {})]
 # The /observables cadence (output.observables_every below, at and not dividing every) in both engines.

@@ -189,12 +189,12 @@ def cross_engine(tmp):
                   sorted(set(jf) - set(lf)), differ))
         worst = worst_difference(jf, lf, scales)
         check("frames-state-np%d" % np_, worst <= tol, "largest scaled difference %.3g > %g" % (worst, tol))
-        m = re.search(r"jdem/inlet: inserted (\d+) particles, inflow energy (\S+) J", log)
+        m = re.search(r"jdem/inlet: inserted (\d+) particles, skipped (\d+), inflow energy (\S+) J", log)
         if np_ == 1 and check("inflow-reported", m is not None, log[-800:]):
             rows = list(csv.DictReader(open(rec)))
             want = inflow_from_record(rows, sc)
-            got = float(m.group(2))
-            check("inflow-energy", int(m.group(1)) == 27 and abs(got - want) <= 1e-12 * abs(want) and
+            got = float(m.group(3))
+            check("inflow-energy", int(m.group(1)) == 27 and int(m.group(2)) == 0 and abs(got - want) <= 1e-12 * abs(want) and
                   abs(jdem_inflow - want) <= 1e-12 * abs(want),
                   "liggghts-jdem %r, jdem %r, from the record %r" % (got, jdem_inflow, want))
             # each later section brings as much as all before it: an unbooked inflow would be a
@@ -233,7 +233,9 @@ def cross_engine(tmp):
 BAD = [
     ("unknown-keyword", lambda l: l.rstrip("\n") + " speed 3\n",
      "fix jdem/inlet: unknown keyword 'speed'; valid: file, origin, velocity, plane, period, offset, "
-     "first_id, stop, overlap_tol, record, append_record"),
+     "first_id, stop, overlap_tol, max_insert_overlap, record, append_record"),
+    ("negative-max-insert-overlap", lambda l: l.rstrip("\n") + " max_insert_overlap -1\n",
+     "fix jdem/inlet: max_insert_overlap must be a number >= 0 (a fraction of the smaller radius) or inf"),
     ("missing-period", lambda l: re.sub(r" period \S+", "", l),
      "fix jdem/inlet: missing keyword 'period'; usage: fix ID group jdem/inlet file SECTION"),
     ("not-a-number", lambda l: re.sub(r" origin (\S+) (\S+) (\S+)", r" origin \1 \2 abc", l),

@@ -518,6 +518,85 @@ static void section_bonds_sort_into_the_resolved_order(void **state) {
     assert_int_equal(jd_inlet_sort_bonds(0, twice, t2), 0);
 }
 
+/* The overlap fraction (ra + rb - d)/min(ra, rb): spheres 0.01 and 0.02 m, 0.027 m apart
+ * (a 3-4-12 right triangle of 0.001 m units: |(0.003, 0.024, 0.012)| = 0.027) overlap by 0.003 m,
+ * 0.3 of the smaller radius; 0.03 m apart they touch (0), 0.04 m apart they are 1.0 apart (-1). */
+static void overlap_fraction_closed_form(void **state) {
+    (void)state;
+    const double a[3] = {0.0, 0.0, 0.0}, b[3] = {0.003, 0.024, 0.012}, c[3] = {0.0, 0.0, 0.04};
+    assert_rel(jd_inlet_overlap_fraction(a, 0.01, b, 0.02), 0.3, 1e-12);
+    assert_rel(jd_inlet_overlap_fraction(b, 0.02, a, 0.01), 0.3, 1e-12);
+    assert_rel(jd_inlet_overlap_fraction(a, 0.01, c, 0.03), 0.0, 0.0);
+    assert_rel(jd_inlet_overlap_fraction(a, 0.01, c, 0.02), -1.0, 1e-12);
+}
+
+/* Three due particles of one copy: 0 and 1 a bonded group, 2 alone; two particles in the domain:
+ * one 0.012 m from particle 1 across the belt (radii 0.01: overlap 0.8), one far away.  worst and with name the
+ * near one; with max_insert_overlap 0.5 particle 1 is skipped and so is its
+ * block partner 0, whose own place is free; particle 2 of the same copy, in no group, is not.
+ * A limit of 0.9 skips none; one of INFINITY none; the booked count moves from inserted to
+ * skipped. */
+static void occupied_place_skips_its_block(void **state) {
+    (void)state;
+    const double rel[9] = {0.0, 0.0, 0.0, -0.03, 0.0, 0.0, -0.06, 0.0, 0.0};
+    const double radius[3] = {0.01, 0.01, 0.01};
+    const int32_t species[3] = {0, 0, 0}, group_of[3] = {0, 0, -1};
+    const size_t first[2] = {0, 2}, member[2] = {0, 1};
+    jd_inlet_spec s = row(3, rel, radius, species);
+    s.n_groups = 1;
+    s.group_first = first;
+    s.group_member = member;
+    s.group_of = group_of;
+    jd_inlet_particle due[3];
+    for (size_t p = 0; p < 3; p++) jd_inlet_particle_at_step(&s, 4, p, 100, &due[p]);
+    const double x[6] = {due[1].position[0], due[1].position[1] + 0.012, due[1].position[2],
+                         5.0, 5.0, 5.0};
+    const double r[2] = {0.01, 0.01};
+    double worst[3];
+    size_t with[3];
+    jd_inlet_worst_overlaps(due, 3, 2, x, r, worst, with);
+    assert_rel(worst[1], 0.8, 1e-12);
+    assert_int_equal(with[1], 0);
+    /* particles 0 and 2 are |(0.03, 0.012, 0)| = 0.0323 m from it: apart, (0.02 - 0.0323)/0.01 */
+    assert_rel(worst[0], (0.02 - sqrt(0.03 * 0.03 + 0.012 * 0.012)) / 0.01, 1e-9);
+    assert_rel(worst[2], worst[0], 1e-9);
+    unsigned char skip[3];
+    s.max_insert_overlap = 0.5;
+    assert_int_equal(jd_inlet_skip_groups(&s, due, 3, worst, skip), 2);
+    assert_int_equal(skip[0], 1);
+    assert_int_equal(skip[1], 1);
+    assert_int_equal(skip[2], 0);
+    s.max_insert_overlap = 0.9;
+    assert_int_equal(jd_inlet_skip_groups(&s, due, 3, worst, skip), 0);
+    s.max_insert_overlap = INFINITY;
+    assert_int_equal(jd_inlet_skip_groups(&s, due, 3, worst, skip), 0);
+    jd_inlet_stream st = {.inserted = 5, .skipped = 1};
+    jd_inlet_book_skipped(&st, 2);
+    assert_int_equal(st.inserted, 3);
+    assert_int_equal(st.skipped, 3);
+    char msg[256];
+    s.max_insert_overlap = NAN;
+    assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_BAD_VALUE);
+    assert_string_equal(msg, "max_insert_overlap nan is not valid; valid: a number >= 0 (a "
+                             "fraction of the smaller radius) or inf");
+}
+
+/* Nothing within reach: worst = -INFINITY and with = SIZE_MAX, also for an empty domain. */
+static void free_place_has_no_partner(void **state) {
+    (void)state;
+    jd_inlet_spec s = one_sphere(ORIGIN_REL, R1, SP1);
+    jd_inlet_particle p;
+    jd_inlet_particle_at_crossing(&s, 0, 0, &p);
+    const double x[3] = {p.position[0] + 0.5, p.position[1], p.position[2]}, r[1] = {0.01};
+    double worst = 0.0;
+    size_t with = 0;
+    jd_inlet_worst_overlaps(&p, 1, 1, x, r, &worst, &with);
+    assert_true(isinf(worst) && worst < 0.0);
+    assert_int_equal(with, SIZE_MAX);
+    jd_inlet_worst_overlaps(&p, 1, 0, NULL, NULL, &worst, &with);
+    assert_true(isinf(worst) && worst < 0.0);
+}
+
 int run_inlet_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(crossing_step_of_each_copy),
@@ -536,6 +615,9 @@ int run_inlet_tests(void) {
         cmocka_unit_test(stream_inserts_a_group_whole),
         cmocka_unit_test(groups_are_the_bond_components),
         cmocka_unit_test(section_bonds_sort_into_the_resolved_order),
+        cmocka_unit_test(overlap_fraction_closed_form),
+        cmocka_unit_test(occupied_place_skips_its_block),
+        cmocka_unit_test(free_place_has_no_partner),
     };
     return cmocka_run_group_tests_name("inlet", tests, NULL, NULL);
 }
