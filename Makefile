@@ -26,6 +26,10 @@ DEB_PACKAGES := gcc g++ make pkg-config clang libclang-rt-14-dev libyaml-dev lib
                 liggghts libliggghts-dev mpi-default-dev mpi-default-bin libadmesh-dev
 
 VERSION  := 0.1.0
+# The source a binary is built from, in its trajectories' creator version ("0.1.0+<commit>",
+# "-dirty" with uncommitted changes to tracked files), so that every campaign result names the
+# code that computed it.  build/source_commit.h is rewritten only when that changes.
+SOURCE_COMMIT := $(shell git describe --always --dirty --abbrev=7 2>/dev/null || echo unknown)
 WARN     := -Wall -Wextra -Werror
 PKG_CFLAGS := $(shell pkg-config --cflags yaml-0.1 hdf5 libadmesh 2>/dev/null)
 PKG_LIBS   := $(shell pkg-config --libs yaml-0.1 hdf5 libadmesh 2>/dev/null) -lm
@@ -38,7 +42,7 @@ PKG_LIBS   := $(shell pkg-config --libs yaml-0.1 hdf5 libadmesh 2>/dev/null) -lm
 ARCH     ?= -march=native
 OPT      := -O3 $(ARCH) -fno-trapping-math -ffp-contract=off
 CFLAGS   := -std=c11 $(OPT) -g $(WARN) -D_POSIX_C_SOURCE=200809L -DJDEM_VERSION=\"$(VERSION)\" \
-            -Ikernel -Iio -Istepper $(PKG_CFLAGS)
+            -Ikernel -Iio -Istepper -Ibuild $(PKG_CFLAGS)
 # The sanitizer build compiles the force loops once, with the feature set as a run-time value
 # (stepper/forces.c, JD_ONE_FORCE_LOOP): it checks the code, not its speed, so one inlined copy
 # of the law under ASan+UBSan instead of one per law set (build times: docs/performance.md).
@@ -110,6 +114,15 @@ build/san/stepper/%.o: stepper/%.c
 # The same bits: the vectoriser never reorders floating-point operations here (no fast-math).
 build/obj/stepper/bonds.o: CFLAGS += -fno-tree-slp-vectorize
 
+build/source_commit.h: FORCE
+	@mkdir -p build
+	@echo '#define JDEM_SOURCE_COMMIT "$(SOURCE_COMMIT)"' > $@.tmp
+	@if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
+.PHONY: FORCE
+FORCE:
+build/obj/stepper/main.o build/san/stepper/main.o build/plugin/liggghts_plugin/dump_h5md_jdem.o: \
+    build/source_commit.h
+
 build/jdem: $(patsubst %.c,build/obj/%.o,$(KERNEL_SRC) $(IO_SRC) $(STEPPER_SRC))
 	$(CC) $(CFLAGS) $(OMPFLAGS) $^ -o $@ $(PKG_LIBS)
 
@@ -120,7 +133,7 @@ build/san/jdem: $(patsubst %.c,build/san/%.o,$(KERNEL_SRC) $(IO_SRC) $(STEPPER_S
 # LIGGGHTS plugin: Debian's libliggghts + our styles; the kernel and the H5MD writer are the same
 # C objects as in the stepper (compiled position-independent), and the same code generation (OPT).
 PLUGIN_CXXFLAGS := -std=c++11 $(OPT) -g -Wall -Wextra -Werror -Wno-unused-parameter -fPIC \
-                   -DOMPI_SKIP_MPICXX -DJDEM_VERSION=\"$(VERSION)\" -Ikernel -Iio -isystem /usr/include/liggghts $(PKG_CFLAGS)
+                   -DOMPI_SKIP_MPICXX -DJDEM_VERSION=\"$(VERSION)\" -Ikernel -Iio -Ibuild -isystem /usr/include/liggghts $(PKG_CFLAGS)
 build/pic/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -fPIC $(DEPFLAGS) -c $< -o $@

@@ -638,6 +638,13 @@ h5md_wall_mesh *h5md_walls_of(jd_h5md *h) { return &h->walls; }
 
 size_t h5md_rows_count(const jd_h5md *h) { return h->rows.n; }
 
+int h5md_set_continues(jd_h5md *h, const char *creators) {
+    const hid_t g = H5Gopen2(h->file, "/h5md/creator", H5P_DEFAULT);
+    const int rc = g >= 0 && h5md_attr_str(g, "continues", creators) == 0 ? 0 : -1;
+    if (g >= 0) H5Gclose(g);
+    return rc;
+}
+
 int jd_h5md_move_mesh(jd_h5md *h, size_t wall, const double (*triangles)[3][3], char *err,
                       size_t errlen) {
     const size_t n = h && wall < h->walls.n_walls ? h->walls.n_vertices[wall] / 3 : 0;

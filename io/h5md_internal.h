@@ -33,6 +33,9 @@ hid_t h5md_str_type_cset(size_t len, H5T_cset_t cset);
 int h5md_attr_write(hid_t obj, const char *name, hid_t ftype, hid_t mtype, int rank,
                     const hsize_t *dims, const void *buf);
 int h5md_attr_str(hid_t obj, const char *name, const char *s);
+/* A fixed-length string attribute into out (truncated to len - 1 characters); 0, or -1 when it
+ * is absent or not such a string. */
+int h5md_attr_read_str(hid_t obj, const char *name, char *out, size_t len);
 int h5md_attr_int(hid_t obj, const char *name, int v);
 int h5md_attr_double(hid_t obj, const char *name, double v);
 hid_t h5md_group_create(hid_t loc, const char *name);
@@ -97,6 +100,9 @@ void h5md_walls_free(h5md_wall_mesh *m);
 h5md_wall_mesh *h5md_walls_of(struct jd_h5md *h);
 /* The writer's particle rows so far (h5md.c). */
 size_t h5md_rows_count(const struct jd_h5md *h);
+/* Record on /h5md/creator, attribute "continues", the creators of the frames a resumed run
+ * copied (h5md_resume.c).  0 or -1. */
+int h5md_set_continues(struct jd_h5md *h, const char *creators);
 /* A moved mesh's triangles where they are now.  0 / -1 (wall k is not a moved mesh of n_tri). */
 int h5md_walls_move_mesh(h5md_wall_mesh *m, size_t k, const double (*tri)[3][3], size_t n_tri);
 

@@ -397,6 +397,21 @@ static int copy_breaks(hid_t f, jd_h5md *h, int64_t step, char *err, size_t errl
     return rc;
 }
 
+/* The creators of the source's frames, earliest first: its "continues" list, then its own
+ * version, on the new file's /h5md/creator ("continues"), so a result names every binary that
+ * computed it. */
+static int copy_creators(hid_t f, jd_h5md *h) {
+    char version[128] = "", earlier[1024] = "", all[1200];
+    const hid_t g = H5Gopen2(f, "/h5md/creator", H5P_DEFAULT);
+    if (g < 0) return -1;
+    const int rc = h5md_attr_read_str(g, "version", version, sizeof version);
+    if (h5md_attr_read_str(g, "continues", earlier, sizeof earlier) != 0) earlier[0] = '\0';
+    H5Gclose(g);
+    if (rc != 0) return -1;
+    snprintf(all, sizeof all, "%s%s%s", earlier, earlier[0] ? ", " : "", version);
+    return h5md_set_continues(h, all);
+}
+
 int jd_h5md_resume_copy(const char *src, jd_h5md *h, int64_t frame_step, int64_t step,
                                   char *err, size_t errlen) {
     H5E_auto2_t fn;
@@ -408,6 +423,7 @@ int jd_h5md_resume_copy(const char *src, jd_h5md *h, int64_t frame_step, int64_t
     if (rc == 0) rc = copy_observables(f, h, step, err, errlen);
     if (rc == 0) rc = copy_bonds(f, h, step, err, errlen);
     if (rc == 0) rc = copy_breaks(f, h, step, err, errlen);
+    if (rc == 0) rc = copy_creators(f, h);
     if (f >= 0) H5Fclose(f);
     H5Eset_auto2(H5E_DEFAULT, fn, data);
     if (rc == -1) /* a read failed (rc -2: the writer's message is in err) */

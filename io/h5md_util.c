@@ -3,6 +3,7 @@
  */
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "h5md_internal.h"
@@ -129,6 +130,24 @@ int h5md_attr_str(hid_t obj, const char *name, const char *s) {
     int rc = h5md_attr_write(obj, name, t, t, 0, NULL, s);
     H5Tclose(t);
     return rc;
+}
+
+int h5md_attr_read_str(hid_t obj, const char *name, char *out, size_t len) {
+    if (len == 0 || H5Aexists(obj, name) <= 0) return -1;
+    const hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
+    const hid_t t = a >= 0 ? H5Aget_type(a) : -1;
+    const size_t n = t >= 0 && H5Tget_class(t) == H5T_STRING && H5Tis_variable_str(t) == 0
+                         ? H5Tget_size(t) : 0;
+    char *buf = n ? malloc(n + 1) : NULL;
+    const int ok = buf && H5Aread(a, t, buf) >= 0;
+    if (ok) {
+        buf[n] = '\0';
+        snprintf(out, len, "%s", buf);
+    }
+    free(buf);
+    if (t >= 0) H5Tclose(t);
+    if (a >= 0) H5Aclose(a);
+    return ok ? 0 : -1;
 }
 
 int h5md_attr_int(hid_t obj, const char *name, int v) {

@@ -30,6 +30,8 @@ using namespace LAMMPS_NS;
 int jdem_dump_close_ok = 0;
 int jdem_dump_close_failed = 0;
 
+#include "source_commit.h" /* JDEM_SOURCE_COMMIT (Makefile) */
+
 #ifndef JDEM_VERSION
 #define JDEM_VERSION "0.1.0"
 #endif
@@ -287,7 +289,7 @@ int DumpH5mdJdem::open_file(const jd_h5md_particles &parts, double dt, char *err
   jd_h5md_meta meta;
   std::memset(&meta, 0, sizeof meta);
   meta.creator = "liggghts-jdem";
-  meta.creator_version = JDEM_VERSION;
+  meta.creator_version = JDEM_VERSION "+" JDEM_SOURCE_COMMIT;
   meta.scene_name = scene_name.empty() ? NULL : scene_name.c_str();
   meta.case_name = case_name.empty() ? NULL : case_name.c_str();
   meta.scene_yaml = scene_yaml.empty() ? NULL : scene_yaml.c_str();

@@ -22,9 +22,13 @@
 #include "scene.h"
 #include "sim.h"
 
+#include "source_commit.h" /* JDEM_SOURCE_COMMIT (Makefile) */
+
 #ifndef JDEM_VERSION
 #define JDEM_VERSION "unknown"
 #endif
+/* The version a trajectory names as its creator's: the release and the source commit. */
+#define JDEM_BUILD JDEM_VERSION "+" JDEM_SOURCE_COMMIT
 
 enum { EXIT_INTERNAL = 1, EXIT_INPUT = 2, EXIT_IO = 3, EXIT_FAILED_RUN = 4, EXIT_NO_MEMORY = 5 };
 
@@ -495,7 +499,7 @@ static jd_h5md *create_output(const jd_scene *sc, const jd_sim *sim, const char 
     if (!yaml || !parts_ok) {
         fprintf(stderr, "jdem: out of memory preparing the output\n");
     } else {
-        const jd_h5md_meta meta = {.creator = "jdem", .creator_version = JDEM_VERSION,
+        const jd_h5md_meta meta = {.creator = "jdem", .creator_version = JDEM_BUILD,
                                    .scene_name = sc->name, .case_name = sc->case_name,
                                    .scene_yaml = yaml, .dt = sc->dt};
         if (!(h = jd_h5md_create(out, &meta, &parts, err, sizeof err)) ||
@@ -659,7 +663,7 @@ int main(int argc, char **argv) {
             return 0;
         }
         if (!strcmp(argv[k], "--version")) {
-            printf("jdem %s\n", JDEM_VERSION);
+            printf("jdem %s\n", JDEM_BUILD);
             return 0;
         }
     }

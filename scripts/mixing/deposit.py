@@ -65,6 +65,19 @@ def read_frame(path, frame=-1):
                        float(p["position/time"][frame]))
 
 
+def built_by(path):
+    """The binaries that computed the trajectory at `path`, earliest first: the creator versions
+    ("0.1.0+<commit>") of the runs it continues (/h5md/creator "continues", written when a run
+    resumes) and its own; "unknown" for a file without them."""
+    import h5py
+    with h5py.File(path, "r") as f:
+        attrs = f["h5md/creator"].attrs if "h5md/creator" in f else {}
+        text = [v.decode() if isinstance(v, bytes) else str(v)
+                for v in (attrs.get("continues", ""), attrs.get("version", "unknown"))]
+    versions = [v.strip() for v in ", ".join(t for t in text if t).split(",") if v.strip()]
+    return list(dict.fromkeys(versions))  # in order, each once
+
+
 def inside_box(dep, lo, hi):
     """Boolean mask of the particles whose centre lies in [lo, hi) (componentwise)."""
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)

@@ -65,7 +65,8 @@ def result(path):
     out = {"particles": int(len(dep.radius)), "time": dep.time, "phi_v": phi,
            "middle_clip": stats.summary(phi[MIDDLE_CLIP]),
            "surface": structure.free_surface(dep, *box), "packing": structure.packing(dep, *box),
-           "energy": energy.balance(path), "bond_steps": bond_steps(path)}
+           "energy": energy.balance(path), "bond_steps": bond_steps(path),
+           "built_by": deposit.built_by(path)}
     try:
         rec = breakage.read_bonds(path)
     except breakage.BreakageError:

@@ -75,7 +75,8 @@ def fill_result(path):
     return {"particles": int(len(dep.radius)), "deposit_height": deposit.deposit_height(dep),
             "sides": sides,
             "points": [{k: float(p[k]) for k in PARAMS} for p in points],
-            "summary": {k: stats.summary([p[k] for p in points]) for k in PARAMS}}
+            "summary": {k: stats.summary([p[k] for p in points]) for k in PARAMS},
+            "built_by": deposit.built_by(path)}
 
 
 def cube_result(path):
@@ -84,7 +85,7 @@ def cube_result(path):
     return {"E": fit.get("E", float("nan")), "nu_xy": fit.get("nu_xy", float("nan")),
             "nu_xz": fit.get("nu_xz", float("nan")), "cond": fit.get("cond", float("nan")),
             "M_wall": r["M_wall"], "M_best_fit": r["M_best_fit"], "K0": r["K0"],
-            "particles": r["particles"]}
+            "particles": r["particles"], "built_by": deposit.built_by(path)}
 
 
 def jitter_fills(d):
@@ -383,9 +384,37 @@ def report(found, missing, taken, figures, rev):
     parts += [elastic_table(found, taken, k, t, f) for k, t, f in TABLES]
     parts.append(horizon_section())
     parts += [spread_table(found, taken), agreement_ch4.table(found), constants_table(found, taken), "### The seed's claims\n",
-              claims_ch4.claims(found, ENGINES), times_table(found, taken),
+              claims_ch4.claims(found, ENGINES), times_table(found, taken), provenance_section(built_of(found)),
               "### Not run\n", "\n".join("- " + m for m in missing) + "\n" if missing else "nothing\n"]
     return "\n".join(parts)
+
+
+def provenance_section(built):
+    """{result name: [creator versions]} as the code behind each result (deposit.built_by);
+    results measured before the trajectories named their commit say "not recorded"."""
+    lines = ["### The code behind each result", "",
+             "the creator versions of each result's trajectories (release + source commit; a run "
+             "resumed by another binary lists both, earliest first)", "",
+             "| result | built by |", "|---|---|"]
+    def named(v):
+        return v if "+" in v else v + " (before the commit was recorded)"
+    lines += ["| %s | %s |" % (n, ", ".join(map(named, v)) if v else "not recorded")
+              for n, v in sorted(built.items())] or ["| none yet | |"]
+    return "\n".join(lines) + "\n"
+
+
+def built_of(found):
+    """{engine/model/fillP or passP_cubes: versions} of the found entries."""
+    out = {}
+    for engine, models in found.items():
+        for model, entry in models.items():
+            for key, value in entry.items():
+                items = value if isinstance(value, list) else [value]
+                if key == "times" or not items or not isinstance(items[0], dict):
+                    continue
+                out["%s/%s/%s" % (engine, model, key)] = list(dict.fromkeys(
+                    v for it in items for v in it.get("built_by", [])))
+    return out
 
 
 def write_atomic(path, text):

@@ -27,7 +27,7 @@ from scripts.mixing import fill_ch5, outflow, params, stats, structure
 from scripts.mixing.fill_ch5 import FRAGMENT_BINS
 from scripts.mixing.plan_ch5 import CASES, RIGID_CASES
 from scripts.mixing_views import scene_geometry
-from scripts.mixing.report_ch4 import commit, cube_result, write_atomic
+from scripts.mixing.report_ch4 import commit, cube_result, provenance_section, write_atomic
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_OUT = os.path.join(ROOT, "out", "mixing", "ch5")
@@ -332,6 +332,10 @@ def report(found, rev):
                   "big spheres red, the small ones in whole blocks blue, in fragments of 2–31 green, "
                   "alone orange (Group 1: all small blue)", ""]
         lines += ["![%s](%s)" % v for v in views]
+    built = {n: list(dict.fromkeys(e.get("built_by", []) + [v for c in e.get("cubes", [])
+                                                             for v in c.get("built_by", [])]))
+             for n, e in found.items()}
+    lines += ["", provenance_section(built)]
     sources = sorted({(n, e["source"]) for n, e in found.items() if e.get("source") != rev})
     lines += ["", "From earlier commits: " + (", ".join("%s (%s)" % s for s in sources) if sources else "none"),
               "", "Not run: %d of %d fills." % (2 * len(CASES + RIGID_CASES) - len(found),

@@ -136,7 +136,22 @@ def sigterm(d):
     subprocess.run(jdem(scene, a), check=True)
     diffs, _ = differences(a, out) if r.returncode == 0 else (["resume failed " + r.stderr], 0)
     check("SIGTERM: the resumed run equals the uninterrupted one", not diffs, "; ".join(diffs[:3]))
+    creators(out, a)
     return ck
+
+
+def creators(resumed, uninterrupted):
+    """The creator version is `jdem --version`'s (the release and the source commit); a resumed
+    trajectory names the binary that computed the frames it copied ("continues")."""
+    version = subprocess.run([JDEM, "--version"], capture_output=True, text=True).stdout.split()[-1]
+    with h5py.File(resumed, "r") as r, h5py.File(uninterrupted, "r") as u:
+        attrs = {k: (v.decode() if isinstance(v, bytes) else str(v))
+                 for k, v in r["h5md/creator"].attrs.items()}
+        plain = "continues" in u["h5md/creator"].attrs
+    check("SIGTERM: the creator names the source commit", attrs.get("version") == version
+          and "+" in version, f"{attrs} against jdem --version {version}")
+    check("SIGTERM: the resumed trajectory names the binary of its first part",
+          attrs.get("continues") == version and not plain, f"{attrs}")
 
 
 def refused(name, cmd, message, status=2):
