@@ -148,15 +148,21 @@ typedef struct jd_contact_state {
     double u_prev;    /* energy stored in the contact's springs at the previous evaluation [J]    */
     double e_damp;    /* energy dissipated by the dashpots and lost at Luding's end       [J]    */
     double e_fric;    /* energy dissipated by the tangential and rolling springs/sliders  [J]    */
+    /* the torques of f_prev about the centres at the previous evaluation, T_a = r_a x (-f),
+     * T_b = r_b x f (rolling moment apart), as their sum and difference so that a <-> b only
+     * flips the difference's sign: the lever arms turn with the contact, and the previous
+     * force works through the levers it was applied with                                     */
+    double ts_prev[3]; /* T_a + T_b                                                         [N m]  */
+    double td_prev[3]; /* T_b - T_a                                                         [N m]  */
 } jd_contact_state;
 
 /* Phases of a contact (jd_contact_state.flags; one at a time, compared as doubles). */
 enum { JD_S_ENDED = 1, JD_S_SLIDING = 2 };
 
-#define JD_CONTACT_STATE_LEN 11 /* doubles in jd_contact_state */
+#define JD_CONTACT_STATE_LEN 17 /* doubles in jd_contact_state */
 /* 1 where the entry is a vector component that changes sign when a and b swap, else 0. */
-static const int jd_contact_state_newton[JD_CONTACT_STATE_LEN] = {1, 1, 1, 0, 1, 1, 1,
-                                                                  0, 0, 0, 0};
+static const int jd_contact_state_newton[JD_CONTACT_STATE_LEN] = {1, 1, 1, 0, 1, 1, 1, 0, 0,
+                                                                  0, 0, 0, 0, 0, 1, 1, 1};
 
 /* Rolling history, only allocated by scenes with rolling resistance. */
 typedef struct jd_rolling_state {
@@ -263,7 +269,7 @@ double jd_hertz_peak_force(double m_eff, double k_n, double v);
  * drop the pair read them first.  Nothing is booked: the little energy still stored at the last
  * contact step returns to the bodies during the separating step. */
 static inline void jd_contact_separate(jd_contact_state *s, jd_rolling_state *r) {
-    for (int d = 0; d < 3; d++) s->xi[d] = s->f_prev[d] = 0.0;
+    for (int d = 0; d < 3; d++) s->xi[d] = s->f_prev[d] = s->ts_prev[d] = s->td_prev[d] = 0.0;
     s->flags = s->fd_prev = s->u_prev = 0.0;
     if (r)
         for (int d = 0; d < 3; d++) r->theta[d] = r->m_prev[d] = 0.0;
@@ -366,6 +372,7 @@ typedef struct jd_contact_step {
     double theta[3];     /* rolling rotation, updated by jd_law_rolling (JD_F_ROLLING)   [rad]  */
     /* the energy bookkeeping's starting values (JD_F_ENERGY; else zero) */
     double f_prev[3], m_prev[3];          /* force [N] and rolling moment [N m] of the last step */
+    double ts_prev[3], td_prev[3];        /* its lever torques' sum and difference [N m]         */
     double fd_prev, u_prev, e_damp, e_fric; /* dashpot force [N], stored energy, totals [J]      */
 } jd_contact_step;
 
@@ -382,11 +389,13 @@ static JD_ALWAYS_INLINE void jd_contact_begin(const unsigned features, const jd_
     for (int d = 0; d < 3; d++) h->theta[d] = 0.0;
     if (rolling)
         for (int d = 0; d < 3; d++) h->theta[d] = restart ? 0.0 : r->theta[d];
-    for (int d = 0; d < 3; d++) h->f_prev[d] = h->m_prev[d] = 0.0;
+    for (int d = 0; d < 3; d++) h->f_prev[d] = h->m_prev[d] = h->ts_prev[d] = h->td_prev[d] = 0.0;
     h->fd_prev = h->u_prev = h->e_damp = h->e_fric = 0.0;
     if (features & JD_F_ENERGY) {
         for (int d = 0; d < 3; d++) {
             h->f_prev[d] = restart ? 0.0 : s->f_prev[d];
+            h->ts_prev[d] = restart ? 0.0 : s->ts_prev[d];
+            h->td_prev[d] = restart ? 0.0 : s->td_prev[d];
             if (rolling) h->m_prev[d] = restart ? 0.0 : r->m_prev[d];
         }
         h->fd_prev = restart ? 0.0 : s->fd_prev;
@@ -513,15 +522,21 @@ typedef struct jd_contact_energy {
  * force; the remainder is the sliders' (friction), or the dashpot's too when there are no
  * sliders.  f, m_roll: this step's force and rolling moment on b; u_new: the energy stored now;
  * dash: the tangential and rolling dashpots' share so far. */
-static JD_ALWAYS_INLINE void jd_law_energy(const unsigned features, const jd_contact_motion *m,
-                                    const jd_normal *nl, const jd_contact_step *h,
-                                    const double f[3], const double m_roll[3], double u_new,
-                                    double dash, double dt, jd_contact_energy *e) {
+static JD_ALWAYS_INLINE void jd_law_energy(const unsigned features, const jd_kinematics *k,
+                                    const jd_contact_motion *m, const jd_normal *nl,
+                                    const jd_contact_step *h, const double f[3],
+                                    const double m_roll[3], double u_new, double dash, double dt,
+                                    jd_contact_energy *e) {
     const int rolling = (features & JD_F_ROLLING) != 0;
-    double w = jd_dot(h->f_prev, m->vrel) + jd_dot(f, m->vrel);
-    if (rolling) w += jd_dot(h->m_prev, m->wrel) + jd_dot(m_roll, m->wrel);
-    double w_prev = jd_dot(h->f_prev, m->vrel); /* the previous step's force alone (Luding's end) */
+    /* the previous step's force alone (also Luding's end): through the centres' velocities and
+     * the torques it was applied with, f.(v_b - v_a) + T_a.w_a + T_b.w_b */
+    double w_prev = 0.0;
+    for (int d = 0; d < 3; d++)
+        w_prev += h->f_prev[d] * (k->vb[d] - k->va[d]) +
+                  0.5 * (h->ts_prev[d] * (k->wa[d] + k->wb[d]) + h->td_prev[d] * (k->wb[d] - k->wa[d]));
     if (rolling) w_prev += jd_dot(h->m_prev, m->wrel);
+    double w = w_prev + jd_dot(f, m->vrel); /* this step's force through this step's levers */
+    if (rolling) w += jd_dot(m_roll, m->wrel);
     e->fd = nl->Cn * m->ddelta;
     dash += 0.5 * (h->fd_prev + e->fd) * m->ddelta * dt;
     const double diss = -0.5 * w * dt - (u_new - h->u_prev);
@@ -543,7 +558,8 @@ static JD_ALWAYS_INLINE void jd_law_energy(const unsigned features, const jd_con
 
 /* The history after the step: unchanged while still ended, reset (and marked ended) at Luding's
  * end, else the evaluated one. */
-static JD_ALWAYS_INLINE void jd_contact_commit(const unsigned features, const jd_contact_step *h,
+static JD_ALWAYS_INLINE void jd_contact_commit(const unsigned features, const jd_contact_geom *g,
+                                        const jd_contact_step *h,
                                         const jd_normal *nl, const double f[3],
                                         const double m_roll[3], double u_new,
                                         const jd_contact_energy *e, jd_contact_state *s,
@@ -556,8 +572,14 @@ static JD_ALWAYS_INLINE void jd_contact_commit(const unsigned features, const jd
         for (int d = 0; d < 3; d++)
             r->theta[d] = carries ? h->theta[d] : (still_ended ? r->theta[d] : 0.0);
     if (features & JD_F_ENERGY) {
+        const double fa[3] = {-f[0], -f[1], -f[2]};
+        double ta[3], tb[3];
+        jd_cross(g->ra, fa, ta);
+        jd_cross(g->rb, f, tb);
         for (int d = 0; d < 3; d++) {
             s->f_prev[d] = carries ? f[d] : (still_ended ? s->f_prev[d] : 0.0);
+            s->ts_prev[d] = carries ? ta[d] + tb[d] : (still_ended ? s->ts_prev[d] : 0.0);
+            s->td_prev[d] = carries ? tb[d] - ta[d] : (still_ended ? s->td_prev[d] : 0.0);
             if (rolling) r->m_prev[d] = carries ? m_roll[d] : (still_ended ? r->m_prev[d] : 0.0);
         }
         s->fd_prev = carries ? e->fd : (still_ended ? s->fd_prev : 0.0);
@@ -629,9 +651,9 @@ static JD_ALWAYS_INLINE int jd_contact(const unsigned features, const jd_pair_co
     if (features & JD_F_FRICTION) jd_law_tangential(features, c, g, &m, &nl, dt, &h, f, &u_new, &dash);
     if (features & JD_F_ROLLING) jd_law_rolling(features, c, g, &m, &nl, dt, &h, m_roll, &u_new, &dash);
     jd_contact_energy e = {0.0, h.e_damp, h.e_fric};
-    if (energy) jd_law_energy(features, &m, &nl, &h, f, m_roll, u_new, dash, dt, &e);
+    if (energy) jd_law_energy(features, k, &m, &nl, &h, f, m_roll, u_new, dash, dt, &e);
 
-    jd_contact_commit(features, &h, &nl, f, m_roll, u_new, &e, s, r);
+    jd_contact_commit(features, g, &h, &nl, f, m_roll, u_new, &e, s, r);
     jd_contact_assemble(features, g, &nl, f, m_roll, out);
     return nl.carries;
 }
@@ -645,7 +667,11 @@ static JD_ALWAYS_INLINE int jd_contact(const unsigned features, const jd_pair_co
 static inline void jd_contact_keep_reference(jd_contact_state *s, const jd_contact_state *evaluated,
                                              jd_rolling_state *r,
                                              const jd_rolling_state *r_evaluated) {
-    for (int d = 0; d < 3; d++) s->f_prev[d] = evaluated->f_prev[d];
+    for (int d = 0; d < 3; d++) {
+        s->f_prev[d] = evaluated->f_prev[d];
+        s->ts_prev[d] = evaluated->ts_prev[d];
+        s->td_prev[d] = evaluated->td_prev[d];
+    }
     s->fd_prev = evaluated->fd_prev;
     s->u_prev = evaluated->u_prev;
     if (r && r_evaluated)

@@ -157,6 +157,9 @@ static inline int jd_record_newton(int hw, int k) {
 static JD_ALWAYS_INLINE void jd_record_load(const double *h, int hw, const double *r, int rw,
                                             jd_contact_state *st, jd_rolling_state *rs) {
     double *a = (double *)st;
+    /* unrolled whole (GCC peels at most 16 iterations by itself), so that an engine's loop over
+     * contacts around it stays the one that is vectorised */
+#pragma GCC unroll 32
     for (int k = 0; k < JD_CONTACT_STATE_LEN; k++) a[k] = k < hw ? h[k] : 0.0;
     if (rs) {
         double *b = (double *)rs;

@@ -108,7 +108,7 @@ struct jd_batch {
     double f[3][JD_BATCH], ta[3][JD_BATCH], tb[3][JD_BATCH];
     double xi[3][JD_BATCH], flags[JD_BATCH], theta[3][JD_BATCH];
     double f_prev[3][JD_BATCH], fd_prev[JD_BATCH], u_prev[JD_BATCH], e_damp[JD_BATCH],
-        e_fric[JD_BATCH], m_prev[3][JD_BATCH];
+        e_fric[JD_BATCH], m_prev[3][JD_BATCH], ts_prev[3][JD_BATCH], td_prev[3][JD_BATCH];
     double delta[JD_BATCH];
     int carries[JD_BATCH], excessive[JD_BATCH];
     /* wall batches: the geometry from the wall's test, the wall's velocity, the coefficients'
@@ -138,7 +138,11 @@ static JD_ALWAYS_INLINE void lane_law(const unsigned F, batch *restrict B, int b
     const int carries = jd_contact(F, co, g, k, dt, &st, (F & JD_F_ROLLING) ? &rs : NULL, &out);
     for (int d = 0; d < 3; d++) {
         B->xi[d][b] = touch ? st.xi[d] : 0.0;
-        if (F & JD_F_ENERGY) B->f_prev[d][b] = touch ? st.f_prev[d] : 0.0;
+        if (F & JD_F_ENERGY) {
+            B->f_prev[d][b] = touch ? st.f_prev[d] : 0.0;
+            B->ts_prev[d][b] = touch ? st.ts_prev[d] : 0.0;
+            B->td_prev[d][b] = touch ? st.td_prev[d] : 0.0;
+        }
         if (F & JD_F_ROLLING) B->theta[d][b] = touch ? rs.theta[d] : 0.0;
         if ((F & JD_F_ROLLING) && (F & JD_F_ENERGY)) B->m_prev[d][b] = touch ? rs.m_prev[d] : 0.0;
         B->f[d][b] = out.f[d];
@@ -162,7 +166,11 @@ static JD_ALWAYS_INLINE void lane_history_write(const unsigned F, const batch *B
     for (int d = 0; d < 3; d++) h[JD_AT(jd_contact_state, xi) + d] = B->xi[d][b];
     h[JD_AT(jd_contact_state, flags)] = B->flags[b];
     if (F & JD_F_ENERGY) {
-        for (int d = 0; d < 3; d++) h[JD_AT(jd_contact_state, f_prev) + d] = B->f_prev[d][b];
+        for (int d = 0; d < 3; d++) {
+            h[JD_AT(jd_contact_state, f_prev) + d] = B->f_prev[d][b];
+            h[JD_AT(jd_contact_state, ts_prev) + d] = B->ts_prev[d][b];
+            h[JD_AT(jd_contact_state, td_prev) + d] = B->td_prev[d][b];
+        }
         h[JD_AT(jd_contact_state, fd_prev)] = B->fd_prev[b];
         h[JD_AT(jd_contact_state, u_prev)] = B->u_prev[b];
         h[JD_AT(jd_contact_state, e_damp)] = B->e_damp[b];
@@ -314,7 +322,7 @@ static JD_ALWAYS_INLINE int batch_evaluate(const jd_particles *ps, const jd_run_
     const jd_pair_const_roll pcr1 = fast->pcr_alike;
     const double r1 = fast->r_alike;
     int m = nb;
-    /* Records of an odd width (the energy sets': 11 and 6 doubles) are no group of loads the
+    /* Records of an odd width (the energy sets': 17 and 6 doubles) are no group of loads the
      * vectoriser can permute, and it does not fall back to one load per lane for a constant
      * stride: read through an index instead, which it gathers. */
     const int indexed = packed || !record_widths_vectorise(F);

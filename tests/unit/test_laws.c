@@ -180,12 +180,13 @@ static void energy_law_books_work_and_luding_end(void **state) {
     (void)state;
     const double dt = 1e-6;
     const jd_contact_motion m = {.vrel = {0, 0, -0.5}, .ddelta = 0.5};
+    const jd_kinematics k = {.vb = {0, 0, -0.5}}; /* no spin: v_rel at the centres is m's */
     jd_normal nl = {.fn = 10.0, .Cn = 2.0, .carries = 1};
     const jd_contact_step h = {.f_prev = {0, 0, 8.0}, .fd_prev = 0.6, .u_prev = 1e-3,
                                .e_damp = 0.25, .e_fric = 0.125};
     const double f[3] = {0, 0, 10.0}, mr[3] = {0, 0, 0}, u_new = 1.5e-3;
     jd_contact_energy e;
-    jd_law_energy(JD_F_DAMPING | JD_F_ENERGY, &m, &nl, &h, f, mr, u_new, 0.0, dt, &e);
+    jd_law_energy(JD_F_DAMPING | JD_F_ENERGY, &k, &m, &nl, &h, f, mr, u_new, 0.0, dt, &e);
     /* trapezoidal work on the bodies, W = -(8 + 10)/2 * 0.5 dt; dissipated = -W - dU, all of it
      * the dashpot's without sliders */
     const double W = 0.5 * (8.0 * -0.5 + 10.0 * -0.5) * dt;
@@ -195,14 +196,38 @@ static void energy_law_books_work_and_luding_end(void **state) {
     /* at Luding's end the stored energy is lost, less the previous force's work this step */
     nl.ends = 1;
     nl.carries = 0;
-    jd_law_energy(JD_F_DAMPING | JD_F_ENERGY, &m, &nl, &h, f, mr, u_new, 0.0, dt, &e);
+    jd_law_energy(JD_F_DAMPING | JD_F_ENERGY, &k, &m, &nl, &h, f, mr, u_new, 0.0, dt, &e);
     assert_rel(e.e_damp, 0.25 + (1e-3 - 0.5 * (8.0 * -0.5) * dt), 1e-14);
     /* with a slider the dashpots' share stays damping and the rest is friction */
     nl.ends = 0;
-    jd_law_energy(JD_F_FRICTION | JD_F_ENERGY, &m, &nl, &h, f, mr, u_new, 1e-7, dt, &e);
+    jd_law_energy(JD_F_FRICTION | JD_F_ENERGY, &k, &m, &nl, &h, f, mr, u_new, 1e-7, dt, &e);
     const double dash = 1e-7 + 0.5 * (0.6 + 1.0) * 0.5 * dt;
     assert_rel(e.e_damp, 0.25 + dash, 1e-14);
     assert_rel(e.e_fric, 0.125 + ((-W - (u_new - 1e-3)) - dash), 1e-13);
+}
+
+/* The previous force works through the levers it was applied with: f_prev = (1, 0, 0) N applied
+ * at r_a = (0, 0, 0.01), r_b = (0, 0, -0.01) m gave T_a = r_a x (-f) = (0, -0.01, 0) and
+ * T_b = r_b x f = (0, -0.01, 0) N m; with the bodies spinning at w_a = (0, 3, 0), w_b = (0, 5, 0)
+ * rad/s and not translating, its work rate is T_a.w_a + T_b.w_b = -0.08 W, whatever the levers
+ * are now (turned to x, where f x r would give 0).  This step's force is zero and nothing is
+ * stored, so without sliders the dashpot books -1/2 (-0.08) dt. */
+static void energy_law_uses_the_previous_levers(void **state) {
+    (void)state;
+    const double dt = 1e-4;
+    const jd_contact_motion m = {.vrel = {0, 0, 0}};
+    const jd_kinematics k = {.wa = {0, 3, 0}, .wb = {0, 5, 0}};
+    const jd_normal nl = {.carries = 1};
+    const jd_contact_step h = {.f_prev = {1, 0, 0}, .ts_prev = {0, -0.02, 0}, .td_prev = {0, 0, 0}};
+    const double f[3] = {0, 0, 0}, mr[3] = {0, 0, 0};
+    jd_contact_energy e;
+    jd_law_energy(JD_F_DAMPING | JD_F_ENERGY, &k, &m, &nl, &h, f, mr, 0.0, 0.0, dt, &e);
+    assert_rel(e.e_damp, -0.5 * -0.08 * dt, 1e-14);
+    /* a <-> b: the difference flips sign, the spins swap: the same work */
+    const jd_kinematics ks = {.wa = {0, 5, 0}, .wb = {0, 3, 0}};
+    const jd_contact_step hs = {.f_prev = {-1, 0, 0}, .ts_prev = {0, -0.02, 0}, .td_prev = {0, 0, 0}};
+    jd_law_energy(JD_F_DAMPING | JD_F_ENERGY, &ks, &m, &nl, &hs, f, mr, 0.0, 0.0, dt, &e);
+    assert_rel(e.e_damp, -0.5 * -0.08 * dt, 1e-14);
 }
 
 static void law_sets_are_the_combinations_with_mu_r_and_mindlin_only_with_friction(void **state) {
@@ -438,6 +463,7 @@ int run_laws_tests(void) {
         cmocka_unit_test(mindlin_over_hertz_tangent_is_2_1mnu_over_2mnu),
         cmocka_unit_test(rolling_law_spring_and_cap),
         cmocka_unit_test(energy_law_books_work_and_luding_end),
+        cmocka_unit_test(energy_law_uses_the_previous_levers),
         cmocka_unit_test(law_sets_are_the_combinations_with_mu_r_and_mindlin_only_with_friction),
         cmocka_unit_test(every_law_set_runs_in_one_compiled_loop),
         cmocka_unit_test(law_set_select_counts_only_interactions_that_occur),
