@@ -539,6 +539,17 @@ size_t jd_inlet_skip_groups(const jd_inlet_spec *s, const jd_inlet_particle *due
     return count;
 }
 
+int jd_inlet_skip_reason(char *buf, size_t len, double worst, int64_t with_id,
+                         double max_insert_overlap, int64_t nth) {
+    const char *rest = nth == JD_INLET_REPORTED ? "; further skips are counted, not reported" : "";
+    if (worst > max_insert_overlap)
+        return snprintf(buf, len, "particle id %lld overlaps its place by %.6g of the smaller "
+                        "radius (max_insert_overlap %g)%s", (long long)with_id, worst,
+                        max_insert_overlap, rest);
+    return snprintf(buf, len, "with its bonded block (max_insert_overlap %g)%s",
+                    max_insert_overlap, rest);
+}
+
 void jd_inlet_book_skipped(jd_inlet_stream *st, size_t n_skipped) {
     st->inserted -= (int64_t)n_skipped;
     st->skipped += (int64_t)n_skipped;

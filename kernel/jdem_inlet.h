@@ -266,6 +266,12 @@ size_t jd_inlet_skip_groups(const jd_inlet_spec *s, const jd_inlet_particle *due
  * count the rest (observable skipped_particles). */
 #define JD_INLET_REPORTED 10
 
+/* Why a due particle is skipped, the text both engines report after "skips particle id I: "
+ * (worst, with_id: its jd_inlet_worst_overlaps value and the id of that particle), then the
+ * limit, and for the JD_INLET_REPORTED-th (nth) skip the note that the rest are only counted. */
+int jd_inlet_skip_reason(char *buf, size_t len, double worst, int64_t with_id,
+                         double max_insert_overlap, int64_t nth);
+
 /* Book n_skipped particles that jd_inlet_pop returned but the engine did not insert. */
 void jd_inlet_book_skipped(jd_inlet_stream *st, size_t n_skipped);
 

@@ -556,9 +556,23 @@ static JD_ALWAYS_INLINE void jd_law_energy(const unsigned features, const jd_kin
     }
 }
 
+/* The torques of a contact force f on b (on a: -f) about the two centres through the levers of
+ * g, T_a = r_a x (-f) and T_b = r_b x f [N m]: what the bodies get (jd_contact_assemble adds the
+ * rolling moment) and what the energy record keeps for the next step (jd_contact_commit). */
+typedef struct jd_lever_torques {
+    double ta[3], tb[3];
+} jd_lever_torques;
+
+static JD_ALWAYS_INLINE void jd_contact_lever_torques(const jd_contact_geom *g, const double f[3],
+                                                      jd_lever_torques *t) {
+    const double fa[3] = {-f[0], -f[1], -f[2]};
+    jd_cross(g->ra, fa, t->ta);
+    jd_cross(g->rb, f, t->tb);
+}
+
 /* The history after the step: unchanged while still ended, reset (and marked ended) at Luding's
  * end, else the evaluated one. */
-static JD_ALWAYS_INLINE void jd_contact_commit(const unsigned features, const jd_contact_geom *g,
+static JD_ALWAYS_INLINE void jd_contact_commit(const unsigned features, const jd_lever_torques *t,
                                         const jd_contact_step *h,
                                         const jd_normal *nl, const double f[3],
                                         const double m_roll[3], double u_new,
@@ -572,14 +586,10 @@ static JD_ALWAYS_INLINE void jd_contact_commit(const unsigned features, const jd
         for (int d = 0; d < 3; d++)
             r->theta[d] = carries ? h->theta[d] : (still_ended ? r->theta[d] : 0.0);
     if (features & JD_F_ENERGY) {
-        const double fa[3] = {-f[0], -f[1], -f[2]};
-        double ta[3], tb[3];
-        jd_cross(g->ra, fa, ta);
-        jd_cross(g->rb, f, tb);
         for (int d = 0; d < 3; d++) {
             s->f_prev[d] = carries ? f[d] : (still_ended ? s->f_prev[d] : 0.0);
-            s->ts_prev[d] = carries ? ta[d] + tb[d] : (still_ended ? s->ts_prev[d] : 0.0);
-            s->td_prev[d] = carries ? tb[d] - ta[d] : (still_ended ? s->td_prev[d] : 0.0);
+            s->ts_prev[d] = carries ? t->ta[d] + t->tb[d] : (still_ended ? s->ts_prev[d] : 0.0);
+            s->td_prev[d] = carries ? t->tb[d] - t->ta[d] : (still_ended ? s->td_prev[d] : 0.0);
             if (rolling) r->m_prev[d] = carries ? m_roll[d] : (still_ended ? r->m_prev[d] : 0.0);
         }
         s->fd_prev = carries ? e->fd : (still_ended ? s->fd_prev : 0.0);
@@ -593,14 +603,15 @@ static JD_ALWAYS_INLINE void jd_contact_commit(const unsigned features, const jd
  * (without rolling resistance nothing is added: the engines' torque sums start from +0, so
  * adding a +0 moment could only have turned a -0 torque into +0, which their sums never see).
  * All zero once the contact has ended (carries 0). */
-static JD_ALWAYS_INLINE void jd_contact_assemble(const unsigned features, const jd_contact_geom *g,
+static JD_ALWAYS_INLINE void jd_contact_assemble(const unsigned features, const jd_lever_torques *t,
                                           const jd_normal *nl, const double f[3],
                                           const double m_roll[3], jd_contact_result *out) {
     const int carries = nl->carries;
-    const double fa[3] = {-f[0], -f[1], -f[2]};
     double ta[3], tb[3];
-    jd_cross(g->ra, fa, ta);
-    jd_cross(g->rb, f, tb);
+    for (int d = 0; d < 3; d++) {
+        ta[d] = t->ta[d];
+        tb[d] = t->tb[d];
+    }
     if (features & JD_F_ROLLING)
         for (int d = 0; d < 3; d++) {
             ta[d] -= m_roll[d];
@@ -653,8 +664,10 @@ static JD_ALWAYS_INLINE int jd_contact(const unsigned features, const jd_pair_co
     jd_contact_energy e = {0.0, h.e_damp, h.e_fric};
     if (energy) jd_law_energy(features, k, &m, &nl, &h, f, m_roll, u_new, dash, dt, &e);
 
-    jd_contact_commit(features, g, &h, &nl, f, m_roll, u_new, &e, s, r);
-    jd_contact_assemble(features, g, &nl, f, m_roll, out);
+    jd_lever_torques t;
+    jd_contact_lever_torques(g, f, &t);
+    jd_contact_commit(features, &t, &h, &nl, f, m_roll, u_new, &e, s, r);
+    jd_contact_assemble(features, &t, &nl, f, m_roll, out);
     return nl.carries;
 }
 

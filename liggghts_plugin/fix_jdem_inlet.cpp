@@ -467,14 +467,10 @@ std::vector<jd_inlet_particle> FixJdemInlet::kept_of(const std::vector<jd_inlet_
 void FixJdemInlet::report_skip(const jd_inlet_particle &p, double worst, int with_tag) {
   const long long nth = skipped() + 1;
   if (comm->me != 0 || nth > JD_INLET_REPORTED) return;
-  char why[160] = "with its bonded block", line[400];
-  if (worst > spec.max_insert_overlap)
-    std::snprintf(why, sizeof why, "particle id %d overlaps its place by %.6g of the smaller radius",
-                  with_tag, worst);
-  std::snprintf(line, sizeof line, "fix %s jdem/inlet: step %lld: skips particle id %lld: %s "
-                "(max_insert_overlap %g)%s\n", id, (long long)update->ntimestep, (long long)p.id,
-                why, spec.max_insert_overlap,
-                nth == JD_INLET_REPORTED ? "; further skips are counted, not reported" : "");
+  char why[256], line[512];
+  jd_inlet_skip_reason(why, sizeof why, worst, with_tag, spec.max_insert_overlap, nth);
+  std::snprintf(line, sizeof line, "fix %s jdem/inlet: step %lld: skips particle id %lld: %s\n", id,
+                (long long)update->ntimestep, (long long)p.id, why);
   if (screen) std::fputs(line, screen);
   if (logfile) std::fputs(line, logfile);
 }

@@ -311,15 +311,12 @@ static void skip_occupied(jd_sim *s, size_t k, size_t due) {
         if (!in->skip[q]) continue;
         const int64_t nth = sim_skipped_particles(s) + 1;
         if (nth <= JD_INLET_REPORTED) {
-            char why[160] = "with its bonded block";
-            if (in->worst[q] > r->spec.max_insert_overlap)
-                snprintf(why, sizeof why, "particle id %lld overlaps its place by %.6g of the "
-                         "smaller radius", (long long)sim_particle_id(ps, in->with[q]), in->worst[q]);
-            fprintf(stderr, "jdem: step %lld: inlet '%s' skips particle id %lld: %s "
-                    "(max_insert_overlap %g)%s\n", (long long)s->step,
-                    s->run.scene->inlets[k].name, (long long)in->buf[q].id, why,
-                    r->spec.max_insert_overlap,
-                    nth == JD_INLET_REPORTED ? "; further skips are counted, not reported" : "");
+            char why[256];
+            jd_inlet_skip_reason(why, sizeof why, in->worst[q],
+                                 in->with[q] == SIZE_MAX ? -1 : sim_particle_id(ps, in->with[q]),
+                                 r->spec.max_insert_overlap, nth);
+            fprintf(stderr, "jdem: step %lld: inlet '%s' skips particle id %lld: %s\n",
+                    (long long)s->step, s->run.scene->inlets[k].name, (long long)in->buf[q].id, why);
         }
         jd_inlet_book_skipped(&r->st, 1);
     }
