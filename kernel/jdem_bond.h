@@ -122,7 +122,8 @@ typedef struct jd_bond_state {
     double flags;     /* JD_BS_* bits stored as a small integer value                    [-]   */
     /* Energy bookkeeping (JD_B_ENERGY), the trapezoidal rule of jd_contact: */
     double f_prev[3]; /* total force on b at the previous evaluation                     [N]   */
-    double m_prev[3]; /* total couple on b at the previous evaluation                    [N m] */
+    double ts_prev[3]; /* T_a + T_b, the torques about the centres it applied then       [N m] */
+    double td_prev[3]; /* T_b - T_a (the previous lever arms and couple, as jd_contact)   [N m] */
     double u_prev;    /* elastic energy stored at the previous evaluation                [J]   */
     double e_damp;    /* energy dissipated by the dashpots (JD_B_DAMPING)                [J]   */
     double e_break;   /* elastic energy released when the bond broke                     [J]   */
@@ -130,11 +131,12 @@ typedef struct jd_bond_state {
 
 enum { JD_BS_INTACT = 1, JD_BS_BROKEN = 2 };
 
-#define JD_BOND_STATE_LEN 18 /* doubles in jd_bond_state */
+#define JD_BOND_STATE_LEN 21 /* doubles in jd_bond_state */
 /* 1 where the entry changes sign when a and b swap (vectors "on b"), else 0.  fn and mn do not:
- * the couple mn n on b becomes -mn n on a = mn n' with the swapped normal n' = -n. */
-static const int jd_bond_state_newton[JD_BOND_STATE_LEN] = {0, 1, 1, 1, 0, 1, 1, 1, 0,
-                                                            1, 1, 1, 1, 1, 1, 0, 0, 0};
+ * the couple mn n on b becomes -mn n on a = mn n' with the swapped normal n' = -n.  The torque
+ * sum ts_prev does not either; the difference td_prev does. */
+static const int jd_bond_state_newton[JD_BOND_STATE_LEN] = {0, 1, 1, 1, 0, 1, 1, 1, 0, 1, 1,
+                                                            1, 0, 0, 0, 1, 1, 1, 0, 0, 0};
 
 /* What one evaluation returns. */
 typedef struct jd_bond_result {
@@ -313,15 +315,25 @@ static JD_ALWAYS_INLINE int jd_bond_strength(const jd_bond_params *p, const jd_b
     return out->mode;
 }
 
+/* The work rate of the previous evaluation's load on the bodies now [W]: its force through the
+ * centres' velocities, its torques about the centres (the lever arms and couple it was applied
+ * with, not today's: the bond point moves with the pair) through their spins,
+ * f.(v_b - v_a) + T_a.w_a + T_b.w_b. */
+static JD_ALWAYS_INLINE double jd_bond_previous_power(const jd_kinematics *k,
+                                                      const jd_bond_state *s) {
+    double w = 0.0;
+    for (int d = 0; d < 3; d++)
+        w += s->f_prev[d] * (k->vb[d] - k->va[d]) +
+             0.5 * (s->ts_prev[d] * (k->wa[d] + k->wb[d]) + s->td_prev[d] * (k->wb[d] - k->wa[d]));
+    return w;
+}
+
 /* A bond that failed this step: with JD_B_ENERGY the energy it stored beyond the half of this
- * step's trapezoid its last force still did is lost (as at Luding's end of a contact); the
+ * step's trapezoid its last load still did is lost (as at Luding's end of a contact); the
  * state becomes broken with zero forces, keeping the accumulators; no force on the bodies. */
-static JD_ALWAYS_INLINE void jd_bond_break(const unsigned features, const jd_bond_motion *m,
+static JD_ALWAYS_INLINE void jd_bond_break(const unsigned features, const jd_kinematics *k,
                                            double dt, jd_bond_state *s, jd_bond_result *out) {
-    if (features & JD_B_ENERGY) {
-        const double w = jd_dot(s->f_prev, m->vrel) + jd_dot(s->m_prev, m->wrel);
-        s->e_break += s->u_prev - 0.5 * w * dt;
-    }
+    if (features & JD_B_ENERGY) s->e_break += s->u_prev - 0.5 * jd_bond_previous_power(k, s) * dt;
     const double e_damp = s->e_damp, e_break = s->e_break;
     double *v = (double *)s;
     for (int q = 0; q < JD_BOND_STATE_LEN; q++) v[q] = 0.0;
@@ -354,23 +366,26 @@ static JD_ALWAYS_INLINE void jd_bond_load(const unsigned features, const jd_bond
 }
 
 /* Energy bookkeeping (JD_B_ENERGY): work on the bodies this step by the trapezoidal rule (as
- * jd_contact); with dashpots, what the springs did not store was dissipated.  Without dashpots
- * nothing is booked: the O(dt^2) remainder is the integrator's, and the undamped energy checks
- * see it. */
+ * jd_contact), the previous load through the levers it was applied with and this step's through
+ * this step's (out: its torques, from jd_bond_assemble); with dashpots, what the springs did not
+ * store was dissipated.  Without dashpots nothing is booked: the O(dt^2) remainder is the
+ * integrator's, and the undamped energy checks see it. */
 static JD_ALWAYS_INLINE void jd_bond_energy_book(const unsigned features, const jd_bond_params *p,
                                                  const jd_bond_section *sec,
-                                                 const jd_bond_motion *m, const double f[3],
-                                                 const double mo[3], double dt, jd_bond_state *s) {
+                                                 const jd_kinematics *k, const jd_bond_motion *m,
+                                                 const double f[3], const double mo[3],
+                                                 const jd_bond_result *out, double dt,
+                                                 jd_bond_state *s) {
     const double u_new = jd_bond_energy(p, sec, s);
     if (features & JD_B_DAMPING) {
-        const double w = jd_dot(s->f_prev, m->vrel) + jd_dot(f, m->vrel) +
-                         jd_dot(s->m_prev, m->wrel) + jd_dot(mo, m->wrel);
+        const double w = jd_bond_previous_power(k, s) + jd_dot(f, m->vrel) + jd_dot(mo, m->wrel);
         s->e_damp += -0.5 * w * dt - (u_new - s->u_prev);
     }
     s->u_prev = u_new;
     for (int d = 0; d < 3; d++) {
         s->f_prev[d] = f[d];
-        s->m_prev[d] = mo[d];
+        s->ts_prev[d] = out->ta[d] + out->tb[d];
+        s->td_prev[d] = out->tb[d] - out->ta[d];
     }
 }
 
@@ -406,13 +421,13 @@ static JD_ALWAYS_INLINE int jd_bond(const unsigned features, const jd_bond_param
     jd_bond_kinematics(g, k, &m);
     jd_bond_springs(&K, g, &m, dt, s);
     if (jd_bond_strength(p, &g->sec, s, out) != JD_BOND_INTACT) {
-        jd_bond_break(features, &m, dt, s, out);
+        jd_bond_break(features, k, dt, s, out);
         return out->mode;
     }
     double f[3], mo[3];
     jd_bond_load(features, p, &K, g, &m, s, f, mo);
-    if (features & JD_B_ENERGY) jd_bond_energy_book(features, p, &g->sec, &m, f, mo, dt, s);
     jd_bond_assemble(g, f, mo, out);
+    if (features & JD_B_ENERGY) jd_bond_energy_book(features, p, &g->sec, k, &m, f, mo, out, dt, s);
     return JD_BOND_INTACT;
 }
 

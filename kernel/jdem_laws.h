@@ -205,7 +205,8 @@ static JD_ALWAYS_INLINE jd_bond_state jd_bond_record_load(const double *a, int s
         st.ft[d] = a[JD_AT(jd_bond_state, ft) + d];
         st.mt[d] = a[JD_AT(jd_bond_state, mt) + d];
         st.f_prev[d] = full ? a[JD_AT(jd_bond_state, f_prev) + d] : 0.0;
-        st.m_prev[d] = full ? a[JD_AT(jd_bond_state, m_prev) + d] : 0.0;
+        st.ts_prev[d] = full ? a[JD_AT(jd_bond_state, ts_prev) + d] : 0.0;
+        st.td_prev[d] = full ? a[JD_AT(jd_bond_state, td_prev) + d] : 0.0;
     }
     st.u_prev = full ? a[JD_AT(jd_bond_state, u_prev)] : 0.0;
     st.e_damp = full ? a[JD_AT(jd_bond_state, e_damp)] : 0.0;
@@ -224,7 +225,8 @@ static JD_ALWAYS_INLINE void jd_bond_record_store(double *a, int sw, const jd_bo
     if (sw == JD_BOND_STATE_LEN) {
         for (int d = 0; d < 3; d++) {
             a[JD_AT(jd_bond_state, f_prev) + d] = st->f_prev[d];
-            a[JD_AT(jd_bond_state, m_prev) + d] = st->m_prev[d];
+            a[JD_AT(jd_bond_state, ts_prev) + d] = st->ts_prev[d];
+            a[JD_AT(jd_bond_state, td_prev) + d] = st->td_prev[d];
         }
         a[JD_AT(jd_bond_state, u_prev)] = st->u_prev;
         a[JD_AT(jd_bond_state, e_damp)] = st->e_damp;

@@ -439,11 +439,43 @@ static void bond_strength_and_break(void **state) {
     assert_rel(out.sigma_max, 0.75 * p.sigma_c, 1e-12);
     s.fn *= 2.0; /* 1.25 sigma_c in tension, no shear: breaks in tension */
     assert_int_equal(jd_bond_strength(&p, &sec, &s, &out), JD_BOND_BROKE_TENSION);
-    const jd_bond_motion m = {.vrel = {0, 0, 0.5}};
-    jd_bond_break(JD_B_ENERGY, &m, 1e-7, &s, &out);
-    assert_rel(s.e_break, 3e-6 - 0.5 * (2.0 * 0.5) * 1e-7, 1e-14);
+    /* its last load still works half a step: f_prev.(v_b - v_a) = 1 W, and its torques
+     * T_a = T_b = (0, -0.01, 0) N m (sum ts_prev, difference 0) on spins (0, 3, 0), (0, 5, 0)
+     * rad/s: -0.08 W */
+    s.ts_prev[1] = -0.02;
+    const jd_kinematics k = {.vb = {0, 0, 0.5}, .wa = {0, 3, 0}, .wb = {0, 5, 0}};
+    jd_bond_break(JD_B_ENERGY, &k, 1e-7, &s, &out);
+    assert_rel(s.e_break, 3e-6 - 0.5 * (2.0 * 0.5 - 0.08) * 1e-7, 1e-14);
     assert_true(s.flags == (double)JD_BS_BROKEN && s.fn == 0.0 && s.mt[0] == 0.0 &&
                 s.u_prev == 0.0 && s.e_damp == 1e-6 && out.f[2] == 0.0);
+}
+
+/* A bond's previous load works through the levers it was applied with, as a contact's
+ * (energy_law_uses_the_previous_levers): f_prev = (1, 0, 0) N gave T_a = T_b = (0, -0.01, 0) N m;
+ * the pair has since turned, so that the bond point's relative velocity (0, 0, 0.08) m/s is
+ * normal to f_prev, but the work rate on spins (0, 3, 0), (0, 5, 0) rad/s is still -0.08 W.
+ * Nothing is stored and this step's load is zero, so the dashpots book -1/2 (-0.08) dt; the
+ * book keeps this step's torques as the next one's sum and difference. */
+static void bond_energy_uses_the_previous_levers(void **state) {
+    (void)state;
+    const jd_bond_params p = bond_params();
+    const jd_bond_section sec = jd_bond_section_of(1.0, 1e-3, 1e-3);
+    const double dt = 1e-7, f[3] = {0, 0, 0}, mo[3] = {0, 0, 0};
+    const jd_kinematics k = {.wa = {0, 3, 0}, .wb = {0, 5, 0}};
+    const jd_bond_motion m = {.vrel = {0, 0, 0.08}, .wrel = {0, 2, 0}};
+    const jd_bond_result out = {.ta = {1, 2, 3}, .tb = {5, 7, 11}};
+    jd_bond_state s = {.flags = JD_BS_INTACT, .f_prev = {1, 0, 0}, .ts_prev = {0, -0.02, 0}};
+    jd_bond_energy_book(JD_B_DAMPING | JD_B_ENERGY, &p, &sec, &k, &m, f, mo, &out, dt, &s);
+    assert_rel(s.e_damp, -0.5 * -0.08 * dt, 1e-14);
+    for (int d = 0; d < 3; d++) {
+        assert_rel(s.ts_prev[d], out.ta[d] + out.tb[d], 0.0);
+        assert_rel(s.td_prev[d], out.tb[d] - out.ta[d], 0.0);
+    }
+    /* a <-> b: the force and the difference flip, the spins swap: the same work */
+    const jd_kinematics ks = {.wa = {0, 5, 0}, .wb = {0, 3, 0}};
+    jd_bond_state t = {.flags = JD_BS_INTACT, .f_prev = {-1, 0, 0}, .ts_prev = {0, -0.02, 0}};
+    jd_bond_energy_book(JD_B_DAMPING | JD_B_ENERGY, &p, &sec, &ks, &m, f, mo, &out, dt, &t);
+    assert_rel(t.e_damp, -0.5 * -0.08 * dt, 1e-14);
 }
 
 static void guard_damping_ratio_over_species_with_particles(void **state) {
@@ -464,6 +496,7 @@ int run_laws_tests(void) {
         cmocka_unit_test(rolling_law_spring_and_cap),
         cmocka_unit_test(energy_law_books_work_and_luding_end),
         cmocka_unit_test(energy_law_uses_the_previous_levers),
+        cmocka_unit_test(bond_energy_uses_the_previous_levers),
         cmocka_unit_test(law_sets_are_the_combinations_with_mu_r_and_mindlin_only_with_friction),
         cmocka_unit_test(every_law_set_runs_in_one_compiled_loop),
         cmocka_unit_test(law_set_select_counts_only_interactions_that_occur),
