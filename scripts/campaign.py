@@ -14,7 +14,9 @@ selected is an error).  A unit the engines cannot run yet (its `blocked` says wh
 key not implemented) is reported as "not yet runnable: WHY" and skipped with the units that need
 it; it does not count as a failure, and the closing line counts it.  Progress and the ETA go to stderr: the ETA is the remaining units'
 estimated cost times the measured seconds per unit of cost of the units finished so far (in this
-run and earlier ones: DIR/.campaign_times.json beside the first unit's output).
+run and earlier ones: DIR/.campaign_times.json beside the first unit's output).  A unit's recorded
+wall and CPU time are its whole: an interrupted attempt's, written to its partial directory every
+SPENT_EVERY seconds, are added to the attempt that finishes it.
 """
 import argparse
 import importlib.util
@@ -110,10 +112,12 @@ class Times:
         except (OSError, ValueError):
             return {}
 
-    def add(self, unit, seconds, cpu_seconds):
+    def add(self, unit, seconds, cpu_seconds, attempts=1):
+        """seconds, cpu_seconds: the unit's wall and CPU time over all its attempts (a resumed
+        unit's earlier ones from its partial directory's SPENT)."""
         import fcntl
         entry = {"seconds": seconds, "cpu_seconds": cpu_seconds, "cost": unit.cost,
-                 "ranks": unit.ranks}
+                 "ranks": unit.ranks, "attempts": attempts}
         # beside the plan's first output, whose directory a selection without that unit never made
         os.makedirs(os.path.dirname(self.path), exist_ok=True)
         with open(self.path + ".lock", "a") as lock:
@@ -137,28 +141,88 @@ def resuming(unit):
     return unit.resumes and os.path.isdir(partial_dir(unit))
 
 
+SPENT = ".spent.json"     # in a unit's partial directory: what its earlier attempts cost
+SPENT_EVERY = 10.0        # [s] how often a running attempt's cost is written there
+
+
+def read_spent(tmp):
+    """{seconds, cpu_seconds, attempts} of the attempts before this one (zero for a fresh unit)."""
+    try:
+        with open(os.path.join(tmp, SPENT)) as f:
+            d = json.load(f)
+        return {k: float(d[k]) for k in ("seconds", "cpu_seconds", "attempts")}
+    except (OSError, ValueError, KeyError, TypeError):
+        return {"seconds": 0.0, "cpu_seconds": 0.0, "attempts": 0.0}
+
+
+def write_spent(tmp, spent):
+    path = os.path.join(tmp, SPENT)
+    with open(path + ".tmp", "w") as f:
+        json.dump(spent, f)
+    os.replace(path + ".tmp", path)
+
+
+def tree_cpu(pid):
+    """User + system CPU seconds of process pid and its live descendants, with the children each
+    has waited for (/proc: utime, stime, cutime, cstime), so that every CPU second is counted once."""
+    children, ticks = {}, {}
+    for name in os.listdir("/proc"):
+        if name.isdigit():
+            try:
+                with open(f"/proc/{name}/stat") as f:
+                    fields = f.read().rsplit(")", 1)[1].split()
+            except OSError:   # gone meanwhile: its parent's cutime has it once waited for
+                continue
+            children.setdefault(int(fields[1]), []).append(int(name))
+            ticks[int(name)] = sum(int(x) for x in fields[11:15])
+    total, todo = 0, [pid]
+    while todo:
+        p = todo.pop()
+        total += ticks.get(p, 0)
+        todo += children.get(p, [])
+    return total / os.sysconf("SC_CLK_TCK")
+
+
+def run_command(argv, tmp, before, start):
+    """Run argv, writing what this attempt has cost so far (added to before) into tmp every
+    SPENT_EVERY seconds: a campaign killed mid-unit loses at most that much of the count."""
+    proc = subprocess.Popen(argv)
+    while True:
+        try:
+            return proc.wait(timeout=SPENT_EVERY)
+        except subprocess.TimeoutExpired:
+            write_spent(tmp, {"seconds": before["seconds"] + time.monotonic() - start,
+                              "cpu_seconds": before["cpu_seconds"] + tree_cpu(proc.pid),
+                              "attempts": before["attempts"] + 1})
+
+
 def run_unit(unit):
-    """Run one unit into its partial directory; returns None or the reason it failed."""
+    """Run one unit into its partial directory; returns (None or the reason it failed, what the
+    earlier attempts of an interrupted unit cost: {seconds, cpu_seconds, attempts})."""
     tmp = partial_dir(unit)
     if not resuming(unit):
         shutil.rmtree(tmp, ignore_errors=True)
     os.makedirs(tmp, exist_ok=True)
+    before, start, cpu0 = read_spent(tmp), time.monotonic(), children_cpu()
     staged = [os.path.join(tmp, os.path.basename(p)) for p in unit.outputs]
     subs = {f"out{i}": p for i, p in enumerate(staged)}
     subs["dir"] = tmp
     argv = [a.format(**subs) for a in unit.command]
-    proc = subprocess.run(argv)
-    if proc.returncode != 0:
-        return f"exit status {proc.returncode}"
+    rc = run_command(argv, tmp, before, start)
+    write_spent(tmp, {"seconds": before["seconds"] + time.monotonic() - start,
+                      "cpu_seconds": before["cpu_seconds"] + children_cpu() - cpu0,
+                      "attempts": before["attempts"] + 1})
+    if rc != 0:
+        return f"exit status {rc}", before
     for s in staged:
         reason = invalid_reason(unit, s)
         if reason:
-            return f"output {os.path.basename(s)} does not validate: {reason}"
+            return f"output {os.path.basename(s)} does not validate: {reason}", before
     for s, final in zip(staged, unit.outputs):
         os.makedirs(os.path.dirname(os.path.abspath(final)), exist_ok=True)
         os.replace(s, final)
     shutil.rmtree(tmp, ignore_errors=True)
-    return None
+    return None, before
 
 
 def children_cpu():
@@ -199,14 +263,14 @@ def run(units, times, everything=None, log=sys.stderr):
               + ("continuing its interrupted run" if resuming(u) else "running")
               + (f"; ETA {fmt_seconds(eta)}" if eta is not None else ""), file=log, flush=True)
         start, cpu0 = time.monotonic(), children_cpu()
-        reason = run_unit(u)
+        reason, before = run_unit(u)
         took, cpu = time.monotonic() - start, children_cpu() - cpu0
         if reason:
             failed += 1
             print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: FAILED after {fmt_seconds(took)}: "
                   f"{reason}", file=log, flush=True)
             continue
-        times.add(u, took, cpu)
+        times.add(u, before["seconds"] + took, before["cpu_seconds"] + cpu, int(before["attempts"]) + 1)
         eta = times.eta(todo[i + 1:])
         print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: done in {fmt_seconds(took)}; "
               f"{len(todo) - i - 1} left, ETA {fmt_seconds(eta)}", file=log, flush=True)

@@ -28,7 +28,7 @@ import subprocess
 
 import numpy as np
 
-from scripts.mixing import agreement_ch4, claims_ch4, compression, deposit, params, plots, stats
+from scripts.mixing import agreement_ch4, claims_ch4, compression, deposit, dt_study_ch4, params, plots, stats
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_OUT = os.path.join(ROOT, "out", "mixing", "ch4")
@@ -331,15 +331,19 @@ def mixing_table(found, taken):
 
 def times_table(found, taken):
     lines = ["### Run times of the finished units", "",
-             "wall time on the shared machine, the CPU time of the unit's processes, and the "
-             "MPI ranks it ran on", "", "| unit | wall [s] | CPU [s] | ranks |", "|---|---|---|---|"]
+             "wall time on the shared machine, the CPU time of the unit's processes, the MPI ranks "
+             "it ran on, and the attempts they add up (a unit resumed after an interruption; "
+             "\"not recorded\": timed before the campaign added up the attempts, so a resumed "
+             "unit's times are its last attempt's only)", "",
+             "| unit | wall [s] | CPU [s] | ranks | attempts |", "|---|---|---|---|---|"]
     for engine in ENGINES:
         for model in MODELS:
             for name, t in sorted(found[engine][model]["times"].items()):
                 cpu, ranks = t.get("cpu_seconds"), t.get("ranks")
-                lines.append("| %s | %.0f | %s | %s |" % (
+                lines.append("| %s | %.0f | %s | %s | %s |" % (
                     name, t["seconds"], "%.0f" % cpu if cpu is not None else "not recorded",
-                    ranks if ranks is not None else 1))   # before ranks were recorded: all ran on one
+                    ranks if ranks is not None else 1,    # before ranks were recorded: all ran on one
+                    t.get("attempts", "not recorded")))
     units = [(u.split("/")[0], "units", model_number(u.split("/")[1]), source)
              for k, source in taken.items() if k[2] == "times" for u in [k[3]]]
     return "\n".join(lines) + "\n" + earlier_note(units)
@@ -383,7 +387,8 @@ def report(found, missing, taken, figures, rev):
              "parameter (docs/mixing.md §1).\n" % rev, mixing_table(found, taken), figures_section(figures)]
     parts += [elastic_table(found, taken, k, t, f) for k, t, f in TABLES]
     parts.append(horizon_section())
-    parts += [spread_table(found, taken), agreement_ch4.table(found), constants_table(found, taken), "### The seed's claims\n",
+    parts += [spread_table(found, taken), agreement_ch4.table(found), constants_table(found, taken),
+              dt_study_ch4.table(found, ENGINES, MODELS, PASSES), "### The seed's claims\n",
               claims_ch4.claims(found, ENGINES), times_table(found, taken), provenance_section(built_of(found)),
               "### Not run\n", "\n".join("- " + m for m in missing) + "\n" if missing else "nothing\n"]
     return "\n".join(parts)

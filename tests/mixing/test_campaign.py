@@ -13,7 +13,8 @@ from tests.mixing.common import ROOT, check, finish
 
 CAMPAIGN = os.path.join(ROOT, "scripts", "campaign.py")
 
-# A dummy unit appends its name to runs.log, sleeps SLEEP_<name> seconds (default 0.1) and
+# A dummy unit appends its name to runs.log, spends BURN_<name> CPU seconds (default 0; then
+# writes the CPU time it measured to OUTPUT.cpu), sleeps SLEEP_<name> seconds (default 0.1) and
 # writes "ok" (or the content of CONTENT_<name>) to its output.
 PLAN = '''
 import os, sys
@@ -26,6 +27,11 @@ name, out = sys.argv[1], sys.argv[2]
 again = os.path.exists(out + ".started")  # left by an interrupted run of this unit
 open(os.path.join({here!r}, "runs.log"), "a").write(name + ("-again" if again else "") + "\\\\n")
 open(out + ".started", "w").close()
+burn = float(os.environ.get("BURN_" + name, "0"))   # CPU seconds to spend first
+while time.process_time() < burn:
+    pass
+if burn:
+    open(out + ".cpu", "w").write(repr(time.process_time()))
 time.sleep(float(os.environ.get("SLEEP_" + name, "0.1")))
 open(out, "w").write(os.environ.get("CONTENT_" + name, "ok"))
 """]
@@ -122,14 +128,18 @@ def test_killed_run_resumes():
 
 def test_resumable_unit_continues():
     """A unit that resumes (a checkpointing run) finds what its killed run left in its partial
-    directory, and the driver says it continues; an ordinary unit (b above) starts afresh."""
+    directory, and the driver says it continues; an ordinary unit (b above) starts afresh.  Its
+    recorded time covers both attempts: the killed one's wall and CPU time as last written to the
+    partial directory (every campaign.SPENT_EVERY s), the CPU its worker measured itself."""
     here = setup()
-    env = {"WITH_R": "1", "SLEEP_r": "30"}
+    env = {"WITH_R": "1", "SLEEP_r": "30", "BURN_r": "1.0"}
     proc = campaign(here, "--unit", "r", env=env, wait=False)
-    started = os.path.join(here, "out", ".partial", "r", "r.txt.started")
-    deadline = time.monotonic() + 20
-    while not os.path.exists(started) and time.monotonic() < deadline:
+    partial = os.path.join(here, "out", ".partial", "r")
+    spent = os.path.join(partial, ".spent.json")
+    deadline = time.monotonic() + 40
+    while not os.path.exists(spent) and time.monotonic() < deadline:
         time.sleep(0.05)
+    burned = float(open(os.path.join(partial, "r.txt.cpu")).read())
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
     reset_log(here)
@@ -139,6 +149,10 @@ def test_resumable_unit_continues():
     check("resumable_unit_says_it_continues",
           "[1/1] r: continuing its interrupted run" in r.stderr, r.stderr)
     check("resumable_unit_final_output", open(final(here, "r")).read() == "ok", "r.txt")
+    t = json.load(open(os.path.join(here, "out", ".campaign_times.json")))["r"]
+    check("resumable_unit_time_counts_both_attempts",
+          t["attempts"] == 2 and t["seconds"] >= 10.0 and t["cpu_seconds"] >= burned,
+          f"recorded {t}; the killed attempt ran >= 10 s and its worker burned {burned:.2f} CPU s")
 
 
 def test_validation_and_selection():

@@ -166,6 +166,34 @@ def test_merge(tmp):
     check("second_commit_keeps_every_entry", second["results"] == summary["results"])
 
 
+def test_dt_study():
+    """dt_study_ch4's rows: each variant's dt read back from its fill's cost (particles x time /
+    dt, plan_ch4), and the largest move from the seed's dt in stds (phi_v 0.02 -> 0.025 at a std
+    of 0.01: 0.50; the cubes alike: 0)."""
+    from scripts.mixing import dt_study_ch4, plan_ch4
+
+    def model(phi_v, dt, cpu, attempts):
+        stat = lambda mean, std: {"mean": mean, "std": std}
+        cost = plan_ch4.FILL_PARTICLES * plan_ch4.FILL_TIME / dt
+        return {"fill1": {"summary": {"phi_v": stat(phi_v, 0.01), "e": stat(0.5, 0.02),
+                                      "rho_b": stat(2500.0, 30.0), "Z": stat(5.0, 0.1)}},
+                "pass1_cubes": [{"M_wall": 1000.0 * (k + 1), "K0": 0.6} for k in range(9)],
+                "times": {"jdem/model1/fill1": dict({"cost": cost, "cpu_seconds": cpu},
+                                                    **({"attempts": attempts} if attempts else {}))}}
+    seed = {"jdem": {"model1": model(0.02, 1e-4, 100.0, None)}}
+    guard = {"jdem": {"model1": model(0.025, 5.5e-5, 180.0, 2)}}
+    dt_study_ch4.committed = lambda variant: guard if variant == "guard" else {}
+    text = dt_study_ch4.table(seed, ("jdem",), ("model1",), (1, 2))
+    rows = [line for line in text.splitlines() if line.startswith("| jdem | model1 | 1 |")]
+    check("dt_study_two_rows", len(rows) == 2, text)
+    check("dt_study_seed_row", rows[0].startswith("| jdem | model1 | 1 | 0.0001 (seed) | 0.0200 ± 0.0100")
+          and rows[0].endswith("| (reference) | 100 (last attempt, if resumed) |"), rows[0])
+    check("dt_study_guard_row", rows[1].startswith("| jdem | model1 | 1 | 5.5e-05 (guard) | 0.0250 ± 0.0100")
+          and rows[1].endswith("| 0.50 (phi_v) | 180 |"), rows[1])
+    check("dt_study_no_pass_2_rows", "| jdem | model1 | 2 |" not in text, text)
+
+
 tmp = tempfile.mkdtemp()
 test_merge(tmp)
+test_dt_study()
 finish()
