@@ -315,25 +315,12 @@ static JD_ALWAYS_INLINE int jd_bond_strength(const jd_bond_params *p, const jd_b
     return out->mode;
 }
 
-/* The work rate of the previous evaluation's load on the bodies now [W]: its force through the
- * centres' velocities, its torques about the centres (the lever arms and couple it was applied
- * with, not today's: the bond point moves with the pair) through their spins,
- * f.(v_b - v_a) + T_a.w_a + T_b.w_b. */
-static JD_ALWAYS_INLINE double jd_bond_previous_power(const jd_kinematics *k,
-                                                      const jd_bond_state *s) {
-    double w = 0.0;
-    for (int d = 0; d < 3; d++)
-        w += s->f_prev[d] * (k->vb[d] - k->va[d]) +
-             0.5 * (s->ts_prev[d] * (k->wa[d] + k->wb[d]) + s->td_prev[d] * (k->wb[d] - k->wa[d]));
-    return w;
-}
-
 /* A bond that failed this step: with JD_B_ENERGY the energy it stored beyond the half of this
  * step's trapezoid its last load still did is lost (as at Luding's end of a contact); the
  * state becomes broken with zero forces, keeping the accumulators; no force on the bodies. */
 static JD_ALWAYS_INLINE void jd_bond_break(const unsigned features, const jd_kinematics *k,
                                            double dt, jd_bond_state *s, jd_bond_result *out) {
-    if (features & JD_B_ENERGY) s->e_break += s->u_prev - 0.5 * jd_bond_previous_power(k, s) * dt;
+    if (features & JD_B_ENERGY) s->e_break += s->u_prev - 0.5 * jd_previous_power(s->f_prev, s->ts_prev, s->td_prev, k) * dt;
     const double e_damp = s->e_damp, e_break = s->e_break;
     double *v = (double *)s;
     for (int q = 0; q < JD_BOND_STATE_LEN; q++) v[q] = 0.0;
@@ -378,7 +365,8 @@ static JD_ALWAYS_INLINE void jd_bond_energy_book(const unsigned features, const 
                                                  jd_bond_state *s) {
     const double u_new = jd_bond_energy(p, sec, s);
     if (features & JD_B_DAMPING) {
-        const double w = jd_bond_previous_power(k, s) + jd_dot(f, m->vrel) + jd_dot(mo, m->wrel);
+        const double w = jd_previous_power(s->f_prev, s->ts_prev, s->td_prev, k) + jd_dot(f, m->vrel) +
+                         jd_dot(mo, m->wrel);
         s->e_damp += -0.5 * w * dt - (u_new - s->u_prev);
     }
     s->u_prev = u_new;
@@ -392,10 +380,11 @@ static JD_ALWAYS_INLINE void jd_bond_energy_book(const unsigned features, const 
 /* Torques about the centres: the force at x_C plus the couple. */
 static JD_ALWAYS_INLINE void jd_bond_assemble(const jd_bond_geom *g, const double f[3],
                                               const double mo[3], jd_bond_result *out) {
-    const double fa[3] = {-f[0], -f[1], -f[2]};
-    jd_cross(g->ra, fa, out->ta);
-    jd_cross(g->rb, f, out->tb);
+    jd_lever_torques t;
+    jd_lever_torques_of(g->ra, g->rb, f, &t);
     for (int d = 0; d < 3; d++) {
+        out->ta[d] = t.ta[d];
+        out->tb[d] = t.tb[d];
         out->f[d] = f[d];
         out->ta[d] -= mo[d];
         out->tb[d] += mo[d];

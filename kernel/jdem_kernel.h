@@ -514,6 +514,33 @@ typedef struct jd_contact_energy {
     double e_fric; /* dissipated by the sliders so far                                 [J]    */
 } jd_contact_energy;
 
+/* The torques of a force f on b (on a: -f) about the two centres through the lever arms r_a, r_b
+ * (contact or bond point minus centre), T_a = r_a x (-f) and T_b = r_b x f [N m]: what the bodies
+ * get (before a couple is added) and what the energy records keep for the next step. */
+typedef struct jd_lever_torques {
+    double ta[3], tb[3];
+} jd_lever_torques;
+
+static JD_ALWAYS_INLINE void jd_lever_torques_of(const double ra[3], const double rb[3],
+                                                 const double f[3], jd_lever_torques *t) {
+    const double fa[3] = {-f[0], -f[1], -f[2]};
+    jd_cross(ra, fa, t->ta);
+    jd_cross(rb, f, t->tb);
+}
+
+/* The power now [W] of a load applied at the previous step (a contact's or a bond's): its force
+ * f_prev on b through the centres' velocities, and its torques about the centres (kept as their
+ * sum ts_prev and difference td_prev, with the lever arms and couple they were applied with, not
+ * today's) through the spins: f.(v_b - v_a) + T_a.w_a + T_b.w_b (docs/model.md §7, §9.3). */
+static JD_ALWAYS_INLINE double jd_previous_power(const double f_prev[3], const double ts_prev[3],
+                                                 const double td_prev[3], const jd_kinematics *k) {
+    double w = 0.0;
+    for (int d = 0; d < 3; d++)
+        w += f_prev[d] * (k->vb[d] - k->va[d]) +
+             0.5 * (ts_prev[d] * (k->wa[d] + k->wb[d]) + td_prev[d] * (k->wb[d] - k->wa[d]));
+    return w;
+}
+
 /* Energy bookkeeping (JD_F_ENERGY), second order in dt like the velocity-Verlet integrator.
  * Velocity Verlet changes the bodies' kinetic energy by the average of the forces at the two
  * ends of a step times its displacement (exactly, up to terms that cancel over a collision), so
@@ -528,12 +555,8 @@ static JD_ALWAYS_INLINE void jd_law_energy(const unsigned features, const jd_kin
                                     const double m_roll[3], double u_new, double dash, double dt,
                                     jd_contact_energy *e) {
     const int rolling = (features & JD_F_ROLLING) != 0;
-    /* the previous step's force alone (also Luding's end): through the centres' velocities and
-     * the torques it was applied with, f.(v_b - v_a) + T_a.w_a + T_b.w_b */
-    double w_prev = 0.0;
-    for (int d = 0; d < 3; d++)
-        w_prev += h->f_prev[d] * (k->vb[d] - k->va[d]) +
-                  0.5 * (h->ts_prev[d] * (k->wa[d] + k->wb[d]) + h->td_prev[d] * (k->wb[d] - k->wa[d]));
+    /* the previous step's force alone (also Luding's end) */
+    double w_prev = jd_previous_power(h->f_prev, h->ts_prev, h->td_prev, k);
     if (rolling) w_prev += jd_dot(h->m_prev, m->wrel);
     double w = w_prev + jd_dot(f, m->vrel); /* this step's force through this step's levers */
     if (rolling) w += jd_dot(m_roll, m->wrel);
@@ -554,20 +577,6 @@ static JD_ALWAYS_INLINE void jd_law_energy(const unsigned features, const jd_kin
         e->e_damp = nl->ends ? h->e_damp + (h->u_prev - 0.5 * w_prev * dt) : e->e_damp;
         e->e_fric = nl->ends ? h->e_fric : e->e_fric;
     }
-}
-
-/* The torques of a contact force f on b (on a: -f) about the two centres through the levers of
- * g, T_a = r_a x (-f) and T_b = r_b x f [N m]: what the bodies get (jd_contact_assemble adds the
- * rolling moment) and what the energy record keeps for the next step (jd_contact_commit). */
-typedef struct jd_lever_torques {
-    double ta[3], tb[3];
-} jd_lever_torques;
-
-static JD_ALWAYS_INLINE void jd_contact_lever_torques(const jd_contact_geom *g, const double f[3],
-                                                      jd_lever_torques *t) {
-    const double fa[3] = {-f[0], -f[1], -f[2]};
-    jd_cross(g->ra, fa, t->ta);
-    jd_cross(g->rb, f, t->tb);
 }
 
 /* The history after the step: unchanged while still ended, reset (and marked ended) at Luding's
@@ -665,7 +674,7 @@ static JD_ALWAYS_INLINE int jd_contact(const unsigned features, const jd_pair_co
     if (energy) jd_law_energy(features, k, &m, &nl, &h, f, m_roll, u_new, dash, dt, &e);
 
     jd_lever_torques t;
-    jd_contact_lever_torques(g, f, &t);
+    jd_lever_torques_of(g->ra, g->rb, f, &t);
     jd_contact_commit(features, &t, &h, &nl, f, m_roll, u_new, &e, s, r);
     jd_contact_assemble(features, &t, &nl, f, m_roll, out);
     return nl.carries;

@@ -82,11 +82,6 @@ def cpu_text(t):
     return "%.0f" % t["cpu_seconds"] + ("" if "attempts" in t else " (last attempt, if resumed)")
 
 
-def cell(pair, fmt):
-    mean, std = pair
-    return "—" if mean is None or math.isnan(mean) else (fmt % mean) + " ± " + (fmt % std)
-
-
 def table(found, engines, models, passes):
     """The markdown section: found is the report's own (seed-dt) results."""
     results = {"seed": found, **{v: committed(v) for v in VARIANTS[1:]}}
@@ -103,7 +98,7 @@ def table(found, engines, models, passes):
         for model in models:
             for p in passes:
                 runs = [(v, results[v].get(engine, {}).get(model, {})) for v in VARIANTS]
-                runs = [(v, e, measures(e, p)) for v, e in runs if measures(e, p)]
+                runs = [(v, e, m) for v, e in runs for m in [measures(e, p)] if m]
                 if len(runs) < 2 or runs[0][0] != "seed":
                     continue
                 ref = runs[0][2]
@@ -113,8 +108,8 @@ def table(found, engines, models, passes):
                     t = times.get("%s/%s/fill%d" % (engine, model, p)) or {}
                     rows.append("| %s | %s | %d | %s (%s) | %s | %s | %s | %s |" % (
                         engine, model, p, "%.3g" % dt if dt else "—", v,
-                        " | ".join(cell(m[key], fmt) for _, key, fmt in FILL_STATS),
-                        " | ".join(cell(m[key], fmt) for _, key, fmt, _ in CUBE_STATS),
+                        " | ".join(stats.cell(*m[key], fmt) for _, key, fmt in FILL_STATS),
+                        " | ".join(stats.cell(*m[key], fmt) for _, key, fmt, _ in CUBE_STATS),
                         move_text(largest_move(m, ref)) if v != "seed" else "(reference)",
                         cpu_text(t)))
     if not rows:

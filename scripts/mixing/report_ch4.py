@@ -22,13 +22,13 @@ nothing is estimated.
 """
 import argparse
 import json
-import math
 import os
 import subprocess
 
 import numpy as np
 
 from scripts.mixing import agreement_ch4, claims_ch4, compression, deposit, dt_study_ch4, params, plots, stats
+from scripts.mixing.stats import cell
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_OUT = os.path.join(ROOT, "out", "mixing", "ch4")
@@ -253,12 +253,6 @@ def taken_rows(taken, name, what):
     """earlier_note rows of the committed entries whose key is `name` (e.g. "fill1")."""
     return [(k[0], what, model_number(k[1]), source) for k, source in taken.items()
             if len(k) == 3 and k[2] == name]
-
-
-def cell(mean, std, fmt):
-    if mean is None or (isinstance(mean, float) and math.isnan(mean)):
-        return "—"
-    return (fmt % mean) + " ± " + (fmt % std)
 
 
 def ours(found, engine, model, p, key):

@@ -5,6 +5,8 @@ The seed does not say over which values its standard deviation runs; the tables 
 sample standard deviation (ddof = 1) of the same kept values, and summary() also gives it over
 all values (docs/mixing.md, "Statistics").
 """
+import math
+
 import numpy as np
 
 
@@ -30,3 +32,10 @@ def summary(values):
     return {"mean": trimmed_mean(v), "std": trimmed_std(v), "n_kept": int(len(kept(v))),
             "std_all": float(np.std(ok, ddof=1)) if len(ok) > 1 else float("nan"),
             "mean_all": float(np.mean(ok)) if len(ok) else float("nan"), "n": int(len(v))}
+
+
+def cell(mean, std, fmt):
+    """A table cell "mean ± std" in fmt, or "—" when there is no mean."""
+    if mean is None or (isinstance(mean, float) and math.isnan(mean)):
+        return "—"
+    return (fmt % mean) + " ± " + (fmt % std)
