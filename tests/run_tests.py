@@ -5,7 +5,11 @@ Each suite is a command.  Suites print one line per check, "PASS name" or "FAIL 
 cmocka suites print their own "[       OK ]" / "[  FAILED  ]" lines.  A suite that exits non-zero
 without reporting a failed check counts as one failed check, so a crash can never pass.
 
-Usage: tests/run_tests.py [SUITE ...]     (default: all, in order)
+Suites run side by side on the machine's cores (JDEM_TEST_JOBS overrides the count): a suite
+whose checks run 2 MPI ranks or 2 threads (WIDE) takes two cores, so it runs alone on a 2-core
+machine.  Each suite's lines are printed together when it ends.
+
+Usage: tests/run_tests.py [SUITE ...]     (default: all)
 """
 import os
 import re
@@ -13,6 +17,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 PY = "/usr/bin/python3"
@@ -168,6 +173,16 @@ SUITES += [("mixing-fill", [PY, "tests/mixing/test_fill.py"], "lines", {})]
 # Runs from a settled deposit (particles_from, an inlet's from_deposit) in both engines.
 SUITES += [("mixing-settled", [PY, "tests/mixing/test_settled.py"], "lines", {})]
 
+# The suites that run 2 MPI ranks or 2 threads in some check.  They run alone on 2 cores: next
+# to another suite, Open MPI's ranks (each run of scripts/engines.py in a session of its own,
+# which Linux schedules as one group) poll for each other on one core and crawl (docs/liggghts.md).
+WIDE = {"engine-fastpaths", "engine-fastpaths-sanitized", "engine-servo", "engine-servo-sanitized",
+        "inlet-bonded-cross-engine", "inlet-cross-engine", "inlet-occupied", "cross-engine",
+        "observables-cadence", "mesh-liggghts", "mesh-engines", "mesh-engines-sanitized",
+        "mesh-motion", "mesh-motion-sanitized", "drum", "liggghts-watchdog", "liggghts-restart",
+        "liggghts-runner-resume", "checkpoint", "liggghts-signals", "liggghts-bonds", "faults"}
+assert WIDE <= {s[0] for s in SUITES}, WIDE - {s[0] for s in SUITES}
+
 CMOCKA_OK = re.compile(r"^\[\s+OK\s+\] (\S+)")
 CMOCKA_FAIL = re.compile(r"^\[\s+FAILED\s+\] (\S+)$")
 
@@ -188,7 +203,7 @@ def count(style, text):
     return passed, failed
 
 
-def run_suite(name, cmd, style, env):
+def run_suite(name, cmd, style, env, report=print):
     # Each suite writes its scratch files (tempfile in Python, mpirun's session files) into a
     # directory of its own (TMPDIR), removed when the suite passes and kept for a look when it
     # fails.
@@ -203,14 +218,62 @@ def run_suite(name, cmd, style, env):
     if proc.returncode != 0 and not failed:
         tail = "\n".join(proc.stdout.splitlines()[-15:])
         failed.append(f"FAIL {name}: exit status {proc.returncode}\n{tail}")
-    print(f"== {name}: {passed} passed, {len(failed)} failed ({elapsed:.1f} s)", flush=True)
-    for line in failed:
-        print("   " + line, flush=True)
+    lines = [f"== {name}: {passed} passed, {len(failed)} failed ({elapsed:.1f} s)"]
+    lines += ["   " + line for line in failed]
     if failed:
-        print(f"   (its scratch files are kept in {tmp})", flush=True)
+        lines.append(f"   (its scratch files are kept in {tmp})")
     else:
         shutil.rmtree(tmp, ignore_errors=True)
+    report("\n".join(lines))
     return passed, len(failed)
+
+
+def cores():
+    """The cores the suites may use: JDEM_TEST_JOBS, else the CPUs this process may run on."""
+    jobs = os.environ.get("JDEM_TEST_JOBS", "")
+    if jobs:
+        if not jobs.isdigit() or int(jobs) < 1:
+            raise SystemExit(f"JDEM_TEST_JOBS={jobs!r}: valid is a whole number from 1")
+        return int(jobs)
+    return len(os.sched_getaffinity(0))
+
+
+def run_side_by_side(suites, jobs):
+    """Run the suites, each once `width` cores are free (WIDE: 2, others 1; never more than
+    jobs), the wide ones first, so that the one-core suites fill the cores at the end.  Returns
+    (passed, failed) summed."""
+    free = [jobs]
+    totals = [0, 0]
+    turn = threading.Condition()
+
+    def report(text):
+        with turn:
+            print(text, flush=True)
+
+    def run(suite, width):
+        try:
+            p, f = run_suite(*suite, report=report)
+        except Exception as e:  # a runner fault is a failed check, never a silent pass
+            report(f"== {suite[0]}: 0 passed, 1 failed\n   FAIL {suite[0]}: runner error: {e!r}")
+            p, f = 0, 1
+        with turn:
+            totals[0] += p
+            totals[1] += f
+            free[0] += width
+            turn.notify_all()
+
+    threads = []
+    for suite in sorted(suites, key=lambda s: s[0] not in WIDE):
+        width = min(jobs, 2 if suite[0] in WIDE else 1)
+        with turn:
+            turn.wait_for(lambda: free[0] >= width)
+            free[0] -= width
+        t = threading.Thread(target=run, args=(suite, width))
+        t.start()
+        threads.append(t)
+    for t in threads:
+        t.join()
+    return totals[0], totals[1]
 
 
 def main(argv):
@@ -220,13 +283,8 @@ def main(argv):
         print(f"unknown suite(s): {', '.join(sorted(unknown))}; "
               f"valid: {', '.join(s[0] for s in SUITES)}", file=sys.stderr)
         return 2
-    total_pass = total_fail = 0
-    for name, cmd, style, env in SUITES:
-        if wanted and name not in wanted:
-            continue
-        p, f = run_suite(name, cmd, style, env)
-        total_pass += p
-        total_fail += f
+    chosen = [s for s in SUITES if not wanted or s[0] in wanted]
+    total_pass, total_fail = run_side_by_side(chosen, cores())
     print(f"{total_pass} passed, {total_fail} failed")
     return 1 if total_fail else 0
 

@@ -16,6 +16,9 @@ from scripts import engines
 ROOT = engines.ROOT
 SCENES = os.path.join(ROOT, "tests", "engine", "scenes")
 JDEM = engines.JDEM
+# The optimised build, for reference runs that only supply numbers to compare with (the
+# O(N^2) all-pairs list): under the sanitizers they take minutes and check no code of interest.
+JDEM_OPTIMISED = os.path.join(ROOT, "build", "jdem")
 
 
 class Checks:
@@ -50,10 +53,11 @@ def scene(name):
     return os.path.join(SCENES, name + ".yaml")
 
 
-def run(scene_name, *args, env=None, check=True):
-    """Run `jdem run SCENE -o TMP/out.h5 --quiet ARGS`; returns (CompletedProcess, output path)."""
+def run(scene_name, *args, env=None, check=True, binary=None):
+    """Run `jdem run SCENE -o TMP/out.h5 --quiet ARGS` with binary (default $JDEM); returns
+    (CompletedProcess, output path)."""
     out = os.path.join(tempfile.mkdtemp(prefix="jdem_engine_"), scene_name + ".h5")
-    p = engines.jdem("run", scene(scene_name), "-o", out, *args, env=env)
+    p = engines.jdem("run", scene(scene_name), "-o", out, *args, env=env, binary=binary or JDEM)
     if check and p.returncode != 0:
         raise RuntimeError(f"jdem run {scene_name} failed ({p.returncode}): {p.stderr.strip()}")
     return p, out
