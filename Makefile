@@ -147,20 +147,20 @@ build/liggghts-jdem: $(patsubst %.cpp,build/plugin/%.o,$(PLUGIN_SRC)) \
 	$(CXX) $^ -o $@ -lliggghts $(PKG_LIBS) -ldl
 
 # ---------------------------------------------------------------------------------------------
-# Unit tests of the kernel (cmocka), plain and sanitized
-build/test_unit: $(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC) $(HEADERS)
-	@mkdir -p build
-	$(CC) $(CFLAGS) -Itests/unit $(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC) -o $@ $(PKG_LIBS) -lcmocka
-build/san/test_unit: $(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC) $(HEADERS)
-	@mkdir -p build/san
-	$(CC) $(CFLAGS) $(SANFLAGS) -Itests/unit $(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC) -o $@ $(PKG_LIBS) -lcmocka
-
-# The scene reader's test program (malformed scenes with their exact messages; round trips)
-build/scene_check: tests/engine/scene_check.c $(SCENE_SRC) $(HEADERS)
-	$(CC) $(CFLAGS) tests/engine/scene_check.c $(SCENE_SRC) -o $@ $(PKG_LIBS)
-build/san/scene_check: tests/engine/scene_check.c $(SCENE_SRC) $(HEADERS)
-	@mkdir -p build/san
-	$(CC) $(CFLAGS) $(SANFLAGS) tests/engine/scene_check.c $(SCENE_SRC) -o $@ $(PKG_LIBS)
+# The test programs link the engine's own objects (compiled once, side by side under make -j)
+# with their test files: the unit tests of the kernel (cmocka) and the scene reader's test program
+# (malformed scenes with their exact messages; round trips), plain and sanitized.
+UNIT_OBJ  := $(patsubst %.c,%.o,$(UNIT_SRC) $(KERNEL_SRC) $(IO_SRC))
+SCENE_OBJ := $(patsubst %.c,%.o,tests/engine/scene_check.c $(SCENE_SRC))
+build/obj/tests/unit/%.o build/san/tests/unit/%.o: CFLAGS += -Itests/unit
+build/test_unit: $(addprefix build/obj/,$(UNIT_OBJ))
+	$(CC) $(CFLAGS) $(OMPFLAGS) $^ -o $@ $(PKG_LIBS) -lcmocka
+build/san/test_unit: $(addprefix build/san/,$(UNIT_OBJ))
+	$(CC) $(CFLAGS) $(OMPFLAGS) $(SANFLAGS) $^ -o $@ $(PKG_LIBS) -lcmocka
+build/scene_check: $(addprefix build/obj/,$(SCENE_OBJ))
+	$(CC) $(CFLAGS) $(OMPFLAGS) $^ -o $@ $(PKG_LIBS)
+build/san/scene_check: $(addprefix build/san/,$(SCENE_OBJ))
+	$(CC) $(CFLAGS) $(OMPFLAGS) $(SANFLAGS) $^ -o $@ $(PKG_LIBS)
 
 unit: build/test_unit build/san/test_unit
 	build/test_unit

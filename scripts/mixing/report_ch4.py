@@ -27,8 +27,10 @@ import subprocess
 
 import numpy as np
 
-from scripts.mixing import agreement_ch4, claims_ch4, compression, deposit, dt_study_ch4, params, plots, stats
+from scripts.mixing import (agreement_ch4, claims_ch4, compression, deposit, dt_study_ch4, params, plots,
+                            stats, structure)
 from scripts.mixing.stats import cell
+from scripts.mixing_views import scene_geometry
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_OUT = os.path.join(ROOT, "out", "mixing", "ch4")
@@ -72,8 +74,9 @@ def fill_result(path):
     big = params.big_mask(dep.radius)
     x = dep.position[:, 0]
     sides = {"big_right": float(np.mean(x[big] > 0.5)), "small_left": float(np.mean(x[~big] < 0.5))}
+    box, _, _ = scene_geometry(path)
     return {"particles": int(len(dep.radius)), "deposit_height": deposit.deposit_height(dep),
-            "sides": sides,
+            "bed_height": structure.free_surface(dep, *box)["mean"], "sides": sides,
             "points": [{k: float(p[k]) for k in PARAMS} for p in points],
             "summary": {k: stats.summary([p[k] for p in points]) for k in PARAMS},
             "built_by": deposit.built_by(path)}
@@ -102,8 +105,8 @@ def spread_table(found, taken):
     --jitter), their trimmed means, and the sample std of those means."""
     lines = ["### Run-to-run spread (the first fill and its realisations with the stream shifted by "
              "K micrometres in y)", "",
-             "| engine | model | realisation | height [m] | φv | e | ρb [kg/m³] | Z |",
-             "|---|---|---|---|---|---|---|---|"]
+             "| engine | model | realisation | top [m] | bed [m] | φv | e | ρb [kg/m³] | Z |",
+             "|---|---|---|---|---|---|---|---|---|"]
     keys = (("phi_v", "%.4f"), ("e", "%.3f"), ("rho_b", "%.0f"), ("Z", "%.2f"))
     shown = set()   # (engine, model) of the rows
     for engine in ENGINES:
@@ -114,12 +117,14 @@ def spread_table(found, taken):
                 continue
             shown.add((engine, model))
             for k, r in enumerate(runs):
-                lines.append("| %s | %s | %s | %.3f | %s |" % (
-                    engine, model, "K = %d" % k, r["deposit_height"],
+                lines.append("| %s | %s | %s | %.3f | %s | %s |" % (
+                    engine, model, "K = %d" % k, r["deposit_height"], bed_height(r),
                     " | ".join(fmt % r["summary"][key]["mean"] for key, fmt in keys)))
             std = lambda vals: float(np.std(vals, ddof=1))
-            lines.append("| %s | %s | std of the %d | %.3f | %s |" % (
+            beds = [r.get("bed_height") for r in runs]
+            lines.append("| %s | %s | std of the %d | %.3f | %s | %s |" % (
                 engine, model, len(runs), std([r["deposit_height"] for r in runs]),
+                "—" if None in beds else "%.3f" % std(beds),
                 " | ".join(fmt % std([r["summary"][key]["mean"] for r in runs]) for key, fmt in keys)))
     if not shown:
         return ""
@@ -303,11 +308,19 @@ def constants_table(found, taken):
     return "\n".join(lines) + "\n" + earlier_note(cube_rows(taken))
 
 
+def bed_height(fill):
+    """The bed's mean surface height [m] (structure.free_surface: spheres held above the bed by
+    an obstacle are not its surface) as a cell, "—" for a result computed before it was kept."""
+    return "—" if fill.get("bed_height") is None else "%.3f" % fill["bed_height"]
+
+
 def mixing_table(found, taken):
     lines = ["### Mixing parameters at the 9 points of Table 4-2 (the seed gives plots only, Figs 4-11/4-12)",
              "", "trimmed mean ± std (ideal φv = %.4f)" % params.IDEAL_PHI_V, "",
-             "| engine | model | pass | particles | height [m] | φv | e | ρb [kg/m³] | Z |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "top: the highest sphere's top; bed: the mean height of the bed's free surface "
+             "(scripts/mixing/structure.py, spheres resting on an obstacle above the bed left out)", "",
+             "| engine | model | pass | particles | top [m] | bed [m] | φv | e | ρb [kg/m³] | Z |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for engine in ENGINES:
         for model in MODELS:
             for p in PASSES:
@@ -315,8 +328,8 @@ def mixing_table(found, taken):
                 if not f:
                     continue
                 s = f["summary"]
-                lines.append("| %s | %s | %d | %d | %.3f | %s | %s | %s | %s |" % (
-                    engine, model, p, f["particles"], f["deposit_height"],
+                lines.append("| %s | %s | %d | %d | %.3f | %s | %s | %s | %s | %s |" % (
+                    engine, model, p, f["particles"], f["deposit_height"], bed_height(f),
                     cell(s["phi_v"]["mean"], s["phi_v"]["std"], "%.4f"), cell(s["e"]["mean"], s["e"]["std"], "%.3f"),
                     cell(s["rho_b"]["mean"], s["rho_b"]["std"], "%.0f"), cell(s["Z"]["mean"], s["Z"]["std"], "%.2f")))
     return "\n".join(lines) + "\n" + earlier_note(

@@ -13,6 +13,7 @@ import tempfile
 
 import h5py
 import numpy as np
+import yaml
 
 from tests.mixing.common import ROOT, check, close, finish
 
@@ -36,6 +37,19 @@ def local_fill(path):
         p["position/value"] = np.array([x])
         p["position/step"] = np.array([100])
         p["position/time"] = np.array([27.0])
+        f["parameters/scene"] = yaml.safe_dump({"walls": [BOX_FLOOR]}).encode()
+
+
+# The box's extent for the height map (scripts/mixing_views.scene_geometry reads the plane walls).
+BOX_FLOOR = {"type": "plane", "corners": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]}
+
+
+def expected_bed_height():
+    """The mean bed top of local_fill's columns (0.05 m, structure.height_map), by hand: the
+    columns of x = 0.25 and 0.27, 0.5 and 0.75 hold small spheres at z = 0.2 (and above them,
+    more than BED_GAP higher, at 0.5 and 0.7: not the bed), so their bed top is 0.2 + R_SMALL;
+    the column of x = 0.55 holds only the big sphere at z = 0.5: 0.5 + R_BIG."""
+    return (3 * (0.2 + R_SMALL) + (0.5 + R_BIG)) / 4
 
 
 def expected_local_points():
@@ -134,6 +148,7 @@ def test_merge(tmp):
     check("local_fill_wins_with_local_source", m3["source"] == rev and m3["particles"] == 11,
           f"source {m3['source']}, {m3['particles']} particles")
     close("local_fill_height", m3["deposit_height"], 0.7 + R_SMALL, 1e-15)
+    close("local_fill_bed_height", m3["bed_height"], expected_bed_height(), 1e-15)
     for k, (g, w) in enumerate(zip(m3["points"], expected_local_points())):
         for key in w:
             close("local_point%d_%s" % (k + 1, key), g[key], w[key], 1e-12 * abs(w[key]) + 1e-15)
@@ -194,6 +209,29 @@ def test_dt_study():
 
 
 tmp = tempfile.mkdtemp()
+def test_agreement():
+    """agreement_ch4: the bed height of two realisations of Model 3 (the only spread) pooled for
+    Model 1's engines, against 2 sqrt(2) s by hand; a fill without a bed height (an older result)
+    gets a row that says so and no verdict."""
+    from scripts.mixing import agreement_ch4
+    fill = lambda bed, phi: dict(hand_fill(phi, 0.54, 2590.0, 5.0), bed_height=bed)
+    found = {"jdem": {"model3": {"fill1": fill(1.000, 0.02), "jitter": [fill(1.010, 0.03)]},
+                      "model1": {"fill1": fill(1.020, 0.0), "fill2": fill(1.0, 0.0)}},
+             "liggghts-jdem": {"model1": {"fill1": fill(1.045, 0.0),
+                                          "fill2": dict(hand_fill(0.0, 0.54, 2590.0, 5.0))}}}
+    rows = {(r[1], r[2]): r for r in agreement_ch4.rows(found)}
+    bound = 2 * math.sqrt(2) * np.std([1.000, 1.010], ddof=1)   # 0.0200
+    bed = rows[(1, "bed height [m]")]
+    check("agreement_bed_bound", bed[6] == "%.3f" % bound, f"{bed}")
+    check("agreement_bed_not_held", bed[8] is False and bed[5] == "0.025", f"{bed}")   # 0.025 > 0.020
+    check("agreement_bed_pooled_from", bed[7] == "pooled: jdem model3", f"{bed}")
+    old = rows[(2, "bed height [m]")]
+    check("agreement_older_fill_no_verdict", old[8] is None and old[4] == "—"
+          and "before the bed height" in old[7], f"{old}")
+    check("agreement_phi_held", rows[(1, "φv")][8] is True, f"{rows[(1, 'φv')]}")
+
+
 test_merge(tmp)
 test_dt_study()
+test_agreement()
 finish()
