@@ -169,7 +169,7 @@ unit: build/test_unit build/san/test_unit
 # ---------------------------------------------------------------------------------------------
 # The suites.  tests/run_tests.py runs every check and prints "N passed, N failed".
 # Both the build and the suites use every core this process may run on (CI: 2); the suites run
-# side by side, a suite with 2 MPI ranks or threads alone on 2 cores (tests/run_tests.py).
+# side by side, a suite with 2 MPI ranks alone on 2 cores (tests/run_tests.py).
 # JDEM_TEST_JOBS=N sets the cores of both.
 JDEM_TEST_JOBS ?= $(shell nproc)
 export JDEM_TEST_JOBS
