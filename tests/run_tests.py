@@ -165,6 +165,8 @@ SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py
                                 f"{PY} tests/mixing/test_outflow.py; g=$?; "
                                 f"{PY} tests/mixing/test_fill_ch5.py; h=$?; exit $((a | b | c | d | e | f | g | h))"],
             "lines", {})]
+# This runner on dummy suites: every check counted once, the 2-rank suites alone, two others at once.
+SUITES += [("runner", [PY, "tests/runner/test_run_tests.py"], "lines", {})]
 # The campaign driver (scripts/campaign.py) with dummy units, a killed run resumed.
 SUITES += [("campaign", [PY, "tests/mixing/test_campaign.py"], "lines", {})]
 # A reduced Chapter 4 fill in jdem (3 sections, 0.8 s): stream, free fall, energy, and the
@@ -244,17 +246,19 @@ def cores():
     return len(os.sched_getaffinity(0))
 
 
-def run_side_by_side(suites, jobs):
+def run_side_by_side(suites, jobs, emit=print):
     """Run the suites, each once `width` cores are free (WIDE: 2, others 1; never more than
     jobs): the wide ones first, then the LONG ones, then the rest in order, so that the one-core
-    suites fill the cores at the end.  Returns (passed, failed) summed."""
+    suites fill the cores at the end.  Each suite's lines go to emit at its end.  Returns
+    (passed, failed) summed."""
     free = [jobs]
     totals = [0, 0]
     turn = threading.Condition()
 
     def report(text):
         with turn:
-            print(text, flush=True)
+            emit(text)
+            sys.stdout.flush()
 
     def run(suite, width):
         try:
