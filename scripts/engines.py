@@ -28,8 +28,10 @@ from typing import NamedTuple
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PY = "/usr/bin/python3"
 # The builds under test: $JDEM and $LIGGGHTS_JDEM (relative to the repository root) when set, as
-# tests/run_tests.py sets JDEM for the suites of the sanitized stepper.
-JDEM = os.path.join(ROOT, os.environ.get("JDEM", os.path.join("build", "jdem")))
+# tests/run_tests.py sets JDEM for the suites of the sanitized stepper; JDEM_BUILD is the
+# optimised stepper whatever $JDEM says.
+JDEM_BUILD = os.path.join(ROOT, "build", "jdem")
+JDEM = os.path.join(ROOT, os.environ["JDEM"]) if os.environ.get("JDEM") else JDEM_BUILD
 LIGGGHTS_JDEM = os.path.join(ROOT, os.environ.get("LIGGGHTS_JDEM", os.path.join("build", "liggghts-jdem")))
 LIGGGHTS = "/usr/bin/liggghts"   # stock LIGGGHTS (Debian's), for the decks written with --builtin
 GNU_TIME = "/usr/bin/time"

@@ -246,6 +246,13 @@ def cores():
     return len(os.sched_getaffinity(0))
 
 
+def start_order(suite):
+    """The WIDE suites first, then the LONG ones longest first, then the rest (a stable sort
+    keeps their listed order)."""
+    name = suite[0]
+    return 0 if name in WIDE else 1 + LONG.index(name) if name in LONG else 1 + len(LONG)
+
+
 def run_side_by_side(suites, jobs, emit=print):
     """Run the suites, each once `width` cores are free (WIDE: 2, others 1; never more than
     jobs): the wide ones first, then the LONG ones, then the rest in order, so that the one-core
@@ -273,11 +280,7 @@ def run_side_by_side(suites, jobs, emit=print):
             turn.notify_all()
 
     threads = []
-    def rank(suite):
-        name = suite[0]
-        return 0 if name in WIDE else 1 + LONG.index(name) if name in LONG else 1 + len(LONG)
-
-    for suite in sorted(suites, key=rank):
+    for suite in sorted(suites, key=start_order):
         width = min(jobs, 2 if suite[0] in WIDE else 1)
         with turn:
             turn.wait_for(lambda: free[0] >= width)

@@ -73,15 +73,16 @@ def rows(found):
             if not (a and b):
                 continue
             for label, get, fmt in STATISTICS:
-                if get(a) is None or get(b) is None:
-                    out.append((model, p, label, "—" if get(a) is None else fmt % get(a),
-                                "—" if get(b) is None else fmt % get(b), "—", "—",
+                va, vb = get(a), get(b)
+                if va is None or vb is None:
+                    out.append((model, p, label, "—" if va is None else fmt % va,
+                                "—" if vb is None else fmt % vb, "—", "—",
                                 "computed before the bed height was kept", None))
                     continue
-                diff = abs(get(a) - get(b))
+                diff = abs(va - vb)
                 sp = spread_for(s, model, label)
                 bound = 2.0 * math.sqrt(2.0) * sp[0] if sp else None
-                out.append((model, p, label, fmt % get(a), fmt % get(b), fmt % diff,
+                out.append((model, p, label, fmt % va, fmt % vb, fmt % diff,
                             fmt % bound if sp else "—", sp[1] if sp else "no spread measured",
                             None if bound is None else diff <= bound))
     return out

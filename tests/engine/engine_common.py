@@ -18,7 +18,7 @@ SCENES = os.path.join(ROOT, "tests", "engine", "scenes")
 JDEM = engines.JDEM
 # The optimised build, for reference runs that only supply numbers to compare with (the
 # O(N^2) all-pairs list): under the sanitizers they take minutes and check no code of interest.
-JDEM_OPTIMISED = os.path.join(ROOT, "build", "jdem")
+JDEM_OPTIMISED = engines.JDEM_BUILD
 
 
 class Checks:
