@@ -9,7 +9,11 @@
  * (LAMMPS' Comm::exchange drops an atom that leaves the box through a non-periodic side; the
  * deck says `thermo_modify lost ignore` so the run goes on): the stepper deletes at its own
  * neighbour builds (stepper/domain.c), the plugin's fix at pre_exchange, which LIGGGHTS calls
- * at the same steps.  A non-finite position counts as outside.
+ * at its reneighbouring steps.  A particle fast enough to trigger a build every step (in
+ * LIGGGHTS, more than skin/2 a step) is deleted in both the step its centre crosses a face
+ * (the stepper's half skins never reach past the domain's faces, stepper/neighbour.c); a
+ * slower one when the next build comes, which may differ by a few steps between the engines.
+ * A non-finite position counts as outside.
  *
  * The energy that leaves with a particle, jd_lost_energy, is booked on the output side of the
  * balance, as the inlets' energy is booked on the input side (jd_obs_lost_energy).

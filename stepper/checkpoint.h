@@ -22,8 +22,9 @@
 
 #include "sim.h"
 
-/* The checkpoint file format this build writes and reads (attribute `format_version`). */
-#define JD_CHECKPOINT_VERSION 1
+/* The checkpoint file format this build writes and reads (attribute `format_version`); 2 added
+ * each particle's half skin (lists/half_skin). */
+#define JD_CHECKPOINT_VERSION 2
 
 /* When to write checkpoints, where, and (after a resume) what the run did before. */
 typedef struct jd_checkpointer {

@@ -83,6 +83,7 @@ static void ck_lists(ck_io *io, jd_neighbour_lists *l, unsigned features, size_t
     ck_list(io, "lists/pairs", &l->pairs, kind);
     ck_list(io, "lists/wall_pairs", &l->wall_pairs, kind);
     ck_doubles(io, "lists/x_build", 3 * n, l->x_build);
+    ck_doubles(io, "lists/half_skin", n, l->half_skin);
     ck_double(io, "lists/drift_bound", &l->drift_bound);
     ck_int64(io, "lists/n_builds", &l->n_builds);
 }

@@ -30,7 +30,6 @@ static inline int not_finite(double x) { return x - x != 0.0; }
 /* What the passes take besides the arrays, as plain values (only the arrays carry restrict). */
 typedef struct pass_consts {
     double dt;                 /* [s] */
-    double lim;                /* (skin/2)^2 [m^2]: the rebuild check */
     double g[3];               /* gravity [m/s^2], for the weight m g (s->fast.weight_in_kick) */
     double dtfm, dtirot, mass; /* every particle's, when they are uniform (s->fast.uniform_mass) */
 } pass_consts;
@@ -42,13 +41,13 @@ typedef struct pass_consts {
  * (s->lists.drift_bound). */
 enum { P_TWICE = 1, P_WEIGHT = 2, P_UNIFORM = 4, P_CHECK = 8 };
 
-/* The rebuild check of particle i: 1 when it moved more than half the skin since the last
- * neighbour build (lim = (skin/2)^2; !(<=) so that a NaN position counts as moved). */
+/* The rebuild check of particle i: 1 when it moved more than its half skin hs[i] since the
+ * last neighbour build (!(<=) so that a NaN position counts as moved). */
 static JD_ALWAYS_INLINE int
-moved_far(const double *restrict x, const double *restrict x0, long i, double lim) {
+moved_far(const double *restrict x, const double *restrict x0, const double *restrict hs, long i) {
     const double d[3] = {x[3 * i] - x0[3 * i], x[3 * i + 1] - x0[3 * i + 1],
                          x[3 * i + 2] - x0[3 * i + 2]};
-    return !(jd_dot(d, d) <= lim);
+    return !(jd_dot(d, d) <= hs[i] * hs[i]);
 }
 
 /* The particles [lo, hi) of initial_integrate, and with twice first the last step's
@@ -63,11 +62,11 @@ moved_far(const double *restrict x, const double *restrict x0, long i, double li
  * drift instead (NaN if some speed is NaN). */
 static JD_ALWAYS_INLINE int
 kick_drift_pass(long lo, long hi, double *restrict x, double *restrict v, double *restrict w,
-                const double *restrict x0, const double *restrict f, const double *restrict t,
-                const double *restrict dtfm, const double *restrict dtirot,
+                const double *restrict x0, const double *restrict hs, const double *restrict f,
+                const double *restrict t, const double *restrict dtfm, const double *restrict dtirot,
                 const double *restrict mass, const pass_consts *c, double *vmax2,
                 const int twice, const int weight, const int uniform, const int check) {
-    const double dt = c->dt, lim = c->lim, g[3] = {c->g[0], c->g[1], c->g[2]};
+    const double dt = c->dt, g[3] = {c->g[0], c->g[1], c->g[2]};
     int bad = 0, was_bad = 0, far = 0;
     int64_t vm = 0; /* the largest u2 below, as its bits: see there */
     for (long i = lo; i < hi; i++) {
@@ -90,7 +89,7 @@ kick_drift_pass(long lo, long hi, double *restrict x, double *restrict v, double
             u[k] = vn;
         }
         if (check) {
-            far |= moved_far(x, x0, i, lim);
+            far |= moved_far(x, x0, hs, i);
         } else {
             /* u2 >= +0 (or NaN), whose bits order as the numbers do: an integer maximum, which
              * GCC vectorises (a floating-point one only with -ffinite-math-only;
@@ -132,12 +131,12 @@ kick_pass(long lo, long hi, double *restrict v, double *restrict w, double *rest
  * functions with restrict arrays: inside an OpenMP region the arrays reach the loop through the
  * region's shared data, and their independence is lost. */
 static int kick_drift(int flags, long lo, long hi, double *restrict x, double *restrict v,
-                      double *restrict w, const double *restrict x0, const double *restrict f,
-                      const double *restrict t, const double *restrict dtfm,
+                      double *restrict w, const double *restrict x0, const double *restrict hs,
+                      const double *restrict f, const double *restrict t, const double *restrict dtfm,
                       const double *restrict dtirot, const double *restrict mass,
                       const pass_consts *c, double *vmax2) {
 #define JD_KICK_DRIFT(tw, we, un, ch) \
-    kick_drift_pass(lo, hi, x, v, w, x0, f, t, dtfm, dtirot, mass, c, vmax2, tw, we, un, ch)
+    kick_drift_pass(lo, hi, x, v, w, x0, hs, f, t, dtfm, dtirot, mass, c, vmax2, tw, we, un, ch)
     switch (flags) {
     case 0: return JD_KICK_DRIFT(0, 0, 0, 0);
     case P_UNIFORM: return JD_KICK_DRIFT(0, 0, 1, 0);
@@ -158,9 +157,9 @@ static int kick_drift(int flags, long lo, long hi, double *restrict x, double *r
 /* The rebuild check alone over [lo, hi): 1 when some particle moved more than half the skin
  * since the last neighbour build. */
 static int far_check(long lo, long hi, const double *restrict x, const double *restrict x0,
-                     double lim) {
+                     const double *restrict hs) {
     int far = 0;
-    for (long i = lo; i < hi; i++) far |= moved_far(x, x0, i, lim);
+    for (long i = lo; i < hi; i++) far |= moved_far(x, x0, hs, i);
     return far;
 }
 
@@ -178,9 +177,8 @@ static int kick(int flags, long lo, long hi, double *restrict v, double *restric
 }
 
 static pass_consts consts_of(const jd_particles *ps, const jd_run_constants *run,
-                             const jd_fast_paths *fast, double skin) {
-    pass_consts c = {.dt = run->dt, .lim = 0.25 * skin * skin,
-                     .g = {run->g[0], run->g[1], run->g[2]}};
+                             const jd_fast_paths *fast) {
+    pass_consts c = {.dt = run->dt, .g = {run->g[0], run->g[1], run->g[2]}};
     if (fast->uniform_mass) {
         c.dtfm = ps->dtfm[0];
         c.dtirot = ps->dtirot[0];
@@ -227,7 +225,7 @@ static int initial_integrate(jd_particles *ps, jd_neighbour_lists *lists,
                              const jd_run_constants *run, const jd_fast_paths *fast,
                              const jd_thread_layout *threads, int pending, int plain,
                              int *moved) {
-    const pass_consts c = consts_of(ps, run, fast, lists->skin);
+    const pass_consts c = consts_of(ps, run, fast);
     const double safe = JD_DRIFT_SAFE * 0.5 * lists->skin;
     const int check = plain || !(lists->drift_bound <= safe); /* plain: the reference */
     const int flags = (pending ? P_TWICE : 0) | (pending && fast->weight_in_kick ? P_WEIGHT : 0) |
@@ -239,7 +237,7 @@ static int initial_integrate(jd_particles *ps, jd_neighbour_lists *lists,
         long lo, hi;
         double vm = 0.0;
         share((long)ps->n, &lo, &hi);
-        bits |= kick_drift(flags, lo, hi, ps->x, ps->v, ps->omega, lists->x_build, ps->f, ps->torque,
+        bits |= kick_drift(flags, lo, hi, ps->x, ps->v, ps->omega, lists->x_build, lists->half_skin, ps->f, ps->torque,
                            ps->dtfm, ps->dtirot, ps->mass, &c, &vm);
         if (vm > vmax2) vmax2 = vm;
     }
@@ -251,7 +249,7 @@ static int initial_integrate(jd_particles *ps, jd_neighbour_lists *lists,
             {
                 long lo, hi;
                 share((long)ps->n, &lo, &hi);
-                far |= far_check(lo, hi, ps->x, lists->x_build, c.lim);
+                far |= far_check(lo, hi, ps->x, lists->x_build, lists->half_skin);
             }
             bits |= far << 1;
         }
@@ -265,7 +263,7 @@ static int initial_integrate(jd_particles *ps, jd_neighbour_lists *lists,
  * s->fast.weight_in_kick the weight is added to it here, and kept. */
 static int final_integrate(jd_particles *ps, const jd_run_constants *run,
                            const jd_fast_paths *fast, const jd_thread_layout *threads) {
-    const pass_consts c = consts_of(ps, run, fast, 0.0);
+    const pass_consts c = consts_of(ps, run, fast);
     const int flags = (fast->weight_in_kick ? P_WEIGHT : 0) | (fast->uniform_mass ? P_UNIFORM : 0);
     int bad = 0;
 #pragma omp parallel num_threads(threads->n) if (threads->n > 1) reduction(| : bad)

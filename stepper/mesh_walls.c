@@ -222,9 +222,9 @@ static int particle_candidates(jd_mesh_walls *mw, const jd_sim_mesh *m, const do
     return 0;
 }
 
-/* Every triangle within R + skin of each particle's position at the last neighbour build,
- * ascending per particle and mesh; particles left without candidates lose their history (they
- * cannot touch the mesh before the next build). */
+/* Every triangle within R + skin/2 + its half skin of each particle's position at the last
+ * neighbour build, ascending per particle and mesh; particles left without candidates lose
+ * their history (they cannot touch the mesh before the next build). */
 static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
     const jd_particles *ps = &s->particles;
     const size_t np = ps->n;
@@ -232,10 +232,11 @@ static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
     mw->cand_start = malloc((mw->n * (np + 1)) * sizeof *mw->cand_start);
     if (!mw->cand_start) return -1;
     size_t at = 0, widest = 1, n_orig = 0;
-    double r_max = 0.0;
+    const double h0 = 0.5 * s->lists.skin, *hs = s->lists.half_skin;
+    double reach_max = 0.0; /* the largest radius + skin/2 + half skin */
     for (size_t i = 0; i < np; i++) {
         if ((size_t)ps->orig[i] + 1 > n_orig) n_orig = (size_t)ps->orig[i] + 1;
-        r_max = fmax(r_max, ps->radius[i]);
+        reach_max = fmax(reach_max, ps->radius[i] + (h0 + hs[i]));
     }
     for (size_t k = 0; k < mw->n; k++) {
         jd_sim_mesh *m = &mw->mesh[k];
@@ -244,11 +245,11 @@ static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
         if (m->corner_at_build) memcpy(m->corner_at_build, m->corner, m->topo.ntri * sizeof *m->corner);
         if (!s->opt.allpairs &&
             sim_mesh_cells_build(&mw->cells, m->topo.ntri, (const double(*)[3][3])m->corner,
-                                 r_max + s->lists.skin) != 0)
+                                 reach_max) != 0)
             return -1;
         for (size_t i = 0; i < np; i++) {
             start[i] = at;
-            if (particle_candidates(mw, m, s->lists.x_build + 3 * i, ps->radius[i] + s->lists.skin,
+            if (particle_candidates(mw, m, s->lists.x_build + 3 * i, ps->radius[i] + (h0 + hs[i]),
                                     s->opt.allpairs, &at) != 0)
                 return -1;
             if (at == start[i]) history_drop(mw, &m->hist, (size_t)ps->orig[i], s->run.features);

@@ -14,11 +14,12 @@
  *
  * A moving mesh moves its corners in the drift, as fix move/mesh does in LIGGGHTS' initial
  * integration, and rebuilds its topology from them (the vertex and edge ids follow the
- * coordinates, as the plugin's do).  Its candidates hold every triangle within R + skin of
- * each particle's position at the last neighbour build, from the triangles where they were at
- * the candidates' build: they are rebuilt with the neighbour list, and in between once some
- * corner has moved more than skin / 2 since (the particle has moved at most skin / 2 since
- * the neighbour build, so a triangle within R now was within R + skin then).
+ * coordinates, as the plugin's do).  Its candidates hold every triangle within R + skin/2 + h
+ * of each particle's position at the last neighbour build (h its own half skin, neighbour.c),
+ * from the triangles where they were at the candidates' build: they are rebuilt with the
+ * neighbour list, and in between once some corner has moved more than skin / 2 since (the
+ * particle has moved at most h since the neighbour build, so a triangle within R now was
+ * within R + skin/2 + h then).
  */
 #ifndef JDEM_MESH_WALLS_H
 #define JDEM_MESH_WALLS_H
@@ -55,7 +56,8 @@ typedef struct jd_sim_mesh {
 } jd_sim_mesh;
 
 /* All mesh walls of a run, and each particle's candidate triangles since the last neighbour
- * build (every triangle within R + skin of the particle's position at the build). */
+ * build (every triangle within R + skin/2 + its half skin of the particle's position at the
+ * build). */
 typedef struct jd_mesh_walls {
     size_t n;
     jd_sim_mesh *mesh;

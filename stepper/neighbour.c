@@ -1,11 +1,14 @@
 /*
  * neighbour.c — contact candidates.
  *
- * A cell list (cell edge >= 2 R_max + skin) yields a half Verlet list of the pairs i < j whose
- * surfaces are closer than the skin, and a list of (particle, wall) candidates within the skin
- * of a wall.  The lists are rebuilt only when some particle, or some wall, has moved more than
- * skin/2 since the last build: then no pair can have closed a gap of one skin in between, so no
- * contact is missed.  (The particles' displacement is checked in the drift, integrate.c.)
+ * A cell list (cell edge >= twice the largest radius + half skin) yields a half Verlet list of
+ * the pairs i < j whose surfaces are closer than the sum of their half skins, and a list of
+ * (particle, wall) candidates closer to a wall than the particle's half skin and the wall's
+ * (skin/2).  Each particle has a half skin of its own, skin/2 or more for a fast one
+ * (set_half_skins).  The lists are rebuilt only when some particle has moved more than its
+ * half skin, or some wall more than skin/2, since the last build: then no pair can have closed
+ * its gap in between, so no contact is missed.  (The particles' displacement is checked in the
+ * drift, integrate.c.)
  *
  * Both lists are sorted by (i, j), which fixes the force summation order (deterministic) and
  * lets the contact history be carried over to a new list by one merge of the two sorted lists.
@@ -165,10 +168,11 @@ static void carry_over(jd_accounts *accounts, const jd_contact_list *old, jd_con
     for (; q < old->n; q++) drop_entry(accounts, old, q);
 }
 
-/* Can particle i touch wall w before the next rebuild (relative motion <= skin)? */
-static int wall_candidate(const jd_sim_wall *w, const double *x, double R, double skin) {
-    return w->type == JD_WALL_PLANE ? jd_geom_plane_near(&w->plane, x, R, skin)
-                                    : jd_geom_cylinder_near(&w->cyl, x, R, skin);
+/* Can particle i touch wall w before the next rebuild: is it within margin (its half skin and
+ * the wall's) of the wall? */
+static int wall_candidate(const jd_sim_wall *w, const double *x, double R, double margin) {
+    return w->type == JD_WALL_PLANE ? jd_geom_plane_near(&w->plane, x, R, margin)
+                                    : jd_geom_cylinder_near(&w->cyl, x, R, margin);
 }
 
 /* The kind of list the run's history needs. */
@@ -309,10 +313,10 @@ static int core_box(const jd_particles *ps, double lo[3], double hi[3]) {
  * range; over the core box (core_box) instead if the whole box would need more than about 8
  * cells per particle and the core box would not; the edge grown if even that needs more
  * (sparse or scattered systems).  Fails on a non-finite position or out of memory. */
-static int cell_grid(const jd_particles *ps, double skin, int64_t step, double *h_out, double lo[3],
-                     int nc[3], char *err, size_t errlen) {
+static int cell_grid(const jd_particles *ps, const double *hs, int64_t step, double *h_out,
+                     double lo[3], int nc[3], char *err, size_t errlen) {
     double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    double rmax = 0.0;
+    double reach = 0.0; /* the largest radius + half skin */
     for (int d = 0; d < 3; d++) lo[d] = INFINITY;
     for (size_t i = 0; i < ps->n; i++) {
         for (int d = 0; d < 3; d++) {
@@ -322,12 +326,13 @@ static int cell_grid(const jd_particles *ps, double skin, int64_t step, double *
                          sim_particle_id(ps, i), (long long)step);
                 return -1;
             }
-            lo[d] = fmin(lo[d], xd);
-            hi[d] = fmax(hi[d], xd);
+            lo[d] = xd < lo[d] ? xd : lo[d]; /* not fmin: a call into libm at every build */
+            hi[d] = xd > hi[d] ? xd : hi[d];
         }
-        rmax = fmax(rmax, ps->radius[i]);
+        const double ri = ps->radius[i] + hs[i];
+        reach = ri > reach ? ri : reach;
     }
-    double h = 2.0 * rmax + skin;
+    double h = 2.0 * reach;
     const double max_cells = 8.0 * (double)ps->n + 64.0;
     double cells = grid_cells(lo, hi, h);
     if (cells > max_cells && ps->n >= JD_GRID_TRIM_MIN_N) {
@@ -356,7 +361,7 @@ static int cell_grid(const jd_particles *ps, double skin, int64_t step, double *
 static int sort_into_cells(jd_sim *s, char *err, size_t errlen) {
     double h, lo[3];
     int nc[3], ax[3];
-    if (cell_grid(&s->particles, s->lists.skin, s->step, &h, lo, nc, err, errlen) != 0) return -1;
+    if (cell_grid(&s->particles, s->lists.half_skin, s->step, &h, lo, nc, err, errlen) != 0) return -1;
     cell_axes(nc, ax);
     if (bin_particles(&s->lists, &s->particles, h, lo, nc, ax) != 0) {
         snprintf(err, errlen, "out of memory sorting %zu particles", s->particles.n);
@@ -381,21 +386,21 @@ static int part_room(jd_pair_part *p) {
 }
 
 /* Push the pairs (i, j) of the partners j > i at [q0, q1) of the cell arrays whose surfaces are
- * closer than the skin into part p: j = items[q], or j = q when items is NULL (particles
+ * closer than the sum of their half skins into part p: j = items[q], or j = q when items is NULL (particles
  * numbered in cell order).  The tests of a block of JD_NEAR_BLOCK partners first, in SIMD
  * lanes, then the pushes in order. */
 #define JD_NEAR_BLOCK 32
-static int push_near(const jd_particles *ps, double skin, size_t i, const int32_t *items,
-                     int32_t q0, int32_t q1, jd_pair_part *p) {
+static int push_near(const jd_particles *ps, const double *restrict hs, size_t i,
+                     const int32_t *items, int32_t q0, int32_t q1, jd_pair_part *p) {
     const double *restrict x = ps->x, *restrict rad = ps->radius;
-    const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i];
+    const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i] + hs[i];
     for (int32_t b = q0; b < q1; b += JD_NEAR_BLOCK) {
         const int nb = q1 - b < JD_NEAR_BLOCK ? (int)(q1 - b) : JD_NEAR_BLOCK;
         int near[JD_NEAR_BLOCK];
         for (int k = 0; k < nb; k++) {
             const size_t j = (size_t)(items ? items[b + k] : b + k);
             const double d0 = x[3 * j] - xi0, d1 = x[3 * j + 1] - xi1, d2 = x[3 * j + 2] - xi2;
-            const double range = ri + rad[j] + skin;
+            const double range = ri + (rad[j] + hs[j]);
             near[k] = j > i && d0 * d0 + d1 * d1 + d2 * d2 < range * range;
         }
         for (int k = 0; k < nb; k++) {
@@ -416,7 +421,7 @@ typedef struct cell_search {
     int sorted;  /* particles numbered in cell order (sort_into_cells) */
 } cell_search;
 
-/* Particle i's pairs (i, j > i) within the skin into part p, sorted by j: the 9 rows of cells
+/* Particle i's pairs (i, j > i) within their half skins into part p, sorted by j: the 9 rows of cells
  * around i's cell, each one run of the cell arrays (its three cells along the fast axis).
  * With the particles in cell order that run is the partners themselves, and those before i + 1
  * are skipped unread; the entries are the same either way. */
@@ -445,8 +450,8 @@ static int pairs_of(const void *ctx, size_t i, jd_pair_part *p) {
             int32_t q0 = lists->cell_start[row];
             const int32_t q1 = lists->cell_start[end];
             if (g->sorted && q0 <= (int32_t)i) q0 = (int32_t)i + 1;
-            if (q0 < q1 && push_near(ps, lists->skin, i, g->sorted ? NULL : lists->cell_items, q0,
-                                     q1, p) != 0)
+            if (q0 < q1 && push_near(ps, lists->half_skin, i, g->sorted ? NULL : lists->cell_items,
+                                     q0, q1, p) != 0)
                 return -1;
         }
     }
@@ -458,16 +463,18 @@ static int pairs_of(const void *ctx, size_t i, jd_pair_part *p) {
 typedef struct wall_search {
     const jd_particles *ps;
     const jd_walls *walls;
-    double skin;  /* [m] */
-    int allpairs; /* every particle with every wall */
+    double skin;      /* [m] the walls' skin (the run's) */
+    const double *hs; /* [m] each particle's half skin */
+    int allpairs;     /* every particle with every wall */
 } wall_search;
 
-/* Particle i's (particle, wall) candidates within the skin into part p, by wall. */
+/* Particle i's (particle, wall) candidates within the skins into part p, by wall. */
 static int walls_of(const void *ctx, size_t i, jd_pair_part *p) {
     const wall_search *q = ctx;
     for (size_t w = 0; w < q->walls->n; w++) {
         if (!q->allpairs &&
-            !wall_candidate(&q->walls->wall[w], q->ps->x + 3 * i, q->ps->radius[i], q->skin))
+            !wall_candidate(&q->walls->wall[w], q->ps->x + 3 * i, q->ps->radius[i],
+                            0.5 * q->skin + q->hs[i]))
             continue;
         if (part_room(p) != 0) return -1;
         p->i[p->n] = (int32_t)i;
@@ -528,7 +535,7 @@ void sim_neighbour_parts_free(jd_neighbour_lists *lists) {
     lists->n_parts = 0;
 }
 
-/* The pairs within the skin, from the cell grid (lists' cell arrays), into l, on `threads`
+/* The pairs within their half skins, from the cell grid (lists' cell arrays), into l, on `threads`
  * threads (build_in_parts); step: for a message; sorted: the particles are numbered in the
  * grid's cell order (sort_into_cells). */
 static int build_pair_list_cells(const jd_particles *ps, jd_neighbour_lists *lists, unsigned kind,
@@ -537,7 +544,7 @@ static int build_pair_list_cells(const jd_particles *ps, jd_neighbour_lists *lis
     if (ps->n < 2) return 0;
     double h, lo[3];
     cell_search g = {.ps = ps, .lists = lists, .sorted = sorted};
-    if (cell_grid(ps, lists->skin, step, &h, lo, g.nc, err, errlen) != 0) return -1;
+    if (cell_grid(ps, lists->half_skin, step, &h, lo, g.nc, err, errlen) != 0) return -1;
     cell_axes(g.nc, g.ax);
     if (bin_particles(lists, ps, h, lo, g.nc, g.ax) != 0 ||
         build_in_parts(lists, ps->n, threads, pairs_of, &g, kind, l) != 0) {
@@ -557,7 +564,43 @@ static int build_pair_list_all(size_t n, unsigned kind, jd_contact_list *l) {
 /* Build a new list into `spare`, carry the history over, swap.  The spares keep their buffers
  * between builds, and the pair spare is reserved at once for the last list and an eighth more,
  * so a build reallocates only when the list grows by more than that. */
+/* The distance from x to the nearest face of the domain [lo, hi) [m] (0 outside). */
+static double domain_clearance(const double lo[3], const double hi[3], const double *x) {
+    double d = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        const double a = x[k] - lo[k], b = hi[k] - x[k];
+        d = a < d ? a : d;
+        d = b < d ? b : d;
+    }
+    return d > 0.0 ? d : 0.0;
+}
+
+/* Each particle's half skin for the lists about to be built: skin/2, or, for a particle that
+ * would cross that in fewer than skin_steps steps at its speed now, the distance it crosses in
+ * skin_steps steps, up to its radius and, with a domain, up to its distance from the domain's
+ * faces.  A particle triggers the next build when it has moved its own half skin (integrate.c),
+ * and a pair is a candidate while its gap is within the sum of the two half skins, so no
+ * contact is missed; a falling stream no longer rebuilds every list every few steps, and a bed
+ * at rest keeps its short list (docs/performance.md).  The domain's bound keeps the deletions
+ * where they were with one skin (stepper/domain.c deletes at builds): a fast particle that
+ * leaves across a face triggers a build at the step its centre crosses it. */
+static void set_half_skins(jd_neighbour_lists *lists, const jd_particles *ps, const jd_scene *sc,
+                           double dt) {
+    const double h0 = 0.5 * lists->skin, reach = (double)lists->skin_steps * dt;
+    for (size_t i = 0; i < ps->n; i++) {
+        const double *v = ps->v + 3 * i;
+        double h = reach * sqrt(jd_dot(v, v));
+        h = h < ps->radius[i] ? h : ps->radius[i];
+        if (sc->has_domain && h > h0) {
+            const double c = domain_clearance(sc->domain_lo, sc->domain_hi, ps->x + 3 * i);
+            h = h < c ? h : c;
+        }
+        lists->half_skin[i] = h > h0 ? h : h0;
+    }
+}
+
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
+    set_half_skins(&s->lists, &s->particles, s->run.scene, s->run.dt);
     const int sorted = !s->opt.allpairs && !s->opt.no_sort && s->particles.n > 1;
     if (sorted && sort_into_cells(s, err, errlen) != 0) return -1;
     const unsigned kind = list_kind(s->run.features);
@@ -590,7 +633,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
     jd_contact_list *wn = &s->lists.wall_spare;
     wn->n = 0;
     const wall_search ws = {.ps = &s->particles, .walls = &s->walls, .skin = s->lists.skin,
-                            .allpairs = s->opt.allpairs};
+                            .hs = s->lists.half_skin, .allpairs = s->opt.allpairs};
     if (s->walls.n &&
         build_in_parts(&s->lists, s->particles.n, s->threads.n, walls_of, &ws, kind, wn) != 0) {
         snprintf(err, errlen, "out of memory building the wall candidate list");

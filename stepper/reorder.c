@@ -123,7 +123,8 @@ int sim_reorder(jd_sim *s, const int32_t *old_of_new, char *err, size_t errlen) 
     double *const vec[] = {ps->x, ps->v, ps->omega, ps->f, ps->torque, lists->x_build};
     for (size_t k = 0; k < sizeof vec / sizeof *vec; k++)
         gather_doubles(vec[k], 3, old_of_new, n, ps->scratch);
-    double *const per[] = {ps->radius, ps->mass, ps->inertia, ps->kp, ps->kw, ps->dtfm, ps->dtirot};
+    double *const per[] = {ps->radius, ps->mass, ps->inertia, ps->kp, ps->kw, ps->dtfm, ps->dtirot,
+                           lists->half_skin};
     for (size_t k = 0; k < sizeof per / sizeof *per; k++)
         gather_doubles(per[k], 1, old_of_new, n, ps->scratch);
     int32_t *iscratch = (int32_t *)ps->scratch; /* 3n doubles hold n int32 */

@@ -22,7 +22,7 @@ static const char *const TOP_KEYS[] = {"jdem_scene", "name", "case", "descriptio
                                        "output", "gravity", "model", "materials", "interactions",
                                        "particles", "generate", "walls", "watchdog", "sweep",
                                        "bond_types", "bonds", "bond_rules", "particles_from",
-                                       "inlets", "domain", NULL};
+                                       "inlets", "domain", "neighbour", NULL};
 static const char *const DOMAIN_KEYS[] = {"lo", "hi", NULL};
 static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_speed",
                                          "coordination_number", NULL};
@@ -30,6 +30,7 @@ static const char *const OUTPUT_KEYS[] = {"every", "observables_every", "compare
                                           "energy", NULL};
 static const char *const MODEL_KEYS[] = {"wall_rule", "damping", "tangential_limit", "mu_r",
                                          "tangential_stiffness", NULL};
+static const char *const NEIGHBOUR_KEYS[] = {"skin_steps", NULL};
 static const char *const WATCHDOG_KEYS[] = {"enabled", "max_overlap_fraction", "max_energy_jump",
                                             NULL};
 
@@ -233,6 +234,15 @@ static int read_watchdog(loader *L) {
            sd_opt_num(&L->c, m, "watchdog", "max_energy_jump", SD_POSITIVE, &w->max_energy_jump);
 }
 
+/* Default 20 steps: a falling stream's lists are rebuilt about every 20 steps instead of every
+ * few, and the pairs of its fast particles grow by a few per cent (docs/performance.md). */
+static int read_neighbour(loader *L) {
+    int rc;
+    const yaml_node_t *m = section(L, "neighbour", NEIGHBOUR_KEYS, &rc);
+    L->s->skin_steps = 20;
+    return rc || scene_opt_int(L, m, "neighbour", "skin_steps", 0, &L->s->skin_steps);
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* Default max_impact_speed                                                                  */
 
@@ -385,7 +395,7 @@ static int read_scene(loader *L) {
     if (sd_keys(&L->c, L->root, NULL, TOP_KEYS) || read_header(L) || read_time(L) ||
         read_output(L) || sd_opt_vec3(&L->c, L->root, NULL, "gravity", s->gravity) ||
         read_domain(L) ||
-        read_model(L) || read_watchdog(L) || scene_read_materials(L) ||
+        read_model(L) || read_watchdog(L) || read_neighbour(L) || scene_read_materials(L) ||
         scene_read_bond_types(L) || scene_read_particles(L) || scene_read_generators(L) ||
         scene_read_deposits(L) ||
         scene_read_inlets(L) || scene_read_walls(L) || scene_read_bonds(L))

@@ -176,6 +176,11 @@ typedef struct jd_scene {
 
     jd_watchdog_limits watchdog;
 
+    /* neighbour lists (docs/scenes.md "Neighbour lists") */
+    int64_t skin_steps;       /* a particle gets a half skin of what it crosses in this many
+                                 steps, if that is more than skin/2 (up to its radius); 0: the
+                                 common skin for all */
+
     /* model options (kernel enums) */
     int wall_rule;            /* jd_wall_rule */
     int damping_map;          /* jd_damping_map */

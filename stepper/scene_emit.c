@@ -148,7 +148,8 @@ static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
            key_str(e, "damping", DAMPING_MAPS[s->damping_map]) ||
            key_str(e, "tangential_limit", XI_LIMITS[s->xi_limit]) || key_num(e, "mu_r", s->mu_r) ||
            key_str(e, "tangential_stiffness", TANGENTIAL_RULES[s->tangential_rule]) ||
-           map_end(e) || emit_watchdog(e, &s->watchdog);
+           map_end(e) || emit_watchdog(e, &s->watchdog) || str(e, "neighbour") ||
+           map_start(e, 0) || key_int(e, "skin_steps", s->skin_steps) || map_end(e);
 }
 
 static int emit_material(yaml_emitter_t *e, const jd_material *m) {

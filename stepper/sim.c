@@ -128,6 +128,7 @@ static size_t carve(jd_sim *s, size_t n, char *block) {
     s->particles.kp = slice(block, &at, n * sizeof *s->particles.kp);
     s->particles.kw = slice(block, &at, n * sizeof *s->particles.kw);
     s->lists.x_build = slice(block, &at, 3 * n * sizeof *s->lists.x_build);
+    s->lists.half_skin = slice(block, &at, n * sizeof *s->lists.half_skin);
     s->particles.scratch = slice(block, &at, 3 * n * sizeof *s->particles.scratch);
     s->particles.species = slice(block, &at, n * sizeof *s->particles.species);
     s->particles.orig = slice(block, &at, n * sizeof *s->particles.orig);
@@ -188,6 +189,7 @@ static int init_particles(jd_sim *s, char *err, size_t errlen) {
      * of a dense packing, and a rebuild is due only after some particle moved 5 % of a
      * diameter (~100 steps at typical granular speeds and time steps). */
     s->lists.skin = 0.2 * rmax;
+    s->lists.skin_steps = sc->skin_steps;
     return 0;
 oom:
     snprintf(err, errlen, "out of memory for %zu particles", n1);
@@ -317,6 +319,7 @@ static size_t list_bytes(const jd_contact_list *l) {
 
 size_t sim_memory_bytes(const jd_sim *s) {
     const size_t per_particle = 6 * 3 * sizeof(double) /* x v omega f torque x_build */ +
+                                sizeof(double) /* half_skin */ +
                                 3 * sizeof(double) /* scratch */ + 7 * sizeof(double) /* constants */ +
                                 4 * sizeof(int32_t) /* species orig cell_of cell_items */;
     const jd_thread_layout *th = &s->threads;

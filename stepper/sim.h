@@ -194,7 +194,7 @@ typedef struct jd_overlap_trip {
 } jd_overlap_trip;
 
 /* The particles: their state and per-particle constants.  The arrays (and the neighbour
- * search's x_build, cell_of, cell_items) are slices of one block (sim.c, hugepages.h); with
+ * search's x_build, half_skin, cell_of, cell_items) are slices of one block (sim.c, hugepages.h); with
  * conveyor inlets they have room for every particle the run can hold, and n counts the active
  * prefix. */
 typedef struct jd_particles {
@@ -273,6 +273,9 @@ typedef struct jd_neighbour_lists {
     jd_contact_list spare, wall_spare;
     double skin;       /* [m] */
     double *x_build;   /* positions at the last build, 3n [m] */
+    double *half_skin; /* [m] each particle's half skin, set at every build (neighbour.c,
+                          set_half_skins): skin/2, or more for a fast particle */
+    int64_t skin_steps; /* the scene's neighbour.skin_steps (set_half_skins) */
     double drift_bound; /* [m] the sum, over the steps since the last neighbour build, of dt
                            times the largest speed: no particle has moved further (integrate.c,
                            the rebuild check) */

@@ -4,7 +4,8 @@ tests/checkpoint/compare_h5.py), on 1 and 2 threads, for a settling bed with wal
 and rolling, a servo compression, an inlet stream, a bonded beam and an inlet of bonded blocks
 (the checkpoint between two copies' insertions), a bed in a turning meshed drum and spheres
 on a meshed conveyor (the mesh's moved corners, its contact history and candidates), spheres
-leaving the domain (the shrinking set, its bonds and loads); SIGTERM writes a
+leaving the domain (the shrinking set, its bonds and loads), spheres raining onto a bed (each
+particle's half skin); SIGTERM writes a
 checkpoint and exits 143; bad checkpoints are refused with their messages; a failed
 checkpoint write keeps the previous checkpoint and stops the run (exit 3)."""
 import math
@@ -37,6 +38,8 @@ CASES = [  # scene, case, checkpoint every N steps
     ("tests/inlet/bonded_section.yaml", None, 2500),
     # a checkpoint between deletions outside the domain (steps 47, 124 and 200)
     ("tests/engine/scenes/domain_exit.yaml", None, 100),
+    # a checkpoint mid-rain, the falling spheres' half skins 4.5 x the bed's
+    ("tests/engine/scenes/shower.yaml", None, 1100),
 ]
 
 

@@ -141,26 +141,36 @@ plain, plain_builds, _ = run_file(base, "--plain-loops")
 # could have moved half the skin (integrate.c, drift_bound): the rebuilds must be the same
 c.check("batched_vs_plain_same_rebuilds", srt_builds == plain_builds,
         f"{srt_builds} neighbour builds against {plain_builds} with the check at every step")
-# Two spheres in free flight, each 0.63 of the skin per step (skin 0.2 R, sim.c): every step
-# must rebuild, also the first step after a build, where the fast check's bound jumps past its
-# mark in one step and the exact test decides on its own (integrate.c, far_check).
+# Two spheres in free flight, each 0.63 of the skin per step (skin 0.2 R, sim.c), with one skin
+# for all: every step must rebuild, also the first step after a build, where the fast check's
+# bound jumps past its mark in one step and the exact test decides on its own (integrate.c,
+# far_check).  With their own half skins (neighbour.skin_steps, docs/scenes.md "Neighbour
+# lists"), 20 steps' flight capped at the radius, they rebuild once they have flown one radius:
+# every ceil(R / (v dt)) = 8 steps.
 STEPS_FAST = 40
-fast = variant(f"""jdem_scene: 1
+FAST_FLIGHT = """jdem_scene: 1
 name: fast_flight
 description: two spheres each moving more than half the skin per step
-time: {{dt: 1.4e-5, steps: {STEPS_FAST}}}
-output: {{every: {STEPS_FAST}}}
+time: {{dt: 1.4e-5, steps: {steps}}}
+output: {{every: {steps}}}
+neighbour: {{skin_steps: {skin_steps}}}
 materials:
   soft: {{youngs_modulus: 1.0e5, poisson_ratio: 0.3, density: 2500, restitution: 0.5, friction: 0.5}}
 particles:
   - {{material: soft, radius: 0.001, position: [0, 0, 0], velocity: [9.0, 0.0, 0.0]}}
   - {{material: soft, radius: 0.001, position: [0.0, 0.01, 0.0], velocity: [-9.0, 0.0, 0.0]}}
-""", "fast_flight")
+"""
 assert 9.0 * 1.4e-5 > 0.5 * 0.2 * 0.001
-_, fast_builds, _ = run_file(fast)
+_, fast_builds, _ = run_file(variant(FAST_FLIGHT.format(steps=STEPS_FAST, skin_steps=0), "fast_flight"))
 c.check("fast_flight_rebuilds_every_step", fast_builds == STEPS_FAST + 1,
         f"{fast_builds} neighbour builds in {STEPS_FAST} steps of 0.63 skin each (expected "
         f"{STEPS_FAST + 1}: the set-up build and one per step)")
+own_every = math.ceil(0.001 / (9.0 * 1.4e-5))
+assert 20 * 9.0 * 1.4e-5 > 0.001 and own_every == 8
+_, own_builds, _ = run_file(variant(FAST_FLIGHT.format(steps=STEPS_FAST, skin_steps=20), "fast_flight_own"))
+c.check("fast_flight_own_skins_rebuild_every_radius", own_builds == 1 + STEPS_FAST // own_every,
+        f"{own_builds} neighbour builds in {STEPS_FAST} steps (expected {1 + STEPS_FAST // own_every}: the "
+        f"set-up build and one every {own_every} steps, when a sphere has flown its radius)")
 c.check("batched_vs_plain_loops_identical", identical(srt, plain),
         "the SIMD-batched force loops differ from the one-contact-at-a-time loops: position "
         f"{rel_diff(srt, plain, 'position'):.3g}")
