@@ -243,7 +243,8 @@ static inline void jd_geom_wall_material(const unsigned features, jd_contact_geo
  * sphere and the wall have moved by at most `margin` [m] relative to each other?  The contact
  * tests above (jd_geom_plane, jd_geom_cylinder) with every distance widened by the margin, so
  * they hold for every sphere that touches the wall now or can touch it within that motion.  Both
- * engines keep the spheres for which they hold at a neighbour rebuild (margin: the skin) and
+ * engines keep the spheres for which they hold at a neighbour rebuild (margin: the skin; the
+ * stepper's, skin/2 + the particle's own half skin) and
  * evaluate only those until the next rebuild.  Return 1 or 0. */
 static inline int jd_geom_plane_near(const jd_plane *w, const double x[3], double R,
                                      double margin) {

@@ -56,7 +56,7 @@ moved_far(const double *restrict x, const double *restrict x0, const double *res
  * are those of kick then the single kick and drift, bit for bit; so is the weight, f + m g,
  * the sum the force evaluation would have stored (forces.c, sim_gravity).  The force with its
  * weight is not stored: nothing looks at it before the next evaluation zeroes it.  Returns
- * bit 0: some new x is not finite; bit 1 (check): some particle moved more than half the skin
+ * bit 0: some new x is not finite; bit 1 (check): some particle moved more than its half skin
  * since the last neighbour build; bit 2 (twice): some v or omega after the first half kick, the
  * last step's state, is not finite.  Without check, *vmax2 is the largest squared speed of the
  * drift instead (NaN if some speed is NaN). */
@@ -154,7 +154,7 @@ static int kick_drift(int flags, long lo, long hi, double *restrict x, double *r
 #undef JD_KICK_DRIFT
 }
 
-/* The rebuild check alone over [lo, hi): 1 when some particle moved more than half the skin
+/* The rebuild check alone over [lo, hi): 1 when some particle moved more than its half skin
  * since the last neighbour build. */
 static int far_check(long lo, long hi, const double *restrict x, const double *restrict x0,
                      const double *restrict hs) {
@@ -198,8 +198,9 @@ static void share(long n, long *lo, long *hi) {
     *hi = n * (tid + 1) / nt;
 }
 
-/* While s->lists.drift_bound is at most this fraction of half the skin, no particle can have moved
- * half the skin since the last build, and the passes need not read x_build. */
+/* While s->lists.drift_bound is at most this fraction of half the common skin, no particle can
+ * have moved its own half skin (never less, neighbour.c set_half_skins) since the last build,
+ * and the passes need not read x_build. */
 #define JD_DRIFT_SAFE 0.5
 
 /* initial_integrate: v += (0.5 dt/m) f; omega += (0.5 dt/0.4)/(r r m) torque; x += dt v.
@@ -209,11 +210,12 @@ static void share(long n, long *lo, long *hi) {
  * applies the last step's final half kick (kick_drift with P_TWICE), with the weight if the
  * force evaluation left it out.
  *
- * The rebuild check (LIGGGHTS' `neigh_modify check yes`): *moved when some particle moved more
- * than half the skin since the last neighbour build.  Exactly that test decides, but it reads
- * x_build, a stream as large as x; so while the sum over the steps of dt times the largest
- * speed (s->lists.drift_bound, which no particle's displacement can exceed) stays within
- * JD_DRIFT_SAFE of half the skin, the pass only finds the largest speed, and on the step the
+ * The rebuild check (LIGGGHTS' `neigh_modify check yes`, each particle against its own half
+ * skin, lists.half_skin): *moved when some particle moved more than its half skin since the
+ * last neighbour build.  Exactly that test decides, but it reads x_build, a stream as large as
+ * x; so while the sum over the steps of dt times the largest speed (s->lists.drift_bound, which
+ * no particle's displacement can exceed) stays within JD_DRIFT_SAFE of half the common skin
+ * (no half skin is smaller), the pass only finds the largest speed, and on the step the
  * sum passes that mark the exact test runs on its own (far_check), then in the pass until the
  * next build.  The rebuilds come at the same steps either way: in a settled bed the sum stays
  * far below the mark, in a pour it passes it a few steps after each build.
@@ -237,8 +239,8 @@ static int initial_integrate(jd_particles *ps, jd_neighbour_lists *lists,
         long lo, hi;
         double vm = 0.0;
         share((long)ps->n, &lo, &hi);
-        bits |= kick_drift(flags, lo, hi, ps->x, ps->v, ps->omega, lists->x_build, lists->half_skin, ps->f, ps->torque,
-                           ps->dtfm, ps->dtirot, ps->mass, &c, &vm);
+        bits |= kick_drift(flags, lo, hi, ps->x, ps->v, ps->omega, lists->x_build, lists->half_skin,
+                           ps->f, ps->torque, ps->dtfm, ps->dtirot, ps->mass, &c, &vm);
         if (vm > vmax2) vmax2 = vm;
     }
     if (!check) {

@@ -393,14 +393,16 @@ static int part_room(jd_pair_part *p) {
 static int push_near(const jd_particles *ps, const double *restrict hs, size_t i,
                      const int32_t *items, int32_t q0, int32_t q1, jd_pair_part *p) {
     const double *restrict x = ps->x, *restrict rad = ps->radius;
-    const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i] + hs[i];
+    const double xi0 = x[3 * i], xi1 = x[3 * i + 1], xi2 = x[3 * i + 2], ri = rad[i], hi = hs[i];
     for (int32_t b = q0; b < q1; b += JD_NEAR_BLOCK) {
         const int nb = q1 - b < JD_NEAR_BLOCK ? (int)(q1 - b) : JD_NEAR_BLOCK;
         int near[JD_NEAR_BLOCK];
         for (int k = 0; k < nb; k++) {
             const size_t j = (size_t)(items ? items[b + k] : b + k);
             const double d0 = x[3 * j] - xi0, d1 = x[3 * j + 1] - xi1, d2 = x[3 * j + 2] - xi2;
-            const double range = ri + (rad[j] + hs[j]);
+            /* the radii and the half skins summed apart: with one skin, hi + hs[j] is the skin
+             * exactly, and the range the bits of ri + rj + skin */
+            const double range = (ri + rad[j]) + (hi + hs[j]);
             near[k] = j > i && d0 * d0 + d1 * d1 + d2 * d2 < range * range;
         }
         for (int k = 0; k < nb; k++) {
@@ -561,9 +563,6 @@ static int build_pair_list_all(size_t n, unsigned kind, jd_contact_list *l) {
     return 0;
 }
 
-/* Build a new list into `spare`, carry the history over, swap.  The spares keep their buffers
- * between builds, and the pair spare is reserved at once for the last list and an eighth more,
- * so a build reallocates only when the list grows by more than that. */
 /* The distance from x to the nearest face of the domain [lo, hi) [m] (0 outside). */
 static double domain_clearance(const double lo[3], const double hi[3], const double *x) {
     double d = INFINITY;
@@ -595,10 +594,13 @@ static void set_half_skins(jd_neighbour_lists *lists, const jd_particles *ps, co
             const double c = domain_clearance(sc->domain_lo, sc->domain_hi, ps->x + 3 * i);
             h = h < c ? h : c;
         }
-        lists->half_skin[i] = h > h0 ? h : h0;
+        lists->half_skin[i] = h > h0 ? h : h0; /* never below skin/2 (integrate.c's fast check) */
     }
 }
 
+/* Build a new list into `spare`, carry the history over, swap.  The spares keep their buffers
+ * between builds, and the pair spare is reserved at once for the last list and an eighth more,
+ * so a build reallocates only when the list grows by more than that. */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
     set_half_skins(&s->lists, &s->particles, s->run.scene, s->run.dt);
     const int sorted = !s->opt.allpairs && !s->opt.no_sort && s->particles.n > 1;

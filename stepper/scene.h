@@ -178,7 +178,8 @@ typedef struct jd_scene {
 
     /* neighbour lists (docs/scenes.md "Neighbour lists") */
     int64_t skin_steps;       /* a particle gets a half skin of what it crosses in this many
-                                 steps, if that is more than skin/2 (up to its radius); 0: the
+                                 steps, if that is more than skin/2 (up to its radius and its
+                                 distance from the domain's faces, never below skin/2); 0: the
                                  common skin for all */
 
     /* model options (kernel enums) */

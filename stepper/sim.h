@@ -116,7 +116,8 @@ typedef struct jd_timing {
  * particle pairs j is a particle index (> i); for wall candidates a wall index.  The entries
  * [0, n_touch) and [n_touch, n) are each sorted by (i, j).  A wall list, and a pair list between
  * renumbering and rebuilding, is one sorted run (n_touch = n); a pair list as built has the
- * candidates whose spheres touched at the build first, those within the skin but apart second:
+ * candidates whose spheres touched at the build first, those within their half skins but apart
+ * second:
  * the force loop evaluates the first in every SIMD lane and tests the second before packing the
  * few that touch into lanes (forces.c), so that no lane is spent on a gap that stays a gap.
  * Buffers grow geometrically and are reused across rebuilds (no allocation per contact).

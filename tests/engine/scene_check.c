@@ -193,6 +193,7 @@ static const char *diff_scenes(const jd_scene *a, const jd_scene *b) {
     SAME(watchdog.enabled);
     SAME(watchdog.max_overlap_fraction);
     SAME(watchdog.max_energy_jump);
+    SAME(skin_steps);
     SAME(n_materials);
     SAME(n_particles);
     SAME(n_walls);
@@ -285,6 +286,7 @@ static const char *check_two_spheres(const jd_scene *s) {
     if (s->max_impact_speed != 20.0) return "default max_impact_speed";
     if (strcmp(s->case_name, "two_spheres") != 0) return "case name";
     if (s->output_every != 100 || s->observables_every != 100) return "output defaults";
+    if (s->skin_steps != 20) return "default neighbour.skin_steps";
     return NULL;
 }
 
@@ -309,6 +311,7 @@ static const char *check_lattice(const jd_scene *s) {
         return "interaction matrix";
     if (s->wall_rule != 1 || s->damping_map != 1 || s->xi_limit != 1 || s->mu_r != 0.5)
         return "model";
+    if (s->skin_steps != 7) return "neighbour.skin_steps";
     /* particle speeds 0 and 2 against walls at rest, plus sqrt(2 |g| H); H is between 0.021375
      * and 0.022625 m whatever the jitter (bounding box from the lattice to the top sphere). */
     if (!(s->max_impact_speed >= 2.0 + sqrt(2.0 * 9.81 * 0.021375) &&
