@@ -232,11 +232,10 @@ static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
     mw->cand_start = malloc((mw->n * (np + 1)) * sizeof *mw->cand_start);
     if (!mw->cand_start) return -1;
     size_t at = 0, widest = 1, n_orig = 0;
-    const double h0 = 0.5 * s->lists.skin, *hs = s->lists.half_skin;
-    double reach_max = 0.0; /* the largest radius + skin/2 + half skin */
+    double reach_max = 0.0; /* the largest radius + wall margin */
     for (size_t i = 0; i < np; i++) {
         if ((size_t)ps->orig[i] + 1 > n_orig) n_orig = (size_t)ps->orig[i] + 1;
-        reach_max = fmax(reach_max, ps->radius[i] + (h0 + hs[i]));
+        reach_max = fmax(reach_max, ps->radius[i] + sim_wall_margin(&s->lists, i));
     }
     for (size_t k = 0; k < mw->n; k++) {
         jd_sim_mesh *m = &mw->mesh[k];
@@ -249,7 +248,8 @@ static int build_candidates(jd_mesh_walls *mw, const jd_sim *s) {
             return -1;
         for (size_t i = 0; i < np; i++) {
             start[i] = at;
-            if (particle_candidates(mw, m, s->lists.x_build + 3 * i, ps->radius[i] + (h0 + hs[i]),
+            if (particle_candidates(mw, m, s->lists.x_build + 3 * i,
+                                    ps->radius[i] + sim_wall_margin(&s->lists, i),
                                     s->opt.allpairs, &at) != 0)
                 return -1;
             if (at == start[i]) history_drop(mw, &m->hist, (size_t)ps->orig[i], s->run.features);

@@ -465,9 +465,8 @@ static int pairs_of(const void *ctx, size_t i, jd_pair_part *p) {
 typedef struct wall_search {
     const jd_particles *ps;
     const jd_walls *walls;
-    double skin;      /* [m] the walls' skin (the run's) */
-    const double *hs; /* [m] each particle's half skin */
-    int allpairs;     /* every particle with every wall */
+    const jd_neighbour_lists *lists; /* the skins (sim_wall_margin) */
+    int allpairs;                    /* every particle with every wall */
 } wall_search;
 
 /* Particle i's (particle, wall) candidates within the skins into part p, by wall. */
@@ -476,7 +475,7 @@ static int walls_of(const void *ctx, size_t i, jd_pair_part *p) {
     for (size_t w = 0; w < q->walls->n; w++) {
         if (!q->allpairs &&
             !wall_candidate(&q->walls->wall[w], q->ps->x + 3 * i, q->ps->radius[i],
-                            0.5 * q->skin + q->hs[i]))
+                            sim_wall_margin(q->lists, i)))
             continue;
         if (part_room(p) != 0) return -1;
         p->i[p->n] = (int32_t)i;
@@ -634,8 +633,8 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
 
     jd_contact_list *wn = &s->lists.wall_spare;
     wn->n = 0;
-    const wall_search ws = {.ps = &s->particles, .walls = &s->walls, .skin = s->lists.skin,
-                            .hs = s->lists.half_skin, .allpairs = s->opt.allpairs};
+    const wall_search ws = {.ps = &s->particles, .walls = &s->walls, .lists = &s->lists,
+                            .allpairs = s->opt.allpairs};
     if (s->walls.n &&
         build_in_parts(&s->lists, s->particles.n, s->threads.n, walls_of, &ws, kind, wn) != 0) {
         snprintf(err, errlen, "out of memory building the wall candidate list");

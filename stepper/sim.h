@@ -431,6 +431,11 @@ void sim_neighbour_parts_free(jd_neighbour_lists *lists);
 /* 1 when some wall moved more than skin/2 [m] since the last build (the particles' part of the
  * rebuild criterion rides in the drift, integrate.c) */
 int sim_neighbour_walls_moved(const jd_walls *walls, double skin);
+/* How near a wall (plane, cylinder or mesh) particle i must come to be its candidate [m]: its
+ * own half skin and the wall's, skin/2 (a wall triggers a build once it has moved skin/2). */
+static inline double sim_wall_margin(const jd_neighbour_lists *lists, size_t i) {
+    return 0.5 * lists->skin + lists->half_skin[i];
+}
 /* Capacity for `need` entries of a list of this kind (JD_LIST_* bits).  Returns 0 or -1. */
 enum { JD_LIST_ROLLING = 1, JD_LIST_ENERGY = 2 };
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind);
