@@ -250,7 +250,8 @@ mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),bu
 # reference_runs/mixing/ch5/models.yaml (Groups 1-3 x Models 1-6) and Chapter 6's two rigid-cement
 # fills (rigid_model1, rigid_model3) in both engines, the resumable units of
 # scripts/mixing/plan_ch5.py.  outputs: out/mixing/ch5/ENGINE/groupG_modelM/fill.h5
-#   make mixing-bonded [MODEL=group2_model3] [ENGINE=jdem|liggghts-jdem] [UNIT=...] [NP=2] [LIST=1]
+#   make mixing-bonded [MODEL=group2_model3] [ENGINE=jdem|liggghts-jdem|cross] [UNIT=...] [NP=2] [LIST=1]
+# (ENGINE=cross: the cross-engine horizons and first breaks, cross/groupG_modelM/horizon)
 .PHONY: mixing-bonded
 mixing-bonded: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,build/liggghts-jdem build/jdem)
 	$(PY) scripts/campaign.py scripts/mixing/plan_ch5.py $(if $(MODEL),--model $(MODEL)) \
@@ -258,9 +259,11 @@ mixing-bonded: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,build/liggghts-jd
 	    $(if $(NP),-- --ranks $(NP))
 
 # Table 5-3 (phi_v at the middle clip) and the breakage of the finished Ch. 5 fills, seed | jdem |
-# liggghts-jdem: out/mixing/ch5/report.md and reference_runs/mixing/ch5/results/.
+# liggghts-jdem: out/mixing/ch5/report.md and reference_runs/mixing/ch5/results/; first the
+# cross-engine horizons and first breaks (reference_runs/mixing/ch5/results/horizon/).
 .PHONY: mixing-bonded-report
 mixing-bonded-report:
+	$(PY) -m scripts.mixing.horizon_ch5 summary --results reference_runs/mixing/ch5/results/horizon
 	$(PY) -m scripts.mixing.report_ch5
 
 # The tables of the finished units, seed | jdem | liggghts-jdem (Tables 4-3...4-5, the mixing

@@ -155,7 +155,8 @@ SUITES += [
 # The Ch. 4 mixing analysis (scripts/mixing) on synthetic deposits, the seed's claims on
 # hand-made results, its pictures, the generator of the second pass and the cubes (reference_runs/mixing/ch4/generate.py),
 # the report's merge of local and committed results (scripts/mixing/report_ch4.py) and the
-# cross-engine horizon on a synthetic pair of trajectories.
+# cross-engine horizon on a synthetic pair of trajectories, and the Ch. 5 horizon's break-by-break
+# comparison on hand-made bond records.
 SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py; a=$?; "
                                 f"{PY} tests/mixing/test_pictures.py; b=$?; "
                                 f"{PY} tests/mixing/test_generate.py; c=$?; "
@@ -163,7 +164,9 @@ SUITES += [("mixing-analysis", ["sh", "-c", f"{PY} tests/mixing/test_analysis.py
                                 f"{PY} tests/mixing/test_report.py; e=$?; "
                                 f"{PY} tests/mixing/test_horizon.py; f=$?; "
                                 f"{PY} tests/mixing/test_outflow.py; g=$?; "
-                                f"{PY} tests/mixing/test_fill_ch5.py; h=$?; exit $((a | b | c | d | e | f | g | h))"],
+                                f"{PY} tests/mixing/test_fill_ch5.py; h=$?; "
+                                f"{PY} tests/mixing/test_horizon_ch5.py; i=$?; "
+                                f"exit $((a | b | c | d | e | f | g | h | i))"],
             "lines", {})]
 # This runner on dummy suites: every check counted once, the 2-rank suites alone, two others at once.
 SUITES += [("runner", [PY, "tests/runner/test_run_tests.py"], "lines", {})]

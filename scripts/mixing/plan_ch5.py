@@ -14,7 +14,10 @@ points 10-18 of Table 5-2 under 5 kPa, each with its own copy of the deposit and
 bonds), and `ENGINE/CASE/cubeK`, K = 10..18, their compressions, into
 out/mixing/ch5/ENGINE/CASE/cubeK.h5 (the 27 points' phi_v are read from the fill itself).
 Chapter 6's rigid cements add two fills per engine, rigid_model1 and rigid_model3 (Figs 6-1 and
-6-2), drawn but not compressed (the seed measures nothing in them).
+6-2), drawn but not compressed (the seed measures nothing in them).  Last, per bonded case
+(Groups 2 and 3), the cross-engine horizon (`cross/groupG_modelM/horizon`: the first
+HORIZON_TIME s of the fill in both engines, compared particle by particle and break by break,
+scripts/mixing/horizon_ch5.py).
 """
 import os
 import shlex
@@ -23,7 +26,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 from scripts.campaign import Unit
 from scripts.mixing.plan_ch4 import (CUBE_PARTICLES, CUBE_TIME, ENGINES, FILL_PARTICLES, FILL_TIME,
-                                     PY, SCENE_COST, SEED_DT, fill_command, fill_ranks, jdem,
+                                     HORIZON_COST, PY, SCENE_COST, SEED_DT, fill_command, fill_ranks, jdem,
                                      resumable, run_command, valid_scene, valid_trajectory)
 
 SCENE = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "models.yaml")
@@ -32,6 +35,9 @@ CUBES = range(10, 19)     # Table 5-2's middle clip
 OUT = os.path.join(ROOT, "out", "mixing", "ch5")
 CASES = [f"group{g}_model{m}" for g in range(1, 4) for m in range(1, 7)]
 RIGID_CASES = ["rigid_model1", "rigid_model3"]   # Ch. 6, Figs 6-1 and 6-2: pictures, no cubes
+# the cross-engine horizons: the bonded groups (Group 1 has no bonds; its horizon is Ch. 4's)
+HORIZON_CASES = [c for c in CASES if not c.startswith("group1_")]
+HORIZON_TIME = 2.0        # [s] past the first breaks (0.6 s) and the trajectory horizon (0.7 s)
 
 
 def fill_unit(engine, case, ranks):
@@ -58,6 +64,27 @@ def cube_units(engine, case):
     return units
 
 
+def valid_horizon(path):
+    from scripts.mixing.horizon_ch4 import read_json
+    try:
+        doc = read_json(path)
+    except (OSError, ValueError) as e:
+        return f"not a horizon result: {e}"
+    return None if "breaks" in doc and "divergence" in doc else "no breaks or divergence"
+
+
+def horizon_unit(case):
+    """The cross-engine horizon of a bonded fill (scripts/mixing/horizon_ch5.py): its first
+    HORIZON_TIME s in both engines, compared particle by particle and break by break."""
+    out = os.path.join(OUT, "cross", case, "horizon.json")
+    inserted = FILL_PARTICLES * HORIZON_TIME / FILL_TIME
+    return Unit(f"cross/{case}/horizon", [out],
+                [PY, os.path.join(HERE, "horizon_ch5.py"), "run", "--case", case,
+                 "--end-time", repr(HORIZON_TIME), "--dir", "{dir}", "-o", "{out0}"],
+                case, "cross", validate=valid_horizon,
+                cost=HORIZON_COST * inserted * HORIZON_TIME / SEED_DT)
+
+
 def units(argv):
     import argparse
     ap = argparse.ArgumentParser(prog="plan_ch5.py")
@@ -68,4 +95,5 @@ def units(argv):
         ap.error("--ranks %d: valid: a positive number of MPI ranks" % a.ranks)
     return [u for engine in ENGINES for case in CASES + RIGID_CASES
             for u in [fill_unit(engine, case, a.ranks)] +
-            (cube_units(engine, case) if case in CASES else [])]
+            (cube_units(engine, case) if case in CASES else [])] + \
+        [horizon_unit(case) for case in HORIZON_CASES]
