@@ -4,7 +4,8 @@
     python3 -m scripts.mixing.speed_ch4 [--case model1] [--end-time 5] [--rounds 3] [--out out/mixing/speed]
 
 The first END_TIME seconds of the case's fill at the seed's dt (--force: the guard refuses it),
-run by jdem on 1 and 2 threads, by liggghts-jdem (our law and walls, fix jdem/inlet) on 1 and 2
+run by jdem on 1 and 2 threads (as the campaign runs it, without energy accounts, and with
+them: `jdem-energy`, output.energy: true), by liggghts-jdem (our law and walls, fix jdem/inlet) on 1 and 2
 ranks, and by LIGGGHTS' own hertz/history pair and primitive walls (the deck generator's
 --builtin mode) with our inlet on 1 and 2 ranks.  The engines are run in turn, so they see the
 same spell of the shared machine, in ROUNDS rounds, every other one in the reverse order, so that
@@ -23,12 +24,14 @@ import re
 import statistics
 import subprocess
 
+import yaml
+
 from scripts import engines
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "generate.py")
-RUNS = (("jdem", 1), ("jdem", 2), ("liggghts-jdem", 1), ("liggghts-jdem", 2),
-        ("liggghts", 1), ("liggghts", 2))
+RUNS = (("jdem", 1), ("jdem", 2), ("jdem-energy", 1), ("jdem-energy", 2), ("liggghts-jdem", 1),
+        ("liggghts-jdem", 2), ("liggghts", 1), ("liggghts", 2))
 OUTPT_RE = re.compile(r"(?m)^Outpt\s+time \(%\) = \S+ \(([0-9.eE+-]+)\)")
 
 
@@ -38,8 +41,8 @@ def particle_steps(record, steps):
         return sum(steps - int(row["step"]) for row in csv.DictReader(f))
 
 
-def run_jdem(resolved, d, threads):
-    out = os.path.join(d, f"jdem_t{threads}.h5")
+def run_jdem(resolved, d, threads, name="jdem"):
+    out = os.path.join(d, f"{name}_t{threads}.h5")
     rec = os.path.join(d, "inlet_record.csv")
     r = engines.jdem("run", resolved, "-o", out, "--force", "--quiet", "--timing",
                      "--threads", str(threads), "--inlet-record", rec, check=True)
@@ -64,6 +67,19 @@ def run_liggghts(resolved, d, engine, ranks):
     return {"loop_s": float(loop) * (1.0 - share), "steps": int(steps)}
 
 
+def with_energy_accounts(scene, d):
+    """The resolved scene of `scene` with output.energy: true, written into d."""
+    with open(scene) as f:
+        doc = yaml.safe_load(f)
+    doc["output"]["energy"] = True
+    path, resolved = os.path.join(d, "fill_energy.yaml"), os.path.join(d, "resolved_energy.yaml")
+    with open(path, "w") as f:
+        yaml.safe_dump(doc, f, sort_keys=False)
+    with open(resolved, "w") as f:
+        f.write(engines.resolve(path, check=True).stdout)
+    return resolved
+
+
 def report(summary):
     rows = ["| engine | cores | loop without output, median (range) [s] | particle-steps/s | "
             "jdem (same cores) is faster by |",
@@ -80,7 +96,8 @@ def report(summary):
             f"other one in the reverse order; load average before the runs "
             f"{summary['load_before']:.2f}, after {summary['load_after']:.2f}; commit "
             f"{summary['commit']}.  `liggghts` is LIGGGHTS' own hertz/history pair and primitive "
-            f"walls with our inlet.\n\n"
+            f"walls with our inlet; `jdem-energy` is jdem with the energy accounts (output.energy: "
+            f"true), which the campaign's Ch. 4 fills leave out and stock LIGGGHTS does not keep.\n\n"
             + "\n".join(rows) + "\n")
 
 
@@ -98,13 +115,19 @@ def main():
                     "--end-time", repr(a.end_time), "-o", scene], check=True, env=engines.python_env())
     with open(resolved, "w") as f:
         f.write(engines.resolve(scene, check=True).stdout)
+    resolved_energy = with_energy_accounts(scene, d)
     load_before = os.getloadavg()[0]
     if a.rounds < 1:
         raise SystemExit(f"speed_ch4: --rounds {a.rounds}: need at least 1")
     times = {run: [] for run in RUNS}
     for k in range(a.rounds):
         for engine, cores in (RUNS if k % 2 == 0 else RUNS[::-1]):
-            r = run_jdem(resolved, d, cores) if engine == "jdem" else run_liggghts(resolved, d, engine, cores)
+            if engine == "jdem":
+                r = run_jdem(resolved, d, cores)
+            elif engine == "jdem-energy":
+                r = run_jdem(resolved_energy, d, cores, engine)
+            else:
+                r = run_liggghts(resolved, d, engine, cores)
             times[(engine, cores)].append(r)
             print(f"speed_ch4: round {k + 1}/{a.rounds}, {engine} on {cores}: {r['loop_s']:.1f} s",
                   flush=True)

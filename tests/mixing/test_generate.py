@@ -110,19 +110,20 @@ check("case_unknown", r.returncode != 0 and "case 'model7' is not in" in r.stder
       and "valid: model1, model2, model3, model4, model5, model6" in r.stderr, r.stderr)
 
 # fill: a case with another dt keeps its frames at the same times (1 s, 0.1 s: the scene's
-# 10000 and 1000 steps of 1e-4 s), and a reduced stream; the cubes' cadence follows the dt too
+# 10000 and 1000 steps of 1e-4 s) and the scene's other output keys (no energy accounts), and a
+# reduced stream; the cubes' cadence follows the dt too
 fill = os.path.join(tmp, "fill.yaml")
 r = gen("fill", "--case", "model3", "--dt", "2.5e-05", "--sections", "4", "--end-time", "0.5",
         "-o", fill)
 doc = yaml.safe_load(open(fill)) if r.returncode == 0 else {}
 check("fill_dt_cadence", doc.get("time", {}).get("dt") == 2.5e-05 and doc.get("output") ==
-      {"every": 40000, "observables_every": 4000}, f"{r.stderr}{doc.get('time')} {doc.get('output')}")
+      {"every": 40000, "observables_every": 4000, "energy": False}, f"{r.stderr}{doc.get('time')} {doc.get('output')}")
 check("fill_reduced", doc.get("inlets", [{}])[0].get("stop") == {"sections": 4}
       and doc["time"]["end_time"] == 0.5 and doc["walls"][5]["present"], f"{doc.get('inlets')}")
 r = gen("fill", "--case", "model1", "--dt", "auto", "-o", fill)
 doc = yaml.safe_load(open(fill)) if r.returncode == 0 else {}
 check("fill_dt_auto", doc.get("time", {}).get("dt") == "auto" and doc.get("output") ==
-      {"every": 10000, "observables_every": 1000}, f"{r.stderr}{doc.get('output')}")
+      {"every": 10000, "observables_every": 1000, "energy": False}, f"{r.stderr}{doc.get('output')}")
 r = gen("cubes", dep, "--case", "model2", "--dt", "5e-05", "-o", os.path.join(tmp, "cubes_dt"))
 c1 = yaml.safe_load(open(os.path.join(tmp, "cubes_dt", "cube1.yaml"))) if r.returncode == 0 else {}
 check("cubes_dt_cadence", c1.get("time", {}).get("dt") == 5e-05 and c1.get("output") ==
@@ -134,7 +135,7 @@ check("fill_dt_bad", r.returncode == 2 and r.stderr.strip().endswith(
 # --frame-every: the horizon's dense frames, in steps of the scene's dt (after a --dt rescale)
 r = gen("fill", "--case", "model2", "--dt", "5e-05", "--frame-every", "400", "-o", fill)
 doc = yaml.safe_load(open(fill)) if r.returncode == 0 else {}
-check("fill_frame_every", doc.get("output") == {"every": 400, "observables_every": 2000},
+check("fill_frame_every", doc.get("output") == {"every": 400, "observables_every": 2000, "energy": False},
       f"{r.stderr}{doc.get('output')}")
 r = gen("fill", "--case", "model1", "--frame-every", "0", "-o", fill)
 check("fill_frame_every_bad", r.returncode == 2 and r.stderr.strip().endswith(
