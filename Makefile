@@ -184,8 +184,10 @@ chung-ooi: build/jdem build/liggghts-jdem
 stability: build/jdem build/liggghts-jdem
 	$(PY) scripts/stability.py --out out/stability
 
+# The first run of a new machine: the Debian packages, the build on every core (JDEM_TEST_JOBS),
+# the Chung–Ooi tests, the stability suite and a short Ch. 4 fill (README).
 demo: deps
-	$(MAKE) all
+	$(MAKE) -j$(JDEM_TEST_JOBS) all
 	$(MAKE) chung-ooi
 	$(MAKE) stability
 	$(MAKE) mixing-demo
