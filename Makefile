@@ -253,7 +253,8 @@ mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),bu
 # fills (rigid_model1, rigid_model3) in both engines, the resumable units of
 # scripts/mixing/plan_ch5.py.  outputs: out/mixing/ch5/ENGINE/groupG_modelM/fill.h5
 #   make mixing-bonded [MODEL=group2_model3] [ENGINE=jdem|liggghts-jdem|cross] [UNIT=...] [NP=2] [LIST=1]
-# (ENGINE=cross: the cross-engine horizons and first breaks, cross/groupG_modelM/horizon)
+# (ENGINE=cross: the cross-engine horizons and first breaks, cross/groupG_modelM/horizon, and
+#  the jdem runs with the stream shifted that measure their spread, cross/groupG_modelM/jitterK)
 .PHONY: mixing-bonded
 mixing-bonded: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,build/liggghts-jdem build/jdem)
 	$(PY) scripts/campaign.py scripts/mixing/plan_ch5.py $(if $(MODEL),--model $(MODEL)) \

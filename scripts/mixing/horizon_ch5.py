@@ -1,10 +1,12 @@
 #!/usr/bin/python3
 """horizon_ch5.py — how long the two engines' bonded fills of the Chapter 5 campaign agree, and
-whether their first bonds break alike (docs/mixing.md §11, "The cross-engine horizon of the
-bonded fills").
+whether their first bonds break alike (docs/mixing.md §11, "The cross-engine horizon and the
+first breaks").
 
     horizon_ch5.py run --case groupG_modelM -o HORIZON.json [--end-time 2] [--frame-every 200]
                        [--dir DIR]
+    horizon_ch5.py realisation --case groupG_modelM --jitter K [--engine liggghts-jdem]
+                               -o REALISATION.json [...]
     horizon_ch5.py summary [--out out/mixing/ch5] [--results DIR]
 
 run: the first T seconds of the case's fill (the resolved case of reference_runs/mixing/ch5/
@@ -14,14 +16,21 @@ the trajectory horizon of horizon_ch4 (particles matched by id, max |dx| / R_max
 max |dv| / sqrt(g d_max) per frame) and the breaks of the two runs side by side
 (break_agreement): whether the bonds formed are the same pairs at the same steps, each engine's
 first break (step, pair, mode), how many breaks agree in order (step, pair, mode) before the
-first that does not, the breaks up to the horizon, and the totals at T; and between which
-observable samples the first sphere touched a wall or an obstacle (first_wall_contact), for the
-seed's claim that weak blocks stay whole in free fall (free_fall_claims).
-summary: the table of every case's HORIZON.json in OUT/cross/CASE/horizon.json and the plot of
-the curves, into OUT/cross/horizon/{summary.json, horizon.md, horizon.png} and, with --results,
-also there (the committed copy, reference_runs/mixing/ch5/results/horizon/).
+first that does not, the breaks up to the horizon, and the totals at T; and the step at which
+the first sphere touched a wall or an obstacle (the observables are sampled at every step), for
+the seed's claim that weak blocks stay whole in free fall (free_fall_claims).
+realisation: one engine (jdem by default) alone on the same scene with the stream shifted by K
+micrometres in y (the run-to-run spread, as Ch. 4's realisations): the breaks' totals at T, into
+REALISATION.json.
+summary: the table of every case's HORIZON.json in OUT/cross/CASE/horizon.json, the totals
+against the spread of the realisations OUT/cross/CASE/{jitterK, liggghts-jdem_jitterK}.json,
+and the plot of the curves,
+into OUT/cross/horizon/{summary.json, horizon.md, horizon.png} and, with --results, also there
+(the committed copy, reference_runs/mixing/ch5/results/horizon/); a case or realisation not run
+here is taken from the committed summary.json, each result naming the commit it was run at.
 """
 import argparse
+import math
 import os
 import re
 import shutil
@@ -30,17 +39,18 @@ import sys
 import numpy as np
 
 from scripts import engines
-from scripts.mixing import breakage, horizon_ch4
+from scripts.mixing import breakage, horizon_ch4, plan_ch4
 from scripts.mixing.report_ch4 import commit
 from scripts.trajectory_divergence import ROUNDOFF, divergence_summary
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 MODELS = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "models.yaml")
-ENGINES = ("jdem", "liggghts-jdem")
+ENGINES = plan_ch4.ENGINES
 END_TIME = 2.0      # [s] the first sections land at 0.6 s, the horizon is near 0.7 s
 FRAME_EVERY = 200   # steps: a frame every 0.02 s at the seed's dt
 RESULT = "horizon.json"
+REALISATIONS = tuple(range(1, 7))   # K of the jittered jdem runs: the run-to-run spread at T
 
 
 # ---- the runs -------------------------------------------------------------------------------
@@ -53,15 +63,27 @@ def set_key(text, key, value):
     return pattern.sub("  %s: %s" % (key, value), text)
 
 
-def write_scene(case, end_time, frame_every, path):
+def shift_stream(text, origin, jitter):
+    """The resolved scene `text` with its inlet's origin (given, [m]) moved by jitter x
+    plan_ch4.JITTER in y: a realisation, as Ch. 4's generate.py --jitter."""
+    moved = [float(origin[0]), float(origin[1]) + plan_ch4.JITTER * jitter, float(origin[2])]
+    return set_key(text, "origin", "[%s]" % ", ".join(repr(x) for x in moved))
+
+
+def write_scene(case, end_time, frame_every, path, jitter=0, observables_every=None):
     """The case as `jdem resolve --case` gives it, cut to end_time, a frame every frame_every
-    steps; returns (path, dt)."""
+    steps and an observable sample every observables_every (default: with the frames), the
+    stream shifted by jitter steps (shift_stream); returns (path, dt).  The sampling changes no
+    bit of the trajectory (suite engine-fastpaths)."""
     import yaml
     text = engines.resolve(MODELS, case, check=True).stdout
-    dt = float(yaml.safe_load(text)["time"]["dt"])
+    doc = yaml.safe_load(text)
+    dt = float(doc["time"]["dt"])
+    if jitter:
+        text = shift_stream(text, doc["inlets"][0]["origin"], jitter)
     text = set_key(text, "steps", str(int(round(end_time / dt))))
-    for key in ("every", "observables_every"):
-        text = set_key(text, key, str(frame_every))
+    text = set_key(text, "every", str(frame_every))
+    text = set_key(text, "observables_every", str(observables_every or frame_every))
     with open(path, "w") as f:
         f.write(text)
     return path, dt
@@ -90,53 +112,134 @@ def describe(brk, dt):
 def break_agreement(a, b, horizon_step, end_step):
     """The breaks of two runs' bond records a and b (breakage.read_bonds) side by side: same_bonds,
     each run's first break, the length of the longest common prefix of their ordered breaks and
-    the first break after it in each, the breaks each has up to horizon_step (and whether they are
-    the same), and each run's broken fractions at end_step."""
+    the first break after it in each, the breaks each has up to horizon_step, the trajectory
+    horizon's (and whether they are the same), and each run's broken fractions at end_step."""
     ka, kb = breaks_in_order(a), breaks_in_order(b)
     n = 0
     while n < min(len(ka), len(kb)) and ka[n] == kb[n]:
         n += 1
     dt = a["dt"]
     first_diff = {e: describe(k[n], dt) if n < len(k) else None for e, k in zip(ENGINES, (ka, kb))}
-    upto = [[k for k in ks if k[0] <= horizon_step] for ks in (ka, kb)] if horizon_step is not None else None
+    upto = [[k for k in ks if k[0] <= horizon_step] for ks in (ka, kb)]
     return {"same_bonds": same_bonds(a, b), "bonds": [len(a["bonds"]), len(b["bonds"])],
             "first": {e: describe(k[0], dt) if k else None for e, k in zip(ENGINES, (ka, kb))},
             "common_prefix": n, "first_difference": first_diff,
-            "by_horizon": None if upto is None else
-            {"step": horizon_step, "breaks": [len(u) for u in upto], "same": upto[0] == upto[1]},
+            "by_horizon": {"step": horizon_step, "breaks": [len(u) for u in upto], "same": upto[0] == upto[1]},
             "totals": {e: breakage.broken_fraction(r, end_step) for e, r in zip(ENGINES, (a, b))}}
 
 
 def first_wall_contact(path):
-    """{"last_free": the last observable sample's step before any sphere touched a wall or an
-    obstacle, "seen": the first sample's step with a wall contact} of a trajectory (None when
-    no sphere touched one): the first wall contact lies in between."""
+    """The step of the first observable sample at which a sphere touches a wall or an obstacle
+    (None when none does), and whether the samples were every step (only then is it the first
+    contact itself: one begun and ended between two samples goes unseen)."""
     import h5py
     with h5py.File(path, "r") as f:
         step = f["observables/wall_contacts/step"][()]
         count = f["observables/wall_contacts/value"][()]
     touching = np.nonzero(count > 0)[0]
-    if len(touching) == 0:
-        return None
-    k = int(touching[0])
-    return {"last_free": int(step[k - 1]) if k > 0 else None, "seen": int(step[k])}
+    every_step = bool(len(step) > 1 and np.all(np.diff(step) == 1))
+    return {"step": int(step[touching[0]]) if len(touching) else None, "every_step": every_step}
+
+
+def realisation(a):
+    """One engine alone on the case's first T seconds with the stream shifted by --jitter: its
+    breaks' totals at T, one realisation of the run-to-run spread."""
+    directory = a.dir or os.path.dirname(os.path.abspath(a.out))
+    os.makedirs(directory, exist_ok=True)
+    scene, _ = write_scene(a.case, a.end_time, a.frame_every, os.path.join(directory, "fill.yaml"),
+                           a.jitter)
+    out = os.path.join(directory, "fill.%s.h5" % a.engine)
+    cmd = plan_ch4.run_command(a.engine, scene, out, False)
+    r, times = engines.cpu_timed_run(cmd)
+    if r.returncode != 0:
+        raise engines.failure(cmd, r.returncode, r.stdout, r.stderr)
+    rec = breakage.read_bonds(out)
+    end_step = int(horizon_ch4.load(out)["step"][-1])
+    totals = breakage.broken_fraction(rec, end_step)
+    horizon_ch4.write_json(a.out, {"case": a.case, "engine": a.engine, "jitter": a.jitter,
+                                   "jitter_m": plan_ch4.JITTER * a.jitter, "totals": totals,
+                                   "times": times, "commit": commit()})
+    print("horizon_ch5: %s in %s, stream shifted by %d x %g m: %d bonds broken by step %d" % (
+        a.case, a.engine, a.jitter, plan_ch4.JITTER, totals["broken"], end_step))
+    return 0
+
+
+def spread_rows(results, realisations):
+    """Per case with realisations: each engine's bonds broken by T over its runs (the horizon's,
+    K = 0, and those with the stream shifted by K), their mean and std, and whether the engines'
+    means differ by at most 2 s sqrt(1/n_jdem + 1/n_liggghts-jdem) (two standard deviations of a
+    difference of means), with s pooled over both engines' runs of the case and also over the
+    cases of the same group (whose counts are alike), since a few runs give few degrees of
+    freedom.  realisations: {case: {engine: [realisation results]}}."""
+    out = []
+    for r in results:
+        reals = realisations.get(r["case"], {})
+        if not any(reals.values()):
+            continue
+        t = r["breaks"]["totals"]
+        q = {"case": r["case"], "group": r["case"].split("_")[0], "jitters": {}, "counts": {}, "mean": {}}
+        for e in ENGINES:
+            mine = sorted(reals.get(e, []), key=lambda x: x["jitter"])
+            q["jitters"][e] = [0] + [x["jitter"] for x in mine]
+            q["counts"][e] = [t[e]["broken"]] + [x["totals"]["broken"] for x in mine]
+            q["mean"][e] = float(np.mean(q["counts"][e]))
+        q["difference"] = q["mean"]["liggghts-jdem"] - q["mean"]["jdem"]
+        out.append(q)
+
+    def pooled(rows):
+        ss = sum(float(np.sum((np.array(q["counts"][e]) - q["mean"][e]) ** 2)) for q in rows for e in ENGINES)
+        dof = sum(len(q["counts"][e]) - 1 for q in rows for e in ENGINES)
+        return math.sqrt(ss / dof), dof
+
+    for q in out:
+        scale = math.sqrt(sum(1.0 / len(q["counts"][e]) for e in ENGINES))
+        for key, rows in (("", [q]), ("pooled_", [p for p in out if p["group"] == q["group"]])):
+            q[key + "std"], q[key + "dof"] = pooled(rows)
+            q[key + "bound"] = 2.0 * q[key + "std"] * scale
+            q[key + "held"] = abs(q["difference"]) <= q[key + "bound"]
+    return out
+
+
+def spread_table(rows):
+    if not rows:
+        return ""
+    lines = ["| case | bonds broken by the end, jdem (K µm: count) | liggghts-jdem (K µm: count) | "
+             "means jdem / liggghts-jdem | difference | s of the case (dof) | 2 s √(1/n + 1/n'): agree "
+             "| s pooled over the group (dof) | 2 s √(1/n + 1/n'): agree |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    verdict = lambda ok: "held" if ok else "**not held**"
+    runs = lambda q, e: ", ".join("%d: %d" % kc for kc in zip(q["jitters"][e], q["counts"][e]))
+    for q in rows:
+        lines.append("| %s | %s | %s | %.1f / %.1f | %+.1f | %.1f (%d) | %.1f: %s | %.1f (%d) | %.1f: %s |" % (
+            q["case"], runs(q, "jdem"), runs(q, "liggghts-jdem"), q["mean"]["jdem"], q["mean"]["liggghts-jdem"],
+            q["difference"], q["std"], q["dof"], q["bound"], verdict(q["held"]), q["pooled_std"],
+            q["pooled_dof"], q["pooled_bound"], verdict(q["pooled_held"])))
+    signed = [q["difference"] for q in rows]
+    lines += ["", "%d of %d cases within two standard deviations of the case's own spread, %d of %d of "
+              "the group's pooled one; liggghts-jdem's mean minus jdem's averages %+.1f bonds over the "
+              "cases (%d above, %d below)." % (
+                  sum(q["held"] for q in rows), len(rows), sum(q["pooled_held"] for q in rows), len(rows),
+                  float(np.mean(signed)), sum(x > 0 for x in signed), sum(x < 0 for x in signed))]
+    return "\n".join(lines) + "\n"
 
 
 def run(a):
     directory = a.dir or os.path.dirname(os.path.abspath(a.out))
     os.makedirs(directory, exist_ok=True)
-    scene, dt = write_scene(a.case, a.end_time, a.frame_every, os.path.join(directory, "fill.yaml"))
+    scene, dt = write_scene(a.case, a.end_time, a.frame_every, os.path.join(directory, "fill.yaml"),
+                            observables_every=1)
     runs = horizon_ch4.run_engines(scene, directory, False)
     trajectories = [horizon_ch4.load(runs[e][0]) for e in ENGINES]
     curve = horizon_ch4.difference_by_id(*trajectories)
     result = horizon_ch4.horizon_result(a.case, dt, curve, {e: runs[e][1] for e in runs})
     d = result["divergence"]
     # the horizon is the last frame below round-off: its step, in the frames' own steps
-    horizon_step = None if d["horizon"] is None else int(round(d["horizon"] / dt))
+    horizon_step = int(round(d["horizon"] / dt))
     end_step = int(min(t["step"][-1] for t in trajectories))
     result["breaks"] = break_agreement(*[breakage.read_bonds(runs[e][0]) for e in ENGINES],
                                        horizon_step, end_step)
     result["first_wall_contact"] = {e: first_wall_contact(runs[e][0]) for e in ENGINES}
+    result["commit"] = commit()
     horizon_ch4.write_json(a.out, result)
     f = result["breaks"]["first"]
     print("horizon_ch5: %s: horizon %s s; first break %s (jdem) / %s (liggghts-jdem); %d breaks "
@@ -164,13 +267,12 @@ def table(results):
         h = b["by_horizon"]
         diff = b["first_difference"]
         t = b["totals"]
-        lines.append("| %s | %s | %s | %s (%d) | %s | %s | %s | %d, then %s / %s | %d / %d (%.3f / %.3f) "
+        lines.append("| %s | %s | %s | %s (%d) | %s | %s | %d / %d (%s) | %d, then %s / %s | %d / %d (%.3f / %.3f) "
                      "| %.0f / %.0f |" % (
                          r["case"], fmt(d["horizon"]), "%.1f" % g["rate"] if g else "—",
                          "yes" if b["same_bonds"] else "**no**", b["bonds"][0],
                          first_cell(b["first"]["jdem"]), first_cell(b["first"]["liggghts-jdem"]),
-                         "—" if h is None else "%d / %d (%s)" % (h["breaks"][0], h["breaks"][1],
-                                                                "yes" if h["same"] else "**no**"),
+                         h["breaks"][0], h["breaks"][1], "yes" if h["same"] else "**no**",
                          b["common_prefix"], first_cell(diff["jdem"]), first_cell(diff["liggghts-jdem"]),
                          t["jdem"]["broken"], t["liggghts-jdem"]["broken"], t["jdem"]["total"],
                          t["liggghts-jdem"]["total"], r["times"]["jdem"]["cpu"],
@@ -180,21 +282,29 @@ def table(results):
 
 def free_fall_claims(results):
     """The seed's claim that weak blocks stay whole in free fall (spec §3.8), per Group 2 case
-    and engine: held when the first bond broke after the last observable sample at which no
-    sphere touched a wall or an obstacle (the sections fall apart from each other, so a bond can
-    only be loaded by a wall, an obstacle or the spheres that already landed)."""
+    and engine: held when no bond broke by the step at which the first sphere touched a wall or
+    an obstacle (sampled at every step; the sections fall apart from each other, so until then
+    only the stream's own contacts load a bond): a bond first feels a wall the step after.  A
+    break with no wall contact before it, or none seen at all, is not held; a case without every
+    step's sample is undecided."""
     lines = []
     for r in results:
-        if not r["case"].startswith("group2_") or "first_wall_contact" not in r:
+        if not r["case"].startswith("group2_"):
             continue
         for e in ENGINES:
-            w, brk = r["first_wall_contact"][e], r["breaks"]["first"][e]
-            if w is None or brk is None or w["last_free"] is None:
-                continue
-            lines.append("- %s %s: weak blocks stay whole in free fall (first wall or obstacle contact "
-                         "between steps %d and %d, first bond break at step %d, %s): **%s**" % (
-                             e, r["case"], w["last_free"], w["seen"], brk["step"], brk["mode"],
-                             "held" if brk["step"] > w["last_free"] else "not held"))
+            w, brk = r.get("first_wall_contact", {}).get(e), r["breaks"]["first"][e]
+            name = "- %s %s: weak blocks stay whole in free fall" % (e, r["case"])
+            if not w or not w["every_step"]:
+                lines.append(name + " (the wall contacts were not sampled at every step): **undecided**")
+            elif brk is None:
+                lines.append(name + " (no bond broke by the end): **held**")
+            elif w["step"] is None:
+                lines.append(name + " (bond %d–%d broke at step %d, no sphere touched a wall): **not held**"
+                             % (brk["pair"][0], brk["pair"][1], brk["step"]))
+            else:
+                lines.append(name + " (first wall or obstacle contact at step %d, first bond break at step "
+                             "%d, %s): **%s**" % (w["step"], brk["step"], brk["mode"],
+                                                  "held" if brk["step"] > w["step"] else "not held"))
     return lines
 
 
@@ -219,18 +329,54 @@ def plot(results, path):
     plt.close(fig)
 
 
+def realisation_path(out, case, k, engine):
+    """Where a realisation's result goes: jitterK.json for jdem's, ENGINE_jitterK.json else."""
+    name = "jitter%d.json" % k if engine == "jdem" else "%s_jitter%d.json" % (engine, k)
+    return os.path.join(out, "cross", case, name)
+
+
+def merged(a, cases):
+    """{case: horizon result} and {case: {engine: [realisations]}}: what was run under a.out,
+    else what the committed summary in a.results holds (so a machine that ran a few cases keeps
+    the others)."""
+    results, reals = {}, {}
+    committed = os.path.join(a.results or "", "summary.json")
+    if a.results and os.path.exists(committed):
+        doc = horizon_ch4.read_json(committed)
+        results = {r["case"]: r for r in doc.get("cases", [])}
+        for c, by_engine in doc.get("realisations", {}).items():
+            for e, xs in by_engine.items():
+                reals.setdefault(c, {}).setdefault(e, {}).update({x["jitter"]: x for x in xs})
+    for c in cases:
+        path = os.path.join(a.out, "cross", c, RESULT)
+        if os.path.exists(path):
+            results[c] = horizon_ch4.read_json(path)
+        for e in ENGINES:
+            for k in REALISATIONS:
+                p = realisation_path(a.out, c, k, e)
+                if os.path.exists(p):
+                    reals.setdefault(c, {}).setdefault(e, {})[k] = horizon_ch4.read_json(p)
+    order = [c for c in cases if c in results]
+    return ([results[c] for c in order],
+            {c: {e: [x for _, x in sorted(xs.items())] for e, xs in by_engine.items()}
+             for c, by_engine in reals.items()})
+
+
 def summary(a):
     from scripts.mixing import plan_ch5
-    found = [os.path.join(a.out, "cross", c, RESULT) for c in plan_ch5.HORIZON_CASES]
-    results = [horizon_ch4.read_json(p) for p in found if os.path.exists(p)]
+    results, reals = merged(a, plan_ch5.HORIZON_CASES)
     if not results:   # nothing run yet: the committed results stay as they are
         print("horizon_ch5: no %s under %s/cross/CASE/; nothing written" % (RESULT, a.out))
         return 0
+    spread = spread_rows(results, reals)
     target = os.path.join(a.out, "cross", "horizon")
     os.makedirs(target, exist_ok=True)
-    horizon_ch4.write_json(os.path.join(target, "summary.json"), {"commit": commit(), "cases": results})
+    commits = sorted({x.get("commit", "not recorded") for x in results +
+                      [y for by_engine in reals.values() for xs in by_engine.values() for y in xs]})
+    horizon_ch4.write_json(os.path.join(target, "summary.json"),
+                           {"commits": commits, "cases": results, "realisations": reals, "spread": spread})
     with open(os.path.join(target, "horizon.md"), "w") as f:
-        f.write(table(results))
+        f.write(table(results) + "\n" + spread_table(spread))
     plot(results, os.path.join(target, "horizon.png"))
     if a.results:
         os.makedirs(a.results, exist_ok=True)
@@ -242,9 +388,13 @@ def summary(a):
 
 
 def read_summary(directory):
-    """The cases' results of a summary directory, or None when it has none."""
+    """(the cases' results, the spread rows, the commits they were run at) of a summary
+    directory, or (None, None, None) when it has none."""
     path = os.path.join(directory, "summary.json")
-    return horizon_ch4.read_json(path)["cases"] if os.path.exists(path) else None
+    if not os.path.exists(path):
+        return None, None, None
+    doc = horizon_ch4.read_json(path)
+    return doc["cases"], doc.get("spread", []), doc.get("commits", [])
 
 
 def main(argv=None):
@@ -256,11 +406,20 @@ def main(argv=None):
     r.add_argument("--end-time", type=float, default=END_TIME)
     r.add_argument("--frame-every", type=int, default=FRAME_EVERY)
     r.add_argument("--dir", help="where the scene and the trajectories go (default: beside -o)")
+    q = sub.add_parser("realisation")
+    q.add_argument("--case", required=True, help="groupG_modelM of reference_runs/mixing/ch5/models.yaml")
+    q.add_argument("--engine", choices=ENGINES, default="jdem")
+    q.add_argument("--jitter", type=int, required=True,
+                   help="the stream's shift in y, in steps of %g m" % plan_ch4.JITTER)
+    q.add_argument("-o", "--out", required=True, help="the result, REALISATION.json")
+    q.add_argument("--end-time", type=float, default=END_TIME)
+    q.add_argument("--frame-every", type=int, default=FRAME_EVERY)
+    q.add_argument("--dir", help="where the scene and the trajectory go (default: beside -o)")
     s = sub.add_parser("summary")
     s.add_argument("--out", default=os.path.join(ROOT, "out", "mixing", "ch5"))
     s.add_argument("--results", help="also write the summary, table and plot here")
     a = ap.parse_args(argv)
-    return run(a) if a.what == "run" else summary(a)
+    return {"run": run, "realisation": realisation, "summary": summary}[a.what](a)
 
 
 if __name__ == "__main__":

@@ -47,6 +47,8 @@ CHECKPOINT_SECONDS = 300                  # a killed jdem fill loses at most thi
 RESTART_STEPS = 2000                      # liggghts-jdem: a restart file every 0.2 s of a fill
 SCENE_COST = 1e6                          # cutting: a read of the deposit
 SPREAD_MODEL, SPREAD_REALISATIONS = "model3", 2   # the run-to-run spread's fills (obstacles: phi_v > 0)
+JITTER = 1.0e-6           # [m] a realisation's stream shift per step of K (generate.py --jitter,
+                          # horizon_ch5.py realisation): far below every length of the scenes
 HORIZON_TIME, HORIZON_FRAME_TIME = 4.0, 0.02      # [s] the cross-engine horizon's fill and frames
 HORIZON_COST = 3.3        # both engines: liggghts-jdem takes 2.3 x jdem's CPU (47 s and 106 s, model1, 4 s)
 

@@ -17,7 +17,9 @@ Chapter 6's rigid cements add two fills per engine, rigid_model1 and rigid_model
 6-2), drawn but not compressed (the seed measures nothing in them).  Last, per bonded case
 (Groups 2 and 3), the cross-engine horizon (`cross/groupG_modelM/horizon`: the first
 HORIZON_TIME s of the fill in both engines, compared particle by particle and break by break,
-scripts/mixing/horizon_ch5.py).
+scripts/mixing/horizon_ch5.py), and each engine's runs of it with the stream shifted by K =
+1..6 micrometres (`cross/groupG_modelM/jitterK`, `.../liggghts-jdem_jitterK`: the run-to-run
+spread of the breaks).
 """
 import os
 import shlex
@@ -29,6 +31,8 @@ from scripts.mixing.plan_ch4 import (CUBE_PARTICLES, CUBE_TIME, ENGINES, FILL_PA
                                      HORIZON_COST, PY, SCENE_COST, SEED_DT, fill_command, fill_ranks, jdem,
                                      resumable, run_command, valid_scene, valid_trajectory)
 
+from scripts.mixing.horizon_ch5 import END_TIME as HORIZON_TIME, REALISATIONS, realisation_path
+
 SCENE = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "models.yaml")
 GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "generate.py")
 CUBES = range(10, 19)     # Table 5-2's middle clip
@@ -37,7 +41,6 @@ CASES = [f"group{g}_model{m}" for g in range(1, 4) for m in range(1, 7)]
 RIGID_CASES = ["rigid_model1", "rigid_model3"]   # Ch. 6, Figs 6-1 and 6-2: pictures, no cubes
 # the cross-engine horizons: the bonded groups (Group 1 has no bonds; its horizon is Ch. 4's)
 HORIZON_CASES = [c for c in CASES if not c.startswith("group1_")]
-HORIZON_TIME = 2.0        # [s] past the first breaks (0.6 s) and the trajectory horizon (0.7 s)
 
 
 def fill_unit(engine, case, ranks):
@@ -73,16 +76,42 @@ def valid_horizon(path):
     return None if "breaks" in doc and "divergence" in doc else "no breaks or divergence"
 
 
+def horizon_particle_steps():
+    """About the particle-steps of one engine's run of a horizon's first HORIZON_TIME s."""
+    return FILL_PARTICLES * HORIZON_TIME / FILL_TIME * HORIZON_TIME / SEED_DT
+
+
 def horizon_unit(case):
     """The cross-engine horizon of a bonded fill (scripts/mixing/horizon_ch5.py): its first
     HORIZON_TIME s in both engines, compared particle by particle and break by break."""
     out = os.path.join(OUT, "cross", case, "horizon.json")
-    inserted = FILL_PARTICLES * HORIZON_TIME / FILL_TIME
     return Unit(f"cross/{case}/horizon", [out],
                 [PY, os.path.join(HERE, "horizon_ch5.py"), "run", "--case", case,
                  "--end-time", repr(HORIZON_TIME), "--dir", "{dir}", "-o", "{out0}"],
-                case, "cross", validate=valid_horizon,
-                cost=HORIZON_COST * inserted * HORIZON_TIME / SEED_DT)
+                case, "cross", validate=valid_horizon, cost=HORIZON_COST * horizon_particle_steps())
+
+
+def realisation_units(case):
+    """Each engine's runs of a case's horizon with the stream shifted by K micrometres
+    (scripts/mixing/horizon_ch5.py realisation): the run-to-run spread of its breaks at
+    HORIZON_TIME (engine "cross": they serve the cross-engine comparison and run with it)."""
+    return [Unit(f"cross/{case}/jitter{k}" if engine == "jdem" else f"cross/{case}/{engine}_jitter{k}",
+                 [realisation_path(OUT, case, k, engine)],
+                 [PY, os.path.join(HERE, "horizon_ch5.py"), "realisation", "--case", case,
+                  "--engine", engine, "--jitter", str(k), "--end-time", repr(HORIZON_TIME),
+                  "--dir", "{dir}", "-o", "{out0}"],
+                 case, "cross", validate=valid_realisation,
+                 cost=(1.0 if engine == "jdem" else HORIZON_COST - 1.0) * horizon_particle_steps())
+            for engine in ENGINES for k in REALISATIONS]
+
+
+def valid_realisation(path):
+    from scripts.mixing.horizon_ch4 import read_json
+    try:
+        doc = read_json(path)
+    except (OSError, ValueError) as e:
+        return f"not a realisation result: {e}"
+    return None if "totals" in doc else "no totals"
 
 
 def units(argv):
@@ -96,4 +125,4 @@ def units(argv):
     return [u for engine in ENGINES for case in CASES + RIGID_CASES
             for u in [fill_unit(engine, case, a.ranks)] +
             (cube_units(engine, case) if case in CASES else [])] + \
-        [horizon_unit(case) for case in HORIZON_CASES]
+        [u for case in HORIZON_CASES for u in [horizon_unit(case)] + realisation_units(case)]

@@ -280,22 +280,29 @@ def outflow_rows(found):
 
 def horizon_section(results=os.path.join(ROOT, "reference_runs", "mixing", "ch5", "results", "horizon")):
     """The cross-engine horizon of the bonded fills and their first breaks: the table of
-    `horizon_ch5.py summary` (the cross/CASE/horizon units), as committed in RESULTS (make
-    mixing-bonded-report refreshes it first)."""
+    `horizon_ch5.py summary` (the cross/CASE/horizon and cross/CASE/jitterK units), as committed
+    in RESULTS (make mixing-bonded-report refreshes it first)."""
     from scripts.mixing import horizon_ch5
-    cases = horizon_ch5.read_summary(results)
+    cases, spread, commits = horizon_ch5.read_summary(results)
     head = ["### Cross-engine horizon and first breaks of the bonded fills, jdem vs liggghts-jdem", ""]
     if not cases:
         return head + ["(not run yet: `make mixing-bonded ENGINE=cross`)"]
+    lines = head + [
+        "the first %g s of each fill in both engines (run at commit %s); particles matched by id, "
+        "per frame (every 0.02 s) the larger of max |Δx| / R_max and max |Δv| / sqrt(g d_max), as in "
+        "Ch. 4; breaks as (step, pair, mode), in order; scripts/mixing/horizon_ch5.py, plot: "
+        "horizon/horizon.png" % (cases[0]["curve"]["time"][-1], ", ".join(commits)), "",
+        horizon_ch5.table(cases)]
+    if spread:
+        lines += ["Past the horizon the engines are two realisations of one chaotic fill: the bonds "
+                  "broken by the end of each engine's runs, the horizon's (K = 0) and those with the "
+                  "stream shifted by K µm in y (`horizon_ch5.py realisation`); the engines' means "
+                  "within two standard deviations of a difference of means (2 s √(1/n + 1/n'), n and "
+                  "n' the runs of each engine):", "", horizon_ch5.spread_table(spread)]
     claims = horizon_ch5.free_fall_claims(cases)
-    return head + [
-        "the first %g s of each fill in both engines; particles matched by id, per frame (every "
-        "0.02 s) the larger of max |Δx| / R_max and max |Δv| / sqrt(g d_max), as in Ch. 4; breaks "
-        "as (step, pair, mode), in order; scripts/mixing/horizon_ch5.py, plot: "
-        "horizon/horizon.png" % cases[0]["curve"]["time"][-1], "",
-        horizon_ch5.table(cases)] + (
-        ["The seed's claim that weak blocks stay whole in free fall, from the same runs:", ""] + claims
-        if claims else [])
+    if claims:
+        lines += ["The seed's claim that weak blocks stay whole in free fall, from the same runs:", ""] + claims
+    return lines
 
 
 def report(found, rev):

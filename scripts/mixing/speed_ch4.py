@@ -1,5 +1,5 @@
 """speed_ch4.py — the Chapter 4 fill's speed in the three engines, measured in one run
-(`make mixing-speed`; docs/mixing.md §9).
+(`make mixing-speed`; docs/mixing.md §10).
 
     python3 -m scripts.mixing.speed_ch4 [--case model1] [--end-time 5] [--rounds 3] [--out out/mixing/speed]
 
@@ -80,7 +80,8 @@ def with_energy_accounts(scene, d):
     return resolved
 
 
-def report(summary):
+def table(summary):
+    """The runs' table: median and range of each configuration, its rate and its ratio to jdem."""
     rows = ["| engine | cores | loop without output, median (range) [s] | particle-steps/s | "
             "jdem (same cores) is faster by |",
             "|---|---:|---:|---:|---:|"]
@@ -89,16 +90,23 @@ def report(summary):
         rows.append(f"| {r['engine']} | {r['cores']} | {r['loop_s']:.1f} "
                     f"({min(r['loop_all']):.1f}–{max(r['loop_all']):.1f}) | {r['rate']:.3g} | "
                     f"{r['loop_s'] / ref['loop_s']:.2f}x |")
-    return (f"# Chapter 4 fill: speed of the three engines\n\n"
-            f"Case {summary['case']}, the first {summary['end_time']} s of the fill at dt = "
+    return "\n".join(rows) + "\n"
+
+
+def describe(summary):
+    """What was timed, in one paragraph."""
+    return (f"Case {summary['case']}, the first {summary['end_time']} s of the fill at dt = "
             f"{summary['dt']} s ({summary['steps']} steps, {summary['inserted']} spheres inserted, "
             f"{summary['particle_steps']:.4g} particle-steps); {summary['rounds']} rounds, every "
             f"other one in the reverse order; load average before the runs "
             f"{summary['load_before']:.2f}, after {summary['load_after']:.2f}; commit "
             f"{summary['commit']}.  `liggghts` is LIGGGHTS' own hertz/history pair and primitive "
             f"walls with our inlet; `jdem-energy` is jdem with the energy accounts (output.energy: "
-            f"true), which the campaign's Ch. 4 fills leave out and stock LIGGGHTS does not keep.\n\n"
-            + "\n".join(rows) + "\n")
+            f"true), which the campaign's Ch. 4 fills leave out and stock LIGGGHTS does not keep.")
+
+
+def report(summary):
+    return "# Chapter 4 fill: speed of the three engines\n\n" + describe(summary) + "\n\n" + table(summary)
 
 
 def main():

@@ -42,10 +42,10 @@ import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 from scripts.mixing import cube_scene, deposit, params
+from scripts.mixing.plan_ch4 import JITTER   # [m] one step of --jitter
 from scripts.stability_scenes import set_path  # the sweep's dotted-path override
 
 MODELS = os.path.join(HERE, "models.yaml")
-JITTER = 1.0e-6           # [m] one step of --jitter: far below every length of the scene
 CELL = (1.0, 0.5, 0.25)   # [RECON] orientation, spec §1.7
 DEPTH = 1.0               # [TEXT] L1539
 FEED_PITCH = 1.1          # [RECON] the first pass's lattice pitch over the sphere diameter
