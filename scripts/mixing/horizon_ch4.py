@@ -181,19 +181,25 @@ def table(results):
                                       + "\n".join(stops) + "\n" if stops else "")
 
 
-def plot(results, path):
+def plot(results, path, title="Chapter 4 first fills", mark=None, mark_label=""):
+    """The cases' difference curves on a log scale, with the round-off level; mark(result), when
+    given, is a time [s] (or None) drawn as a dashed line in the case's colour (mark_label says
+    what it is)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(8, 5))
     for r in results:
         c = r["curve"]
-        ax.semilogy(c["time"], np.maximum(np.maximum(c["dx"], c["dv"]), 1e-18), label=r["case"])
+        line, = ax.semilogy(c["time"], np.maximum(np.maximum(c["dx"], c["dv"]), 1e-18), label=r["case"])
+        t = mark(r) if mark else None
+        if t is not None:
+            ax.axvline(t, color=line.get_color(), lw=0.6, ls="--")
     ax.axhline(ROUNDOFF, color="k", lw=0.8, ls=":", label="round-off level %.0e" % ROUNDOFF)
-    ax.set_xlabel("time [s]")
+    ax.set_xlabel("time [s]" + ("  (dashed: %s)" % mark_label if mark else ""))
     ax.set_ylabel("max(|Δx| / R_max, |Δv| / sqrt(g d_max))  (1e-18: identical)")
-    ax.set_title("Chapter 4 first fills: jdem vs liggghts-jdem, particles matched by id")
-    ax.legend(fontsize=8)
+    ax.set_title("%s: jdem vs liggghts-jdem, particles matched by id" % title)
+    ax.legend(fontsize=8 if len(results) <= 6 else 7)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -211,13 +217,18 @@ def summary(a):
     with open(os.path.join(target, "horizon.md"), "w") as f:
         f.write(table(results))
     plot(results, os.path.join(target, "horizon.png"))
-    if a.results:
-        os.makedirs(a.results, exist_ok=True)
-        for name in ("summary.json", "horizon.md", "horizon.png"):
-            shutil.copy(os.path.join(target, name), os.path.join(a.results, name))
+    publish(target, a.results)
     print("horizon_ch4: %d model(s) into %s%s" % (len(results), target,
                                                   " and " + a.results if a.results else ""))
     return 0
+
+
+def publish(target, results, names=("summary.json", "horizon.md", "horizon.png")):
+    """Copy a summary's files from TARGET into RESULTS (the committed copy), when given."""
+    if results:
+        os.makedirs(results, exist_ok=True)
+        for name in names:
+            shutil.copy(os.path.join(target, name), os.path.join(results, name))
 
 
 def read_summary(directory):

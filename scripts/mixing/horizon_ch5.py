@@ -33,7 +33,6 @@ import argparse
 import math
 import os
 import re
-import shutil
 import sys
 
 import numpy as np
@@ -41,7 +40,7 @@ import numpy as np
 from scripts import engines
 from scripts.mixing import breakage, horizon_ch4, plan_ch4
 from scripts.mixing.report_ch4 import commit
-from scripts.trajectory_divergence import ROUNDOFF, divergence_summary
+from scripts.trajectory_divergence import ROUNDOFF
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -309,24 +308,9 @@ def free_fall_claims(results):
 
 
 def plot(results, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(8, 5))
-    for r in results:
-        c = r["curve"]
-        line, = ax.semilogy(c["time"], np.maximum(np.maximum(c["dx"], c["dv"]), 1e-18), label=r["case"])
-        first = r["breaks"]["first"]["jdem"]
-        if first:
-            ax.axvline(first["time"], color=line.get_color(), lw=0.6, ls="--")
-    ax.axhline(ROUNDOFF, color="k", lw=0.8, ls=":", label="round-off level %.0e" % ROUNDOFF)
-    ax.set_xlabel("time [s]  (dashed: each case's first break in jdem)")
-    ax.set_ylabel("max(|Δx| / R_max, |Δv| / sqrt(g d_max))  (1e-18: identical)")
-    ax.set_title("Chapter 5 bonded fills: jdem vs liggghts-jdem, particles matched by id")
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    """horizon_ch4's plot of the difference curves, each case's first break in jdem dashed."""
+    first = lambda r: r["breaks"]["first"]["jdem"]["time"] if r["breaks"]["first"]["jdem"] else None
+    horizon_ch4.plot(results, path, "Chapter 5 bonded fills", first, "each case's first break in jdem")
 
 
 def realisation_path(out, case, k, engine):
@@ -378,10 +362,7 @@ def summary(a):
     with open(os.path.join(target, "horizon.md"), "w") as f:
         f.write(table(results) + "\n" + spread_table(spread))
     plot(results, os.path.join(target, "horizon.png"))
-    if a.results:
-        os.makedirs(a.results, exist_ok=True)
-        for name in ("summary.json", "horizon.md", "horizon.png"):
-            shutil.copy(os.path.join(target, name), os.path.join(a.results, name))
+    horizon_ch4.publish(target, a.results)
     print("horizon_ch5: %d case(s) into %s%s" % (len(results), target,
                                                  " and " + a.results if a.results else ""))
     return 0

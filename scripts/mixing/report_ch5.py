@@ -21,8 +21,6 @@ import argparse
 import json
 import os
 
-import numpy as np
-
 from scripts.mixing import fill_ch5, outflow, params, stats, structure
 from scripts.mixing.fill_ch5 import FRAGMENT_BINS
 from scripts.mixing.plan_ch5 import CASES, RIGID_CASES
