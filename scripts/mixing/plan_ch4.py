@@ -274,13 +274,20 @@ def model_units(engine, model, variant, ranks):
         + spread_units(engine, model, variant, ranks)
 
 
-def valid_horizon(path):
-    try:
-        with open(path) as f:
-            doc = json.load(f)
-    except (OSError, ValueError) as e:
-        return f"not a horizon result: {e}"
-    return None if "divergence" in doc else "no divergence"
+def valid_json(what, *keys):
+    """A unit's validator for a JSON result (`what` names it in the message) that must hold
+    every one of keys."""
+    def validate(path):
+        try:
+            with open(path) as f:
+                doc = json.load(f)
+        except (OSError, ValueError) as e:
+            return f"not a {what} result: {e}"
+        return None if all(k in doc for k in keys) else "no " + " or ".join(keys)
+    return validate
+
+
+valid_horizon = valid_json("horizon", "divergence")
 
 
 def horizon_unit(model, variant):

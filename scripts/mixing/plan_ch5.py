@@ -29,7 +29,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 from scripts.campaign import Unit
 from scripts.mixing.plan_ch4 import (CUBE_PARTICLES, CUBE_TIME, ENGINES, FILL_PARTICLES, FILL_TIME,
                                      HORIZON_COST, PY, SCENE_COST, SEED_DT, fill_command, fill_ranks, jdem,
-                                     resumable, run_command, valid_scene, valid_trajectory)
+                                     resumable, run_command, valid_json, valid_scene, valid_trajectory)
 
 from scripts.mixing.horizon_ch5 import END_TIME as HORIZON_TIME, REALISATIONS, realisation_path
 
@@ -67,15 +67,6 @@ def cube_units(engine, case):
     return units
 
 
-def valid_horizon(path):
-    from scripts.mixing.horizon_ch4 import read_json
-    try:
-        doc = read_json(path)
-    except (OSError, ValueError) as e:
-        return f"not a horizon result: {e}"
-    return None if "breaks" in doc and "divergence" in doc else "no breaks or divergence"
-
-
 def horizon_particle_steps():
     """About the particle-steps of one engine's run of a horizon's first HORIZON_TIME s."""
     return FILL_PARTICLES * HORIZON_TIME / FILL_TIME * HORIZON_TIME / SEED_DT
@@ -88,7 +79,8 @@ def horizon_unit(case):
     return Unit(f"cross/{case}/horizon", [out],
                 [PY, os.path.join(HERE, "horizon_ch5.py"), "run", "--case", case,
                  "--end-time", repr(HORIZON_TIME), "--dir", "{dir}", "-o", "{out0}"],
-                case, "cross", validate=valid_horizon, cost=HORIZON_COST * horizon_particle_steps())
+                case, "cross", validate=valid_json("horizon", "breaks", "divergence"),
+                cost=HORIZON_COST * horizon_particle_steps())
 
 
 def realisation_units(case):
@@ -100,18 +92,9 @@ def realisation_units(case):
                  [PY, os.path.join(HERE, "horizon_ch5.py"), "realisation", "--case", case,
                   "--engine", engine, "--jitter", str(k), "--end-time", repr(HORIZON_TIME),
                   "--dir", "{dir}", "-o", "{out0}"],
-                 case, "cross", validate=valid_realisation,
+                 case, "cross", validate=valid_json("realisation", "totals"),
                  cost=(1.0 if engine == "jdem" else HORIZON_COST - 1.0) * horizon_particle_steps())
             for engine in ENGINES for k in REALISATIONS]
-
-
-def valid_realisation(path):
-    from scripts.mixing.horizon_ch4 import read_json
-    try:
-        doc = read_json(path)
-    except (OSError, ValueError) as e:
-        return f"not a realisation result: {e}"
-    return None if "totals" in doc else "no totals"
 
 
 def units(argv):
