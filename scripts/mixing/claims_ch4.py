@@ -2,12 +2,20 @@
 (report_ch4.py; docs/mixing.md §3).  Each check states its measure and says "held" or "not
 held" with the numbers; a check whose units are not all finished is left out.
 
+A claim that orders the models by their trimmed mean φv is weighed against the run-to-run
+spread (agreement_ch4.spreads: the std s of one fill's realisations, the model's own or
+pooled): a difference of two models' means counts only beyond 2 sqrt(s_a² + s_b²), two standard
+deviations of the difference of two independent fills.  Within it the claim is "not resolved":
+one fill per model cannot order them (docs/mixing.md §3).
+
 found[engine][model] holds "fillP" (fill_result: per-point parameters, their trimmed summary and
 the cohorts' sides) and "passP_cubes" (cube_result per cube) of report_ch4.py.
 """
+import math
+
 import numpy as np
 
-from scripts.mixing import params, stats
+from scripts.mixing import agreement_ch4, params, stats
 
 MODELS = tuple("model%d" % m for m in range(1, 7))
 PASSES = (1, 2)
@@ -15,6 +23,36 @@ PASSES = (1, 2)
 
 def verdict(ok):
     return "held" if ok else "not held"
+
+
+UNRESOLVED = "not resolved (within the run-to-run spread)"
+
+
+def phi_spread(found):
+    """model -> (s, source) of the trimmed mean phi_v over a fill's realisations, or None."""
+    s = agreement_ch4.spreads(found)
+    return lambda model: agreement_ch4.spread_for(s, model, "φv")
+
+
+def ordered(phi, spread, pairs):
+    """Verdict and margin text of "a mixes better than b" for every (a, b) in pairs: held when
+    every difference phi_a - phi_b exceeds 2 sqrt(s_a² + s_b²), not held when one falls below
+    minus it, otherwise not resolved; plain signs when no spread is measured."""
+    signs, bounds = [], []
+    for a, b in pairs:
+        sa, sb = spread(a), spread(b)
+        if not (sa and sb):
+            signs.append(1 if phi[a] > phi[b] else -1)
+            continue
+        bound = 2.0 * math.hypot(sa[0], sb[0])
+        bounds.append(bound)
+        d = phi[a] - phi[b]
+        signs.append(1 if d > bound else (-1 if d < -bound else 0))
+    text = verdict(all(x > 0 for x in signs)) if all(x != 0 for x in signs) or -1 in signs \
+        else UNRESOLVED
+    if not bounds:
+        return text, "no run-to-run spread measured"
+    return text, "a difference counts beyond 2√(s_a² + s_b²) = %.4f" % max(bounds)
 
 
 def phi_means(found, engine, p):
@@ -51,26 +89,29 @@ def model2_split(found, engine):
               verdict(side["big_right"] > 0.5 and side["small_left"] > 0.5))]
     phi = phi_means(found, engine, 1)
     if len(phi) == len(MODELS):
-        worst = min(phi, key=phi.get)
-        out.append("%s pass 1: Model 2 mixes worst (trimmed mean φv per model: %s): %s"
-                   % (engine, ", ".join("%s %.4f" % (m[5:], phi[m]) for m in MODELS),
-                      verdict(worst == "model2")))
+        text, margin = ordered(phi, phi_spread(found), [(m, "model2") for m in MODELS
+                                                         if m != "model2"])
+        out.append("%s pass 1: Model 2 mixes worst (trimmed mean φv per model: %s; %s): %s"
+                   % (engine, ", ".join("%s %.4f" % (m[5:], phi[m]) for m in MODELS), margin,
+                      text))
     return out
 
 
 def obstacles_left(found, engine):
     """Obstacles shifted left (Models 3, 4) mix better than Models 1, 2; Model 5 slightly better
     than Model 3 (first pass, trimmed mean phi_v)."""
-    phi = phi_means(found, engine, 1)
+    phi, spread = phi_means(found, engine, 1), phi_spread(found)
     out = []
     if all(m in phi for m in ("model1", "model2", "model3", "model4")):
-        ok = min(phi["model3"], phi["model4"]) > max(phi["model1"], phi["model2"])
+        text, margin = ordered(phi, spread, [(a, b) for a in ("model3", "model4")
+                                             for b in ("model1", "model2")])
         out.append("%s pass 1: Models 3 and 4 mix better than 1 and 2 (φv %.4f, %.4f against "
-                   "%.4f, %.4f): %s" % (engine, phi["model3"], phi["model4"], phi["model1"],
-                                        phi["model2"], verdict(ok)))
+                   "%.4f, %.4f; %s): %s" % (engine, phi["model3"], phi["model4"], phi["model1"],
+                                            phi["model2"], margin, text))
     if "model3" in phi and "model5" in phi:
-        out.append("%s pass 1: Model 5 mixes slightly better than Model 3 (φv %.4f against %.4f): %s"
-                   % (engine, phi["model5"], phi["model3"], verdict(phi["model5"] > phi["model3"])))
+        text, margin = ordered(phi, spread, [("model5", "model3")])
+        out.append("%s pass 1: Model 5 mixes slightly better than Model 3 (φv %.4f against %.4f; "
+                   "%s): %s" % (engine, phi["model5"], phi["model3"], margin, text))
     return out
 
 
@@ -82,8 +123,14 @@ def second_pass(found, engine):
     both = [m for m in MODELS if m in one and m in two]
     if len(both) >= 2:
         a, b = np.std([one[m] for m in both], ddof=1), np.std([two[m] for m in both], ddof=1)
+        # Noise alone scatters the models' means by about the run-to-run s of one mean, so a
+        # change of their std within 2 s is not told from it (pass 1's s: pass 2 has no repeats).
+        s = phi_spread(found)(None)
+        text = verdict(b < a) if not s or abs(a - b) > 2.0 * s[0] else UNRESOLVED
+        margin = "a change counts beyond 2 s = %.4f, s of pass 1" % (2.0 * s[0]) if s else \
+            "no run-to-run spread measured"
         out.append("%s: after the second pass the models' means agree better (std of the %d "
-                   "models' φv means %.4f → %.4f): %s" % (engine, len(both), a, b, verdict(b < a)))
+                   "models' φv means %.4f → %.4f; %s): %s" % (engine, len(both), a, b, margin, text))
     pairs = [(found[engine][m]["fill1"]["summary"]["phi_v"]["std"],
               found[engine][m]["fill2"]["summary"]["phi_v"]["std"]) for m in both]
     if pairs:

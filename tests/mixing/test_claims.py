@@ -13,9 +13,11 @@ MODELS = claims_ch4.MODELS
 def fill(phi_values, rho=2600.0, z=5.0, big_right=0.9, small_left=0.6):
     """A fill result: nine points with these phi_v values, rho_b and Z varying by +-1 %."""
     wobble = [1 + 0.01 * ((k % 3) - 1) for k in range(9)]
-    points = [{"phi_v": v, "rho_b": rho * w, "Z": z * w} for v, w in zip(phi_values, wobble)]
+    points = [{"phi_v": v, "rho_b": rho * w, "Z": z * w, "n": 0.36 * w}
+              for v, w in zip(phi_values, wobble)]
     return {"points": points, "sides": {"big_right": big_right, "small_left": small_left},
-            "summary": {k: stats.summary([q[k] for q in points]) for k in ("phi_v", "rho_b", "Z")}}
+            "summary": {k: stats.summary([q[k] for q in points])
+                        for k in ("phi_v", "rho_b", "Z", "n")}}
 
 
 def spread(mean, half):
@@ -82,6 +84,28 @@ def test_incomplete_is_silent():
     check("left_needs_models_1_to_4", len(claims_ch4.obstacles_left(f, "jdem")) == 1)
 
 
-for t in (test_all_hold, test_each_fails, test_discrimination_index, test_incomplete_is_silent):
+def test_run_to_run_spread():
+    """With Model 3 repeated (trimmed means 0.040, 0.038, 0.042: s = 0.002), "Model 5 mixes
+    better than Model 3" counts beyond 2 sqrt(s² + s²) = 0.005657 (Model 5 without repeats takes
+    the pooled s, Model 3's): held at +0.010, not resolved at +0.004 and -0.004, not held at
+    -0.006."""
+    f = campaign()
+    f["jdem"]["model3"]["jitter"] = [fill(spread(0.038, 0.004)), fill(spread(0.042, 0.004))]
+    bound = 2.0 * (2.0 ** 0.5) * 0.002
+    for phi5, want in ((0.050, "held"), (0.044, claims_ch4.UNRESOLVED),
+                       (0.036, claims_ch4.UNRESOLVED), (0.034, "not held")):
+        g = copy.deepcopy(f)
+        g["jdem"]["model5"]["fill1"] = fill(spread(phi5, 0.004))
+        line = claims_ch4.obstacles_left(g, "jdem")[1]
+        check("model5_vs_3_at_%.3f" % phi5, line.endswith(": " + want), line)
+        check("model5_bound_%.3f" % phi5, ("= %.4f)" % bound) in line, line)
+    g = copy.deepcopy(f)   # Model 2 within the spread of Model 1 (0.002 against 0.010 + 0.004)
+    g["jdem"]["model1"]["fill1"] = fill(spread(0.006, 0.004))
+    line = claims_ch4.model2_split(g, "jdem")[1]
+    check("worst_unresolved", line.endswith(": " + claims_ch4.UNRESOLVED), line)
+
+
+for t in (test_all_hold, test_each_fails, test_discrimination_index, test_incomplete_is_silent,
+          test_run_to_run_spread):
     t()
 finish()
