@@ -237,7 +237,9 @@ accuracy: all
 # Jiang's Chapter 4 mixing campaign (docs/mixing.md §4): the resumable units of
 # scripts/mixing/plan_ch4.py, with progress and an ETA; finished units are skipped.
 #   make mixing [MODEL=model2] [ENGINE=jdem|liggghts-jdem|cross] [UNIT=jdem/model2/fill1]
-#               [DT=seed|guard|half] [NP=2] [LIST=1]  outputs: out/mixing/ch4*/ENGINE/MODEL/
+#               [DT=seed|guard|half] [NP=2] [LIST=1] [RERUN=1]  outputs: out/mixing/ch4*/ENGINE/MODEL/
+# A unit whose result is committed (reference_runs/mixing/ch4/results/) is skipped unless a unit
+# that runs reads its outputs; RERUN=1 runs the committed units again (scripts/campaign.py).
 # (NP: the MPI ranks of each liggghts-jdem fill)
 # (ENGINE=cross: the cross-engine horizons, cross/modelM/horizon, which run both engines)
 # The engine's binary only when the selection names one engine (ENGINE=, or UNIT=ENGINE/...).
@@ -246,6 +248,7 @@ MIXING_ENGINE = $(or $(ENGINE),$(firstword $(subst /, ,$(UNIT))))
 mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),build/liggghts-jdem build/jdem,all))
 	$(PY) scripts/campaign.py scripts/mixing/plan_ch4.py $(if $(MODEL),--model $(MODEL)) \
 	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
+	    $(if $(RERUN),--rerun-committed) \
 	    $(if $(DT)$(NP),--) $(if $(DT),--dt $(DT)) $(if $(NP),--ranks $(NP))
 
 # Jiang's Chapter 5 bonded-block campaign (docs/mixing.md §11): the 18 fills of
@@ -253,12 +256,14 @@ mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),bu
 # fills (rigid_model1, rigid_model3) in both engines, the resumable units of
 # scripts/mixing/plan_ch5.py.  outputs: out/mixing/ch5/ENGINE/groupG_modelM/fill.h5
 #   make mixing-bonded [MODEL=group2_model3] [ENGINE=jdem|liggghts-jdem|cross] [UNIT=...] [NP=2] [LIST=1]
+#                      [RERUN=1]   (committed units: as `make mixing`)
 # (ENGINE=cross: the cross-engine horizons and first breaks, cross/groupG_modelM/horizon, and
 #  the jdem runs with the stream shifted that measure their spread, cross/groupG_modelM/jitterK)
 .PHONY: mixing-bonded
 mixing-bonded: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,build/liggghts-jdem build/jdem)
 	$(PY) scripts/campaign.py scripts/mixing/plan_ch5.py $(if $(MODEL),--model $(MODEL)) \
 	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
+	    $(if $(RERUN),--rerun-committed) \
 	    $(if $(NP),-- --ranks $(NP))
 
 # Table 5-3 (phi_v at the middle clip) and the breakage of the finished Ch. 5 fills, seed | jdem |

@@ -5,7 +5,10 @@
 
 PLAN.py defines units(argv) returning a list of Unit.  A unit is done when every one of its
 final outputs exists and validates; a rerun skips the done units, so an interrupted campaign
-resumes where it stopped.  A unit runs with its outputs in a directory of its own next to the
+resumes where it stopped.  A unit whose result is committed to the repository (its `committed`
+says where) is skipped too on a machine that lacks its outputs (a fresh clone), unless a unit
+that runs reads them: then it runs again, and so do the chosen units derived from it, so that no
+committed result stands beside a new source.  --rerun-committed ignores the committed results.  A unit runs with its outputs in a directory of its own next to the
 first output (DIR/.partial/UNIT/, the same file names), and they are moved to their final names
 (os.replace, atomic per file) only once all of them validate: a killed run never leaves a
 partial file under a final name, and its partial directory is cleared when the unit runs again.
@@ -46,6 +49,8 @@ class Unit:
     resumes: bool = False       # the command continues from what an interrupted run of it left
                                 # in "{dir}" (a checkpoint), so that directory is kept
     ranks: int = 1              # the processes it runs on (MPI ranks), recorded with its times
+    committed: object = None    # f() -> None, or where the repository keeps the unit's result
+                                # (a committed summary): see runs()
 
 
 def non_empty(path):
@@ -61,6 +66,29 @@ def invalid_reason(unit, path):
 
 def is_done(unit):
     return all(invalid_reason(unit, p) is None for p in unit.outputs)
+
+
+def committed_where(unit):
+    return unit.committed() if unit.committed else None
+
+
+def runs(chosen, by_name, use_committed=True):
+    """The names of the chosen units to run: those neither done here nor committed; the chosen
+    needs of those that are not done here (a committed result holds no output file to read); and
+    the chosen units, not done here, that read a unit that runs."""
+    names = {u.name for u in chosen}
+    out = {u.name for u in chosen if not is_done(u) and not (use_committed and committed_where(u))}
+    grew = True
+    while grew:
+        grew = False
+        for u in chosen:
+            new = [n for n in u.needs if u.name in out and n in names and n not in out
+                   and not is_done(by_name[n])]
+            if u.name not in out and not is_done(u) and any(n in out for n in u.needs):
+                new.append(u.name)
+            out.update(new)
+            grew = grew or bool(new)
+    return out
 
 
 def blocked_reason(unit, by_name, memo):
@@ -84,15 +112,20 @@ def select(units, model=None, engine=None, name=None):
             and (engine is None or u.engine == engine) and (name is None or u.name == name)]
 
 
-def check_needs(units, chosen):
+def check_needs(units, chosen, to_run):
+    """None, or why a unit to run cannot: it needs an unknown unit, or one whose outputs are not
+    here and that is not selected (a committed result holds no output file to read)."""
     names = {u.name for u in chosen}
     by_name = {u.name: u for u in units}
     for u in chosen:
         for n in u.needs:
             if n not in by_name:
                 return f"unit {u.name} needs unknown unit {n}"
-            if n not in names and not is_done(by_name[n]):
-                return f"unit {u.name} needs {n}, which is neither done nor selected"
+            if u.name in to_run and n not in names and not is_done(by_name[n]):
+                where = committed_where(by_name[n])
+                return (f"unit {u.name} needs {n}, which is neither done nor selected"
+                        + (f" (its result is committed in {where}, but not its output files: "
+                           f"select it too)" if where else ""))
     return None
 
 
@@ -236,16 +269,19 @@ def fmt_seconds(s):
     return f"{s:.1f} s" if s < 120 else f"{s / 60:.1f} min" if s < 7200 else f"{s / 3600:.1f} h"
 
 
-def run(units, times, everything=None, log=sys.stderr):
-    """Run the units in order, skipping the done ones and reporting those not yet runnable;
-    returns (number failed, number not yet runnable).  everything: the whole plan (for the
-    needs of a selection; default `units`)."""
+def run(units, times, everything=None, log=sys.stderr, to_run=None):
+    """Run the units in order, skipping the done and the committed ones (those not in to_run,
+    default runs(units)) and reporting those not yet runnable; returns (number failed, number
+    not yet runnable).  everything: the whole plan (for the needs of a selection; default
+    `units`)."""
     by_name = {u.name: u for u in (everything or units)}
     memo = {}
-    todo = [u for u in units if not is_done(u)]
+    to_run = runs(units, by_name) if to_run is None else to_run
+    todo = [u for u in units if u.name in to_run]
     for u in units:
         if u not in todo:
-            print(f"campaign: skip {u.name} (done)", file=log, flush=True)
+            print(f"campaign: skip {u.name} (" + ("done" if is_done(u) else
+                  f"committed in {committed_where(u)}") + ")", file=log, flush=True)
     blocked = [u for u in todo if blocked_reason(u, by_name, memo)]
     todo = [u for u in todo if u not in blocked]
     for u in blocked:
@@ -274,9 +310,11 @@ def run(units, times, everything=None, log=sys.stderr):
         eta = times.eta(todo[i + 1:])
         print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: done in {fmt_seconds(took)}; "
               f"{len(todo) - i - 1} left, ETA {fmt_seconds(eta)}", file=log, flush=True)
+    here = sum(1 for u in units if u not in todo and is_done(u))
     print(f"campaign: {len(todo) - failed - skipped} run, {failed} failed, "
           + (f"{skipped} skipped after a failure, " if skipped else "")
-          + f"{len(blocked)} not yet runnable, {len(units) - len(todo) - len(blocked)} already done",
+          + f"{len(blocked)} not yet runnable, {here} already done"
+          + (f", {len(units) - len(todo) - here} committed" if len(units) - len(todo) - here else ""),
           file=log, flush=True)
     return failed, len(blocked)
 
@@ -294,7 +332,10 @@ def main(argv):
     ap.add_argument("--model")
     ap.add_argument("--engine")
     ap.add_argument("--unit")
-    ap.add_argument("--list", action="store_true", help="list the units and whether they are done")
+    ap.add_argument("--list", action="store_true",
+                    help="list the units and whether they are done, committed or to do")
+    ap.add_argument("--rerun-committed", action="store_true",
+                    help="run the units whose result is committed but whose outputs are not here")
     # the plan's own arguments follow "--", wherever the driver's options stand (argparse alone
     # matches an optional positional list once, next to `plan`, and refuses later ones)
     cut = argv.index("--") if "--" in argv else len(argv)
@@ -310,20 +351,23 @@ def main(argv):
               f"valid models: {sorted({str(u.model) for u in units})}, engines: "
               f"{sorted({str(u.engine) for u in units})}", file=sys.stderr)
         return 2
+    by_name = {u.name: u for u in units}
+    to_run = runs(chosen, by_name, not a.rerun_committed)
     if a.list:
-        by_name, memo = {u.name: u for u in units}, {}
+        memo = {}
         for u in chosen:
-            why = None if is_done(u) else blocked_reason(u, by_name, memo)
-            print(f"{'done' if is_done(u) else 'todo'} {u.name}"
-                  + (f" (not yet runnable: {why})" if why else ""))
+            why = blocked_reason(u, by_name, memo) if u.name in to_run else None
+            state = "todo" if u.name in to_run else "done" if is_done(u) else "committed"
+            print(f"{state} {u.name}" + (f" (not yet runnable: {why})" if why else "")
+                  + (f" ({committed_where(u)})" if state == "committed" else ""))
         return 0
-    problem = check_needs(units, chosen)
+    problem = check_needs(units, chosen, to_run)
     if problem:
         print(f"campaign: {problem}", file=sys.stderr)
         return 2
     times = Times(os.path.join(os.path.dirname(os.path.abspath(units[0].outputs[0])),
                                ".campaign_times.json"))
-    failed, _ = run(chosen, times, units)
+    failed, _ = run(chosen, times, units, to_run=to_run)
     return 1 if failed else 0
 
 

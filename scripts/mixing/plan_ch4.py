@@ -15,6 +15,10 @@ out/mixing/ch4_dt_half/.  --ranks N runs each liggghts-jdem fill on N MPI ranks 
 ranks sums forces in another order: another realisation, as the spread's are).  A unit's cost for
 the ETA is its particle-steps.
 
+A unit whose result is committed (reference_runs/mixing/ch4/results/: summary.json of
+report_ch4.py, horizon/summary.json of horizon_ch4.py; the seed-dt variant only) is skipped on a
+machine without its outputs unless a unit that runs reads them (scripts/campaign.py).
+
 A unit whose engine lacks a feature it needs is "not yet runnable": the plan asks the engine
 itself, by reading a probe scene that uses the feature (jdem resolve; for liggghts-jdem also the
 deck generator), so the gate lifts by itself once the feature lands.
@@ -35,6 +39,7 @@ from scripts.campaign import Unit
 PY = "/usr/bin/python3"
 SCENE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "models.yaml")
 GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "generate.py")
+RESULTS = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "results")
 OUT = {"seed": os.path.join(ROOT, "out", "mixing", "ch4"),
        "guard": os.path.join(ROOT, "out", "mixing", "ch4_dt_guard"),
        "half": os.path.join(ROOT, "out", "mixing", "ch4_dt_half")}
@@ -65,6 +70,41 @@ def valid_trajectory(path):
     except (OSError, KeyError) as e:
         return f"not a trajectory: {e}"
     return None if frames > 0 else "no frame"
+
+
+def read_committed(path):
+    """A committed summary's JSON, {} when it is absent or unreadable (then nothing counts as
+    committed and the units run)."""
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return {}
+
+
+@functools.lru_cache(maxsize=None)
+def committed_ch4():
+    return read_committed(os.path.join(RESULTS, "summary.json")).get("results", {})
+
+
+@functools.lru_cache(maxsize=None)
+def committed_horizons():
+    return {m.get("case") for m in read_committed(os.path.join(RESULTS, "horizon", "summary.json"))
+            .get("models", [])}
+
+
+def committed_entry(engine, model, key, count=1):
+    """f() for Unit.committed: where report_ch4.py's committed summary holds the result
+    key of the engine's model ("fill1", "fill2", "passP_cubes", "jitter"), a list of at least
+    `count` entries for the lists; None when it does not."""
+    def where():
+        entry = committed_ch4().get(engine, {}).get(model, {}).get(key)
+        if not entry or (isinstance(entry, list) and len(entry) < count):
+            return None
+        source = (entry[count - 1] if isinstance(entry, list) else entry).get("source", "?")
+        return "%s: %s of commit %s" % (os.path.relpath(os.path.join(RESULTS, "summary.json"), ROOT),
+                                       key, source)
+    return where
 
 
 def valid_scene(path):
@@ -227,25 +267,27 @@ def spread_units(engine, model, variant, ranks):
                  fill1_command(engine, model, dt_arg, True, k, ranks), model, engine,
                  validate=valid_trajectory, cost=FILL_PARTICLES * FILL_TIME / dt,
                  blocked=gate(engine, "conveyor inlet"), resumes=resumable(engine),
-                 ranks=fill_ranks(engine, ranks))
+                 ranks=fill_ranks(engine, ranks), committed=committed_entry(engine, model, "jitter", k))
             for k in range(1, SPREAD_REALISATIONS + 1)]
 
 
-def pass_units(engine, model, p, deposit, base, dt_arg, dt, force):
-    """The 9 cube scenes of one deposit and their compressions."""
+def pass_units(engine, model, p, deposit, base, dt_arg, dt, force, committed):
+    """The 9 cube scenes of one deposit and their compressions (committed: whether the seed
+    variant's committed results count)."""
     name = f"{engine}/{model}/pass{p}"
+    cubes_kept = committed_entry(engine, model, f"pass{p}_cubes", 9) if committed else None
     cube_dir = os.path.join(base, f"pass{p}_cubes")
     scenes = [os.path.join(cube_dir, f"cube{k}.yaml") for k in range(1, 10)]
     units = [Unit(f"{name}_cubes", scenes, [PY, GENERATE, "cubes", deposit, "--case", model,
                                             "--dt", dt_arg, "-o", "{dir}"],
                   model, engine, needs=[f"{engine}/{model}/fill{p}"], validate=valid_scene,
-                  cost=SCENE_COST)]
+                  cost=SCENE_COST, committed=cubes_kept)]
     for k, scene in enumerate(scenes, start=1):
         units.append(Unit(f"{name}_cube{k}", [os.path.join(base, f"pass{p}_cube{k}.h5")],
                           run_command(engine, scene, "{out0}", force), model, engine,
                           needs=[f"{name}_cubes"], validate=valid_trajectory,
                           cost=CUBE_PARTICLES * CUBE_TIME / dt,
-                          blocked=gate(engine, "servo wall")))
+                          blocked=gate(engine, "servo wall"), committed=cubes_kept))
     return units
 
 
@@ -257,20 +299,24 @@ def model_units(engine, model, variant, ranks):
     dt_arg, dt = variant_dt(variant, model)
     force = variant == "seed"   # the guard refuses the seed's dt (docs/mixing.md §6)
     fill_cost = FILL_PARTICLES * FILL_TIME / dt
+    kept = (lambda key: committed_entry(engine, model, key)) if variant == "seed" else (lambda key: None)
     units = [
         Unit(f"{pre}/fill1", [fill1], fill1_command(engine, model, dt_arg, force, ranks=ranks), model, engine,
              validate=valid_trajectory, cost=fill_cost, blocked=gate(engine, "conveyor inlet"),
-             resumes=resumable(engine), ranks=fill_ranks(engine, ranks)),
+             resumes=resumable(engine), ranks=fill_ranks(engine, ranks), committed=kept("fill1")),
         Unit(f"{pre}/pass2_scene", [pass2], [PY, GENERATE, "second-pass", fill1, "--case", model,
                                              "--dt", dt_arg, "-o", "{out0}"],
-             model, engine, needs=[f"{pre}/fill1"], validate=valid_scene, cost=SCENE_COST),
+             model, engine, needs=[f"{pre}/fill1"], validate=valid_scene, cost=SCENE_COST,
+             committed=kept("fill2")),   # an intermediate: settled with the fill it feeds
         Unit(f"{pre}/fill2", [fill2], fill_command(engine, pass2, force, ranks=ranks), model, engine,
              needs=[f"{pre}/pass2_scene"], validate=valid_trajectory, cost=fill_cost,
              resumes=resumable(engine), ranks=fill_ranks(engine, ranks),
-             blocked=gate(engine, "conveyor inlet", "inlet section from a deposit")),
+             blocked=gate(engine, "conveyor inlet", "inlet section from a deposit"),
+             committed=kept("fill2")),
     ]
-    return units + pass_units(engine, model, 1, fill1, base, dt_arg, dt, force) \
-        + pass_units(engine, model, 2, fill2, base, dt_arg, dt, force) \
+    seed = variant == "seed"
+    return units + pass_units(engine, model, 1, fill1, base, dt_arg, dt, force, seed) \
+        + pass_units(engine, model, 2, fill2, base, dt_arg, dt, force, seed) \
         + spread_units(engine, model, variant, ranks)
 
 
@@ -303,7 +349,9 @@ def horizon_unit(model, variant):
                  "-o", "{out0}"],
                 model, "cross", validate=valid_horizon,
                 cost=HORIZON_COST * inserted * HORIZON_TIME / dt,
-                blocked=gate("liggghts-jdem", "conveyor inlet"))   # it asks jdem too
+                blocked=gate("liggghts-jdem", "conveyor inlet"),   # it asks jdem too
+                committed=(lambda: os.path.relpath(os.path.join(RESULTS, "horizon", "summary.json"), ROOT)
+                           if model in committed_horizons() else None) if variant == "seed" else None)
 
 
 def units(argv):

@@ -19,8 +19,11 @@ Chapter 6's rigid cements add two fills per engine, rigid_model1 and rigid_model
 HORIZON_TIME s of the fill in both engines, compared particle by particle and break by break,
 scripts/mixing/horizon_ch5.py), and each engine's runs of it with the stream shifted by K =
 1..6 micrometres (`cross/groupG_modelM/jitterK`, `.../liggghts-jdem_jitterK`: the run-to-run
-spread of the breaks).
+spread of the breaks).  A unit whose result is committed (reference_runs/mixing/ch5/results/:
+summary.json of report_ch5.py, horizon/summary.json of horizon_ch5.py) is skipped on a machine
+without its outputs unless a unit that runs reads them (scripts/campaign.py).
 """
+import functools
 import os
 import shlex
 
@@ -29,7 +32,8 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 from scripts.campaign import Unit
 from scripts.mixing.plan_ch4 import (CUBE_PARTICLES, CUBE_TIME, ENGINES, FILL_PARTICLES, FILL_TIME,
                                      HORIZON_COST, PY, SCENE_COST, SEED_DT, fill_command, fill_ranks, jdem,
-                                     resumable, run_command, valid_json, valid_scene, valid_trajectory)
+                                     read_committed, resumable, run_command, valid_json, valid_scene,
+                                     valid_trajectory)
 
 from scripts.mixing.horizon_ch5 import END_TIME as HORIZON_TIME, REALISATIONS, realisation_path
 
@@ -37,10 +41,47 @@ SCENE = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "models.yaml")
 GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "generate.py")
 CUBES = range(10, 19)     # Table 5-2's middle clip
 OUT = os.path.join(ROOT, "out", "mixing", "ch5")
+RESULTS = os.path.join(ROOT, "reference_runs", "mixing", "ch5", "results")
 CASES = [f"group{g}_model{m}" for g in range(1, 4) for m in range(1, 7)]
 RIGID_CASES = ["rigid_model1", "rigid_model3"]   # Ch. 6, Figs 6-1 and 6-2: pictures, no cubes
 # the cross-engine horizons: the bonded groups (Group 1 has no bonds; its horizon is Ch. 4's)
 HORIZON_CASES = [c for c in CASES if not c.startswith("group1_")]
+
+
+@functools.lru_cache(maxsize=None)
+def committed_ch5():
+    return read_committed(os.path.join(RESULTS, "summary.json")).get("results", {})
+
+
+@functools.lru_cache(maxsize=None)
+def committed_horizons():
+    return read_committed(os.path.join(RESULTS, "horizon", "summary.json"))
+
+
+def committed_fill(engine, case, cubes=False):
+    """f() for Unit.committed: where report_ch5.py's committed summary holds the engine's fill of
+    the case (with cubes: and its 9 compressions)."""
+    def where():
+        entry = committed_ch5().get(f"{engine}/{case}")
+        if not entry or (cubes and len(entry.get("cubes") or []) < len(CUBES)):
+            return None
+        return "%s: %s/%s%s of commit %s" % (os.path.relpath(os.path.join(RESULTS, "summary.json"), ROOT),
+                                            engine, case, ", cubes" if cubes else "",
+                                            entry.get("source", "?"))
+    return where
+
+
+def committed_horizon(case, engine=None, k=None):
+    """f() for Unit.committed: where horizon_ch5.py's committed summary holds the case's horizon
+    (engine and k: that engine's realisation K)."""
+    def where():
+        h = committed_horizons()
+        if engine is None:
+            found = any(c.get("case") == case for c in h.get("cases", []))
+        else:
+            found = any(r.get("jitter") == k for r in h.get("realisations", {}).get(case, {}).get(engine, []))
+        return os.path.relpath(os.path.join(RESULTS, "horizon", "summary.json"), ROOT) if found else None
+    return where
 
 
 def fill_unit(engine, case, ranks):
@@ -48,7 +89,8 @@ def fill_unit(engine, case, ranks):
     return Unit(f"{engine}/{case}/fill", [os.path.join(OUT, engine, case, "fill.h5")],
                 fill_command(engine, "{dir}/fill.yaml", False, resolve, ranks=ranks), case, engine,
                 validate=valid_trajectory, cost=FILL_PARTICLES * FILL_TIME / SEED_DT,
-                resumes=resumable(engine), ranks=fill_ranks(engine, ranks))
+                resumes=resumable(engine), ranks=fill_ranks(engine, ranks),
+                committed=committed_fill(engine, case))
 
 
 def cube_units(engine, case):
@@ -58,12 +100,13 @@ def cube_units(engine, case):
     units = [Unit(f"{engine}/{case}/cubes", scenes,
                   [PY, GENERATE, "cubes", os.path.join(base, "fill.h5"), "--case", case,
                    "-o", "{dir}"], case, engine, needs=[f"{engine}/{case}/fill"],
-                  validate=valid_scene, cost=SCENE_COST)]
+                  validate=valid_scene, cost=SCENE_COST, committed=committed_fill(engine, case, True))]
     for k, scene in zip(CUBES, scenes):
         units.append(Unit(f"{engine}/{case}/cube{k}", [os.path.join(base, f"cube{k}.h5")],
                           run_command(engine, scene, "{out0}", False), case, engine,
                           needs=[f"{engine}/{case}/cubes"], validate=valid_trajectory,
-                          cost=CUBE_PARTICLES * CUBE_TIME / SEED_DT))
+                          cost=CUBE_PARTICLES * CUBE_TIME / SEED_DT,
+                          committed=committed_fill(engine, case, True)))
     return units
 
 
@@ -80,7 +123,7 @@ def horizon_unit(case):
                 [PY, os.path.join(HERE, "horizon_ch5.py"), "run", "--case", case,
                  "--end-time", repr(HORIZON_TIME), "--dir", "{dir}", "-o", "{out0}"],
                 case, "cross", validate=valid_json("horizon", "breaks", "divergence"),
-                cost=HORIZON_COST * horizon_particle_steps())
+                cost=HORIZON_COST * horizon_particle_steps(), committed=committed_horizon(case))
 
 
 def realisation_units(case):
@@ -93,7 +136,8 @@ def realisation_units(case):
                   "--engine", engine, "--jitter", str(k), "--end-time", repr(HORIZON_TIME),
                   "--dir", "{dir}", "-o", "{out0}"],
                  case, "cross", validate=valid_json("realisation", "totals"),
-                 cost=(1.0 if engine == "jdem" else HORIZON_COST - 1.0) * horizon_particle_steps())
+                 cost=(1.0 if engine == "jdem" else HORIZON_COST - 1.0) * horizon_particle_steps(),
+                 committed=committed_horizon(case, engine, k))
             for engine in ENGINES for k in REALISATIONS]
 
 

@@ -42,14 +42,21 @@ def valid(path):
     return None if text == "ok" else f"content {{text!r}}, expected 'ok'"
 
 
+def kept(name):
+    """Unit.committed: the units named in COMMITTED (comma-separated) have a committed result."""
+    return lambda: ("summary.json: " + name) if name in os.environ.get("COMMITTED", "").split(",") \
+        else None
+
+
 def units(argv):
     out = lambda n: os.path.join(HERE, "out", n + ".txt")
     plan = [
-        Unit("a", [out("a")], WORKER + ["a", "{{out0}}"], model="m1", engine="e1", validate=valid),
+        Unit("a", [out("a")], WORKER + ["a", "{{out0}}"], model="m1", engine="e1", validate=valid,
+             committed=kept("a")),
         Unit("b", [out("b")], WORKER + ["b", "{{out0}}"], model="m1", engine="e2", validate=valid,
-             needs=["a"]),
+             needs=["a"], committed=kept("b")),
         Unit("c", [out("c")], WORKER + ["c", "{{out0}}"], model="m2", engine="e1", validate=valid,
-             cost=2.0),
+             cost=2.0, committed=kept("c")),
     ]
     if os.environ.get("WITH_R"):  # r: the resumable unit's test only
         return plan + [Unit("r", [out("r")], WORKER + ["r", "{{out0}}"], model="m4", engine="e1",
@@ -181,6 +188,33 @@ def test_validation_and_selection():
     check("select_nothing", r.returncode == 2 and "no unit matches --model m9" in r.stderr, r.stderr)
     r = campaign(here, "--list")
     check("list", r.stdout.split("\n")[:3] == ["done a", "done b", "done c"], r.stdout)
+
+
+def test_committed_results():
+    """On a machine without the outputs, a committed unit is skipped unless a unit to run reads
+    it; a unit derived from one that runs again runs too; --rerun-committed runs them all."""
+    here = setup()
+    r = campaign(here, env={"COMMITTED": "a,c"})
+    check("committed_need_runs_again", r.returncode == 0 and runs(here) == ["a", "b"]
+          and "skip c (committed in summary.json: c)" in r.stderr
+          and r.stderr.rstrip().endswith("0 already done, 1 committed"), f"ran {runs(here)}: {r.stderr}")
+    here = setup()
+    r = campaign(here, env={"COMMITTED": "a,b,c"})
+    check("all_committed_none_runs", r.returncode == 0 and runs(here) == [], f"ran {runs(here)}")
+    r = campaign(here, "--list", env={"COMMITTED": "a,b,c"})
+    check("list_committed", r.stdout.split("\n")[0] == "committed a (summary.json: a)", r.stdout)
+    r = campaign(here, env={"COMMITTED": "b,c"})   # a runs, so b (derived from it) does too
+    check("derived_runs_again", r.returncode == 0 and runs(here) == ["a", "b"], f"ran {runs(here)}")
+    here = setup()
+    r = campaign(here, "--engine", "e2", env={"COMMITTED": "a"})
+    check("committed_need_not_selected", r.returncode == 2 and "unit b needs a, which is neither "
+          "done nor selected (its result is committed in summary.json: a, but not its output "
+          "files: select it too)" in r.stderr, r.stderr)
+    r = campaign(here, "--rerun-committed", env={"COMMITTED": "a,b,c"})
+    check("rerun_committed", r.returncode == 0 and runs(here) == ["a", "b", "c"], f"ran {runs(here)}")
+    r = campaign(here, env={"COMMITTED": "a,b,c"})   # done here: nothing runs, nothing committed
+    check("done_beats_committed", runs(here) == ["a", "b", "c"]
+          and r.stderr.rstrip().endswith("3 already done"), r.stderr)
 
 
 def test_not_yet_runnable():
@@ -328,6 +362,7 @@ def test_ch4_ranks():
 
 
 test_validation_and_selection()
+test_committed_results()
 test_not_yet_runnable()
 test_times_beside_unrun_first_unit()
 test_times_shared_by_campaigns_at_once()
