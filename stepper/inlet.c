@@ -366,6 +366,25 @@ int sim_inlets_step(jd_sim *s, char *err, size_t errlen) {
     return rc;
 }
 
+double sim_inlets_pending_particle_steps(const jd_sim *s, int64_t last) {
+    if (!s->inlets) return 0.0;
+    double sum = 0.0;
+    for (size_t k = 0; k < s->inlets->n_inlets; k++) {
+        const inlet_run *r = &s->inlets->run[k];
+        for (size_t p = 0; p < r->spec.n; p++) {
+            const int64_t c0 = r->st.cursor[p].copy, m = r->copies - c0;
+            if (m <= 0 || r->st.cursor[p].step == JD_INLET_NEVER) continue;
+            /* one particle's copies cross at evenly spaced steps (a rigid motion): the series
+             * between the first and the last, to round-off */
+            const double k0 = (double)jd_inlet_insertion_step(&r->spec, c0, p);
+            const double k1 = (double)jd_inlet_insertion_step(&r->spec, r->copies - 1, p);
+            const double steps = (double)m * ((double)last - 0.5 * (k0 + k1));
+            if (steps > 0.0) sum += steps;
+        }
+    }
+    return sum;
+}
+
 int64_t sim_inlets_inserted(const jd_sim *s) {
     return s->inlets ? (int64_t)s->particles.n + s->inlets->lost - (int64_t)s->inlets->n_scene : 0;
 }

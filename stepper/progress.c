@@ -20,14 +20,18 @@ void progress_start(jd_progress *p, int enabled, int64_t total_steps) {
     p->t_start = p->t_last = now();
 }
 
+/* The ETA: the work left in particle-steps (the present particles to the last step, and those
+ * an inlet has still to insert) over the particle-steps per second so far, so that a growing
+ * set is not timed at its early, cheaper rate. */
 static void print_line(jd_progress *p, int64_t step, double sim_time, double t) {
     const double elapsed = t - p->t_start;
-    const double rate = elapsed > 0.0 ? (double)step / elapsed : 0.0; /* steps/s */
-    const double eta = rate > 0.0 ? (double)(p->total - step) / rate : 0.0;
+    const double rate = elapsed > 0.0 ? p->particle_steps / elapsed : 0.0; /* particle-steps/s */
+    const double left = (double)p->n * (double)(p->total - step) +
+                        (p->pending ? p->pending(p->ctx, p->total) : 0.0);
+    const double eta = rate > 0.0 ? left / rate : 0.0;
     fprintf(stderr, "%sstep %lld/%lld  t = %.6g s  %zu particles  %.3g particle-steps/s  "
             "ETA %.0f s%s", p->tty ? "\r\033[K" : "", (long long)step, (long long)p->total,
-            sim_time, p->n, elapsed > 0.0 ? p->particle_steps / elapsed : 0.0, eta,
-            p->tty ? "" : "\n");
+            sim_time, p->n, rate, eta, p->tty ? "" : "\n");
     fflush(stderr);
     p->printed = 1;
 }

@@ -454,6 +454,10 @@ int sim_run(jd_sim *s, jd_h5md *h, int show_progress, char *err, size_t errlen) 
     return sim_run_checkpointed(s, h, show_progress, NULL, err, errlen);
 }
 
+static double pending_particle_steps(const void *s, int64_t last) {
+    return sim_inlets_pending_particle_steps(s, last);
+}
+
 int sim_run_checkpointed(jd_sim *s, jd_h5md *h, int show_progress, jd_checkpointer *ck,
                          char *err, size_t errlen) {
     const jd_scene *sc = s->run.scene;
@@ -462,6 +466,10 @@ int sim_run_checkpointed(jd_sim *s, jd_h5md *h, int show_progress, jd_checkpoint
     const int64_t written = ck ? ck->resumed_step : -1;
     jd_progress p;
     progress_start(&p, show_progress, last);
+    if (s->inlets) {
+        p.pending = pending_particle_steps;
+        p.ctx = s;
+    }
     if (written >= 0) { /* the rate and ETA count the time before the resume */
         p.t_start -= ck->elapsed;
         p.particle_steps = ck->particle_steps;

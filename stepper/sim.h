@@ -401,6 +401,9 @@ void sim_inlets_log(jd_sim *s, FILE *log);
 int sim_inlets_step(jd_sim *s, char *err, size_t errlen);
 int64_t sim_inlets_inserted(const jd_sim *s);
 double sim_inlets_seconds(const jd_sim *s); /* wall time of the insertions [s] */
+/* The particle-steps that the particles not yet inserted will add from their insertion to step
+ * `last` (the progress line's ETA; an upper bound once a deposit-height rule ends a stream). */
+double sim_inlets_pending_particle_steps(const jd_sim *s, int64_t last);
 double sim_inlets_energy(const jd_sim *s);  /* kinetic + gravitational energy brought in [J] */
 /* The trajectory's rows (every particle the run can hold, sorted by id) and their constants
  * (arrays of sim_inlets_rows entries). */
@@ -561,6 +564,10 @@ typedef struct jd_progress {
     double particle_steps;  /* sum of n over the steps done: the rate of a growing set */
     double t_start, t_last; /* CLOCK_MONOTONIC seconds */
     int printed;
+    /* the particle-steps still to come beyond the present particles' (an inlet's stream), or
+     * NULL: the ETA is the remaining work over the measured particle-steps per second */
+    double (*pending)(const void *ctx, int64_t total_steps);
+    const void *ctx;
 } jd_progress;
 void progress_start(jd_progress *p, int enabled, int64_t total_steps);
 /* After each step: step done, its time [s], the particles it had. */
