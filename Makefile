@@ -283,7 +283,8 @@ mixing-bonded-report:
 # one run: out/mixing/speed/report.md and summary.json (docs/mixing.md §10).
 .PHONY: mixing-speed
 mixing-speed: all
-	$(PY) -m scripts.mixing.speed_ch4 $(if $(SPEED_TIME),--end-time $(SPEED_TIME)) $(if $(SPEED_ROUNDS),--rounds $(SPEED_ROUNDS))
+	$(PY) -m scripts.mixing.speed_ch4 $(if $(SPEED_TIME),--end-time $(SPEED_TIME)) $(if $(SPEED_ROUNDS),--rounds $(SPEED_ROUNDS)) \
+	    $(if $(SPEED_ONLY),--only $(SPEED_ONLY))
 
 .PHONY: mixing-report
 mixing-report:

@@ -19,6 +19,8 @@ infinite plane through it and a cylinder loses its end caps and its side: equiva
 no particle reaches an edge, a rim or the far side.  A material with E < 5e6 Pa gets
 `soft_particles yes` (LIGGGHTS' own models refuse it in SI units otherwise).
 
+--skin F sets LIGGGHTS' neighbour skin to F times the largest radius (default 0.2, jdem's skin).
+
 Inlets (the resolved scene's `inlets:`) become one `fix jdem/inlet` each, with the section in
 `inlet_NAME.txt` beside the deck; --inlet-record FILE makes them write the insertion record of
 `jdem run --inlet-record`.  A scene of inlets alone starts from an empty box (create_box).
@@ -460,12 +462,19 @@ def inlet_lines(scene, tid, deck_dir, record):
     return L
 
 
+# The neighbour skin over the largest radius: jdem's (docs/scenes.md "Neighbour lists"), so that the
+# engines' lists hold the same pairs; LIGGGHTS without jdem's per-particle skins rebuilds more
+# often and runs a Chapter 4 fill faster at 0.5 (--skin; docs/performance.md).
+SKIN_FACTOR = 0.2
+
+
 def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=False, particles=None,
-               inlet_record=None, restart=None, processors=None):
+               inlet_record=None, restart=None, processors=None, skin_factor=SKIN_FACTOR):
     """The deck of SCENE.  PARTICLES: its particles, gathered by a ParticleStream while
     resolved_stream.read_resolved read the scene; None: SCENE["particles"] is their list.
     RESTART: None, or a Restart (restart files every N steps; the deck continuing from one).
-    PROCESSORS: None, or the rank grid [PX, PY, PZ] (strings: counts or '*')."""
+    PROCESSORS: None, or the rank grid [PX, PY, PZ] (strings: counts or '*').  SKIN_FACTOR: the
+    neighbour skin in units of the largest radius."""
     deck_dir = os.path.dirname(os.path.abspath(deck_path))
     os.makedirs(deck_dir, exist_ok=True)
     if particles is None:
@@ -478,7 +487,7 @@ def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=
             raise
     try:
         write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
-                         inlet_record, restart or Restart(), processors)
+                         inlet_record, restart or Restart(), processors, skin_factor)
     finally:
         particles.remove()
 
@@ -502,7 +511,7 @@ def restart_lines(restart):
 
 
 def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
-                     inlet_record, restart, processors):
+                     inlet_record, restart, processors, skin_factor):
     mats = scene["materials"]
     names = list(mats.keys())
     ntypes = len(names)
@@ -558,7 +567,7 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
     L.append("atom_style      granular\n")
     L.append("atom_modify     map array sort 0 0.0\n")
     L.append("newton          off\n")
-    skin = 0.2 * rmax
+    skin = skin_factor * rmax
     blines, ghost_cut = bond_lines(scene, tid, deck_dir, particles, skin) if not builtin else ([], None)
     if builtin and (scene.get("bonds") or scene.get("bond_rules")):
         fail("--builtin: LIGGGHTS has no parallel bonds")
@@ -691,7 +700,12 @@ def main():
                     help="continue from this restart file (the trajectory from the interrupted run's)")
     ap.add_argument("--processors", nargs=3, metavar=("PX", "PY", "PZ"),
                     help="the MPI rank grid (LIGGGHTS' processors command; '*' lets it choose)")
+    ap.add_argument("--skin", type=float, default=SKIN_FACTOR, metavar="F",
+                    help="the neighbour skin in units of the largest radius (default %s, jdem's)"
+                    % SKIN_FACTOR)
     a = ap.parse_args()
+    if not (math.isfinite(a.skin) and a.skin > 0):
+        fail("--skin %s: valid: a positive number (the skin over the largest radius)" % a.skin)
     for c in a.processors or []:
         if c != "*" and not (c.isdigit() and int(c) > 0):
             fail("--processors %s: %r is not a rank count; valid: a positive integer or *"
@@ -718,7 +732,7 @@ def main():
         if "*" not in pattern:
             fail("--restart-pattern %r: the name needs a '*' for the step" % pattern)
         write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin, a.force, particles, a.inlet_record,
-                   Restart(a.restart_every, pattern, a.resume), a.processors)
+                   Restart(a.restart_every, pattern, a.resume), a.processors, a.skin)
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
         fail("%s: cannot read the resolved scene: %s" % (source, e))
     except (KeyError, TypeError, ValueError, AttributeError, IndexError, RecursionError, OverflowError) as e:

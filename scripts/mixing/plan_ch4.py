@@ -54,6 +54,10 @@ SCENE_COST = 1e6                          # cutting: a read of the deposit
 SPREAD_MODEL, SPREAD_REALISATIONS = "model3", 2   # the run-to-run spread's fills (obstacles: phi_v > 0)
 JITTER = 1.0e-6           # [m] a realisation's stream shift per step of K (generate.py --jitter,
                           # horizon_ch5.py realisation): far below every length of the scenes
+LIGGGHTS_SKIN = 0.5      # liggghts-jdem's neighbour skin over R_max in the fills and cubes: without
+                          # jdem's per-particle skins LIGGGHTS rebuilds its lists every 6 steps at
+                          # jdem's 0.2 and runs a fill 20 % faster at 0.5 (docs/performance.md);
+                          # the horizons keep 0.2, the lists of jdem
 HORIZON_TIME, HORIZON_FRAME_TIME = 4.0, 0.02      # [s] the cross-engine horizon's fill and frames
 HORIZON_COST = 3.3        # both engines: liggghts-jdem takes 2.3 x jdem's CPU (47 s and 106 s, model1, 4 s)
 
@@ -213,14 +217,14 @@ def fill_ranks(engine, ranks):
     return ranks if engine == "liggghts-jdem" else 1
 
 
-def run_command(engine, scene, out, force, ranks=1):
+def run_command(engine, scene, out, force, ranks=1, skin=LIGGGHTS_SKIN):
     """argv running `scene` (a path or a "{...}" placeholder) into `out`; liggghts-jdem on
-    `ranks` MPI ranks."""
+    `ranks` MPI ranks with the neighbour skin `skin` R_max (None: the deck generator's, jdem's)."""
     extra = ["--force"] if force else []
     if engine == "jdem":
         return [jdem(), "run", scene, "-o", out, *extra]   # its progress line shows in the log
     return [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out, *extra,
-            *rank_args(ranks)]
+            *(["--skin", repr(skin)] if skin else []), *rank_args(ranks)]
 
 
 def resumable(engine):

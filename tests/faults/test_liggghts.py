@@ -395,12 +395,32 @@ def setup_watchdog(c, d):
     c.check("setup_watchdog_no_files", not os.path.exists(out) and not os.path.exists(out + ".part"), files(deck))
 
 
+def skin(c, d):
+    """--skin F: LIGGGHTS' neighbour skin F R_max (the resting scene's R_max = 10 mm), jdem's 0.2 by
+    default; a skin that is not a positive number is refused with exit 2 and no deck."""
+    res = os.path.join(d, "resolved.yaml")
+    with open(res, "w") as f:
+        f.write(resolved_text(resting(d)))
+    for label, extra, want in (("default", [], "neighbor        0.002 bin\n"),
+                               ("half", ["--skin", "0.5"], "neighbor        0.005 bin\n")):
+        deck = os.path.join(d, label, "in.jdem")
+        r = run([PY, GEN, res, "-o", deck, "--trajectory", os.path.join(d, "o.h5"), *extra])
+        text = open(deck).read() if os.path.exists(deck) else ""
+        c.check("skin_" + label, r.rc == 0 and want in text, "%r; want %r" % (r, want))
+    for label, value in (("zero", "0"), ("nan", "nan"), ("negative", "-1")):
+        deck = os.path.join(d, "bad_" + label, "in.jdem")
+        r = run([PY, GEN, res, "-o", deck, "--trajectory", os.path.join(d, "o.h5"), "--skin", value])
+        c.check("skin_refused_" + label, r.rc == EXIT["input"] and "--skin %s: valid: a positive number "
+                "(the skin over the largest radius)" % float(value) in r.err
+                and not os.path.exists(deck), repr(r))
+
+
 def main():
     c = Checks()
     d = scratch("jdem_faults_liggghts_")
     for name, case in (("injection", injection), ("paths", paths), ("concurrent", concurrent),
                        ("typo", typo_keeps_result), ("watchdog", watchdog_class), ("sigterm", sigterm), ("rank_errors", rank_errors),
-                       ("bad_files", bad_files), ("setup_watchdog", setup_watchdog)):
+                       ("bad_files", bad_files), ("setup_watchdog", setup_watchdog), ("skin", skin)):
         sub = os.path.join(d, name)
         os.makedirs(sub)
         case(c, sub)

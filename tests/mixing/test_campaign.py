@@ -354,6 +354,8 @@ def test_ch4_ranks():
     cube = plan["liggghts-jdem/model1/pass1_cube1"].command
     check("ch4_ranks_fill", "--np 2 --processors 1 2 1" in lig and "--np" not in jd
           and "--np" not in cube, f"liggghts-jdem: {lig}; jdem: {jd}; cube: {cube}")
+    check("ch4_liggghts_skin", "--skin 0.5" in lig and "--skin" not in jd
+          and cube[cube.index("--skin") + 1] == "0.5", f"liggghts-jdem: {lig}; jdem: {jd}; cube: {cube}")
     r = subprocess.run([sys.executable, CAMPAIGN, os.path.join(ROOT, "scripts", "mixing", "plan_ch4.py"),
                         "--unit", "liggghts-jdem/model1/fill1", "--list", "--", "--ranks", "2"],
                        capture_output=True, text=True)
