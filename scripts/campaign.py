@@ -314,7 +314,8 @@ def run(units, times, everything=None, log=sys.stderr, to_run=None):
     print(f"campaign: {len(todo) - failed - skipped} run, {failed} failed, "
           + (f"{skipped} skipped after a failure, " if skipped else "")
           + f"{len(blocked)} not yet runnable, {here} already done"
-          + (f", {len(units) - len(todo) - here} committed" if len(units) - len(todo) - here else ""),
+          + (f", {len(units) - len(todo) - len(blocked) - here} committed"
+             if len(units) - len(todo) - len(blocked) - here else ""),
           file=log, flush=True)
     return failed, len(blocked)
 

@@ -372,14 +372,21 @@ double sim_inlets_pending_particle_steps(const jd_sim *s, int64_t last) {
     for (size_t k = 0; k < s->inlets->n_inlets; k++) {
         const inlet_run *r = &s->inlets->run[k];
         for (size_t p = 0; p < r->spec.n; p++) {
-            const int64_t c0 = r->st.cursor[p].copy, m = r->copies - c0;
-            if (m <= 0 || r->st.cursor[p].step == JD_INLET_NEVER) continue;
+            const int64_t c0 = r->st.cursor[p].copy;
+            double m = (double)(r->copies - c0);
+            if (m <= 0.0 || r->st.cursor[p].step == JD_INLET_NEVER) continue;
             /* one particle's copies cross at evenly spaced steps (a rigid motion): the series
-             * between the first and the last, to round-off */
+             * between the first and the last, to round-off; the copies of a section that starts
+             * by `last` whose particle p crosses after it are cut off */
             const double k0 = (double)jd_inlet_insertion_step(&r->spec, c0, p);
-            const double k1 = (double)jd_inlet_insertion_step(&r->spec, r->copies - 1, p);
-            const double steps = (double)m * ((double)last - 0.5 * (k0 + k1));
-            if (steps > 0.0) sum += steps;
+            double k1 = (double)jd_inlet_insertion_step(&r->spec, r->copies - 1, p);
+            if (k0 > (double)last) continue;
+            if (k1 > (double)last) {
+                const double spacing = m > 1.0 ? (k1 - k0) / (m - 1.0) : 1.0;
+                m = floor(((double)last - k0) / spacing) + 1.0;
+                k1 = k0 + (m - 1.0) * spacing;
+            }
+            sum += m * ((double)last - 0.5 * (k0 + k1));
         }
     }
     return sum;

@@ -28,9 +28,10 @@ static void print_line(jd_progress *p, int64_t step, double sim_time, double t) 
     const double rate = elapsed > 0.0 ? p->particle_steps / elapsed : 0.0; /* particle-steps/s */
     const double left = (double)p->n * (double)(p->total - step) +
                         (p->pending ? p->pending(p->ctx, p->total) : 0.0);
-    const double eta = rate > 0.0 ? left / rate : 0.0;
+    char eta[32] = "?"; /* no rate yet (an inlet's first particles have not arrived) */
+    if (rate > 0.0) snprintf(eta, sizeof eta, "%.0f s", left / rate);
     fprintf(stderr, "%sstep %lld/%lld  t = %.6g s  %zu particles  %.3g particle-steps/s  "
-            "ETA %.0f s%s", p->tty ? "\r\033[K" : "", (long long)step, (long long)p->total,
+            "ETA %s%s", p->tty ? "\r\033[K" : "", (long long)step, (long long)p->total,
             sim_time, p->n, rate, eta, p->tty ? "" : "\n");
     fflush(stderr);
     p->printed = 1;

@@ -224,7 +224,7 @@ def run_command(engine, scene, out, force, ranks=1, skin=LIGGGHTS_SKIN):
     if engine == "jdem":
         return [jdem(), "run", scene, "-o", out, *extra]   # its progress line shows in the log
     return [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out, *extra,
-            *(["--skin", repr(skin)] if skin else []), *rank_args(ranks)]
+            *(["--skin", repr(skin)] if skin is not None else []), *rank_args(ranks)]
 
 
 def resumable(engine):

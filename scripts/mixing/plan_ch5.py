@@ -4,7 +4,8 @@
                         [--unit NAME] [--list] [-- --ranks N]
 
 Per engine (jdem, liggghts-jdem) and case of reference_runs/mixing/ch5/models.yaml (Groups 1-3
-x Models 1-6): the fill, `ENGINE/groupG_modelM/fill` into out/mixing/ch5/ENGINE/CASE/fill.h5, at
+x Models 1-6): the fill, `ENGINE/groupG_modelM/fill` into out/mixing/ch5/ENGINE/CASE/fill.h5 (a
+liggghts-jdem fill and its cubes at plan_ch4.LIGGGHTS_SKIN, as Chapter 4's: the same stream), at
 the seed's dt = 1e-4 s, which the guard accepts for Table 5-1's softer small spheres (largest
 safe dt 1.28e-4 s; Chapter 4's needs --force, docs/mixing.md §6).  Each fill is resumable the way plan_ch4's are (jdem's checkpoints,
 LIGGGHTS' restart files), and writes its scene first: `jdem resolve` of the case, the one scene

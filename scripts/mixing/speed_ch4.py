@@ -61,11 +61,10 @@ def run_jdem(resolved, d, threads, name="jdem"):
 def run_liggghts(resolved, d, engine, ranks):
     deck_dir = os.path.join(d, f"{engine}_deck")
     deck = os.path.join(deck_dir, "in.jdem")
-    if not os.path.exists(deck):
-        engines.write_deck(resolved, deck, "--force", "--trajectory",
-                           os.path.join(d, f"{engine}.h5"),
-                           *(["--builtin"] if engine in STOCK else []),
-                           *(["--skin", repr(SKIN[engine])] if SKIN[engine] else []), check=True)
+    engines.write_deck(resolved, deck, "--force", "--trajectory",   # every run: never a stale deck
+                       os.path.join(d, f"{engine}.h5"),
+                       *(["--builtin"] if engine in STOCK else []),
+                       *(["--skin", repr(SKIN[engine])] if SKIN[engine] is not None else []), check=True)
     log = f"log.{ranks}"
     engines.run_deck(deck_dir, ranks=ranks, log=log, mpi_flags=("--bind-to", "none"), check=True)
     text = open(os.path.join(deck_dir, log), errors="replace").read()

@@ -227,8 +227,8 @@ def test_not_yet_runnable():
     check("blocked_says_why", "campaign: skip d: not yet runnable: the engine has no frobnicator"
           in r.stderr and "campaign: skip e: not yet runnable: needs d, which is not yet runnable"
           in r.stderr, r.stderr)
-    check("blocked_counted", "campaign: 0 run, 0 failed, 2 not yet runnable, 0 already done"
-          in r.stderr, r.stderr)
+    check("blocked_counted", r.stderr.rstrip().endswith(
+        "campaign: 0 run, 0 failed, 2 not yet runnable, 0 already done"), r.stderr)
     r = campaign(here, "--model", "m3", "--list", env={"WITH_D": "1", "BLOCKED_d": "no frobnicator"})
     check("blocked_listed", r.stdout.split("\n")[:2] == ["todo d (not yet runnable: no frobnicator)",
           "todo e (not yet runnable: needs d, which is not yet runnable)"], r.stdout)
@@ -355,7 +355,8 @@ def test_ch4_ranks():
     check("ch4_ranks_fill", "--np 2 --processors 1 2 1" in lig and "--np" not in jd
           and "--np" not in cube, f"liggghts-jdem: {lig}; jdem: {jd}; cube: {cube}")
     check("ch4_liggghts_skin", "--skin 0.5" in lig and "--skin" not in jd
-          and cube[cube.index("--skin") + 1] == "0.5", f"liggghts-jdem: {lig}; jdem: {jd}; cube: {cube}")
+          and "--skin" in cube and cube[cube.index("--skin") + 1] == "0.5",
+          f"liggghts-jdem: {lig}; jdem: {jd}; cube: {cube}")
     r = subprocess.run([sys.executable, CAMPAIGN, os.path.join(ROOT, "scripts", "mixing", "plan_ch4.py"),
                         "--unit", "liggghts-jdem/model1/fill1", "--list", "--", "--ranks", "2"],
                        capture_output=True, text=True)

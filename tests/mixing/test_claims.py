@@ -99,6 +99,13 @@ def test_run_to_run_spread():
         line = claims_ch4.obstacles_left(g, "jdem")[1]
         check("model5_vs_3_at_%.3f" % phi5, line.endswith(": " + want), line)
         check("model5_bound_%.3f" % phi5, ("= %.4f)" % bound) in line, line)
+    g = copy.deepcopy(f)   # pass 2's means as scattered as pass 1's, to within 2 s = 0.004
+    first = [g["jdem"][m]["fill1"]["summary"]["phi_v"]["mean"] for m in MODELS]
+    for m, v in zip(MODELS, first):
+        g["jdem"][m]["fill2"] = fill(spread(v + 0.05, 0.002))
+    line = claims_ch4.second_pass(g, "jdem")[0]
+    check("second_pass_unresolved", line.endswith(": " + claims_ch4.UNRESOLVED)
+          and "a change counts beyond 2 s = 0.0040" in line, line)
     g = copy.deepcopy(f)   # Model 2 within the spread of Model 1 (0.002 against 0.010 + 0.004)
     g["jdem"]["model1"]["fill1"] = fill(spread(0.006, 0.004))
     line = claims_ch4.model2_split(g, "jdem")[1]
