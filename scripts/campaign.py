@@ -72,19 +72,19 @@ def committed_where(unit):
     return unit.committed() if unit.committed else None
 
 
-def runs(chosen, by_name, use_committed=True):
+def runs(chosen, use_committed=True):
     """The names of the chosen units to run: those neither done here nor committed; the chosen
     needs of those that are not done here (a committed result holds no output file to read); and
     the chosen units, not done here, that read a unit that runs."""
-    names = {u.name for u in chosen}
-    out = {u.name for u in chosen if not is_done(u) and not (use_committed and committed_where(u))}
+    done = {u.name: is_done(u) for u in chosen}   # once: a validation may open an HDF5 file
+    out = {u.name for u in chosen if not done[u.name] and not (use_committed and committed_where(u))}
     grew = True
     while grew:
         grew = False
         for u in chosen:
-            new = [n for n in u.needs if u.name in out and n in names and n not in out
-                   and not is_done(by_name[n])]
-            if u.name not in out and not is_done(u) and any(n in out for n in u.needs):
+            new = [n for n in u.needs if u.name in out and n in done and n not in out
+                   and not done[n]]
+            if u.name not in out and not done[u.name] and any(n in out for n in u.needs):
                 new.append(u.name)
             out.update(new)
             grew = grew or bool(new)
@@ -276,7 +276,7 @@ def run(units, times, everything=None, log=sys.stderr, to_run=None):
     `units`)."""
     by_name = {u.name: u for u in (everything or units)}
     memo = {}
-    to_run = runs(units, by_name) if to_run is None else to_run
+    to_run = runs(units) if to_run is None else to_run
     todo = [u for u in units if u.name in to_run]
     for u in units:
         if u not in todo:
@@ -353,7 +353,7 @@ def main(argv):
               f"{sorted({str(u.engine) for u in units})}", file=sys.stderr)
         return 2
     by_name = {u.name: u for u in units}
-    to_run = runs(chosen, by_name, not a.rerun_committed)
+    to_run = runs(chosen, not a.rerun_committed)
     if a.list:
         memo = {}
         for u in chosen:
