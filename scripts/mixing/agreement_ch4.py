@@ -7,8 +7,10 @@ one engine differ by.  For every model and pass with both engines' fill, each st
 difference |jdem - liggghts-jdem| is set against 2 sqrt(2) s: s the sample standard deviation of
 that statistic over the realisations of one fill (the first fill and its jittered repeats,
 generate.py --jitter), sqrt(2) for the difference of two independent runs, 2 for two standard
-deviations.  s is the model's own where it has realisations, else pooled over the models that
-have them.  The height is the bed's mean surface height (structure.free_surface), which the
+deviations.  s is the model's own where it has at least OWN_SPREAD_RUNS realisations, else
+pooled over every model's realisations (one jittered fill of each model, two of Model 3: a std
+from two runs has one degree of freedom, and its 95 % interval spans 0.03 to 2.2 times the true
+one, so a model's own is taken only from three).  The height is the bed's mean surface height (structure.free_surface), which the
 same 41280 spheres set through their packing in every model, so it pools like the intensive
 statistics (phi_v, packing fraction, rho_b, Z); the highest sphere's top is not compared: a
 sphere resting on an obstacle sets it (Model 3's two realisations: 1.580 and 1.110 m).  A fill
@@ -20,6 +22,7 @@ import numpy as np
 
 ENGINES = ("jdem", "liggghts-jdem")
 MODELS = tuple("model%d" % m for m in range(1, 7))
+OWN_SPREAD_RUNS = 3   # realisations from which a model's own std is used rather than the pool
 PASSES = (1, 2)
 # (label, how to read it from a fill_result, format); packing fraction = 1 - n (porosity)
 STATISTICS = (("bed height [m]", lambda r: r.get("bed_height"), "%.3f"),
@@ -36,7 +39,8 @@ def realisations(entry):
 
 def spreads(found):
     """{(model or None for the pool, label): (s, source)}: each model's sample std over its
-    realisations, and the pooled one (over every engine and model with at least two)."""
+    realisations where it has OWN_SPREAD_RUNS, and the pooled one (over every engine and model
+    with at least two)."""
     out, pooled = {}, {}
     for engine in ENGINES:
         for model in MODELS:
@@ -48,7 +52,8 @@ def spreads(found):
                 if None in vals:
                     continue
                 s = float(np.std(vals, ddof=1))
-                out[(model, label)] = (s, "%s %s, %d realisations" % (engine, model, len(runs)))
+                if len(runs) >= OWN_SPREAD_RUNS:
+                    out[(model, label)] = (s, "%s %s, %d realisations" % (engine, model, len(runs)))
                 acc = pooled.setdefault(label, [0.0, 0, []])
                 acc[0] += s * s * (len(vals) - 1)
                 acc[1] += len(vals) - 1

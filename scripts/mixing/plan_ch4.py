@@ -51,7 +51,11 @@ CUBE_PARTICLES, CUBE_TIME = 400, 10.0     # about 400 spheres in a 0.2 m cube, u
 CHECKPOINT_SECONDS = 300                  # a killed jdem fill loses at most this much of its work
 RESTART_STEPS = 2000                      # liggghts-jdem: a restart file every 0.2 s of a fill
 SCENE_COST = 1e6                          # cutting: a read of the deposit
-SPREAD_MODEL, SPREAD_REALISATIONS = "model3", 2   # the run-to-run spread's fills (obstacles: phi_v > 0)
+SPREAD_REALISATIONS = {"jdem": {m: 2 if m == "model3" else 1 for m in MODELS},  # the run-to-run
+                       "liggghts-jdem": {"model3": 2}}  # spread's fills: every model once in jdem,
+                       # which the pool over the models needs (agreement_ch4.spreads); Model 3
+                       # (obstacles: phi_v > 0) twice, and in the other engine too, which checks
+                       # that the spread is the fill's, not an engine's
 JITTER = 1.0e-6           # [m] a realisation's stream shift per step of K (generate.py --jitter,
                           # horizon_ch5.py realisation): far below every length of the scenes
 LIGGGHTS_SKIN = 0.5      # liggghts-jdem's neighbour skin over R_max in the fills and cubes: without
@@ -262,8 +266,8 @@ def fill1_command(engine, model, dt_arg, force, jitter=0, ranks=1):
 
 def spread_units(engine, model, variant, ranks):
     """The run-to-run spread: the first fill again with the stream shifted by K micrometres
-    (generate.py --jitter), K = 1..SPREAD_REALISATIONS, for SPREAD_MODEL only."""
-    if model != SPREAD_MODEL or variant != "seed":
+    (generate.py --jitter), K = 1..SPREAD_REALISATIONS[engine][model], the seed's dt only."""
+    if variant != "seed":
         return []
     base = os.path.join(OUT[variant], engine, model)
     dt_arg, dt = variant_dt(variant, model)
@@ -272,7 +276,7 @@ def spread_units(engine, model, variant, ranks):
                  validate=valid_trajectory, cost=FILL_PARTICLES * FILL_TIME / dt,
                  blocked=gate(engine, "conveyor inlet"), resumes=resumable(engine),
                  ranks=fill_ranks(engine, ranks), committed=committed_entry(engine, model, "jitter", k))
-            for k in range(1, SPREAD_REALISATIONS + 1)]
+            for k in range(1, SPREAD_REALISATIONS[engine].get(model, 0) + 1)]
 
 
 def pass_units(engine, model, p, deposit, base, dt_arg, dt, force, committed):

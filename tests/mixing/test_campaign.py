@@ -264,9 +264,9 @@ def test_times_shared_by_campaigns_at_once():
 
 def test_ch4_plan():
     """The plan of make mixing (docs/mixing.md §4): 2 engines x 6 models x (2 fills, 1 second-
-    pass scene, 2 x (1 cube-scene unit + 9 compressions)) = 276 units, plus per engine the
-    spread model's realisations (2 x SPREAD_REALISATIONS) and the 6 cross-engine horizons last,
-    unique names, and every need an earlier unit."""
+    pass scene, 2 x (1 cube-scene unit + 9 compressions)) = 276 units, plus the run-to-run
+    spread's realisations (jdem: one of every model, two of Model 3; liggghts-jdem: two of Model
+    3) and the 6 cross-engine horizons last, unique names, and every need an earlier unit."""
     from scripts.mixing import plan_ch4
     units = plan_ch4.units([])
     seen = set()
@@ -274,7 +274,7 @@ def test_ch4_plan():
     for u in units:
         order_ok &= all(n in seen for n in u.needs)
         seen.add(u.name)
-    want = 276 + 2 * plan_ch4.SPREAD_REALISATIONS + 6
+    want = 276 + (6 + 1) + 2 + 6
     check("ch4_plan_units", len(units) == want and len(seen) == want, f"{len(units)} units")
     cross = [u.name for u in units[-6:] if u.engine == "cross"]
     check("ch4_plan_horizons_last", cross == ["cross/model%d/horizon" % m for m in range(1, 7)]
@@ -283,10 +283,10 @@ def test_ch4_plan():
           f"{[u.name for u in units[-6:]]}")
     check("ch4_plan_needs_come_first", order_ok, "a need after its unit")
     m3 = [u.name for u in units if u.model == "model3" and u.engine == "liggghts-jdem"]
-    check("ch4_plan_model_engine", len(m3) == 23 + plan_ch4.SPREAD_REALISATIONS
-          and m3[0] == "liggghts-jdem/model3/fill1"
-          and m3[-1] == "liggghts-jdem/model3/fill1_jitter%d" % plan_ch4.SPREAD_REALISATIONS,
-          f"{len(m3)}: {m3[:3]} ... {m3[-1:]}")
+    check("ch4_plan_model_engine", len(m3) == 23 + 2 and m3[0] == "liggghts-jdem/model3/fill1"
+          and m3[-1] == "liggghts-jdem/model3/fill1_jitter2", f"{len(m3)}: {m3[:3]} ... {m3[-1:]}")
+    j1 = [u.name for u in units if u.model == "model1" and "jitter" in u.name]
+    check("ch4_plan_spread_of_every_model", j1 == ["jdem/model1/fill1_jitter1"], f"{j1}")
 
 
 def test_ch4_fill_resumes():

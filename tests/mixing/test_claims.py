@@ -110,6 +110,14 @@ def test_run_to_run_spread():
     g["jdem"]["model1"]["fill1"] = fill(spread(0.006, 0.004))
     line = claims_ch4.model2_split(g, "jdem")[1]
     check("worst_unresolved", line.endswith(": " + claims_ch4.UNRESOLVED), line)
+    # Model 5 repeated once (0.048 and 0.054): a std of one degree of freedom is not its own
+    # (0.004243 would give a bound of 0.00938 and "not resolved") but joins the pool:
+    # sqrt((8e-6 + 1.8e-5) / 3) = 0.002944, bound 2 sqrt(0.002² + 0.002944²) = 0.00712 < 0.008
+    g = copy.deepcopy(f)
+    g["jdem"]["model5"]["fill1"] = fill(spread(0.048, 0.004))
+    g["jdem"]["model5"]["jitter"] = [fill(spread(0.054, 0.004))]
+    line = claims_ch4.obstacles_left(g, "jdem")[1]
+    check("one_repeat_joins_the_pool", line.endswith(": held") and "= 0.0071)" in line, line)
 
 
 for t in (test_all_hold, test_each_fails, test_discrimination_index, test_incomplete_is_silent,
