@@ -209,6 +209,46 @@ int64_t jd_inlet_insertion_step(const jd_inlet_spec *s, int64_t copy, size_t p) 
     return jd_inlet_group_start(s, copy, &s->group_member[first], s->group_first[g + 1] - first);
 }
 
+int64_t jd_inlet_copies_by(const jd_inlet_spec *s, int64_t stop_step, int64_t last) {
+    const int64_t lim = stop_step == JD_INLET_NO_STOP ? last
+                                                     : (stop_step - 1 < last ? stop_step - 1 : last);
+    if (jd_inlet_section_start(s, 0) > lim) return 0;
+    int64_t lo = 1, hi = 1; /* copies [0, lo) start by lim; find hi that does not */
+    while ((s->max_sections == 0 || hi < s->max_sections) && jd_inlet_section_start(s, hi) <= lim) {
+        lo = hi + 1;
+        hi *= 2;
+        if (s->max_sections && hi > s->max_sections) hi = s->max_sections;
+    }
+    if (s->max_sections && hi >= s->max_sections &&
+        jd_inlet_section_start(s, s->max_sections - 1) <= lim)
+        return s->max_sections;
+    while (lo < hi) { /* copy lo - 1 starts by lim, copy hi does not */
+        const int64_t mid = lo + (hi - lo) / 2;
+        if (jd_inlet_section_start(s, mid) <= lim) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+}
+
+double jd_inlet_pending_particle_steps(const jd_inlet_spec *s, const jd_inlet_cursor *cursor,
+                                       int64_t copies, int64_t last) {
+    double sum = 0.0;
+    for (size_t p = 0; p < s->n; p++) {
+        const int64_t c0 = cursor[p].copy;
+        double m = (double)(copies - c0);
+        if (m <= 0.0 || cursor[p].step == JD_INLET_NEVER) continue;
+        const double k0 = (double)jd_inlet_insertion_step(s, c0, p);
+        double k1 = (double)jd_inlet_insertion_step(s, copies - 1, p);
+        if (k0 > (double)last) continue;
+        if (k1 > (double)last) { /* the copies inserted after `last` are cut off */
+            const double spacing = m > 1.0 ? (k1 - k0) / (m - 1.0) : 1.0;
+            m = floor(((double)last - k0) / spacing) + 1.0;
+            k1 = k0 + (m - 1.0) * spacing;
+        }
+        sum += m * ((double)last - 0.5 * (k0 + k1));
+    }
+    return sum;
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* Checks                                                                                   */
 /* ---------------------------------------------------------------------------------------- */

@@ -228,6 +228,24 @@ void jd_inlet_stream_init(const jd_inlet_spec *s, jd_inlet_stream *st, jd_inlet_
 size_t jd_inlet_pop(const jd_inlet_spec *s, jd_inlet_stream *st, int64_t step,
                     jd_inlet_particle *out, size_t cap);
 
+/* Copies of the stream that start at or before step `last` and are admitted by its limits:
+ * max_sections and stop_step (the spec's, or a stream's lowered one, jd_inlet_height_stop)
+ * [-].  The engines size their buffers by it, and the progress estimate counts its copies. */
+int64_t jd_inlet_copies_by(const jd_inlet_spec *s, int64_t stop_step, int64_t last);
+
+/* The work the stream still brings until step `last` [particle-steps]: for every particle not
+ * yet inserted (cursor[p].copy up to copies - 1, copies from jd_inlet_copies_by) whose insertion
+ * step k <= last, last - k steps of it in the domain.  One particle's copies cross one period
+ * apart in time (a rigid motion), so its share is summed in closed form as an arithmetic series
+ * between its first and last pending insertion step.  The steps themselves are whole (k is the
+ * first step at or past the crossing), so each term may be off by less than one step: the sum is
+ * within the number of pending insertions it counts of the exact one (exact when a period is a
+ * whole number of steps).
+ * A progress line's ETA divides the work left (this plus the particles present times the steps
+ * left) by the measured particle-steps per second.  O(n) jd_inlet_insertion_step calls. */
+double jd_inlet_pending_particle_steps(const jd_inlet_spec *s, const jd_inlet_cursor *cursor,
+                                       int64_t copies, int64_t last);
+
 /* ---- Insertion into an occupied place ----
  *
  * The pending stream is rigid and takes part in nothing, so a particle already in the domain can

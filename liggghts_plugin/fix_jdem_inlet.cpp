@@ -48,6 +48,9 @@ FixJdemInlet::FixJdemInlet(LAMMPS *lmp, int narg, char **arg)
   next_reneighbor = -1; /* set by init() once dt is known */
   nevery = 1;
   restart_global = 1; /* the position in the stream (jdem_restart.h) */
+  scalar_flag = 1;    /* compute_scalar: the work still to come, at any step */
+  global_freq = 1;
+  extscalar = 0;
 }
 
 FixJdemInlet::~FixJdemInlet() {
@@ -566,6 +569,13 @@ void FixJdemInlet::end_of_step() {
   if (height > 0.0 && jd_inlet_height_due(update->ntimestep, every)) height_rule();
   if (update->ntimestep > stream.next_step)
     error->all(FLERR, "fix jdem/inlet: a due step passed without its insertion (internal error)");
+}
+
+double FixJdemInlet::compute_scalar() {
+  if (!started) return 0.0;
+  const int64_t last = (int64_t)update->laststep;
+  return jd_inlet_pending_particle_steps(&spec, cursor.data(),
+                                         jd_inlet_copies_by(&spec, stream.stop_step, last), last);
 }
 
 /* The run's account: every rank's time spent inserting, the slowest one reported. */

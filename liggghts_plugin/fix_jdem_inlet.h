@@ -79,6 +79,10 @@ class FixJdemInlet : public Fix {
   void pre_exchange();
   void end_of_step();
   void post_run();
+  /* f_ID: the work the stream still brings until the run's last step [particle-steps]
+   * (jd_inlet_pending_particle_steps), the same on every rank; scripts/liggghts_run.py's ETA
+   * reads it through fix print (scripts/scene_to_liggghts.py) */
+  double compute_scalar();
   /* restart files (jdem_restart.h) */
   void write_restart(FILE *);
   void restart(char *);

@@ -12,7 +12,11 @@ runs.  It generates the deck with scene_to_liggghts.py there and runs build/ligg
 The dump writes OUT.h5.part and renames it, with its OUT.xdmf, only once the run is complete: an
 earlier OUT.h5 and OUT.xdmf stay in place until then, and a stopped run leaves OUT.h5.part.
 While LIGGGHTS runs, a line `liggghts_run: step S/N (P %), ETA T` goes to stderr every minute,
-S the newest step that its log's thermo output or its newest restart file shows.
+S the newest step that its log's thermo output or its newest restart file shows.  A deck with
+inlets writes progress.txt (fix print: the step, the particles present and the work the inlets
+still bring, fix jdem/inlet's f_ID), and the ETA is then the work left in particle-steps over the
+particle-steps per second measured so far, as build/jdem's, not the steps left: a fill whose
+particle count grows 40-fold takes far longer per step at its end.
 SIGINT and SIGTERM are forwarded to LIGGGHTS (or to mpirun's ranks) and waited for: it stops at its next
 step and keeps OUT.h5.part.  --force runs an unsafe time step anyway (fix jdem/guard ... force).
 --inlet-record FILE writes the inlets' insertions as `jdem run --inlet-record` does.
@@ -50,6 +54,7 @@ import time
 import yaml
 
 from scripts import engines
+from scripts.scene_to_liggghts import PROGRESS_FILE   # the inlet decks' step, particles, pending work
 
 EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_IO, EXIT_WATCHDOG, EXIT_MEMORY = 0, 1, 2, 3, 4, 5
 
@@ -232,12 +237,15 @@ THERMO_STEP = re.compile(r"^\s*(\d+)\s+\S")
 
 
 class Progress:
-    """The run's step from its log (thermo lines) and its restart files, shown every minute."""
+    """The run's step from its log (thermo lines) and its restart files, shown every minute; with
+    the deck's progress.txt (inlet decks) the ETA counts particle-steps."""
 
     def __init__(self, deck_dir, total_steps, every=60.0):
         self.deck_dir, self.total, self.every = deck_dir, total_steps, every
         self.start = self.last_shown = time.monotonic()
         self.first_step = None
+        # the last (step, particles) seen, the particle-steps since the first, and when that was
+        self.sample_seen, self.work_done, self.work_start = None, 0.0, self.start
 
     def step(self):
         steps = [int(f.rsplit(".", 1)[1]) for f in restart_files(self.deck_dir)]
@@ -246,6 +254,36 @@ class Progress:
             if m:
                 steps.append(int(m.group(1)))
         return max(steps) if steps else None
+
+    def sample(self):
+        """(step, particles, pending particle-steps) of progress.txt's last line, or None."""
+        for line in reversed(tail(os.path.join(self.deck_dir, PROGRESS_FILE), 3).splitlines()):
+            words = line.split()
+            try:
+                if len(words) == 3 and not line.startswith("#"):
+                    return int(float(words[0])), float(words[1]), float(words[2])
+            except ValueError:
+                pass
+        return None
+
+    def work_eta(self, now):
+        """The ETA in particle-steps, or None without a sample: the work between two samples
+        seen is the trapezoid of their particle counts; the work left is the particles present
+        times the steps left plus what the inlets still bring."""
+        got = self.sample()
+        if got is None:
+            return None
+        step, atoms, pending = got
+        if self.sample_seen is None or step < self.sample_seen[0]:
+            self.sample_seen, self.work_done, self.work_start = (step, atoms), 0.0, now
+            return None
+        s0, a0 = self.sample_seen
+        self.work_done += (step - s0) * 0.5 * (a0 + atoms)
+        self.sample_seen = (step, atoms)
+        if self.work_done <= 0.0:
+            return None
+        rate = self.work_done / (now - self.work_start)
+        return (atoms * max(self.total - step, 0) + pending) / rate
 
     def __call__(self):
         now = time.monotonic()
@@ -256,10 +294,14 @@ class Progress:
             return
         if self.first_step is None:   # the first step seen (a continued run's is its file's)
             self.first_step, self.start = s, now
+            self.work_eta(now)
             return
         self.last_shown = now
         done = s - self.first_step
-        eta = "%.0f s" % ((self.total - s) * (now - self.start) / done) if done > 0 else "unknown"
+        seconds = self.work_eta(now)
+        if seconds is None and done > 0:
+            seconds = (self.total - s) * (now - self.start) / done
+        eta = "%.0f s" % seconds if seconds is not None else "unknown"
         say("step %d/%d (%.0f %%), ETA %s" % (s, self.total, 100.0 * s / self.total, eta))
 
 

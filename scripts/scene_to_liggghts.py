@@ -430,7 +430,7 @@ def inlet_lines(scene, tid, deck_dir, record):
         return []
     mats = scene["materials"]
     L = ["\n# conveyor inlets (fix jdem/inlet: the stream of kernel/jdem_inlet.h; docs/mixing.md 2.1)\n"]
-    taken = set()
+    taken, idents = set(), []
     for k, inlet in enumerate(inlets):
         ident = identifier(inlet["name"], "in_", taken)
         fname = "inlet_%s.txt" % ident[3:]
@@ -459,7 +459,23 @@ def inlet_lines(scene, tid, deck_dir, record):
         if record:
             words += " %s %s" % ("record" if k == 0 else "append_record", word(os.path.abspath(record), "record path"))
         L.append("fix %s all jdem/inlet %s\n" % (ident, words))
-    return L
+        idents.append(ident)
+    return L + progress_lines(idents)
+
+
+PROGRESS_FILE = "progress.txt"   # in the deck directory; scripts/liggghts_run.py reads it
+PROGRESS_EVERY = 1000            # steps between its lines
+
+
+def progress_lines(inlet_fixes):
+    """The run's progress for scripts/liggghts_run.py's ETA: the step, the particles present and
+    the work the inlets still bring until the last step (f_ID of each fix jdem/inlet, in
+    particle-steps), as fix print writes them into progress.txt."""
+    return ["variable        jd_step equal step\n",
+            "variable        jd_atoms equal atoms\n",
+            "variable        jd_pending equal %s\n" % "+".join("f_" + i for i in inlet_fixes),
+            'fix progress all print %d "${jd_step} ${jd_atoms} ${jd_pending}" file %s screen no '
+            'title "# step particles pending_particle_steps"\n' % (PROGRESS_EVERY, PROGRESS_FILE)]
 
 
 # The neighbour skin over the largest radius: jdem's (docs/scenes.md "Neighbour lists"), so that the

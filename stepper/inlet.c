@@ -71,27 +71,6 @@ struct jd_sim_inlets {
     FILE *log;             /* the insertion record (sim_inlets_log), or NULL */
 };
 
-/* Copies of stream r that start at or before `last` and are admitted by its limits. */
-static int64_t copies_by(const jd_inlet_spec *sp, int64_t last) {
-    const int64_t lim = sp->stop_step == JD_INLET_NO_STOP ? last : (sp->stop_step - 1 < last
-                                                                         ? sp->stop_step - 1
-                                                                         : last);
-    if (jd_inlet_section_start(sp, 0) > lim) return 0;
-    int64_t lo = 1, hi = 1; /* copies [0, lo) start by lim; find hi that does not */
-    while ((sp->max_sections == 0 || hi < sp->max_sections) && jd_inlet_section_start(sp, hi) <= lim) {
-        lo = hi + 1;
-        hi *= 2;
-        if (sp->max_sections && hi > sp->max_sections) hi = sp->max_sections;
-    }
-    if (sp->max_sections && hi >= sp->max_sections && jd_inlet_section_start(sp, sp->max_sections - 1) <= lim)
-        return sp->max_sections;
-    while (lo < hi) { /* copy lo - 1 starts by lim, copy hi does not */
-        const int64_t mid = lo + (hi - lo) / 2;
-        if (jd_inlet_section_start(sp, mid) <= lim) lo = mid + 1; else hi = mid;
-    }
-    return lo;
-}
-
 static int by_id(const void *a, const void *b) {
     const int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
     return x < y ? -1 : x > y;
@@ -129,7 +108,7 @@ size_t sim_inlets_capacity(const jd_scene *sc) {
     for (size_t k = 0; k < sc->n_inlets; k++) {
         jd_inlet_spec sp;
         scene_inlet_spec(sc, k, &sp);
-        cap += (size_t)copies_by(&sp, sc->steps) * sp.n;
+        cap += (size_t)jd_inlet_copies_by(&sp, sp.stop_step, sc->steps) * sp.n;
     }
     return cap;
 }
@@ -171,7 +150,7 @@ int sim_inlets_init(jd_sim *s, char *err, size_t errlen) {
     for (size_t k = 0; k < sc->n_inlets; k++) {
         inlet_run *r = &in->run[k];
         scene_inlet_spec(sc, k, &r->spec);
-        r->copies = copies_by(&r->spec, sc->steps);
+        r->copies = jd_inlet_copies_by(&r->spec, r->spec.stop_step, sc->steps);
         r->cursor = malloc(r->spec.n * sizeof *r->cursor);
         if (!r->cursor) goto oom;
         jd_inlet_stream_init(&r->spec, &r->st, r->cursor);
@@ -371,23 +350,9 @@ double sim_inlets_pending_particle_steps(const jd_sim *s, int64_t last) {
     double sum = 0.0;
     for (size_t k = 0; k < s->inlets->n_inlets; k++) {
         const inlet_run *r = &s->inlets->run[k];
-        for (size_t p = 0; p < r->spec.n; p++) {
-            const int64_t c0 = r->st.cursor[p].copy;
-            double m = (double)(r->copies - c0);
-            if (m <= 0.0 || r->st.cursor[p].step == JD_INLET_NEVER) continue;
-            /* one particle's copies cross at evenly spaced steps (a rigid motion): the series
-             * between the first and the last, to round-off; the copies of a section that starts
-             * by `last` whose particle p crosses after it are cut off */
-            const double k0 = (double)jd_inlet_insertion_step(&r->spec, c0, p);
-            double k1 = (double)jd_inlet_insertion_step(&r->spec, r->copies - 1, p);
-            if (k0 > (double)last) continue;
-            if (k1 > (double)last) {
-                const double spacing = m > 1.0 ? (k1 - k0) / (m - 1.0) : 1.0;
-                m = floor(((double)last - k0) / spacing) + 1.0;
-                k1 = k0 + (m - 1.0) * spacing;
-            }
-            sum += m * ((double)last - 0.5 * (k0 + k1));
-        }
+        const int64_t copies = jd_inlet_copies_by(&r->spec, r->st.stop_step, last);
+        sum += jd_inlet_pending_particle_steps(&r->spec, r->st.cursor,
+                                               copies < r->copies ? copies : r->copies, last);
     }
     return sum;
 }

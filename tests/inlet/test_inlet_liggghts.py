@@ -24,6 +24,13 @@ scripts/scene_to_liggghts.py writes from it (--inlet-record), on 1 and 2 MPI ran
 * the deck's own trajectory: the unmodified deck writes dump h5md/jdem, a growing particle set
   (ids -1 in empty slots), whose live particles at every frame are jdem's, within the same
   tolerance.
+* progress: the deck's progress.txt (fix print of fix jdem/inlet's f_ID) gives at each of its
+  steps the particles the record inserted by then (exactly) and the work still to come: the sum
+  of last - k over the record's later insertion steps k, to within one step per insertion counted
+  (the kernel sums each particle's copies as an arithmetic series, kernel/jdem_inlet.h, and the
+  big sphere's copies here come 1401 and 1400 steps apart, at 1600, 3001 and 4401, by the
+  round-off of its crossing times); scripts/liggghts_run.py's ETA from two such lines against
+  its closed form.
 * bad input: each malformed fix jdem/inlet argument stops LIGGGHTS with its exact message.
 """
 import csv
@@ -143,6 +150,41 @@ def inflow_from_record(rows, sc):
     return total
 
 
+def check_progress(path, rows, last):
+    """The deck's progress.txt against the insertion record (see the module's docstring)."""
+    steps = [int(r["step"]) for r in rows]
+    lines = [w.split() for w in open(path) if not w.startswith("#")] if os.path.exists(path) else []
+    bad = []
+    for w in lines:
+        s, n, pending = int(w[0]), float(w[1]), float(w[2])
+        later = [k for k in steps if k > s]
+        want = (sum(k <= s for k in steps), float(sum(last - k for k in later)))
+        if n != want[0] or abs(pending - want[1]) >= max(len(later), 1):
+            bad.append("step %d: %g particles, %r pending; from the record %d, %r (within %d)"
+                       % ((s, n, pending) + want + (len(later),)))
+    check("progress-pending-work", len(lines) >= 7 and not bad and any(float(w[2]) > 0 for w in lines),
+          "%d lines; %s" % (len(lines), "; ".join(bad[:3])))
+
+
+def check_progress_eta(tmp):
+    """liggghts_run's ETA from progress.txt: 10 particles at step 100, then 30 at step 200 and
+    100 particle-steps still to come, 10 s apart: 2000 particle-steps done at 200 a second, and
+    30 x (1000 - 200) + 100 = 24100 left, 120.5 s."""
+    from scripts.liggghts_run import PROGRESS_FILE, Progress
+    d = os.path.join(tmp, "eta")
+    os.makedirs(d)
+    progress = Progress(d, 1000)
+    path = os.path.join(d, PROGRESS_FILE)
+    with open(path, "w") as f:
+        f.write("# step particles pending_particle_steps\n100 10 500\n")
+    first = progress.work_eta(0.0)
+    with open(path, "a") as f:
+        f.write("200 30 100\n")
+    second = progress.work_eta(10.0)
+    check("progress-eta", first is None and second is not None and abs(second - 120.5) < 1e-12,
+          "%r, %r" % (first, second))
+
+
 def cross_engine(tmp):
     jdem_h5, jdem_rec = os.path.join(tmp, "fill.jdem.h5"), os.path.join(tmp, "jdem.csv")
     r = engines.jdem("run", SCENE, "-o", jdem_h5, "--inlet-record", jdem_rec, "--quiet")
@@ -204,6 +246,9 @@ def cross_engine(tmp):
             check("inflow-beyond-watchdog-limit", "jdem/watchdog" in deck_text and "energy 0.05" in deck_text and
                   per_copy[1] > 0.05 * per_copy[0] and per_copy[2] > 0.05 * (per_copy[0] + per_copy[1]),
                   "inflow per section %s; deck watchdog line present: %s" % (per_copy, "jdem/watchdog" in deck_text))
+        if np_ == 1:
+            check_progress(os.path.join(deck_dir, "progress.txt"), list(csv.DictReader(open(rec))),
+                           int(sc["time"]["steps"]))
     if 1 in lig_frames and 2 in lig_frames:
         worst = worst_difference(lig_frames[1], lig_frames[2], scales)
         check("ranks-1-vs-2", not same_particles(lig_frames[1], lig_frames[2]) and worst <= tol,
@@ -336,6 +381,7 @@ def main():
             return
     tmp = tempfile.mkdtemp(prefix="inlet-cross-")
     got = cross_engine(tmp)
+    check_progress_eta(tmp)
     stop_rules(tmp)
     if got:
         bad_input(*got)

@@ -183,6 +183,51 @@ static void stop_step_keeps_whole_sections(void **state) {
     assert_int_equal(jd_inlet_pop(&s, &st, 500, out, 1), 0);
 }
 
+/* The work a stream still brings (jd_inlet_pending_particle_steps) against the sum over its
+ * particles one by one, and jd_inlet_copies_by against a count of the section starts: the row of
+ * stream_order_ids_and_steps (crossings at 101, 51, 151 + 300 c, all integers, so both sums are
+ * exact), 6 sections, after the insertions of every 50th step, to a last step that cuts the
+ * stream's copies off (1000, 1234) and one beyond it (5000); then a stop step (700: the copies
+ * starting at 51, 351 and 651 only). */
+static void pending_work_is_the_sum_over_particles(void **state) {
+    (void)state;
+    const double rel[9] = {-0.1005, 0, 0, -0.0505, 0, 0.05, -0.1505, 0.0, -0.05};
+    const double radius[3] = {0.01, 0.01, 0.02};
+    const int32_t species[3] = {0, 0, 1};
+    jd_inlet_spec s = row(3, rel, radius, species);
+    s.max_sections = 6;
+    jd_inlet_cursor cur[3];
+    jd_inlet_stream st;
+    jd_inlet_stream_init(&s, &st, cur);
+    const int64_t lasts[3] = {1000, 1234, 5000};
+    int checked_nonzero = 0;
+    for (int64_t step = 0; step <= 2000; step++) {
+        jd_inlet_particle out[8];
+        while (st.next_step == step && jd_inlet_pop(&s, &st, step, out, 8) > 0) {}
+        if (step % 50) continue;
+        for (size_t q = 0; q < 3; q++) {
+            const int64_t last = lasts[q];
+            int64_t want_copies = 0;
+            while (want_copies < s.max_sections && jd_inlet_section_start(&s, want_copies) <= last)
+                want_copies++;
+            const int64_t copies = jd_inlet_copies_by(&s, s.stop_step, last);
+            assert_int_equal(copies, want_copies);
+            double want = 0.0;
+            for (int64_t c = 0; c < copies; c++)
+                for (size_t p = 0; p < s.n; p++) {
+                    const int64_t k = jd_inlet_insertion_step(&s, c, p);
+                    if (k > step && k <= last) want += (double)(last - k);
+                }
+            assert_true(jd_inlet_pending_particle_steps(&s, cur, copies, last) == want);
+            checked_nonzero += want > 0.0;
+        }
+    }
+    assert_true(checked_nonzero > 40);
+    assert_int_equal(jd_inlet_copies_by(&s, 700, 5000), 3);
+    assert_int_equal(jd_inlet_copies_by(&s, 700, 350), 1);
+    assert_int_equal(jd_inlet_copies_by(&s, JD_INLET_NO_STOP, 50), 0);
+}
+
 /* Two particles of different copies due at one step (period shorter than one step's travel) and
  * cap 1: one particle per call, in id order, the rest stays due at the same step. */
 static void cap_leaves_the_rest_due(void **state) {
@@ -605,6 +650,7 @@ int run_inlet_tests(void) {
         cmocka_unit_test(inclined_plane_closed_form),
         cmocka_unit_test(stream_order_ids_and_steps),
         cmocka_unit_test(stop_step_keeps_whole_sections),
+        cmocka_unit_test(pending_work_is_the_sum_over_particles),
         cmocka_unit_test(cap_leaves_the_rest_due),
         cmocka_unit_test(jiang_section_period),
         cmocka_unit_test(check_messages),
