@@ -106,15 +106,19 @@ static void inclined_plane_closed_form(void **state) {
     assert_rel(p.position[0], -0.05 + 359.0 / 1024.0, 1e-12);
 }
 
+static const double ROW_REL[9] = {-0.1005, 0, 0, -0.0505, 0, 0.05, -0.1505, 0.0, -0.05};
+static const double ROW_RADIUS[3] = {0.01, 0.01, 0.02};
+static const int32_t ROW_SPECIES[3] = {0, 0, 1};
+
+/* The row of three of stream_order_ids_and_steps. */
+static jd_inlet_spec three_in_a_row(void) { return row(3, ROW_REL, ROW_RADIUS, ROW_SPECIES); }
+
 /* Three particles at x = -0.10, -0.05, -0.15 (relative to origin 0), L = 0.3, 4 sections, dt 1e-3:
  * particle p of copy c crosses at ceil((d_p + 0.3 c)/1e-3) + tiny; the stream pops every particle
  * once, at its step, in increasing step and, within a step, increasing id. */
 static void stream_order_ids_and_steps(void **state) {
     (void)state;
-    const double rel[9] = {-0.1005, 0, 0, -0.0505, 0, 0.05, -0.1505, 0.0, -0.05};
-    const double radius[3] = {0.01, 0.01, 0.02};
-    const int32_t species[3] = {0, 0, 1};
-    jd_inlet_spec s = row(3, rel, radius, species);
+    jd_inlet_spec s = three_in_a_row();
     s.max_sections = 4;
     char msg[256];
     assert_int_equal(jd_inlet_check(&s, 0, msg, sizeof msg), JD_INLET_OK);
@@ -191,10 +195,7 @@ static void stop_step_keeps_whole_sections(void **state) {
  * starting at 51, 351 and 651 only). */
 static void pending_work_is_the_sum_over_particles(void **state) {
     (void)state;
-    const double rel[9] = {-0.1005, 0, 0, -0.0505, 0, 0.05, -0.1505, 0.0, -0.05};
-    const double radius[3] = {0.01, 0.01, 0.02};
-    const int32_t species[3] = {0, 0, 1};
-    jd_inlet_spec s = row(3, rel, radius, species);
+    jd_inlet_spec s = three_in_a_row();
     s.max_sections = 6;
     jd_inlet_cursor cur[3];
     jd_inlet_stream st;
