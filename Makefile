@@ -290,6 +290,7 @@ mixing-speed: all
 # DT=guard|half: first that variant's report (reference_runs/mixing/ch4_dt_DT/results/), which the
 # main report's "error against run time" table reads
 mixing-report:
+	$(if $(filter-out guard half,$(DT)),$(error DT=$(DT): valid for mixing-report: guard or half (the seed's dt is the main report)))
 	$(if $(filter guard half,$(DT)),$(PY) scripts/mixing/report_ch4.py --out out/mixing/ch4_dt_$(DT) \
 	    --results reference_runs/mixing/ch4_dt_$(DT)/results)
 	$(PY) scripts/mixing/horizon_ch4.py summary --results reference_runs/mixing/ch4/results/horizon

@@ -230,7 +230,7 @@ size_t jd_inlet_pop(const jd_inlet_spec *s, jd_inlet_stream *st, int64_t step,
 
 /* Copies of the stream that start at or before step `last` and are admitted by its limits:
  * max_sections and stop_step (the spec's, or a stream's lowered one, jd_inlet_height_stop)
- * [-].  The engines size their buffers by it, and the progress estimate counts its copies. */
+ * [-].  build/jdem sizes its buffers by it, and the progress estimate counts its copies. */
 int64_t jd_inlet_copies_by(const jd_inlet_spec *s, int64_t stop_step, int64_t last);
 
 /* The work the stream still brings until step `last` [particle-steps]: for every particle not

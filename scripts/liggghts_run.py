@@ -244,8 +244,9 @@ class Progress:
         self.deck_dir, self.total, self.every = deck_dir, total_steps, every
         self.start = self.last_shown = time.monotonic()
         self.first_step = None
-        # the last (step, particles) seen, the particle-steps since the first, and when that was
-        self.sample_seen, self.work_done, self.work_start = None, 0.0, self.start
+        # the newest (step, particles) seen and when it appeared, the particle-steps since the
+        # first sample, and when that appeared
+        self.sample_seen, self.sample_time, self.work_done, self.work_start = None, None, 0.0, None
 
     def step(self):
         steps = [int(f.rsplit(".", 1)[1]) for f in restart_files(self.deck_dir)]
@@ -267,23 +268,28 @@ class Progress:
         return None
 
     def work_eta(self, now):
-        """The ETA in particle-steps, or None without a sample: the work between two samples
-        seen is the trapezoid of their particle counts; the work left is the particles present
-        times the steps left plus what the inlets still bring."""
+        """The ETA in seconds from the work in particle-steps, or None before two samples: the
+        work between two samples is the trapezoid of their particle counts, timed from when
+        each sample was first seen; the work left is the particles present times the steps left
+        plus what the inlets still bring, less what went on since the newest sample appeared.
+        A step lower than the last one seen (a new attempt's file) starts the count again."""
         got = self.sample()
         if got is None:
             return None
         step, atoms, pending = got
         if self.sample_seen is None or step < self.sample_seen[0]:
             self.sample_seen, self.work_done, self.work_start = (step, atoms), 0.0, now
+            self.sample_time = now
             return None
         s0, a0 = self.sample_seen
-        self.work_done += (step - s0) * 0.5 * (a0 + atoms)
-        self.sample_seen = (step, atoms)
-        if self.work_done <= 0.0:
+        if step > s0:
+            self.work_done += (step - s0) * 0.5 * (a0 + atoms)
+            self.sample_seen, self.sample_time = (step, atoms), now
+        if self.work_done <= 0.0 or self.sample_time <= self.work_start:
             return None
-        rate = self.work_done / (now - self.work_start)
-        return (atoms * max(self.total - step, 0) + pending) / rate
+        rate = self.work_done / (self.sample_time - self.work_start)
+        left = (atoms * max(self.total - step, 0) + pending) / rate
+        return max(left - (now - self.sample_time), 0.0)
 
     def __call__(self):
         now = time.monotonic()
@@ -386,6 +392,10 @@ def main():
         return 128 + child.signal
 
     run = liggghts_command(a, deck_dir)
+    try:   # an earlier attempt's; LIGGGHTS writes it anew, and until then it would time its work
+        os.remove(os.path.join(deck_dir, PROGRESS_FILE))
+    except FileNotFoundError:
+        pass
     progress = Progress(deck_dir, total_steps(text))
 
     def meanwhile():

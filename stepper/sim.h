@@ -402,7 +402,8 @@ int sim_inlets_step(jd_sim *s, char *err, size_t errlen);
 int64_t sim_inlets_inserted(const jd_sim *s);
 double sim_inlets_seconds(const jd_sim *s); /* wall time of the insertions [s] */
 /* The particle-steps that the particles not yet inserted will add from their insertion to step
- * `last` (the progress line's ETA; an upper bound once a deposit-height rule ends a stream). */
+ * `last` (the progress line's ETA; jd_inlet_pending_particle_steps: a stream that a
+ * deposit-height rule will end counts in full until the rule ends it). */
 double sim_inlets_pending_particle_steps(const jd_sim *s, int64_t last);
 double sim_inlets_energy(const jd_sim *s);  /* kinetic + gravitational energy brought in [J] */
 /* The trajectory's rows (every particle the run can hold, sorted by id) and their constants

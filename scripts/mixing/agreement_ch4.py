@@ -7,13 +7,15 @@ one engine differ by.  For every model and pass with both engines' fill, each st
 difference |jdem - liggghts-jdem| is set against 2 sqrt(2) s: s the sample standard deviation of
 that statistic over the realisations of one fill (the first fill and its jittered repeats,
 generate.py --jitter), sqrt(2) for the difference of two independent runs, 2 for two standard
-deviations.  s is the model's own where it has at least OWN_SPREAD_RUNS realisations, else
-pooled over every model's realisations (one jittered fill of each model, two of Model 3: a std
-from two runs has one degree of freedom, and its 95 % interval spans 0.03 to 2.2 times the true
-one, so a model's own is taken only from three).  The height is the bed's mean surface height (structure.free_surface), which the
-same 41280 spheres set through their packing in every model, so it pools like the intensive
-statistics (phi_v, packing fraction, rho_b, Z); the highest sphere's top is not compared: a
-sphere resting on an obstacle sets it (Model 3's two realisations: 1.580 and 1.110 m).  A fill
+deviations.  s is the model's own, pooled over both engines' realisations of it, where that has
+at least OWN_SPREAD_DOF degrees of freedom (three realisations in one engine, or two in each),
+else pooled over every model's realisations (one jittered fill of each model, two of Model 3 in
+each engine: a std from two runs has one degree of freedom, and its 95 % interval spans 0.03 to
+2.2 times the true one).  The height is the bed's mean surface height (structure.free_surface),
+which the same 41280 spheres set through their packing in every model, so it pools like the
+intensive statistics (phi_v, packing fraction, rho_b, Z); the highest sphere's top is not
+compared: a sphere resting on an obstacle sets it (Model 3's first two realisations: 1.580 and
+1.110 m).  A fill
 computed before the bed height was kept has none: its row says so.
 """
 import math
@@ -22,7 +24,7 @@ import numpy as np
 
 ENGINES = ("jdem", "liggghts-jdem")
 MODELS = tuple("model%d" % m for m in range(1, 7))
-OWN_SPREAD_RUNS = 3   # realisations from which a model's own std is used rather than the pool
+OWN_SPREAD_DOF = 2    # degrees of freedom from which a model's own std is used rather than the pool
 PASSES = (1, 2)
 # (label, how to read it from a fill_result, format); packing fraction = 1 - n (porosity)
 STATISTICS = (("bed height [m]", lambda r: r.get("bed_height"), "%.3f"),
@@ -38,12 +40,13 @@ def realisations(entry):
 
 
 def spreads(found):
-    """{(model or None for the pool, label): (s, source)}: each model's sample std over its
-    realisations where it has OWN_SPREAD_RUNS, and the pooled one (over every engine and model
-    with at least two)."""
+    """{(model or None for the pool, label): (s, source)}: each model's sample std pooled over
+    both engines' realisations where it has OWN_SPREAD_DOF degrees of freedom, and the pooled one
+    over every engine and model with at least two realisations."""
     out, pooled = {}, {}
-    for engine in ENGINES:
-        for model in MODELS:
+    for model in MODELS:
+        own = {}
+        for engine in ENGINES:
             runs = realisations(found.get(engine, {}).get(model, {}))
             if len(runs) < 2:
                 continue
@@ -51,13 +54,15 @@ def spreads(found):
                 vals = [get(r) for r in runs]
                 if None in vals:
                     continue
-                s = float(np.std(vals, ddof=1))
-                if len(runs) >= OWN_SPREAD_RUNS:
-                    out[(model, label)] = (s, "%s %s, %d realisations" % (engine, model, len(runs)))
-                acc = pooled.setdefault(label, [0.0, 0, []])
-                acc[0] += s * s * (len(vals) - 1)
-                acc[1] += len(vals) - 1
-                acc[2].append("%s %s" % (engine, model))
+                ss = float(np.var(vals, ddof=1)) * (len(vals) - 1)
+                for acc, name in ((own.setdefault(label, [0.0, 0, []]), "%s, %d" % (engine, len(runs))),
+                                  (pooled.setdefault(label, [0.0, 0, []]), "%s %s" % (engine, model))):
+                    acc[0] += ss
+                    acc[1] += len(vals) - 1
+                    acc[2].append(name)
+        for label, (ss, dof, names) in own.items():
+            if dof >= OWN_SPREAD_DOF:
+                out[(model, label)] = (math.sqrt(ss / dof), "%s, realisations: %s" % (model, "; ".join(names)))
     for label, (ss, dof, names) in pooled.items():
         out[(None, label)] = (math.sqrt(ss / dof), "pooled: " + ", ".join(names))
     return out

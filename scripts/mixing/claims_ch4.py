@@ -29,10 +29,10 @@ UNRESOLVED = "not resolved (within the run-to-run spread)"
 
 
 def phi_spread(found):
-    """model -> (s, source) of the trimmed mean phi_v over a fill's realisations, or None.  The
-    spread is taken as the model's whichever engine ran the realisations, and pooled over both
-    engines (agreement_ch4.spreads): past the horizon the engines are realisations of one chaotic
-    fill, so their spreads measure the same thing."""
+    """model -> (s, source) of the trimmed mean phi_v over a fill's realisations, or None
+    (agreement_ch4.spreads): the model's own, pooled over both engines' realisations of it, once
+    it has two degrees of freedom, else the pool over every model; past the horizon the engines
+    are realisations of one chaotic fill, so their spreads measure the same thing."""
     s = agreement_ch4.spreads(found)
     return lambda model: agreement_ch4.spread_for(s, model, "φv")
 

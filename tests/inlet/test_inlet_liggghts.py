@@ -169,7 +169,8 @@ def check_progress(path, rows, last):
 def check_progress_eta(tmp):
     """liggghts_run's ETA from progress.txt: 10 particles at step 100, then 30 at step 200 and
     100 particle-steps still to come, 10 s apart: 2000 particle-steps done at 200 a second, and
-    30 x (1000 - 200) + 100 = 24100 left, 120.5 s."""
+    30 x (1000 - 200) + 100 = 24100 left, 120.5 s; read again 20 s later with no new line, 100.5 s;
+    a line of a lower step (a new attempt) starts the count again: no ETA."""
     from scripts.liggghts_run import PROGRESS_FILE, Progress
     d = os.path.join(tmp, "eta")
     os.makedirs(d)
@@ -181,8 +182,13 @@ def check_progress_eta(tmp):
     with open(path, "a") as f:
         f.write("200 30 100\n")
     second = progress.work_eta(10.0)
-    check("progress-eta", first is None and second is not None and abs(second - 120.5) < 1e-12,
-          "%r, %r" % (first, second))
+    later = progress.work_eta(30.0)
+    with open(path, "a") as f:
+        f.write("50 5 900\n")
+    again = progress.work_eta(40.0)
+    check("progress-eta", first is None and second is not None and abs(second - 120.5) < 1e-12
+          and later is not None and abs(later - 100.5) < 1e-12 and again is None,
+          "%r, %r, %r, %r" % (first, second, later, again))
 
 
 def cross_engine(tmp):

@@ -118,6 +118,13 @@ def test_run_to_run_spread():
     g["jdem"]["model5"]["jitter"] = [fill(spread(0.054, 0.004))]
     line = claims_ch4.obstacles_left(g, "jdem")[1]
     check("one_repeat_joins_the_pool", line.endswith(": held") and "= 0.0071)" in line, line)
+    # and two in the other engine too (0.050 and 0.052): two degrees of freedom, Model 5's own
+    # over both engines, sqrt((1.8e-5 + 2e-6) / 2) = 0.003162, bound 2 sqrt(0.002² + 0.003162²) =
+    # 0.0075 (the pool over every model would give 0.0066)
+    g["liggghts-jdem"] = {"model5": {"fill1": fill(spread(0.050, 0.004)),
+                                     "jitter": [fill(spread(0.052, 0.004))]}}
+    line = claims_ch4.obstacles_left(g, "jdem")[1]
+    check("own_spread_over_both_engines", line.endswith(": held") and "= 0.0075)" in line, line)
 
 
 for t in (test_all_hold, test_each_fails, test_discrimination_index, test_incomplete_is_silent,
