@@ -11,7 +11,10 @@ deviations.  s is the model's own, pooled over both engines' realisations of it,
 at least OWN_SPREAD_DOF degrees of freedom (three realisations in one engine, or two in each),
 else pooled over every model's realisations (one jittered fill of each model, two of Model 3 in
 each engine: a std from two runs has one degree of freedom, and its 95 % interval spans 0.03 to
-2.2 times the true one).  The height is the bed's mean surface height (structure.free_surface),
+2.2 times the true one).  φv is floored at zero: a model whose realisations all separate the
+cohorts (φv below a tenth of the ideal in every one, as Model 1's) has no φv spread to measure,
+so its zero std neither stands as its own nor joins the pool, which would otherwise shrink the
+spread of the models that mix (SEGREGATED).  The height is the bed's mean surface height (structure.free_surface),
 which the same 41280 spheres set through their packing in every model, so it pools like the
 intensive statistics (phi_v, packing fraction, rho_b, Z); the highest sphere's top is not
 compared: a sphere resting on an obstacle sets it (Model 3's first two realisations: 1.580 and
@@ -22,9 +25,12 @@ import math
 
 import numpy as np
 
+from scripts.mixing import params
+
 ENGINES = ("jdem", "liggghts-jdem")
 MODELS = tuple("model%d" % m for m in range(1, 7))
 OWN_SPREAD_DOF = 2    # degrees of freedom from which a model's own std is used rather than the pool
+SEGREGATED = 0.1 * params.IDEAL_PHI_V   # φv of a realisation that separates the cohorts (claims_ch4)
 PASSES = (1, 2)
 # (label, how to read it from a fill_result, format); packing fraction = 1 - n (porosity)
 STATISTICS = (("bed height [m]", lambda r: r.get("bed_height"), "%.3f"),
@@ -52,7 +58,7 @@ def spreads(found):
                 continue
             for label, get, _ in STATISTICS:
                 vals = [get(r) for r in runs]
-                if None in vals:
+                if None in vals or (label == "φv" and max(vals) < SEGREGATED):
                     continue
                 ss = float(np.var(vals, ddof=1)) * (len(vals) - 1)
                 for acc, name in ((own.setdefault(label, [0.0, 0, []]), "%s, %d" % (engine, len(runs))),

@@ -72,7 +72,7 @@ def zero_phi(found, engine):
             f = found[engine][m].get("fill%d" % p)
             if not f:
                 continue
-            small = sum(q["phi_v"] < 0.1 * params.IDEAL_PHI_V for q in f["points"])
+            small = sum(q["phi_v"] < agreement_ch4.SEGREGATED for q in f["points"])
             out.append("%s %s pass %d: \"many zero or very small φv values\" (below a tenth of the "
                        "ideal %.4f) at %d of the 9 points: %s"
                        % (engine, m, p, params.IDEAL_PHI_V, small, verdict(small >= 5)))

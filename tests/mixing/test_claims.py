@@ -124,6 +124,12 @@ def test_run_to_run_spread():
     g["liggghts-jdem"] = {"model5": {"fill1": fill(spread(0.050, 0.004)),
                                      "jitter": [fill(spread(0.052, 0.004))]}}
     line = claims_ch4.obstacles_left(g, "jdem")[1]
+    h = copy.deepcopy(g)   # Model 1 repeated at φv 0.001 and 0.0: segregated, it stays out of the pool
+    h["jdem"]["model1"]["fill1"] = fill(spread(0.001, 0.001))
+    h["jdem"]["model1"]["jitter"] = [fill(spread(0.0, 0.0))]
+    del h["liggghts-jdem"]
+    one = claims_ch4.obstacles_left(h, "jdem")[1]
+    check("segregated_model_stays_out_of_the_pool", one.endswith(": held") and "= 0.0071)" in one, one)
     check("own_spread_over_both_engines", line.endswith(": held") and "= 0.0075)" in line, line)
 
 
