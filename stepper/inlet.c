@@ -350,9 +350,8 @@ double sim_inlets_pending_particle_steps(const jd_sim *s, int64_t last) {
     double sum = 0.0;
     for (size_t k = 0; k < s->inlets->n_inlets; k++) {
         const inlet_run *r = &s->inlets->run[k];
-        const int64_t copies = jd_inlet_copies_by(&r->spec, r->st.stop_step, last);
-        sum += jd_inlet_pending_particle_steps(&r->spec, r->st.cursor,
-                                               copies < r->copies ? copies : r->copies, last);
+        sum += jd_inlet_pending_particle_steps(
+            &r->spec, r->st.cursor, jd_inlet_copies_by(&r->spec, r->st.stop_step, last), last);
     }
     return sum;
 }
