@@ -10,6 +10,7 @@
  *   - A resolved file carries the case name in a top-level `case:` key (see scene_emit.c), so
  *     that `jdem resolve` output loads back as the same case.
  */
+#include <libgen.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -54,6 +55,16 @@ int scene_opt_int(loader *L, const yaml_node_t *map, const char *path, const cha
     char sub[SD_PATH_MAX];
     sd_join(sub, path, key);
     return n ? sd_int(&L->c, n, sub, lo, out) : 0;
+}
+
+int scene_file_path(loader *L, const yaml_node_t *node, const char *path, const char *file,
+                    char *out, size_t size) {
+    char dir[sizeof L->s->path];
+    snprintf(dir, sizeof dir, "%s", L->s->path);
+    int n = file[0] == '/' ? snprintf(out, size, "%s", file)
+                           : snprintf(out, size, "%s/%s", dirname(dir), file);
+    if (n < (int)size) return 0;
+    return sd_fail(&L->c, node, path, "the path is too long; valid: at most %zu characters", size - 1);
 }
 
 /* An optional section: absent is fine, present must be a mapping with known keys. */

@@ -84,7 +84,7 @@ static double round6(double x) { return rint(x * 1e6) / 1e6; }
 typedef struct deposit_entry {
     const yaml_node_t *map, *file_node, *frame_node, *region_node;
     char path[SD_PATH_MAX];
-    const char *file;
+    char file[1024]; /* the H5MD trajectory, relative paths resolved against the scene's folder */
     int64_t frame;
     int has_region;
     double lo[3], hi[3], shift[3];
@@ -134,12 +134,13 @@ static int read_entry(loader *L, const yaml_node_t *map, const char *list_path, 
     d->file_node = sd_get(&L->c, map, "file");
     if (!d->file_node)
         return sd_missing(&L->c, map, d->path, "file", "the path of an H5MD trajectory");
-    d->file = sd_scalar(d->file_node);
+    const char *file = sd_scalar(d->file_node);
     char sub[SD_PATH_MAX];
     sd_join(sub, d->path, "file");
-    if (!d->file || !*d->file)
+    if (!file || !*file)
         return sd_fail(&L->c, d->file_node, sub, "expected a file name, got %s; valid: the path "
                        "of an H5MD trajectory", sd_kind(d->file_node));
+    if (scene_file_path(L, d->file_node, sub, file, d->file, sizeof d->file)) return -1;
     d->frame_node = sd_get(&L->c, map, "frame");
     return scene_opt_int(L, map, d->path, "frame", INT64_MIN + 1, &d->frame) ||
                    read_region(L, d) || read_dilation(L, d) ||

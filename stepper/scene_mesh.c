@@ -4,7 +4,6 @@
  * (jd_mesh_build), so that a degenerate triangle is reported at load time by its index.
  */
 #include <errno.h>
-#include <libgen.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,14 +15,6 @@
 
 /* admesh 0.98 refuses a file shorter than the 84-byte binary header plus four facets. */
 #define STL_MIN_BYTES 284
-
-/* file relative to the scene file's folder (absolute paths as they are) into out. */
-static int resolve_path(const char *scene_path, const char *file, char *out, size_t size) {
-    if (file[0] == '/') return snprintf(out, size, "%s", file) >= (int)size;
-    char dir[sizeof ((jd_scene *)0)->path];
-    snprintf(dir, sizeof dir, "%s", scene_path);
-    return snprintf(out, size, "%s/%s", dirname(dir), file) >= (int)size;
-}
 
 /* The file's size in bytes, or -1 with errno when it cannot be opened for reading. */
 static long readable_size(const char *file) {
@@ -191,9 +182,7 @@ int scene_read_mesh_wall(loader *L, const yaml_node_t *w, const char *path, jd_m
     if (!text || !*text)
         return sd_fail(&L->c, file, sub, "expected a file name, got %s; valid: the path of an STL "
                        "file", sd_kind(file));
-    if (resolve_path(L->s->path, text, mw->file, sizeof mw->file))
-        return sd_fail(&L->c, file, sub, "the path is too long; valid: at most %zu characters",
-                       sizeof mw->file - 1);
+    if (scene_file_path(L, file, sub, text, mw->file, sizeof mw->file)) return -1;
     mw->scale = 1.0;
     if (sd_opt_num(&L->c, w, path, "scale", SD_POSITIVE, &mw->scale) ||
         read_stl(L, file, sub, mw))

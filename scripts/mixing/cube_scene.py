@@ -45,18 +45,25 @@ def cube_walls(lo, hi, target):
     return walls
 
 
-def cube_doc(case_doc, dep, deposit_path, centre, target):
+def deposit_reference(deposit_path, scene_dir):
+    """The deposit's path as a scene in scene_dir names it: relative to that folder (engines
+    resolve a scene's files against its folder), so that a campaign's directory can be moved or
+    reached through another link without its scenes losing their deposits."""
+    return os.path.relpath(os.path.realpath(deposit_path), os.path.realpath(scene_dir))
+
+
+def cube_doc(case_doc, dep, deposit_path, centre, target, scene_dir):
     """The case's scene (materials, bonds, model) turned into the cube at `centre` of the deposit
-    `dep` (deposit.read_frame of deposit_path): no inlet, the cube's walls, the kept particles,
-    10 s at the case's dt, frames every 0.1 s and observables every 0.01 s (in steps of the
-    seed's dt for an auto dt)."""
+    `dep` (deposit.read_frame of deposit_path), to be read from scene_dir: no inlet, the cube's
+    walls, the kept particles, 10 s at the case's dt, frames every 0.1 s and observables every
+    0.01 s (in steps of the seed's dt for an auto dt)."""
     lo, hi = (centre - CUBE / 2).round(12).tolist(), (centre + CUBE / 2).round(12).tolist()
     cut = deposit.keep_box(dep, lo, hi, source=deposit_path)
     doc = dict(case_doc)
     doc.pop("inlets", None)
     doc.pop("sweep", None)
     doc["walls"] = cube_walls(*outline(cut), target)
-    doc["particles_from"] = [{"file": os.path.abspath(deposit_path), "frame": -1,
+    doc["particles_from"] = [{"file": deposit_reference(deposit_path, scene_dir), "frame": -1,
                               "region": {"lo": lo, "hi": hi}}]
     dt = doc["time"]["dt"]
     doc["time"] = {"dt": dt, "end_time": END_TIME,

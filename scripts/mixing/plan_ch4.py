@@ -287,7 +287,8 @@ def pass_units(engine, model, p, deposit, base, dt_arg, dt, force, committed):
     cube_dir = os.path.join(base, f"pass{p}_cubes")
     scenes = [os.path.join(cube_dir, f"cube{k}.yaml") for k in range(1, 10)]
     units = [Unit(f"{name}_cubes", scenes, [PY, GENERATE, "cubes", deposit, "--case", model,
-                                            "--dt", dt_arg, "-o", "{dir}"],
+                                            "--dt", dt_arg, "-o", "{dir}",
+                                            "--scene-dir", cube_dir],
                   model, engine, needs=[f"{engine}/{model}/fill{p}"], validate=valid_scene,
                   cost=SCENE_COST, committed=cubes_kept)]
     for k, scene in enumerate(scenes, start=1):
@@ -313,7 +314,8 @@ def model_units(engine, model, variant, ranks):
              validate=valid_trajectory, cost=fill_cost, blocked=gate(engine, "conveyor inlet"),
              resumes=resumable(engine), ranks=fill_ranks(engine, ranks), committed=kept("fill1")),
         Unit(f"{pre}/pass2_scene", [pass2], [PY, GENERATE, "second-pass", fill1, "--case", model,
-                                             "--dt", dt_arg, "-o", "{out0}"],
+                                             "--dt", dt_arg, "-o", "{out0}",
+                                             "--scene-dir", base],
              model, engine, needs=[f"{pre}/fill1"], validate=valid_scene, cost=SCENE_COST,
              committed=kept("fill2")),   # an intermediate: settled with the fill it feeds
         Unit(f"{pre}/fill2", [fill2], fill_command(engine, pass2, force, ranks=ranks), model, engine,

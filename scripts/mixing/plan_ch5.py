@@ -100,7 +100,8 @@ def cube_units(engine, case):
     scenes = [os.path.join(base, "cubes", f"cube{k}.yaml") for k in CUBES]
     units = [Unit(f"{engine}/{case}/cubes", scenes,
                   [PY, GENERATE, "cubes", os.path.join(base, "fill.h5"), "--case", case,
-                   "-o", "{dir}"], case, engine, needs=[f"{engine}/{case}/fill"],
+                   "-o", "{dir}", "--scene-dir", os.path.join(base, "cubes")],
+                  case, engine, needs=[f"{engine}/{case}/fill"],
                   validate=valid_scene, cost=SCENE_COST, committed=committed_fill(engine, case, True))]
     for k, scene in zip(CUBES, scenes):
         units.append(Unit(f"{engine}/{case}/cube{k}", [os.path.join(base, f"cube{k}.h5")],

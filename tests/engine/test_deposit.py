@@ -20,12 +20,16 @@ of this test are made from its last frame.  Checks:
   - the other engine: the LIGGGHTS deck made from the resolved scene (scene_to_liggghts.py) runs
     the same particles, and its trajectory matches build/jdem's (compare_trajectories.py); a
     scene started from liggghts-jdem's trajectory gets its last frame bit for bit;
+  - a relative file: resolved against the scene file's folder, not the working directory, so a
+    scene and its deposit moved together keep their particles (the same as with the absolute
+    path), and a missing one is named by the path tried;
   - bad input: the exact message of each (a missing file, a frame that does not exist, a file
     that is not HDF5, an HDF5 file that is not H5MD, an H5MD file without particles, an empty region, a region outside the
     deposit with the wording of scripts/mixing/deposit.py, a region that keeps nothing, a
     material the scene lacks), each with exit status 2.
 """
 import os
+import shutil
 import tempfile
 
 import h5py
@@ -337,6 +341,31 @@ def check_bad(c, work, src):
     c.check("deposit_bad_material", rc == 2 and got == want, "rc %d, got %r, want %r" % (rc, got, want))
 
 
+def check_relative_file(c, work, src):
+    """file: ../deposit.h5 from work/moved/scenes/, resolved from the filesystem's root as the
+    working directory, before and after the folder is renamed: the same particles as the
+    absolute path gives."""
+    rc, want, err = resolve(write_scene(work, "absolute", "{file: %s}" % src))
+    before = os.path.join(work, "moved")
+    os.makedirs(os.path.join(before, "scenes"))
+    shutil.copyfile(src, os.path.join(before, "deposit.h5"))
+    write_scene(os.path.join(before, "scenes"), "relative", "{file: ../deposit.h5}")
+    write_scene(os.path.join(before, "scenes"), "relative_missing", "{file: ../missing.h5}")
+    after = os.path.join(work, "moved_again")
+    os.rename(before, after)
+    got = engines.resolve(os.path.join(after, "scenes", "relative.yaml"), binary=JDEM, cwd="/")
+    c.check("deposit_relative_to_scene", rc == 0 and got.returncode == 0 and
+            resolved_particles(got.stdout) == resolved_particles(want),
+            "rc %d/%d: %s %s" % (rc, got.returncode, err, got.stderr.strip()))
+    missing = os.path.join(after, "scenes", "../missing.h5")
+    p = engines.resolve(os.path.join(after, "scenes", "relative_missing.yaml"), binary=JDEM, cwd="/")
+    got_msg = p.stderr.strip().split(": ", 2)[-1]
+    want_msg = ("key 'particles_from.0.file': %s: no such file; valid: an H5MD trajectory written "
+                "by jdem or liggghts-jdem" % missing)
+    c.check("deposit_relative_missing", p.returncode == 2 and got_msg == want_msg,
+            "rc %d, got %r, want %r" % (p.returncode, got_msg, want_msg))
+
+
 def main():
     c = Checks()
     work = tempfile.mkdtemp(prefix="jdem_deposit_")
@@ -348,6 +377,7 @@ def main():
     check_renumber(c, work, src)
     check_dilation(c, work, src)
     check_empty_slots(c, work, src)
+    check_relative_file(c, work, src)
     check_bad(c, work, src)
     check_bonds(c, work)
     if done:

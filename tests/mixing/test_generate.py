@@ -64,6 +64,15 @@ ok = all(abs(t[q][0] + centre[q][0] + 0.55 - front[q]) < 1e-12 for q in range(8)
 ok &= all(abs(t[q][2] + centre[q][2] - 0.1375 - 1.8) < 1e-12 for q in range(8))
 ok &= all(abs(t[q][1] + centre[q][1] - 0.5) < 1e-12 for q in range(8))
 check("second_pass_queue", ok, f"{[c['translate'] for c in cells]}")
+# the deposit named relative to the folder the scene is read from: beside it by default, or
+# --scene-dir's (the campaign writes into a partial folder and moves the scene to its final one)
+check("second_pass_deposit_beside", {c["file"] for c in cells} == {"dep.h5"}, f"{cells[0]['file']}")
+os.makedirs(os.path.join(tmp, "partial"))
+r = gen("second-pass", dep, "--case", "model5", "-o", os.path.join(tmp, "partial", "p.yaml"),
+        "--scene-dir", os.path.join(tmp, "final", "model5"))
+moved = yaml.safe_load(open(os.path.join(tmp, "partial", "p.yaml"))) if r.returncode == 0 else {}
+check("second_pass_deposit_from_scene_dir", r.returncode == 0 and
+      moved["inlets"][0]["section"]["from_deposit"][0]["file"] == "../../dep.h5", r.stderr)
 check("second_pass_inserted_once", doc["inlets"][0]["stop"] == {"sections": 1}, f"{doc['inlets'][0]}")
 check("second_pass_keeps_model", doc["walls"][5]["present"] and doc["walls"][6]["axis"][0][0] == 0.7,
       f"{doc['walls'][5:]}")
@@ -71,6 +80,8 @@ r = gen("cubes", dep, "--case", "model2", "-o", os.path.join(tmp, "cubes"))
 check("cubes_run", r.returncode == 0, r.stderr)
 c5 = yaml.safe_load(open(os.path.join(tmp, "cubes", "cube5.yaml")))
 region = c5["particles_from"][0]["region"]
+check("cube_deposit_relative", c5["particles_from"][0]["file"] == "../dep.h5",
+      f"{c5['particles_from'][0]['file']}")
 check("cube5_region", region == {"lo": [0.4, 0.4, 0.4], "hi": [0.6, 0.6, 0.6]}, f"{region}")
 top = c5["walls"][-1]
 normal = np.cross(np.subtract(top["corners"][1], top["corners"][0]),

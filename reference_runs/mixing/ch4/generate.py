@@ -109,7 +109,7 @@ def unloading_dilation(cut):
     return max(1.0, round(float(s), 9))
 
 
-def cells(dep, deposit_path, gap):
+def cells(dep, deposit_path, gap, scene_dir):
     """The from_deposit entries of the second pass, in queue order: each cell dilated
     (unloading_dilation) about its centre, its front gap m behind the previous cell's back."""
     belt = []
@@ -126,7 +126,7 @@ def cells(dep, deposit_path, gap):
         half_len = [s * c / 2 for c in CELL]
         shift = [front - half_len[0] - centre[0], 0.5 - centre[1], 1.8 + half_len[2] - centre[2]]
         front -= 2 * half_len[0] + gap
-        belt.append({"file": os.path.abspath(deposit_path), "frame": -1,
+        belt.append({"file": cube_scene.deposit_reference(deposit_path, scene_dir), "frame": -1,
                      "region": {"lo": lo, "hi": hi}, "dilate": s, "translate": shift})
     return belt
 
@@ -140,7 +140,8 @@ def second_pass(args):
     doc["name"] = "mixing_ch4_pass2"
     doc["description"] = f"Jiang (2021) Ch. 4 second mixing pass, {args.case} (Fig. 4-9)"
     inlet = doc["inlets"][0]
-    inlet["section"] = {"from_deposit": cells(dep, args.deposit, args.gap)}
+    inlet["section"] = {"from_deposit": cells(dep, args.deposit, args.gap,
+                                             args.scene_dir or os.path.dirname(os.path.abspath(args.out)))}
     inlet["origin"] = [0.0, 0.0, 0.0]  # the translations place the cells
     inlet["stop"] = {"sections": 1}   # inserted once: the period is never used
     write(args.out, doc, f"second pass of {args.deposit} ({args.case}), gap {args.gap} m")
@@ -151,7 +152,7 @@ def cubes(args):
     os.makedirs(args.out, exist_ok=True)
     for k, c in enumerate(params.POINTS_TABLE_4_2, start=1):
         doc = cube_scene.cube_doc(case_scene(args.case, args.dt), dep, args.deposit, c,
-                                  SERVO_TARGET)
+                                  SERVO_TARGET, args.scene_dir or args.out)
         doc["name"] = f"mixing_ch4_cube{k}"
         doc["description"] = f"Jiang (2021) Ch. 4 compression test, cube {k} (Table 4-2)"
         write(os.path.join(args.out, f"cube{k}.yaml"), doc,
@@ -199,6 +200,9 @@ def main():
                            help="shift the stream by K micrometres in y (a realisation for the spread)")
             p.add_argument("--frame-every", type=steps,
                            help="a frame every N steps (default: the seed's snapshots, 1 s)")
+        if name != "fill":
+            p.add_argument("--scene-dir", help="the folder the scene(s) will be read from, against "
+                           "which their deposit path is relative (default: --out's)")
         if name == "second-pass":
             p.add_argument("--gap", type=float, default=0.06,
                            help="[RECON] gap between queued cells [m], default 2 R_big")

@@ -45,7 +45,8 @@ def cubes(args):
     base = case_scene(args.case)
     os.makedirs(args.out, exist_ok=True)
     for k, c in enumerate(MIDDLE_CLIP, start=FIRST_POINT):
-        doc = cube_scene.cube_doc(base, dep, args.deposit, c, SERVO_TARGET)
+        doc = cube_scene.cube_doc(base, dep, args.deposit, c, SERVO_TARGET,
+                                    args.scene_dir or args.out)
         doc["name"] = f"mixing_ch5_cube{k}"
         doc["description"] = f"Jiang (2021) Ch. 5 compression test at point {k} (Table 5-2)"
         for key in ("case", "bonds"):   # the resolved case's; the cube's come from the deposit
@@ -62,6 +63,8 @@ def main():
     p.add_argument("deposit")
     p.add_argument("--case", required=True)
     p.add_argument("-o", "--out", required=True)
+    p.add_argument("--scene-dir", help="the folder the scenes will be read from, against which "
+                   "their deposit path is relative (default: --out)")
     args = ap.parse_args()
     try:
         cubes(args)
