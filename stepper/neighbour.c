@@ -431,18 +431,23 @@ typedef struct cell_search {
     int sorted;  /* particles numbered in cell order (sort_into_cells) */
 } cell_search;
 
-/* The runs [lo[r], hi[r]) of the cell arrays that hold the 3 x 3 x 3 cells around particle
- * i's: one per row of three cells along the fast axis (up to 9); their count. */
-static int cell_runs(const cell_search *g, size_t i, int32_t lo[9], int32_t hi[9]) {
+/* Particle i's pairs (i, j > i) within their half skins into part p, sorted by j: the 9 rows of cells
+ * around i's cell, each one run of the cell arrays (its three cells along the fast axis).
+ * With the particles in cell order that run is the partners themselves, and those before i + 1
+ * are skipped unread; the entries are the same either way. */
+static int pairs_of(const void *ctx, size_t i, jd_pair_part *p) {
+    const cell_search *g = ctx;
+    const jd_particles *ps = g->ps;
+    const jd_neighbour_lists *lists = g->lists;
     const int *nc = g->nc, *ax = g->ax;
-    const int32_t ci = g->lists->cell_of[i];
+    const int32_t ci = lists->cell_of[i];
     int c[3];
     c[ax[2]] = ci % nc[ax[2]];
     c[ax[1]] = (ci / nc[ax[2]]) % nc[ax[1]];
     c[ax[0]] = ci / (nc[ax[2]] * nc[ax[1]]);
     const int f0 = c[ax[2]] > 0 ? c[ax[2]] - 1 : 0; /* the row's cells along the fast axis */
     const int f1 = c[ax[2]] + 1 < nc[ax[2]] ? c[ax[2]] + 1 : nc[ax[2]] - 1;
-    int n = 0;
+    const size_t first = p->n;
     for (int ds = -1; ds <= 1; ds++) {
         int nb[3];
         nb[ax[0]] = c[ax[0]] + ds;
@@ -452,27 +457,13 @@ static int cell_runs(const cell_search *g, size_t i, int32_t lo[9], int32_t hi[9
             if (nb[ax[1]] < 0 || nb[ax[1]] >= nc[ax[1]]) continue;
             nb[ax[2]] = f0;
             const size_t row = cell_number(nb, nc, ax), end = row + (size_t)(f1 - f0) + 1;
-            lo[n] = g->lists->cell_start[row];
-            hi[n++] = g->lists->cell_start[end];
+            int32_t q0 = lists->cell_start[row];
+            const int32_t q1 = lists->cell_start[end];
+            if (g->sorted && q0 <= (int32_t)i) q0 = (int32_t)i + 1;
+            if (q0 < q1 && push_near(ps, lists->half_skin, i, g->sorted ? NULL : lists->cell_items,
+                                     q0, q1, p) != 0)
+                return -1;
         }
-    }
-    return n;
-}
-
-/* Particle i's pairs (i, j > i) within their half skins into part p, sorted by j: the 9 rows of cells
- * around i's cell, each one run of the cell arrays (its three cells along the fast axis).
- * With the particles in cell order that run is the partners themselves, and those before i + 1
- * are skipped unread; the entries are the same either way. */
-static int pairs_of(const void *ctx, size_t i, jd_pair_part *p) {
-    const cell_search *g = ctx;
-    int32_t lo[9], hi[9];
-    const int runs = cell_runs(g, i, lo, hi);
-    const size_t first = p->n;
-    for (int r = 0; r < runs; r++) {
-        const int32_t q0 = g->sorted && lo[r] <= (int32_t)i ? (int32_t)i + 1 : lo[r];
-        if (q0 < hi[r] && push_near(g->ps, g->lists->half_skin, i,
-                                    g->sorted ? NULL : g->lists->cell_items, q0, hi[r], p) != 0)
-            return -1;
     }
     sort_segment(p->j + first, p->n - first);
     return 0;
@@ -670,22 +661,38 @@ typedef struct moved_search {
  * the lower index, so that each pair comes once.  The 27 cells around its own, all partners. */
 static int pairs_of_moved(const void *ctx, size_t k, jd_pair_part *p) {
     const moved_search *q = ctx;
-    const double *x = q->g.ps->x, *rad = q->g.ps->radius, *hs = q->g.lists->half_skin;
-    const int32_t *items = q->g.lists->cell_items;
+    const cell_search *g = &q->g;
+    const double *x = g->ps->x, *rad = g->ps->radius, *hs = g->lists->half_skin;
+    const int32_t *items = g->lists->cell_items;
     const size_t i = (size_t)q->moved[k];
-    int32_t lo[9], hi[9];
-    const int runs = cell_runs(&q->g, i, lo, hi);
-    for (int r = 0; r < runs; r++) {
-        for (int32_t e = lo[r]; e < hi[r]; e++) {
-            const size_t j = (size_t)items[e];
-            if (j == i || (q->in_moved[j] && j < i)) continue;
-            const double d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1],
-                         d2 = x[3 * j + 2] - x[3 * i + 2];
-            const double range = (rad[i] + rad[j]) + (hs[i] + hs[j]); /* as push_near */
-            if (!(d0 * d0 + d1 * d1 + d2 * d2 < range * range)) continue;
-            if (part_room(p) != 0) return -1;
-            p->i[p->n] = (int32_t)(i < j ? i : j);
-            p->j[p->n++] = (int32_t)(i < j ? j : i);
+    const int *nc = g->nc, *ax = g->ax;
+    const int32_t ci = g->lists->cell_of[i];
+    int c[3];
+    c[ax[2]] = ci % nc[ax[2]];
+    c[ax[1]] = (ci / nc[ax[2]]) % nc[ax[1]];
+    c[ax[0]] = ci / (nc[ax[2]] * nc[ax[1]]);
+    const int f0 = c[ax[2]] > 0 ? c[ax[2]] - 1 : 0;
+    const int f1 = c[ax[2]] + 1 < nc[ax[2]] ? c[ax[2]] + 1 : nc[ax[2]] - 1;
+    for (int ds = -1; ds <= 1; ds++) {
+        int nb[3];
+        nb[ax[0]] = c[ax[0]] + ds;
+        if (nb[ax[0]] < 0 || nb[ax[0]] >= nc[ax[0]]) continue;
+        for (int dm = -1; dm <= 1; dm++) {
+            nb[ax[1]] = c[ax[1]] + dm;
+            if (nb[ax[1]] < 0 || nb[ax[1]] >= nc[ax[1]]) continue;
+            nb[ax[2]] = f0;
+            const size_t row = cell_number(nb, nc, ax), end = row + (size_t)(f1 - f0) + 1;
+            for (int32_t e = g->lists->cell_start[row]; e < g->lists->cell_start[end]; e++) {
+                const size_t j = (size_t)items[e];
+                if (j == i || (q->in_moved[j] && j < i)) continue;
+                const double d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1],
+                             d2 = x[3 * j + 2] - x[3 * i + 2];
+                const double range = (rad[i] + rad[j]) + (hs[i] + hs[j]); /* as push_near */
+                if (!(d0 * d0 + d1 * d1 + d2 * d2 < range * range)) continue;
+                if (part_room(p) != 0) return -1;
+                p->i[p->n] = (int32_t)(i < j ? i : j);
+                p->j[p->n++] = (int32_t)(i < j ? j : i);
+            }
         }
     }
     return 0;
