@@ -5,7 +5,7 @@ and rolling, a servo compression, an inlet stream, a bonded beam and an inlet of
 (the checkpoint between two copies' insertions), a bed in a turning meshed drum and spheres
 on a meshed conveyor (the mesh's moved corners, its contact history and candidates), spheres
 leaving the domain (the shrinking set, its bonds and loads), spheres raining onto a bed (each
-particle's half skin), a sparse rain (the partial builds' reference positions); SIGTERM writes a
+particle's half skin); SIGTERM writes a
 checkpoint and exits 143; bad checkpoints are refused with their messages; a failed
 checkpoint write keeps the previous checkpoint and stops the run (exit 3)."""
 import math
@@ -40,8 +40,6 @@ CASES = [  # scene, case, checkpoint every N steps
     ("tests/engine/scenes/domain_exit.yaml", None, 100),
     # a checkpoint mid-rain, the falling spheres' half skins 4.5 x the bed's
     ("tests/engine/scenes/shower.yaml", None, 1100),
-    # a checkpoint between partial neighbour builds (each particle's reference position)
-    ("tests/engine/scenes/drizzle.yaml", None, 2100),
 ]
 
 

@@ -75,31 +75,6 @@ c.check("shower_sorted_vs_allpairs", dx <= 1e-12 and np.array_equal(rs["obs"]["c
 c.check("shower_has_impacts", ra["obs"]["contacts"].max() > 200 and ra["obs"]["wall_contacts"].max() > 50,
         f"{ra['obs']['contacts'].max():g} contacts, {ra['obs']['wall_contacts'].max():g} wall contacts at most")
 
-# Partial builds: a sparse rain onto the bed, so that at most builds fewer than half the spheres
-# have moved and only theirs are searched again (stepper/neighbour.c).  The kept entries must
-# still hold every pair that comes into contact: bit for bit the all-pairs run, which rebuilds at
-# the same steps; renumbered at the full builds, the same to round-off.
-drizzle_run, drizzle = run("drizzle", "--no-sort", "--timing")
-_, drizzle_all = run("drizzle", env={"JDEM_NEIGHBOUR": "allpairs"}, binary=JDEM_OPTIMISED)
-da, db = load(drizzle), load(drizzle_all)
-c.check("drizzle_partial_verlet_vs_allpairs_bitwise",
-        np.array_equal(da["position"], db["position"]) and np.array_equal(da["velocity"], db["velocity"]),
-        "positions or velocities differ: a kept entry list missed a contact")
-_, drizzle_sorted = run("drizzle")
-ds = load(drizzle_sorted)
-order_s, order_b = np.argsort(ds["id"]), np.argsort(db["id"])
-dx = np.max(np.abs(ds["position"][:, order_s] - db["position"][:, order_b])) / np.max(np.abs(db["position"]))
-c.check("drizzle_sorted_vs_allpairs", dx <= 1e-12 and np.array_equal(ds["obs"]["contacts"], db["obs"]["contacts"]),
-        f"the renumbered run's positions differ from the all-pairs run's by {dx:.3g} of the largest, "
-        "or its contact counts differ")
-timing = engines.jdem_timing(drizzle_run.stderr) or {}
-c.check("drizzle_builds_are_mostly_partial",
-        timing.get("partial_builds", 0) > timing.get("builds", 0) / 2 and
-        da["obs"]["contacts"].max() > 50 and da["obs"]["wall_contacts"].max() > 50,
-        f"{timing.get('partial_builds')} partial of {timing.get('builds')} builds, "
-        f"{da['obs']['contacts'].max():g} contacts, {da['obs']['wall_contacts'].max():g} wall contacts "
-        "at most (the scene must exercise the partial path and the walls)")
-
 
 def builds(stderr):
     found = re.search(r"(\d+) neighbour builds", stderr)
