@@ -57,8 +57,12 @@ int scene_opt_int(loader *L, const yaml_node_t *map, const char *path, const cha
     return n ? sd_int(&L->c, n, sub, lo, out) : 0;
 }
 
-int scene_file_path(loader *L, const yaml_node_t *node, const char *path, const char *file,
+int scene_file_path(loader *L, const yaml_node_t *node, const char *path, const char *what,
                     char *out, size_t size) {
+    const char *file = sd_scalar(node);
+    if (!file || !*file)
+        return sd_fail(&L->c, node, path, "expected a file name, got %s; valid: the path of %s",
+                       sd_kind(node), what);
     char dir[sizeof L->s->path];
     snprintf(dir, sizeof dir, "%s", L->s->path);
     int n = file[0] == '/' ? snprintf(out, size, "%s", file)

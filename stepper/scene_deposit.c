@@ -134,13 +134,10 @@ static int read_entry(loader *L, const yaml_node_t *map, const char *list_path, 
     d->file_node = sd_get(&L->c, map, "file");
     if (!d->file_node)
         return sd_missing(&L->c, map, d->path, "file", "the path of an H5MD trajectory");
-    const char *file = sd_scalar(d->file_node);
     char sub[SD_PATH_MAX];
     sd_join(sub, d->path, "file");
-    if (!file || !*file)
-        return sd_fail(&L->c, d->file_node, sub, "expected a file name, got %s; valid: the path "
-                       "of an H5MD trajectory", sd_kind(d->file_node));
-    if (scene_file_path(L, d->file_node, sub, file, d->file, sizeof d->file)) return -1;
+    if (scene_file_path(L, d->file_node, sub, "an H5MD trajectory", d->file, sizeof d->file))
+        return -1;
     d->frame_node = sd_get(&L->c, map, "frame");
     return scene_opt_int(L, map, d->path, "frame", INT64_MIN + 1, &d->frame) ||
                    read_region(L, d) || read_dilation(L, d) ||

@@ -60,10 +60,11 @@ static inline void sub3(const double a[3], const double b[3], double out[3]) {
 int scene_opt_int(loader *L, const yaml_node_t *map, const char *path, const char *key,
                   int64_t lo, int64_t *out);
 
-/* scene.c: the file named at node (key path) resolved against the scene file's folder into
- * out[size] (an absolute path as it is), so that a scene and the files beside it can be moved
- * together; a path that does not fit is refused. */
-int scene_file_path(loader *L, const yaml_node_t *node, const char *path, const char *file,
+/* scene.c: the file named at node (key path; what: "an STL file", for the message when it
+ * names none) resolved against the scene file's folder into out[size] (an absolute path as it
+ * is), so that a scene and the files beside it can be moved together; a path that does not fit
+ * is refused. */
+int scene_file_path(loader *L, const yaml_node_t *node, const char *path, const char *what,
                     char *out, size_t size);
 
 /* scene_materials.c */

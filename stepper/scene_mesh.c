@@ -178,11 +178,7 @@ int scene_read_mesh_wall(loader *L, const yaml_node_t *w, const char *path, jd_m
     sd_join(sub, path, "file");
     const yaml_node_t *file = sd_get(&L->c, w, "file");
     if (!file) return sd_missing(&L->c, w, path, "file", "the path of an STL file");
-    const char *text = sd_scalar(file);
-    if (!text || !*text)
-        return sd_fail(&L->c, file, sub, "expected a file name, got %s; valid: the path of an STL "
-                       "file", sd_kind(file));
-    if (scene_file_path(L, file, sub, text, mw->file, sizeof mw->file)) return -1;
+    if (scene_file_path(L, file, sub, "an STL file", mw->file, sizeof mw->file)) return -1;
     mw->scale = 1.0;
     if (sd_opt_num(&L->c, w, path, "scale", SD_POSITIVE, &mw->scale) ||
         read_stl(L, file, sub, mw))
