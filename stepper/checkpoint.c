@@ -212,6 +212,7 @@ static int check_identity(ck_io *io, const identity *want, const jd_checkpointer
 /* After the state is in place: what the run derives from it (the fast paths' view of the
  * particles, the threads' shares, the wall-force room), as a neighbour build leaves it. */
 static int derive(jd_sim *s, char *err, size_t errlen) {
+    s->lists.n_built = s->particles.n; /* a checkpoint is written between steps, after any build */
     sim_particle_kinds(&s->fast, &s->particles, s->run.n_materials, s->opt.plain_loops);
     if (sim_forces_partition(&s->threads, &s->lists, s->particles.n) != 0) {
         snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads.n);

@@ -397,8 +397,9 @@ static void print_timing(const jd_sim *s) {
         double v;
     } part[] = {{"neighbour search", t->neighbour}, {"pair forces", t->pairs},
                 {"wall forces", t->walls}, {"integration", t->integration}, {"output", t->output}};
-    fprintf(stderr, "jdem: timing of %lld steps, %zu particles, %d thread(s), %lld neighbour builds:\n",
-            (long long)s->step, s->particles.n, s->threads.n, (long long)s->lists.n_builds);
+    fprintf(stderr, "jdem: timing of %lld steps, %zu particles, %d thread(s), %lld neighbour builds "
+            "(%lld of this process's partial):\n", (long long)s->step, s->particles.n, s->threads.n,
+            (long long)s->lists.n_builds, (long long)s->lists.n_partial);
     char laws[96];
     fprintf(stderr, "jdem:   law set %s\n", jd_law_set_describe(s->run.features, laws, sizeof laws));
     for (size_t k = 0; k < sizeof part / sizeof *part; k++)
@@ -411,10 +412,10 @@ static void print_timing(const jd_sim *s) {
             s->particles.n ? (double)sim_memory_bytes(s) / (double)s->particles.n : 0.0);
     fprintf(stderr, "jdem-timing: neighbour=%.6f pairs=%.6f walls=%.6f integration=%.6f output=%.6f "
             "loop=%.6f steps=%lld builds=%lld threads=%d pair_entries=%zu wall_entries=%zu "
-            "engine_bytes=%zu\n",
+            "engine_bytes=%zu partial_builds=%lld\n",
             t->neighbour, t->pairs, t->walls, t->integration, t->output, t->loop, (long long)s->step,
             (long long)s->lists.n_builds, s->threads.n, s->lists.pairs.n, s->lists.wall_pairs.n,
-            sim_memory_bytes(s));
+            sim_memory_bytes(s), (long long)s->lists.n_partial);
     const int64_t inserted = sim_inlets_inserted(s);
     if (inserted > 0)
         fprintf(stderr, "jdem-inlets: inserted=%lld seconds=%.6f ns_per_particle=%.1f\n",

@@ -10,6 +10,17 @@
  * its gap in between, so no contact is missed.  (The particles' displacement is checked in the
  * drift, integrate.c.)
  *
+ * A build is partial when few particles have moved (sim_neighbour_build): the particles that
+ * moved more than JD_MOVED_FRACTION of their half skin get new half skins and reference
+ * positions, and only their pairs and wall candidates are searched again; every other entry is
+ * kept.  A kept particle can still move its whole half skin from its reference position, that
+ * is up to its half skin plus the distance it has drifted from there already; so the search
+ * range of a pair with a kept particle has the largest such drift added (pairs_of_moved), and
+ * an entry kept or left out at one build stays right until either particle triggers the next.
+ * Every JD_FULL_BUILD_EVERY-th build, any build after particles were deleted or a wall moved,
+ * and any build when many moved, is full: everything searched again, every half skin renewed and
+ * the particles renumbered in cell order.
+ *
  * Both lists are sorted by (i, j), which fixes the force summation order (deterministic) and
  * lets the contact history be carried over to a new list by one merge of the two sorted lists.
  * Entries that are not carried over are dropped after their dissipated energies are added to
@@ -141,6 +152,7 @@ static void drop_from(jd_accounts *accounts, jd_contact_list *l, int pairs, size
 }
 
 void sim_lists_drop_from(jd_sim *s, size_t keep) {
+    s->lists.renumbered = 1;
     drop_from(&s->accounts, &s->lists.pairs, 1, keep);
     drop_from(&s->accounts, &s->lists.wall_pairs, 0, keep);
 }
@@ -310,11 +322,11 @@ static int core_box(const jd_particles *ps, double lo[3], double hi[3]) {
 }
 
 /* The cell grid over the particles' bounding box: cell edge h >= the largest interaction
- * range; over the core box (core_box) instead if the whole box would need more than about 8
+ * range (twice the largest radius + half skin, and `extra` [m]: a partial build's kept drift); over the core box (core_box) instead if the whole box would need more than about 8
  * cells per particle and the core box would not; the edge grown if even that needs more
  * (sparse or scattered systems).  Fails on a non-finite position or out of memory. */
-static int cell_grid(const jd_particles *ps, const double *hs, int64_t step, double *h_out,
-                     double lo[3], int nc[3], char *err, size_t errlen) {
+static int cell_grid(const jd_particles *ps, const double *hs, double extra, int64_t step,
+                     double *h_out, double lo[3], int nc[3], char *err, size_t errlen) {
     double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     double reach = 0.0; /* the largest radius + half skin */
     for (int d = 0; d < 3; d++) lo[d] = INFINITY;
@@ -332,7 +344,7 @@ static int cell_grid(const jd_particles *ps, const double *hs, int64_t step, dou
         const double ri = ps->radius[i] + hs[i];
         reach = ri > reach ? ri : reach;
     }
-    double h = 2.0 * reach;
+    double h = 2.0 * reach + extra;
     const double max_cells = 8.0 * (double)ps->n + 64.0;
     double cells = grid_cells(lo, hi, h);
     if (cells > max_cells && ps->n >= JD_GRID_TRIM_MIN_N) {
@@ -361,7 +373,7 @@ static int cell_grid(const jd_particles *ps, const double *hs, int64_t step, dou
 static int sort_into_cells(jd_sim *s, char *err, size_t errlen) {
     double h, lo[3];
     int nc[3], ax[3];
-    if (cell_grid(&s->particles, s->lists.half_skin, s->step, &h, lo, nc, err, errlen) != 0) return -1;
+    if (cell_grid(&s->particles, s->lists.half_skin, 0.0, s->step, &h, lo, nc, err, errlen) != 0) return -1;
     cell_axes(nc, ax);
     if (bin_particles(&s->lists, &s->particles, h, lo, nc, ax) != 0) {
         snprintf(err, errlen, "out of memory sorting %zu particles", s->particles.n);
@@ -423,23 +435,18 @@ typedef struct cell_search {
     int sorted;  /* particles numbered in cell order (sort_into_cells) */
 } cell_search;
 
-/* Particle i's pairs (i, j > i) within their half skins into part p, sorted by j: the 9 rows of cells
- * around i's cell, each one run of the cell arrays (its three cells along the fast axis).
- * With the particles in cell order that run is the partners themselves, and those before i + 1
- * are skipped unread; the entries are the same either way. */
-static int pairs_of(const void *ctx, size_t i, jd_pair_part *p) {
-    const cell_search *g = ctx;
-    const jd_particles *ps = g->ps;
-    const jd_neighbour_lists *lists = g->lists;
+/* The runs [lo[r], hi[r]) of the cell arrays that hold the 3 x 3 x 3 cells around particle
+ * i's: one per row of three cells along the fast axis (up to 9); their count. */
+static int cell_runs(const cell_search *g, size_t i, int32_t lo[9], int32_t hi[9]) {
     const int *nc = g->nc, *ax = g->ax;
-    const int32_t ci = lists->cell_of[i];
+    const int32_t ci = g->lists->cell_of[i];
     int c[3];
     c[ax[2]] = ci % nc[ax[2]];
     c[ax[1]] = (ci / nc[ax[2]]) % nc[ax[1]];
     c[ax[0]] = ci / (nc[ax[2]] * nc[ax[1]]);
     const int f0 = c[ax[2]] > 0 ? c[ax[2]] - 1 : 0; /* the row's cells along the fast axis */
     const int f1 = c[ax[2]] + 1 < nc[ax[2]] ? c[ax[2]] + 1 : nc[ax[2]] - 1;
-    const size_t first = p->n;
+    int n = 0;
     for (int ds = -1; ds <= 1; ds++) {
         int nb[3];
         nb[ax[0]] = c[ax[0]] + ds;
@@ -449,13 +456,27 @@ static int pairs_of(const void *ctx, size_t i, jd_pair_part *p) {
             if (nb[ax[1]] < 0 || nb[ax[1]] >= nc[ax[1]]) continue;
             nb[ax[2]] = f0;
             const size_t row = cell_number(nb, nc, ax), end = row + (size_t)(f1 - f0) + 1;
-            int32_t q0 = lists->cell_start[row];
-            const int32_t q1 = lists->cell_start[end];
-            if (g->sorted && q0 <= (int32_t)i) q0 = (int32_t)i + 1;
-            if (q0 < q1 && push_near(ps, lists->half_skin, i, g->sorted ? NULL : lists->cell_items,
-                                     q0, q1, p) != 0)
-                return -1;
+            lo[n] = g->lists->cell_start[row];
+            hi[n++] = g->lists->cell_start[end];
         }
+    }
+    return n;
+}
+
+/* Particle i's pairs (i, j > i) within their half skins into part p, sorted by j: the 9 rows of cells
+ * around i's cell, each one run of the cell arrays (its three cells along the fast axis).
+ * With the particles in cell order that run is the partners themselves, and those before i + 1
+ * are skipped unread; the entries are the same either way. */
+static int pairs_of(const void *ctx, size_t i, jd_pair_part *p) {
+    const cell_search *g = ctx;
+    int32_t lo[9], hi[9];
+    const int runs = cell_runs(g, i, lo, hi);
+    const size_t first = p->n;
+    for (int r = 0; r < runs; r++) {
+        const int32_t q0 = g->sorted && lo[r] <= (int32_t)i ? (int32_t)i + 1 : lo[r];
+        if (q0 < hi[r] && push_near(g->ps, g->lists->half_skin, i,
+                                    g->sorted ? NULL : g->lists->cell_items, q0, hi[r], p) != 0)
+            return -1;
     }
     sort_segment(p->j + first, p->n - first);
     return 0;
@@ -495,13 +516,12 @@ static int parts_reserve(jd_neighbour_lists *lists, int threads) {
     return 0;
 }
 
-/* The entries of particles 0 .. n - 1, entries_of(ctx, i, part) each, appended to l (of this
- * kind) in ascending i: each of `threads` threads takes one equal range of i into its part, and
- * the parts are joined in thread order, so the list is the same for every thread count.  0, or
- * -1 when out of memory. */
-typedef int (*entries_fn)(const void *ctx, size_t i, jd_pair_part *p);
-static int build_in_parts(jd_neighbour_lists *lists, size_t n, int threads, entries_fn entries_of,
-                          const void *ctx, unsigned kind, jd_contact_list *l) {
+/* The entries of items 0 .. n - 1, entries_of(ctx, k, part) each, into the threads' parts:
+ * each of `threads` threads takes one equal range of k, so that the parts joined in thread
+ * order are the same for every thread count.  0, or -1 when out of memory. */
+typedef int (*entries_fn)(const void *ctx, size_t k, jd_pair_part *p);
+static int run_parts(jd_neighbour_lists *lists, size_t n, int threads, entries_fn entries_of,
+                     const void *ctx) {
     if (parts_reserve(lists, threads) != 0) return -1;
     for (int t = 0; t < threads; t++) lists->parts[t].n = 0; /* also of a thread OpenMP withholds */
     int failed = 0;
@@ -509,13 +529,20 @@ static int build_in_parts(jd_neighbour_lists *lists, size_t n, int threads, entr
     {
         const int t = omp_get_thread_num(), nt = omp_get_num_threads();
         jd_pair_part p = lists->parts[t]; /* a copy: the parts share cache lines */
-        for (size_t i = n * (size_t)t / (size_t)nt; i < n * (size_t)(t + 1) / (size_t)nt && !failed; i++)
-            failed |= entries_of(ctx, i, &p) != 0;
+        for (size_t k = n * (size_t)t / (size_t)nt; k < n * (size_t)(t + 1) / (size_t)nt && !failed; k++)
+            failed |= entries_of(ctx, k, &p) != 0;
         lists->parts[t] = p;
     }
+    return failed ? -1 : 0;
+}
+
+/* The parts' entries (run_parts), in thread order, appended to l (of this kind).  0 or -1. */
+static int build_in_parts(jd_neighbour_lists *lists, size_t n, int threads, entries_fn entries_of,
+                          const void *ctx, unsigned kind, jd_contact_list *l) {
+    if (run_parts(lists, n, threads, entries_of, ctx) != 0) return -1;
     size_t total = l->n;
     for (int t = 0; t < threads; t++) total += lists->parts[t].n;
-    if (failed || sim_list_reserve(l, total, kind) != 0) return -1;
+    if (sim_list_reserve(l, total, kind) != 0) return -1;
     for (int t = 0; t < threads; t++) {
         const jd_pair_part *p = &lists->parts[t];
         if (!p->n) continue; /* its arrays may not exist yet */
@@ -545,7 +572,7 @@ static int build_pair_list_cells(const jd_particles *ps, jd_neighbour_lists *lis
     if (ps->n < 2) return 0;
     double h, lo[3];
     cell_search g = {.ps = ps, .lists = lists, .sorted = sorted};
-    if (cell_grid(ps, lists->half_skin, step, &h, lo, g.nc, err, errlen) != 0) return -1;
+    if (cell_grid(ps, lists->half_skin, 0.0, step, &h, lo, g.nc, err, errlen) != 0) return -1;
     cell_axes(g.nc, g.ax);
     if (bin_particles(lists, ps, h, lo, g.nc, g.ax) != 0 ||
         build_in_parts(lists, ps->n, threads, pairs_of, &g, kind, l) != 0) {
@@ -573,7 +600,7 @@ static double domain_clearance(const double lo[3], const double hi[3], const dou
     return d > 0.0 ? d : 0.0;
 }
 
-/* Each particle's half skin for the lists about to be built: skin/2, or, for a particle that
+/* A particle's half skin for the lists about to be built: skin/2, or, for a particle that
  * would cross that in fewer than skin_steps steps at its speed now, the distance it crosses in
  * skin_steps steps, up to its radius and, with a domain, up to its distance from the domain's
  * faces.  A particle triggers the next build when it has moved its own half skin (integrate.c),
@@ -582,81 +609,294 @@ static double domain_clearance(const double lo[3], const double hi[3], const dou
  * at rest keeps its short list (docs/performance.md).  The domain's bound keeps the deletions
  * where they were with one skin (stepper/domain.c deletes at builds): a fast particle that
  * leaves across a face triggers a build at the step its centre crosses it. */
-static void set_half_skins(jd_neighbour_lists *lists, const jd_particles *ps, const jd_scene *sc,
-                           double dt) {
+static double half_skin_of(const jd_neighbour_lists *lists, const jd_particles *ps,
+                           const jd_scene *sc, double dt, size_t i) {
     const double h0 = 0.5 * lists->skin, reach = (double)lists->skin_steps * dt;
-    for (size_t i = 0; i < ps->n; i++) {
-        const double *v = ps->v + 3 * i;
-        double h = reach * sqrt(jd_dot(v, v));
-        h = h < ps->radius[i] ? h : ps->radius[i];
-        if (sc->has_domain && h > h0) {
-            const double c = domain_clearance(sc->domain_lo, sc->domain_hi, ps->x + 3 * i);
-            h = h < c ? h : c;
-        }
-        lists->half_skin[i] = h > h0 ? h : h0; /* never below skin/2 (integrate.c's fast check) */
+    const double *v = ps->v + 3 * i;
+    double h = reach * sqrt(jd_dot(v, v));
+    h = h < ps->radius[i] ? h : ps->radius[i];
+    if (sc->has_domain && h > h0) {
+        const double c = domain_clearance(sc->domain_lo, sc->domain_hi, ps->x + 3 * i);
+        h = h < c ? h : c;
     }
+    return h > h0 ? h : h0; /* never below skin/2 (integrate.c's fast check) */
+}
+
+/* Partial builds.  A particle is searched again when it has moved more than this fraction of
+ * its half skin since its last search (the one that triggered the build has moved all of it);
+ * the others keep their entries. */
+#define JD_MOVED_FRACTION 0.25
+/* A build is full when more than n / JD_PARTIAL_LIMIT particles moved, and every
+ * JD_FULL_BUILD_EVERY-th build: the particles renumbered in cell order again, and the entries
+ * of pairs that drifted apart dropped (docs/performance.md, "Partial neighbour builds"). */
+#define JD_PARTIAL_LIMIT 2
+#define JD_FULL_BUILD_EVERY 16
+
+/* Whether some wall has moved since the last full build (then a kept wall candidate's margin
+ * would not cover the wall's remaining travel: a partial build is not allowed). */
+static int any_wall_moved(const jd_walls *walls) {
+    for (size_t w = 0; w < walls->n; w++)
+        if (jd_dot(walls->wall[w].disp, walls->wall[w].disp) > 0.0) return 1;
+    return 0;
+}
+
+/* Whether this build may be partial: nothing renumbered or deleted since the last one, no wall
+ * moved since the last full build, no mesh walls (their candidates are searched for every
+ * particle), and not a build due to be full. */
+static int partial_allowed(const jd_sim *s) {
+    return s->lists.n_builds % JD_FULL_BUILD_EVERY != 0 && !s->lists.renumbered && !s->meshes &&
+           s->particles.n >= s->lists.n_built && !any_wall_moved(&s->walls);
+}
+
+/* Mark the particles that moved more than JD_MOVED_FRACTION of their half skin since their last
+ * search, and those inserted since the last build (lists->moved, in_moved); their count.
+ * *kept_drift: the largest displacement of the others [m], the drift bound they carry on. */
+static size_t mark_moved(jd_neighbour_lists *lists, const jd_particles *ps, double *kept_drift) {
+    size_t m = 0;
+    double d2max = 0.0;
+    for (size_t i = 0; i < ps->n; i++) {
+        int moved = 1;
+        if (i < lists->n_built) {
+            const double *x = ps->x + 3 * i, *x0 = lists->x_build + 3 * i;
+            const double d0 = x[0] - x0[0], d1 = x[1] - x0[1], d2 = x[2] - x0[2];
+            const double r2 = d0 * d0 + d1 * d1 + d2 * d2, lim = JD_MOVED_FRACTION * lists->half_skin[i];
+            moved = r2 > lim * lim;
+            if (!moved && r2 > d2max) d2max = r2;
+        }
+        lists->in_moved[i] = (uint8_t)moved;
+        if (moved) lists->moved[m++] = (int32_t)i;
+    }
+    *kept_drift = sqrt(d2max);
+    return m;
+}
+
+/* What a partial build searches: the grid, and the particles that moved. */
+typedef struct moved_search {
+    cell_search g; /* binned in index order (items), not renumbered */
+    const int32_t *moved;
+    const uint8_t *in_moved;
+    double drift;  /* the largest distance of a kept particle from its reference position [m] */
+} moved_search;
+
+/* The pairs of moved particle moved[k] with every particle within their half skins, into part
+ * p as (lower index, higher): against an unmoved partner always, its range grown by the kept
+ * particles' drift (it may still move its half skin from its reference position), against a
+ * moved one only from the lower index, so that each pair comes once.  The 27 cells around its
+ * own (the grid's cells are grown by the drift too), all partners. */
+static int pairs_of_moved(const void *ctx, size_t k, jd_pair_part *p) {
+    const moved_search *q = ctx;
+    const double *x = q->g.ps->x, *rad = q->g.ps->radius, *hs = q->g.lists->half_skin;
+    const int32_t *items = q->g.lists->cell_items;
+    const size_t i = (size_t)q->moved[k];
+    int32_t lo[9], hi[9];
+    const int runs = cell_runs(&q->g, i, lo, hi);
+    for (int r = 0; r < runs; r++) {
+        for (int32_t e = lo[r]; e < hi[r]; e++) {
+            const size_t j = (size_t)items[e];
+            if (j == i || (q->in_moved[j] && j < i)) continue;
+            const double d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1],
+                         d2 = x[3 * j + 2] - x[3 * i + 2];
+            const double range = (rad[i] + rad[j]) + (hs[i] + hs[j]) + (q->in_moved[j] ? 0.0 : q->drift);
+            if (!(d0 * d0 + d1 * d1 + d2 * d2 < range * range)) continue;
+            if (part_room(p) != 0) return -1;
+            p->i[p->n] = (int32_t)(i < j ? i : j);
+            p->j[p->n++] = (int32_t)(i < j ? j : i);
+        }
+    }
+    return 0;
+}
+
+/* The wall candidates of moved particle moved[k] (walls_of). */
+typedef struct moved_walls {
+    wall_search ws;
+    const int32_t *moved;
+} moved_walls;
+
+static int walls_of_moved(const void *ctx, size_t k, jd_pair_part *p) {
+    const moved_walls *q = ctx;
+    return walls_of(&q->ws, (size_t)q->moved[k], p);
+}
+
+static int key_cmp(const void *a, const void *b) {
+    const int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static int64_t entry_key(const jd_contact_list *l, size_t c) {
+    return ((int64_t)l->i[c] << 32) | (int64_t)(uint32_t)l->j[c];
+}
+
+/* The parts (run_parts) as sorted keys in lists->keys; their count, or -1 out of memory. */
+static ptrdiff_t sorted_part_keys(jd_neighbour_lists *lists, int threads) {
+    size_t total = 0;
+    for (int t = 0; t < threads; t++) total += lists->parts[t].n;
+    if (total > lists->keys_cap) {
+        int64_t *k = realloc(lists->keys, (total + total / 2) * sizeof *k);
+        if (!k) return -1;
+        lists->keys = k;
+        lists->keys_cap = total + total / 2;
+    }
+    size_t n = 0;
+    for (int t = 0; t < threads; t++)
+        for (size_t e = 0; e < lists->parts[t].n; e++)
+            lists->keys[n++] = ((int64_t)lists->parts[t].i[e] << 32) | (int64_t)(uint32_t)lists->parts[t].j[e];
+    if (n > 1) qsort(lists->keys, n, sizeof *lists->keys, key_cmp); /* keys is NULL while empty */
+    return (ptrdiff_t)n;
+}
+
+/* The first entry at or after c of old's run [c, end) that no moved particle is in (`pairs`: j
+ * is a particle too), or end. */
+static size_t next_kept(const jd_contact_list *old, size_t c, size_t end, const uint8_t *in_moved,
+                        int pairs) {
+    while (c < end && (in_moved[old->i[c]] || (pairs && in_moved[old->j[c]]))) c++;
+    return c;
+}
+
+/* Into nw (empty, one sorted run): old's entries that no moved particle is in (its two sorted
+ * runs) merged with the nkeys new ones (sorted keys).  0 or -1 out of memory. */
+static int merge_kept(const jd_contact_list *old, const uint8_t *in_moved, int pairs,
+                      const int64_t *keys, size_t nkeys, unsigned kind, jd_contact_list *nw) {
+    if (sim_list_reserve(nw, old->n + nkeys, kind) != 0) return -1;
+    size_t a = next_kept(old, 0, old->n_touch, in_moved, pairs);
+    size_t b = next_kept(old, old->n_touch, old->n, in_moved, pairs);
+    size_t k = 0, n = 0;
+    while (a < old->n_touch || b < old->n || k < nkeys) {
+        const int64_t ka = a < old->n_touch ? entry_key(old, a) : INT64_MAX;
+        const int64_t kb = b < old->n ? entry_key(old, b) : INT64_MAX;
+        const int64_t kk = k < nkeys ? keys[k] : INT64_MAX;
+        const int64_t m = ka < kb ? (ka < kk ? ka : kk) : (kb < kk ? kb : kk);
+        nw->i[n] = (int32_t)(m >> 32);
+        nw->j[n++] = (int32_t)(uint32_t)(m & 0xffffffff);
+        if (m == ka) a = next_kept(old, a + 1, old->n_touch, in_moved, pairs);
+        else if (m == kb) b = next_kept(old, b + 1, old->n, in_moved, pairs);
+        else k++;
+    }
+    nw->n = n;
+    nw->n_touch = n;
+    return 0;
+}
+
+/* The new pair list (nw, one sorted run) of a partial build: the moved particles' pairs searched
+ * on the grid, the others' kept. */
+static int partial_pair_list(jd_sim *s, size_t m, double kept_drift, unsigned kind,
+                             jd_contact_list *nw, char *err, size_t errlen) {
+    jd_neighbour_lists *lists = &s->lists;
+    const jd_particles *ps = &s->particles;
+    moved_search q = {.g = {.ps = ps, .lists = lists, .sorted = 0}, .moved = lists->moved,
+                      .in_moved = lists->in_moved, .drift = kept_drift};
+    double h, lo[3];
+    if (cell_grid(ps, lists->half_skin, q.drift, s->step, &h, lo, q.g.nc, err, errlen) != 0) return -1;
+    cell_axes(q.g.nc, q.g.ax);
+    ptrdiff_t nkeys = -1;
+    if (bin_particles(lists, ps, h, lo, q.g.nc, q.g.ax) == 0 &&
+        run_parts(lists, m, s->threads.n, pairs_of_moved, &q) == 0)
+        nkeys = sorted_part_keys(lists, s->threads.n);
+    if (nkeys < 0 || merge_kept(&lists->pairs, lists->in_moved, 1, lists->keys, (size_t)nkeys, kind, nw) != 0) {
+        snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", lists->pairs.n);
+        return -1;
+    }
+    return 0;
+}
+
+/* The new wall list (wn, one sorted run) of a partial build. */
+static int partial_wall_list(jd_sim *s, size_t m, unsigned kind, jd_contact_list *wn) {
+    jd_neighbour_lists *lists = &s->lists;
+    const moved_walls q = {.ws = {.ps = &s->particles, .walls = &s->walls, .lists = lists,
+                                  .allpairs = s->opt.allpairs},
+                           .moved = lists->moved};
+    if (run_parts(lists, m, s->threads.n, walls_of_moved, &q) != 0) return -1;
+    const ptrdiff_t nkeys = sorted_part_keys(lists, s->threads.n);
+    return nkeys < 0 ? -1 : merge_kept(&lists->wall_pairs, lists->in_moved, 0, lists->keys,
+                                       (size_t)nkeys, kind, wn);
 }
 
 /* Build a new list into `spare`, carry the history over, swap.  The spares keep their buffers
  * between builds, and the pair spare is reserved at once for the last list and an eighth more,
- * so a build reallocates only when the list grows by more than that. */
+ * so a build reallocates only when the list grows by more than that.  Partial when
+ * partial_allowed and at most n / JD_PARTIAL_LIMIT particles moved; a full build renews every
+ * half skin and reference position.  The all-pairs reference keeps the same half skins,
+ * reference positions and build steps, with every pair. */
 int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
-    set_half_skins(&s->lists, &s->particles, s->run.scene, s->run.dt);
-    const int sorted = !s->opt.allpairs && !s->opt.no_sort && s->particles.n > 1;
+    jd_neighbour_lists *lists = &s->lists;
+    jd_particles *ps = &s->particles;
+    double kept_drift = 0.0;
+    size_t m = ps->n; /* the particles searched again (and given new half skins): all, if full */
+    const int may = partial_allowed(s);
+    const size_t n_moved = may ? mark_moved(lists, ps, &kept_drift) : ps->n;
+    const int partial = may && n_moved <= ps->n / JD_PARTIAL_LIMIT;
+    if (partial)
+        m = n_moved;
+    else
+        kept_drift = 0.0;
+    for (size_t k = 0; k < m; k++) {
+        const size_t i = partial ? (size_t)lists->moved[k] : k;
+        lists->half_skin[i] = half_skin_of(lists, ps, s->run.scene, s->run.dt, i);
+    }
+    const int sorted = !partial && !s->opt.allpairs && !s->opt.no_sort && ps->n > 1;
     if (sorted && sort_into_cells(s, err, errlen) != 0) return -1;
     const unsigned kind = list_kind(s->run.features);
-    jd_contact_list *nw = &s->lists.spare;
+    jd_contact_list *nw = &lists->spare;
     nw->n = 0;
-    if (sim_list_reserve(nw, s->lists.pairs.n + s->lists.pairs.n / 8 + 1, kind) != 0) {
-        snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", s->lists.pairs.n);
+    if (sim_list_reserve(nw, lists->pairs.n + lists->pairs.n / 8 + 1, kind) != 0) {
+        snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", lists->pairs.n);
         return -1;
     }
     if (s->opt.allpairs) {
-        if (build_pair_list_all(s->particles.n, kind, nw) != 0) {
-            snprintf(err, errlen, "out of memory building the all-pairs list (%zu particles)",
-                     s->particles.n);
+        if (build_pair_list_all(ps->n, kind, nw) != 0) {
+            snprintf(err, errlen, "out of memory building the all-pairs list (%zu particles)", ps->n);
             return -1;
         }
-    } else if (build_pair_list_cells(&s->particles, &s->lists, kind, sorted, s->threads.n, s->step,
-                                     nw, err, errlen) != 0) {
+    } else if (partial ? partial_pair_list(s, m, kept_drift, kind, nw, err, errlen) != 0
+                       : build_pair_list_cells(ps, lists, kind, sorted, s->threads.n, s->step, nw,
+                                               err, errlen) != 0) {
         return -1;
     }
     nw->n_touch = nw->n;
-    carry_over(&s->accounts, &s->lists.pairs, nw);
+    carry_over(&s->accounts, &lists->pairs, nw);
     /* the old list's buffers take the new list, split */
-    if (split_touching(&s->particles, kind, nw, &s->lists.pairs) != 0) {
+    if (split_touching(ps, kind, nw, &lists->pairs) != 0) {
         snprintf(err, errlen, "out of memory building the neighbour list (%zu pairs)", nw->n);
         return -1;
     }
-    list_fit(&s->lists.pairs);
+    list_fit(&lists->pairs);
     list_fit(nw);
 
-    jd_contact_list *wn = &s->lists.wall_spare;
+    jd_contact_list *wn = &lists->wall_spare;
     wn->n = 0;
-    const wall_search ws = {.ps = &s->particles, .walls = &s->walls, .lists = &s->lists,
-                            .allpairs = s->opt.allpairs};
+    const wall_search ws = {.ps = ps, .walls = &s->walls, .lists = lists, .allpairs = s->opt.allpairs};
     if (s->walls.n &&
-        build_in_parts(&s->lists, s->particles.n, s->threads.n, walls_of, &ws, kind, wn) != 0) {
+        (partial ? partial_wall_list(s, m, kind, wn)
+                 : build_in_parts(lists, ps->n, s->threads.n, walls_of, &ws, kind, wn)) != 0) {
         snprintf(err, errlen, "out of memory building the wall candidate list");
         return -1;
     }
     wn->n_touch = wn->n;
-    carry_over(&s->accounts, &s->lists.wall_pairs, wn);
-    const jd_contact_list t = s->lists.wall_pairs;
-    s->lists.wall_pairs = *wn;
+    carry_over(&s->accounts, &lists->wall_pairs, wn);
+    const jd_contact_list t = lists->wall_pairs;
+    lists->wall_pairs = *wn;
     *wn = t;
-    list_fit(&s->lists.wall_pairs);
+    list_fit(&lists->wall_pairs);
     list_fit(wn);
 
-    if (sim_forces_partition(&s->threads, &s->lists, s->particles.n) != 0) {
+    if (sim_forces_partition(&s->threads, lists, ps->n) != 0) {
         snprintf(err, errlen, "out of memory for the force buffers of %d threads", s->threads.n);
         return -1;
     }
-    if (sim_walls_reserve(&s->walls, s->lists.wall_pairs.n, err, errlen) != 0) return -1;
-    memcpy(s->lists.x_build, s->particles.x, 3 * s->particles.n * sizeof *s->particles.x);
-    s->lists.drift_bound = 0.0;
-    for (size_t w = 0; w < s->walls.n; w++) memset(s->walls.wall[w].disp, 0, sizeof s->walls.wall[w].disp);
-    s->lists.n_builds++;
+    if (sim_walls_reserve(&s->walls, lists->wall_pairs.n, err, errlen) != 0) return -1;
+    if (partial) {
+        for (size_t k = 0; k < m; k++) {
+            const size_t i = (size_t)lists->moved[k];
+            memcpy(lists->x_build + 3 * i, ps->x + 3 * i, 3 * sizeof *ps->x);
+        }
+    } else {
+        memcpy(lists->x_build, ps->x, 3 * ps->n * sizeof *ps->x);
+        for (size_t w = 0; w < s->walls.n; w++) memset(s->walls.wall[w].disp, 0, sizeof s->walls.wall[w].disp);
+    }
+    lists->drift_bound = kept_drift;
+    lists->n_built = ps->n;
+    lists->renumbered = 0;
+    lists->n_partial += partial;
+    lists->n_builds++;
     return 0;
 }
 

@@ -134,6 +134,8 @@ static size_t carve(jd_sim *s, size_t n, char *block) {
     s->particles.orig = slice(block, &at, n * sizeof *s->particles.orig);
     s->lists.cell_of = slice(block, &at, n * sizeof *s->lists.cell_of);
     s->lists.cell_items = slice(block, &at, n * sizeof *s->lists.cell_items);
+    s->lists.moved = slice(block, &at, n * sizeof *s->lists.moved);
+    s->lists.in_moved = slice(block, &at, n * sizeof *s->lists.in_moved);
     return at;
 }
 
@@ -301,6 +303,7 @@ void sim_free(jd_sim *s) {
     sim_walls_free(&s->walls);
     sim_mesh_walls_free(s->meshes);
     free(s->lists.cell_start);
+    free(s->lists.keys);
     sim_neighbour_parts_free(&s->lists);
     sim_contact_list_free(&s->lists.pairs);
     sim_contact_list_free(&s->lists.wall_pairs);
@@ -321,13 +324,14 @@ size_t sim_memory_bytes(const jd_sim *s) {
     const size_t per_particle = 6 * 3 * sizeof(double) /* x v omega f torque x_build */ +
                                 sizeof(double) /* half_skin */ +
                                 3 * sizeof(double) /* scratch */ + 7 * sizeof(double) /* constants */ +
-                                4 * sizeof(int32_t) /* species orig cell_of cell_items */;
+                                5 * sizeof(int32_t) /* species orig cell_of cell_items moved */ +
+                                sizeof(uint8_t) /* in_moved */;
     const jd_thread_layout *th = &s->threads;
     const jd_neighbour_lists *l = &s->lists;
     size_t overflow = 0;
     for (int t = 0; th->shares && t < th->n; t++) overflow += 6 * th->shares[t].cap * sizeof(double);
     return s->particles.n * per_particle + overflow + sim_bonds_memory_bytes(s->bonds, s->particles.n) +
-           l->cell_cap * sizeof(int32_t) + list_bytes(&l->pairs) + list_bytes(&l->wall_pairs) +
+           l->cell_cap * sizeof(int32_t) + l->keys_cap * sizeof(int64_t) + list_bytes(&l->pairs) + list_bytes(&l->wall_pairs) +
            list_bytes(&l->spare) + list_bytes(&l->wall_spare) + s->walls.n * sizeof *s->walls.wall +
            s->run.n_materials * s->run.n_materials * sizeof *s->run.coeffs;
 }

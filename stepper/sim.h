@@ -33,7 +33,7 @@
  * sim_compute_forces, sim_neighbour_build with its renumbering, the inlets) take the whole run.
  * docs/architecture.md lists which pass touches which part.
  *
- * Particle order.  At every neighbour rebuild the particles are renumbered in the order of
+ * Particle order.  At every full neighbour build the particles are renumbered in the order of
  * their neighbour cells (reorder.c), so that the particles of one cell, and the neighbours a
  * contact loop visits, lie close in memory.  orig[i] is the scene index (position in the scene,
  * sorted by id) of the particle now at index i; everything the engine shows (frames, watchdog
@@ -281,6 +281,13 @@ typedef struct jd_neighbour_lists {
                            times the largest speed: no particle has moved further (integrate.c,
                            the rebuild check) */
     int64_t n_builds;
+    int64_t n_partial;  /* of them partial: only the pairs of the particles that moved redone */
+    size_t n_built;     /* particles at the last build (those beyond were inserted since) */
+    int renumbered;     /* particles deleted or renumbered since the last build: the next is full */
+    int32_t *moved;     /* a partial build's particles, ascending (n) */
+    uint8_t *in_moved;  /* 1 for the particles in moved (n) */
+    int64_t *keys;      /* a partial build's new entries, (i << 32) | j (keys_cap) */
+    size_t keys_cap;
     int32_t *cell_of, *cell_items, *cell_start; /* cell of each particle, particles by cell, and
                                                    each cell's first item (cell_cap + 1) */
     size_t cell_cap;   /* capacity of cell_start */

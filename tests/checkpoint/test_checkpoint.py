@@ -5,8 +5,9 @@ and rolling, a servo compression, an inlet stream, a bonded beam and an inlet of
 (the checkpoint between two copies' insertions), a bed in a turning meshed drum and spheres
 on a meshed conveyor (the mesh's moved corners, its contact history and candidates), spheres
 leaving the domain (the shrinking set, its bonds and loads), spheres raining onto a bed (each
-particle's half skin); SIGTERM writes a
-checkpoint and exits 143; bad checkpoints are refused with their messages; a failed
+particle's half skin), a sparse rain (the partial builds' reference positions), the inlet
+stream again just before an insertion whose build is full (every half skin renewed); SIGTERM
+writes a checkpoint and exits 143; bad checkpoints are refused with their messages; a failed
 checkpoint write keeps the previous checkpoint and stops the run (exit 3)."""
 import math
 import os
@@ -40,6 +41,11 @@ CASES = [  # scene, case, checkpoint every N steps
     ("tests/engine/scenes/domain_exit.yaml", None, 100),
     # a checkpoint mid-rain, the falling spheres' half skins 4.5 x the bed's
     ("tests/engine/scenes/shower.yaml", None, 1100),
+    # a checkpoint between partial neighbour builds (each particle's reference position)
+    ("tests/engine/scenes/drizzle.yaml", None, 2100),
+    # a checkpoint just before an insertion whose build is full because most particles moved
+    # (step 64000): every half skin renewed, the inserted particle's too
+    ("tests/checkpoint/scenes/inlet_stream.yaml", None, 63162),
 ]
 
 

@@ -59,21 +59,47 @@ c.check("far_particle_sorted_vs_allpairs", np.max(np.abs(fs["position"][-1][orde
 # run, which rebuilds at the same steps; renumbered, to round-off, with the same contacts), and
 # the fast spheres' own skins must spare rebuilds (the same scene with one skin for all,
 # skin_steps: 0, rebuilds at least twice as often).
-rain_run, rain = run("shower", "--no-sort")
-_, rain_all = run("shower", env={"JDEM_NEIGHBOUR": "allpairs"}, binary=JDEM_OPTIMISED)
-ra, rb = load(rain), load(rain_all)
-c.check("shower_verlet_vs_allpairs_bitwise",
-        np.array_equal(ra["position"], rb["position"]) and np.array_equal(ra["velocity"], rb["velocity"]),
-        "positions or velocities differ: a contact was missed by the lists")
-_, rain_sorted = run("shower")
-rs = load(rain_sorted)
-order_s, order_b = np.argsort(rs["id"]), np.argsort(rb["id"])
-dx = np.max(np.abs(rs["position"][:, order_s] - rb["position"][:, order_b])) / np.max(np.abs(rb["position"]))
-c.check("shower_sorted_vs_allpairs", dx <= 1e-12 and np.array_equal(rs["obs"]["contacts"], rb["obs"]["contacts"]),
-        f"the renumbered run's positions differ from the all-pairs run's by {dx:.3g} of the largest, or "
-        "its contact counts differ (the half skins must follow the particles' new numbers)")
+def against_allpairs(name):
+    """The scene's Verlet run (scene order, --timing) bit for bit against the all-pairs run, and
+    its renumbered run to round-off with the same contact counts; (Verlet run, its trajectory)."""
+    verlet_run, verlet = run(name, "--no-sort", "--timing")
+    _, allpairs = run(name, env={"JDEM_NEIGHBOUR": "allpairs"}, binary=JDEM_OPTIMISED)
+    va, vb = load(verlet), load(allpairs)
+    c.check(f"{name}_verlet_vs_allpairs_bitwise",
+            np.array_equal(va["position"], vb["position"]) and np.array_equal(va["velocity"], vb["velocity"]),
+            "positions or velocities differ: a contact was missed by the lists")
+    vs = load(run(name)[1])
+    order_s, order_b = np.argsort(vs["id"]), np.argsort(vb["id"])
+    dx = np.max(np.abs(vs["position"][:, order_s] - vb["position"][:, order_b])) / np.max(np.abs(vb["position"]))
+    c.check(f"{name}_sorted_vs_allpairs", dx <= 1e-12 and np.array_equal(vs["obs"]["contacts"], vb["obs"]["contacts"]),
+            f"the renumbered run's positions differ from the all-pairs run's by {dx:.3g} of the largest, or "
+            "its contact counts differ (the half skins must follow the particles' new numbers)")
+    return verlet_run, va
+
+
+rain_run, ra = against_allpairs("shower")
 c.check("shower_has_impacts", ra["obs"]["contacts"].max() > 200 and ra["obs"]["wall_contacts"].max() > 50,
         f"{ra['obs']['contacts'].max():g} contacts, {ra['obs']['wall_contacts'].max():g} wall contacts at most")
+# Partial builds: a sparse rain onto the bed, so that at most builds fewer than half the spheres
+# have moved and only theirs are searched again (stepper/neighbour.c); the kept entries must
+# still hold every pair that comes into contact.
+drizzle_run, da = against_allpairs("drizzle")
+timing = engines.jdem_timing(drizzle_run.stderr) or {}
+c.check("drizzle_builds_are_mostly_partial",
+        timing.get("partial_builds", 0) > timing.get("builds", 0) / 2 and
+        da["obs"]["contacts"].max() > 50 and da["obs"]["wall_contacts"].max() > 50,
+        f"{timing.get('partial_builds')} partial of {timing.get('builds')} builds, "
+        f"{da['obs']['contacts'].max():g} contacts, {da['obs']['wall_contacts'].max():g} wall contacts "
+        "at most (the scene must exercise the partial path and the walls)")
+
+# A partial build's range for a kept partner: a sphere still behind its reference position turns
+# back towards a moved one; the pair must be in the list (drift_partner.yaml says how).
+drift_run, dr = against_allpairs("drift_partner")
+timing = engines.jdem_timing(drift_run.stderr) or {}
+c.check("drift_partner_contact_after_partial_build",
+        timing.get("partial_builds", 0) >= 1 and dr["obs"]["contacts"].max() == 1,
+        f"{timing.get('partial_builds')} partial builds, {dr['obs']['contacts'].max():g} contacts at most "
+        "(the scene must touch after a partial build)")
 
 
 def builds(stderr):
