@@ -199,7 +199,7 @@ static void share(long n, long *lo, long *hi) {
 }
 
 /* While s->lists.drift_bound is at most this fraction of half the common skin, no particle can
- * have moved its own half skin (never less, neighbour.c set_half_skins) since the last build,
+ * have moved its own half skin (never less, neighbour.c half_skin_of) since the last build,
  * and the passes need not read x_build. */
 #define JD_DRIFT_SAFE 0.5
 

@@ -5,7 +5,7 @@
  * the pairs i < j whose surfaces are closer than the sum of their half skins, and a list of
  * (particle, wall) candidates closer to a wall than the particle's half skin and the wall's
  * (skin/2).  Each particle has a half skin of its own, skin/2 or more for a fast one
- * (set_half_skins).  The lists are rebuilt only when some particle has moved more than its
+ * (half_skin_of).  The lists are rebuilt only when some particle has moved more than its
  * half skin, or some wall more than skin/2, since the last build: then no pair can have closed
  * its gap in between, so no contact is missed.  (The particles' displacement is checked in the
  * drift, integrate.c.)

@@ -273,13 +273,15 @@ typedef struct jd_neighbour_lists {
      * the next: a fresh list would grow from empty, copying and faulting in its pages every build */
     jd_contact_list spare, wall_spare;
     double skin;       /* [m] */
-    double *x_build;   /* positions at the last build, 3n [m] */
-    double *half_skin; /* [m] each particle's half skin, set at every build (neighbour.c,
-                          set_half_skins): skin/2, or more for a fast particle */
-    int64_t skin_steps; /* the scene's neighbour.skin_steps (set_half_skins) */
-    double drift_bound; /* [m] the sum, over the steps since the last neighbour build, of dt
-                           times the largest speed: no particle has moved further (integrate.c,
-                           the rebuild check) */
+    double *x_build;   /* each particle's position at its last search (every build's if full,
+                          only the moved particles' at a partial one), 3n [m] */
+    double *half_skin; /* [m] each particle's half skin, set when it is searched (neighbour.c,
+                          half_skin_of): skin/2, or more for a fast particle */
+    int64_t skin_steps; /* the scene's neighbour.skin_steps (half_skin_of) */
+    double drift_bound; /* [m] the largest distance of a kept particle from x_build at the last
+                           build, plus the sum over the steps since of dt times the largest
+                           speed: no particle is further from its x_build (integrate.c, the
+                           rebuild check) */
     int64_t n_builds;
     int64_t n_partial;  /* of them partial: only the pairs of the particles that moved redone */
     size_t n_built;     /* particles at the last build (those beyond were inserted since) */
