@@ -113,8 +113,17 @@ void sim_contact_list_free(jd_contact_list *l) {
     memset(l, 0, sizeof *l);
 }
 
+/* The entry (i, j) as one number whose order is the lists' order, (i, j) (indices >= 0). */
+static int64_t pair_key(int32_t i, int32_t j) {
+    return ((int64_t)i << 32) | (int64_t)(uint32_t)j;
+}
+
+static int64_t entry_key(const jd_contact_list *l, size_t c) {
+    return pair_key(l->i[c], l->j[c]);
+}
+
 static int key_less(const jd_contact_list *a, size_t p, const jd_contact_list *b, size_t q) {
-    return a->i[p] < b->i[q] || (a->i[p] == b->i[q] && a->j[p] < b->j[q]);
+    return entry_key(a, p) < entry_key(b, q);
 }
 
 /* The dissipation accumulated by entry c (energy bookkeeping only), harvested into the run's
@@ -322,7 +331,8 @@ static int core_box(const jd_particles *ps, double lo[3], double hi[3]) {
 }
 
 /* The cell grid over the particles' bounding box: cell edge h >= the largest interaction
- * range (twice the largest radius + half skin, and `extra` [m]: a partial build's kept drift); over the core box (core_box) instead if the whole box would need more than about 8
+ * range (twice the largest radius + half skin, and `extra` [m]: a partial build's kept
+ * drift); over the core box (core_box) instead if the whole box would need more than about 8
  * cells per particle and the core box would not; the edge grown if even that needs more
  * (sparse or scattered systems).  Fails on a non-finite position or out of memory. */
 static int cell_grid(const jd_particles *ps, const double *hs, double extra, int64_t step,
@@ -632,20 +642,20 @@ static double half_skin_of(const jd_neighbour_lists *lists, const jd_particles *
 #define JD_PARTIAL_LIMIT 2
 #define JD_FULL_BUILD_EVERY 16
 
-/* Whether some wall has moved since the last full build (then a kept wall candidate's margin
- * would not cover the wall's remaining travel: a partial build is not allowed). */
-static int any_wall_moved(const jd_walls *walls) {
+/* Whether some wall has moved further than sqrt(lim2) [m] since the last full build. */
+static int walls_moved_beyond(const jd_walls *walls, double lim2) {
     for (size_t w = 0; w < walls->n; w++)
-        if (jd_dot(walls->wall[w].disp, walls->wall[w].disp) > 0.0) return 1;
+        if (jd_dot(walls->wall[w].disp, walls->wall[w].disp) > lim2) return 1;
     return 0;
 }
 
 /* Whether this build may be partial: nothing renumbered or deleted since the last one, no wall
- * moved since the last full build, no mesh walls (their candidates are searched for every
+ * moved since the last full build (a kept wall candidate's margin covers the wall's travel only
+ * from where it was then), no mesh walls (their candidates are searched for every
  * particle), and not a build due to be full. */
 static int partial_allowed(const jd_sim *s) {
     return s->lists.n_builds % JD_FULL_BUILD_EVERY != 0 && !s->lists.renumbered && !s->meshes &&
-           s->particles.n >= s->lists.n_built && !any_wall_moved(&s->walls);
+           s->particles.n >= s->lists.n_built && !walls_moved_beyond(&s->walls, 0.0);
 }
 
 /* Mark the particles that moved more than JD_MOVED_FRACTION of their half skin since their last
@@ -722,10 +732,6 @@ static int key_cmp(const void *a, const void *b) {
     return (x > y) - (x < y);
 }
 
-static int64_t entry_key(const jd_contact_list *l, size_t c) {
-    return ((int64_t)l->i[c] << 32) | (int64_t)(uint32_t)l->j[c];
-}
-
 /* The parts (run_parts) as sorted keys in lists->keys; their count, or -1 out of memory. */
 static ptrdiff_t sorted_part_keys(jd_neighbour_lists *lists, int threads) {
     size_t total = 0;
@@ -739,7 +745,7 @@ static ptrdiff_t sorted_part_keys(jd_neighbour_lists *lists, int threads) {
     size_t n = 0;
     for (int t = 0; t < threads; t++)
         for (size_t e = 0; e < lists->parts[t].n; e++)
-            lists->keys[n++] = ((int64_t)lists->parts[t].i[e] << 32) | (int64_t)(uint32_t)lists->parts[t].j[e];
+            lists->keys[n++] = pair_key(lists->parts[t].i[e], lists->parts[t].j[e]);
     if (n > 1) qsort(lists->keys, n, sizeof *lists->keys, key_cmp); /* keys is NULL while empty */
     return (ptrdiff_t)n;
 }
@@ -798,12 +804,12 @@ static int partial_pair_list(jd_sim *s, size_t m, double kept_drift, unsigned ki
     return 0;
 }
 
-/* The new wall list (wn, one sorted run) of a partial build. */
-static int partial_wall_list(jd_sim *s, size_t m, unsigned kind, jd_contact_list *wn) {
+/* The new wall list (wn, one sorted run) of a partial build: the moved particles' candidates
+ * searched (ws), the others' kept. */
+static int partial_wall_list(jd_sim *s, const wall_search *ws, size_t m, unsigned kind,
+                             jd_contact_list *wn) {
     jd_neighbour_lists *lists = &s->lists;
-    const moved_walls q = {.ws = {.ps = &s->particles, .walls = &s->walls, .lists = lists,
-                                  .allpairs = s->opt.allpairs},
-                           .moved = lists->moved};
+    const moved_walls q = {.ws = *ws, .moved = lists->moved};
     if (run_parts(lists, m, s->threads.n, walls_of_moved, &q) != 0) return -1;
     const ptrdiff_t nkeys = sorted_part_keys(lists, s->threads.n);
     return nkeys < 0 ? -1 : merge_kept(&lists->wall_pairs, lists->in_moved, 0, lists->keys,
@@ -865,7 +871,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
     wn->n = 0;
     const wall_search ws = {.ps = ps, .walls = &s->walls, .lists = lists, .allpairs = s->opt.allpairs};
     if (s->walls.n &&
-        (partial ? partial_wall_list(s, m, kind, wn)
+        (partial ? partial_wall_list(s, &ws, m, kind, wn)
                  : build_in_parts(lists, ps->n, s->threads.n, walls_of, &ws, kind, wn)) != 0) {
         snprintf(err, errlen, "out of memory building the wall candidate list");
         return -1;
@@ -901,8 +907,5 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
 }
 
 int sim_neighbour_walls_moved(const jd_walls *walls, double skin) {
-    const double lim = 0.25 * skin * skin; /* (skin/2)^2 */
-    for (size_t w = 0; w < walls->n; w++)
-        if (jd_dot(walls->wall[w].disp, walls->wall[w].disp) > lim) return 1;
-    return 0;
+    return walls_moved_beyond(walls, 0.25 * skin * skin); /* (skin/2)^2 */
 }

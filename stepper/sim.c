@@ -331,8 +331,9 @@ size_t sim_memory_bytes(const jd_sim *s) {
     size_t overflow = 0;
     for (int t = 0; th->shares && t < th->n; t++) overflow += 6 * th->shares[t].cap * sizeof(double);
     return s->particles.n * per_particle + overflow + sim_bonds_memory_bytes(s->bonds, s->particles.n) +
-           l->cell_cap * sizeof(int32_t) + l->keys_cap * sizeof(int64_t) + list_bytes(&l->pairs) + list_bytes(&l->wall_pairs) +
-           list_bytes(&l->spare) + list_bytes(&l->wall_spare) + s->walls.n * sizeof *s->walls.wall +
+           l->cell_cap * sizeof(int32_t) + l->keys_cap * sizeof(int64_t) + list_bytes(&l->pairs) +
+           list_bytes(&l->wall_pairs) + list_bytes(&l->spare) + list_bytes(&l->wall_spare) +
+           s->walls.n * sizeof *s->walls.wall +
            s->run.n_materials * s->run.n_materials * sizeof *s->run.coeffs;
 }
 
