@@ -11,8 +11,8 @@ balance and the bond-steps, its pictures (the break map and the snapshot sheet);
 below each obstacle (outflow.py); and when all 9 compressions of the middle clip are done
 (OUT/ENGINE/CASE/cubeK.h5, K = 10..18) Tables 5-4 and 5-5 (E, nu_xy, nu_xz of the orthotropic
 fit on the best-fit particle strain) and the unambiguous M and K0 (report_ch4.cube_result, the
-Ch. 4 analysis); the run times from the campaign's .campaign_times.json.  Then the seed's claims
-that the finished fills decide.  Writes OUT/report.md and OUT/summary.json, and with --results
+Ch. 4 analysis); the run times (CPU, else wall) from the campaign's .campaign_times.json.  Then
+the seed's claims that the finished fills decide.  Writes OUT/report.md and OUT/summary.json, and with --results
 (default reference_runs/mixing/ch5/results for the default OUT) also there; a fill not under OUT
 is taken from the committed summary.json, with the commit it came from.  The seed reports no
 breakage at all (spec §4.3): those columns have no seed value.
@@ -77,12 +77,39 @@ def measure(path, name, out, spent, directory, rev):
     cubes = [os.path.join(out, name, "cube%d.h5" % k) for k in CUBES]
     if all(os.path.exists(c) for c in cubes):
         entry["cubes"] = [cube_result(c) for c in cubes]
-        took = [spent.get("%s/cube%d" % (name, k), {}).get("seconds") for k in CUBES]
-        if all(t is not None for t in took):
-            entry["cube_seconds"] = float(sum(took))
-    if name + "/fill" in spent:
-        entry["seconds"] = spent[name + "/fill"].get("seconds")
+        for key in ("seconds", "cpu_seconds"):
+            took = [spent.get("%s/cube%d" % (name, k), {}).get(key) for k in CUBES]
+            if all(t is not None for t in took):
+                entry["cube_" + key] = float(sum(took))
+    fill = spent.get(name + "/fill", {})
+    for key in ("seconds", "cpu_seconds", "ranks"):
+        if fill.get(key) is not None:
+            entry[key] = fill[key]
     return entry
+
+
+RUN_TIME_NOTE = ("run times are the CPU time of the unit's processes (all ranks), since the wall "
+                 "clock of a shared machine also counts the pauses of the runs beside it; \"w\" marks "
+                 "a wall time, where a unit ran before its CPU time was recorded")
+
+
+def cpu_or_wall(e, prefix=""):
+    """The entry's CPU seconds (prefix "cube_": its 9 compressions'), else its wall seconds, else
+    None; and whether it is the CPU time."""
+    if not e:
+        return None, False
+    if e.get(prefix + "cpu_seconds"):
+        return e[prefix + "cpu_seconds"], True
+    return e.get(prefix + "seconds") or None, False
+
+
+def run_time(e, prefix=""):
+    """A run-time cell: CPU seconds, "N w" for a wall time only, "—" when not timed."""
+    t, cpu = cpu_or_wall(e, prefix)
+    if t is None:
+        return "—"
+    ranks = e.get("ranks", 1) if not prefix else 1
+    return "%.0f" % t + ("" if cpu else " w") + (" (%d ranks)" % ranks if ranks > 1 else "")
 
 
 def collect(out, committed, rev, directory):
@@ -132,7 +159,7 @@ def elastic_tables(found):
                 cols += [elastic_cell(e, key, fmt) for e in es]
             cols.append(" / ".join(elastic_cell(e, "M_wall", "%.0f") for e in es))
             cols.append(" / ".join(elastic_cell(e, "K0", "%.3f") for e in es))
-            cols.append(" / ".join("%.0f" % e["cube_seconds"] if e and e.get("cube_seconds") else "—" for e in es))
+            cols.append(" / ".join(run_time(e, "cube_") for e in es))
             lines.append("| %d | %d | %s |" % (g, m, " | ".join(cols)))
     if len(lines) == 6:
         lines.append("(no case has all 9 compressions yet)")
@@ -211,20 +238,21 @@ def energy_table(found):
     lines = ["### Energy balance and speed of the fills (scripts/mixing/energy.py)", "",
              "largest residual of KE + RE + elastic + gravitational + dissipated (the bonds' stored, "
              "damped and breakage energy included) − wall work − inflow, over the energy in play and "
-             "over the inflow; the stability suite holds 1e-3 of the energy in play", "",
+             "over the inflow; the stability suite holds 1e-3 of the energy in play; bond-steps per "
+             "second of the run time (" + RUN_TIME_NOTE + ")", "",
              "| engine | case | residual / in play | residual / inflow | breakage [J] | inflow [J] "
-             "| bond-steps | run time [s] | bond-steps/s |",
+             "| bond-steps | run time [s] | bond-steps per second |",
              "|---|---|---|---|---|---|---|---|---|"]
     worst = None
     for name, e in sorted(found.items()):
         b = e.get("energy")
         if not b:
             continue
-        rate = e["bond_steps"] / e["seconds"] if e.get("seconds") and e.get("bond_steps") else None
+        took, _ = cpu_or_wall(e)
+        rate = e["bond_steps"] / took if took and e.get("bond_steps") else None
         lines.append("| %s | %s | %.2e | %.2e | %.3g | %.4g | %.3g | %s | %s |" % (
             *name.split("/"), b["residual_in_play"], b["residual_inflow"], b["breakage"], b["inflow"],
-            e.get("bond_steps", 0.0), "%.0f" % e["seconds"] if e.get("seconds") else "—",
-            "%.3g" % rate if rate else "—"))
+            e.get("bond_steps", 0.0), run_time(e), "%.3g" % rate if rate else "—"))
         if worst is None or b["residual_in_play"] > worst[1]:
             worst = (name, b["residual_in_play"])
     if worst:
@@ -259,7 +287,7 @@ def rigid_section(found):
         lines.append("| %s | %s | %s | %s | %s | %s | %s | %s |" % (
             *name.split("/"), cell(e), k.get("formed", "—"), k.get("broken", "—"),
             k.get("fragments", "—"), k.get("whole_blocks", "—"),
-            "%.0f" % e["seconds"] if e.get("seconds") else "—"))
+            run_time(e)))
     if not rigid:
         lines.append("(not run yet: `make mixing-bonded MODEL=rigid_model1`, `MODEL=rigid_model3`)")
     lines += ["", "Final middle clips (the spheres cut by y = 0.5 m):", ""]
@@ -309,13 +337,13 @@ def report(found, rev):
              "(commit %s); a row from an earlier commit names it. docs/mixing.md §11." % rev, "",
              "### Table 5-3: φv at the middle clip (points 10–18 of Table 5-2, y = 0.5 m)", "",
              "trimmed mean ± std (scripts/mixing/stats.py; the seed does not say how it trims); "
-             "ideal φv = 0.0625", "",
+             "ideal φv = 0.0625; " + RUN_TIME_NOTE, "",
              "| group | model | seed | jdem | liggghts-jdem | run time jdem / liggghts-jdem [s] |",
              "|---|---|---|---|---|---|"]
     for g in GROUPS:
         for m in MODELS:
             a, b = (found.get("%s/%s" % (e, case(g, m))) for e in ENGINES)
-            t = " / ".join("%.0f" % x["seconds"] if x and x.get("seconds") else "—" for x in (a, b))
+            t = " / ".join(run_time(x) for x in (a, b))
             lines.append("| %d | %d | %.4f ± %.4f | %s | %s | %s |" % (g, m, *SEED_PHI_V[g][m - 1], cell(a), cell(b), t))
     lines += ["", "### Breakage over the whole fill (the seed reports none, spec §4.3)", "",
               "| engine | case | bonds formed | broken | tension | shear | fragments at the end | whole blocks | single spheres |",

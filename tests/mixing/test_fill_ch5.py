@@ -15,6 +15,7 @@ fill_ch5}.py), on hand-made trajectories whose answers follow in closed form:
 * the report: a bonded fill and a Ch. 6 rigid fill under --out appear in the new tables (the
   worst fill named, the rigid fill's bonds all intact) with the numbers measured above.
 """
+import json
 import math
 import os
 import re
@@ -184,6 +185,11 @@ def test_report(tmp):
     for case, r, residual in (("group2_model3", rec, 0.25), ("rigid_model3", rec_rigid, 0.01)):
         os.makedirs(os.path.join(out, "jdem", case))
         write_fill(os.path.join(out, "jdem", case, "fill.h5"), dep, r, residual)
+    # the campaign's times: the bonded fill with its CPU time, the rigid one timed on the wall only
+    os.makedirs(os.path.join(out, "jdem", "group1_model1"))
+    with open(os.path.join(out, "jdem", "group1_model1", ".campaign_times.json"), "w") as f:
+        json.dump({"jdem/group2_model3/fill": {"seconds": 5000.0, "cpu_seconds": 1200.0, "ranks": 1},
+                   "jdem/rigid_model3/fill": {"seconds": 777.0}}, f)
     run = subprocess.run([sys.executable, "-m", "scripts.mixing.report_ch5", "--out", out],
                          cwd=ROOT, capture_output=True, text=True)
     check("report: runs on a bonded and a rigid fill", run.returncode == 0, run.stderr[-800:])
@@ -195,9 +201,11 @@ def test_report(tmp):
         slope["inclination"], slope["slope_x"]) in text)
     check("report: the worst fill is the bonded one, 0.25 J of its 4 J in play",
           "Worst fill: jdem/group2_model3, 6.25e-02 of the energy in play (**beyond**" in text)
-    check("report: the rigid fill's bonds all intact (3 formed, 0 broken, 2 fragments)",
-          re.search(r"\| jdem \| rigid_model3 \| [^|]+ \| 3 \| 0 \| 2 \| 0 \| — \|", text) is not None)
-    check("report: the bond-steps, 3 x 100", "| 300 |" in text)
+    check("report: the rigid fill's bonds all intact (3 formed, 0 broken, 2 fragments), "
+          "its wall time marked w",
+          re.search(r"\| jdem \| rigid_model3 \| [^|]+ \| 3 \| 0 \| 2 \| 0 \| 777 w \|", text) is not None)
+    check("report: the bond-steps, 3 x 100, per CPU second (300 / 1200 s, not the wall's 5000 s)",
+          "| 300 | 1200 | 0.25 |" in text)
     for png in ("jdem_group2_model3_views.png", "jdem_rigid_model3_clip.png", "jdem_group2_model3_breaks.png"):
         check("report: draws %s" % png, os.path.exists(os.path.join(out, png)) and "(%s)" % png in text)
 
