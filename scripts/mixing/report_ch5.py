@@ -263,6 +263,39 @@ def energy_table(found):
     return lines
 
 
+def hours(seconds):
+    """The sum of a list of seconds in hours, or "—" for none."""
+    return "%.2f" % (sum(seconds) / 3600.0) if seconds else "—"
+
+
+def campaign_time_table(found):
+    """The time of the campaign so far per engine: its finished fills' and compressions' wall and
+    CPU times summed, and the 20 fills projected from the mean fill."""
+    lines = ["### Time of the campaign per engine", "",
+             "the units' wall and CPU times summed over the finished fills and their 9 compressions "
+             "each (the units run one after another on a lane, so the sums are the campaign's time "
+             "on one lane; wall times include any pause, and units timed before the CPU time was "
+             "recorded have a wall time only); the whole campaign's 20 fills projected from the "
+             "mean CPU time per fill", "",
+             "| engine | fills timed | fills' wall [h] | fills' CPU [h] | cube sets timed "
+             "| cubes' wall [h] | cubes' CPU [h] | 20 fills projected [CPU h] |",
+             "|---|---|---|---|---|---|---|---|"]
+    for engine in ENGINES:
+        es = [e for n, e in sorted(found.items()) if n.split("/")[0] == engine]
+        fills = [e for e in es if e.get("seconds")]
+        cubes = [e for e in es if e.get("cube_seconds")]
+        if not fills and not cubes:
+            lines.append("| %s | 0 | — | — | 0 | — | — | — |" % engine)
+            continue
+        cpu = [e["cpu_seconds"] for e in fills if e.get("cpu_seconds")]
+        cube_cpu = [e["cube_cpu_seconds"] for e in cubes if e.get("cube_cpu_seconds")]
+        lines.append("| %s | %d (%d with CPU) | %s | %s | %d (%d with CPU) | %s | %s | %s |" % (
+            engine, len(fills), len(cpu), hours([e["seconds"] for e in fills]), hours(cpu),
+            len(cubes), len(cube_cpu), hours([e["cube_seconds"] for e in cubes]), hours(cube_cpu),
+            "%.1f" % (20 * sum(cpu) / len(cpu) / 3600.0) if cpu else "—"))
+    return lines
+
+
 def surface_claim(engine, m, g1, g3):
     """Strong bonds leave an inclined free surface and more voids near the walls (Group 3 against
     Group 1 of the same model)."""
@@ -377,7 +410,8 @@ def report(found, rev):
         lines += ["", "Where the bonds broke (front view, the obstacles grey):", ""]
         lines += ["![%s](%s)" % m for m in maps]
     lines += [""] + horizon_section()
-    lines += [""] + structure_table(found) + [""] + energy_table(found) + [""] + elastic_tables(found)
+    lines += [""] + structure_table(found) + [""] + energy_table(found) + [""] + campaign_time_table(found)
+    lines += [""] + elastic_tables(found)
     lines += [""] + claims(found)
     lines += [""] + rigid_section(found)
     views = [(n, e["views"]) for n, e in sorted(found.items()) if e.get("views")]

@@ -206,6 +206,8 @@ def test_report(tmp):
           re.search(r"\| jdem \| rigid_model3 \| [^|]+ \| 3 \| 0 \| 2 \| 0 \| 777 w \|", text) is not None)
     check("report: the bond-steps, 3 x 100, per CPU second (300 / 1200 s, not the wall's 5000 s)",
           "| 300 | 1200 | 0.25 |" in text)
+    check("report: the campaign's time, 2 fills (1 with CPU): 5777 s wall, 1200 s CPU, 20 fills 6.7 CPU h",
+          "| jdem | 2 (1 with CPU) | 1.60 | 0.33 | 0 (0 with CPU) | — | — | 6.7 |" in text)
     for png in ("jdem_group2_model3_views.png", "jdem_rigid_model3_clip.png", "jdem_group2_model3_breaks.png"):
         check("report: draws %s" % png, os.path.exists(os.path.join(out, png)) and "(%s)" % png in text)
 
