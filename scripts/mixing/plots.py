@@ -14,6 +14,9 @@ positions in the front view (x-z), tension and shear apart, with the box and the
 mixing_figure: the seed's Fig. 4-11 (pass 1) or 4-12 (pass 2) of one engine from the results of
 report_ch4.py (summary.json): its six panels (a)-(f), phi_v, phi_m, e, n, rho_b and Z, each a
 strip plot over the models with a finished fill of that pass.
+bonded_figure: the seed's Fig. 5-24, 5-25 or 5-26 (Groups 1, 2, 3) of one engine from the fills
+of report_ch5.py: (a) phi_v at the 27 points of Table 5-2 in three segments, y = 0.25, 0.5 and
+0.75 m, and (b) at the 9 points of the middle clip, each a strip plot over the models.
 """
 import os
 
@@ -204,4 +207,62 @@ def write_mixing_figures(results, engines, directory):
             fig.savefig(os.path.join(directory, figure_name(engine, p)))
             plt.close(fig)
             written[(engine, p)] = figure_name(engine, p)
+    return written
+
+
+# Figs 5-24 to 5-26, one per group; the 27 points of Table 5-2 are three rows of 9 at y = 0.25,
+# 0.5 and 0.75 m (points 1-9, 10-18, 19-27), the middle clip the second.
+SEED_BONDED_FIGURE = {1: "5-24", 2: "5-25", 3: "5-26"}
+Y_SEGMENTS = ((0.25, 0, 9), (0.5, 9, 18), (0.75, 18, 27))
+
+
+def bonded_figure_name(engine, group):
+    """File name of the figure of one engine and group, e.g. fig5-24_jdem.png."""
+    return "fig%s_%s.png" % (SEED_BONDED_FIGURE[group], engine)
+
+
+def bonded_figure(found, engine, group):
+    """The open matplotlib figure of Fig. 5-24, 5-25 or 5-26 (group 1, 2, 3) for `engine` from
+    found["ENGINE/groupG_modelM"]["phi_v"] (the 27 points, report_ch5.py), or None when no model
+    of the group has a fill.  The caller saves and closes it."""
+    fills = {}
+    for m in range(1, 7):
+        entry = found.get("%s/group%d_model%d" % (engine, group, m))
+        if entry and entry.get("phi_v"):
+            fills[str(m)] = list(entry["phi_v"])
+    if not fills:
+        return None
+    fig = plt.figure(figsize=(13, 8), dpi=100)
+    grid = fig.add_gridspec(2, 3)
+    first = None
+    for k, (y, lo, hi) in enumerate(Y_SEGMENTS):
+        ax = fig.add_subplot(grid[0, k], sharey=first)
+        first = first or ax
+        draw_strip(ax, {m: v[lo:hi] for m, v in fills.items()}, "φv", IDEAL_PHI_V)
+        ax.set_xlabel("model")
+        ax.set_title("(a) y = %.2f m, points %d–%d" % (y, lo + 1, hi))
+    ax = fig.add_subplot(grid[1, :])
+    draw_strip(ax, {m: v[9:18] for m, v in fills.items()}, "φv", IDEAL_PHI_V)
+    ax.set_xlabel("model")
+    ax.set_title("(b) the middle clip, points 10–18 (Table 5-3)")
+    fig.suptitle("Fig. %s: φv at the points of Table 5-2, Group %d, %s (dots: points; red square: "
+                 "trimmed mean; grey bar: its std; dashed: ideal φv)"
+                 % (SEED_BONDED_FIGURE[group], group, engine), fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def write_bonded_figures(found, engines, directories):
+    """Write every Fig. 5-24/25/26 that has data into each of `directories`; returns {(engine,
+    group): file name}."""
+    written = {}
+    for engine in engines:
+        for group in SEED_BONDED_FIGURE:
+            fig = bonded_figure(found, engine, group)
+            if fig is None:
+                continue
+            for d in directories:
+                fig.savefig(os.path.join(d, bonded_figure_name(engine, group)))
+            plt.close(fig)
+            written[(engine, group)] = bonded_figure_name(engine, group)
     return written

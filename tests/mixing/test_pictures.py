@@ -130,8 +130,47 @@ def test_mixing_figure():
           and os.path.getsize(os.path.join(tmp, "fig4-11_jdem.png")) > 10000, f"{written}")
 
 
+def test_bonded_figure(tmp):
+    """Fig. 5-25 (Group 2) of jdem from Models 1 and 4 (Model 4's point 14, in the middle clip,
+    without small spheres); Group 1 has no fill."""
+    rng = np.random.default_rng(5)
+    found = {"jdem/group2_model4": {"phi_v": [float(v) for v in rng.uniform(0, 0.2, 27)]},
+             "jdem/group2_model1": {"phi_v": [float(v) for v in rng.uniform(0, 0.2, 27)]},
+             "liggghts-jdem/group3_model2": {"phi_v": [float(v) for v in rng.uniform(0, 0.2, 27)]}}
+    found["jdem/group2_model4"]["phi_v"][13] = float("inf")
+    fig = plots.bonded_figure(found, "jdem", 2)
+    axes = fig.axes
+    check("bonded_figure_has_four_panels", len(axes) == 4, f"{len(axes)} axes")
+    # (a) the rows y = 0.25, 0.5, 0.75 (points 1-9, 10-18, 19-27), (b) the middle clip
+    for ax, (lo, hi) in zip(axes, ((0, 9), (9, 18), (18, 27), (9, 18))):
+        ticks = [t.get_text() for t in ax.get_xticklabels()]
+        check(f"bonded_figure_points{lo + 1}_models_in_order", ticks == ["1", "4"], f"{ticks}")
+        for i, m in enumerate(("1", "4")):
+            values = found["jdem/group2_model" + m]["phi_v"][lo:hi]
+            pts = artist(ax, "points " + m)
+            finite = [v for v in values if math.isfinite(v)]
+            check(f"bonded_figure_points{lo + 1}_model{m}", pts is not None
+                  and list(pts.get_ydata()) == finite and set(pts.get_xdata()) == {i},
+                  f"{None if pts is None else list(pts.get_ydata())} vs {finite}")
+            mean, std = trimmed(values)
+            close(f"bonded_figure_points{lo + 1}_model{m}_mean",
+                  float(artist(ax, "mean " + m).get_ydata()[0]), mean, 1e-12)
+            bar = artist(ax, "std " + m).lines[2][0].get_segments()[0]
+            close(f"bonded_figure_points{lo + 1}_model{m}_std", float(bar[1][1]) - float(bar[0][1]),
+                  2 * std, 1e-12)
+        close(f"bonded_figure_points{lo + 1}_ideal", float(artist(ax, "ideal").get_ydata()[0]),
+              0.0625, 1e-15)
+    plots.plt.close(fig)
+    check("bonded_figure_none_without_fills", plots.bonded_figure(found, "jdem", 1) is None)
+    written = plots.write_bonded_figures(found, ("jdem", "liggghts-jdem"), [tmp])
+    check("bonded_figures_written", written == {("jdem", 2): "fig5-25_jdem.png",
+                                                ("liggghts-jdem", 3): "fig5-26_liggghts-jdem.png"}
+          and os.path.getsize(os.path.join(tmp, "fig5-25_jdem.png")) > 10000, f"{written}")
+
+
 tmp = tempfile.mkdtemp()
 test_views(tmp)
 test_strip_plot(tmp)
 test_mixing_figure()
+test_bonded_figure(tmp)
 finish()
