@@ -162,6 +162,33 @@ def strip_plot(values_by_model, path, name="phi_v", ideal=None, title=None):
     return drawn
 
 
+# What the strip panels of a figure show, in its caption.
+STRIP_KEY = "(dots: points; red square: trimmed mean; grey bar: its std; dashed: ideal φv)"
+
+
+def strip_panel(ax, values_by_model, name, ideal, title):
+    """One panel of a figure: the strip plot over the models, titled."""
+    draw_strip(ax, values_by_model, name, ideal)
+    ax.set_xlabel("model")
+    ax.set_title(title)
+
+
+def write_figures(make, name, engines, keys, directories):
+    """Save make(engine, key) (an open figure, or None: no data) as name(engine, key) into each
+    of `directories`, for every engine and key; returns {(engine, key): file name}."""
+    written = {}
+    for engine in engines:
+        for key in keys:
+            fig = make(engine, key)
+            if fig is None:
+                continue
+            for d in directories:
+                fig.savefig(os.path.join(d, name(engine, key)))
+            plt.close(fig)
+            written[(engine, key)] = name(engine, key)
+    return written
+
+
 # The panels (a)-(f) of Figs 4-11 and 4-12: (summary.json key, axis label); the ideal line on phi_v.
 FIGURE_PANELS = (("phi_v", "φv"), ("phi_m", "φm"), ("e", "e"), ("n", "n"),
                  ("rho_b", "ρb [kg/m³]"), ("Z", "Z"))
@@ -185,12 +212,10 @@ def mixing_figure(results, engine, p):
     fig, axes = plt.subplots(2, 3, figsize=(12, 7), dpi=100)
     for ax, letter, (key, label) in zip(axes.flat, "abcdef", FIGURE_PANELS):
         values = {m: [q[key] for q in f["points"]] for m, f in fills.items()}
-        draw_strip(ax, values, label, IDEAL_PHI_V if key == "phi_v" else None)
-        ax.set_xlabel("model")
-        ax.set_title("(%s) %s" % (letter, label))
-    fig.suptitle("Fig. %s: mixing parameters at the 9 points of Table 4-2, %s, pass %d "
-                 "(dots: points; red square: trimmed mean; grey bar: its std; dashed: ideal φv)"
-                 % (SEED_FIGURE[p], engine, p), fontsize=9)
+        strip_panel(ax, values, label, IDEAL_PHI_V if key == "phi_v" else None,
+                    "(%s) %s" % (letter, label))
+    fig.suptitle("Fig. %s: mixing parameters at the 9 points of Table 4-2, %s, pass %d %s"
+                 % (SEED_FIGURE[p], engine, p, STRIP_KEY), fontsize=9)
     fig.tight_layout()
     return fig
 
@@ -198,16 +223,8 @@ def mixing_figure(results, engine, p):
 def write_mixing_figures(results, engines, directory):
     """Write every Fig. 4-11/4-12 that has data into `directory`; returns {(engine, pass): file
     name}."""
-    written = {}
-    for engine in engines:
-        for p in SEED_FIGURE:
-            fig = mixing_figure(results, engine, p)
-            if fig is None:
-                continue
-            fig.savefig(os.path.join(directory, figure_name(engine, p)))
-            plt.close(fig)
-            written[(engine, p)] = figure_name(engine, p)
-    return written
+    return write_figures(lambda e, p: mixing_figure(results, e, p), figure_name, engines,
+                         SEED_FIGURE, [directory])
 
 
 # Figs 5-24 to 5-26, one per group; the 27 points of Table 5-2 are three rows of 9 at y = 0.25,
@@ -238,16 +255,12 @@ def bonded_figure(found, engine, group):
     for k, (y, lo, hi) in enumerate(Y_SEGMENTS):
         ax = fig.add_subplot(grid[0, k], sharey=first)
         first = first or ax
-        draw_strip(ax, {m: v[lo:hi] for m, v in fills.items()}, "φv", IDEAL_PHI_V)
-        ax.set_xlabel("model")
-        ax.set_title("(a) y = %.2f m, points %d–%d" % (y, lo + 1, hi))
-    ax = fig.add_subplot(grid[1, :])
-    draw_strip(ax, {m: v[9:18] for m, v in fills.items()}, "φv", IDEAL_PHI_V)
-    ax.set_xlabel("model")
-    ax.set_title("(b) the middle clip, points 10–18 (Table 5-3)")
-    fig.suptitle("Fig. %s: φv at the points of Table 5-2, Group %d, %s (dots: points; red square: "
-                 "trimmed mean; grey bar: its std; dashed: ideal φv)"
-                 % (SEED_BONDED_FIGURE[group], group, engine), fontsize=9)
+        strip_panel(ax, {m: v[lo:hi] for m, v in fills.items()}, "φv", IDEAL_PHI_V,
+                    "(a) y = %.2f m, points %d–%d" % (y, lo + 1, hi))
+    strip_panel(fig.add_subplot(grid[1, :]), {m: v[9:18] for m, v in fills.items()}, "φv",
+                IDEAL_PHI_V, "(b) the middle clip, points 10–18 (Table 5-3)")
+    fig.suptitle("Fig. %s: φv at the points of Table 5-2, Group %d, %s %s"
+                 % (SEED_BONDED_FIGURE[group], group, engine, STRIP_KEY), fontsize=9)
     fig.tight_layout()
     return fig
 
@@ -255,14 +268,5 @@ def bonded_figure(found, engine, group):
 def write_bonded_figures(found, engines, directories):
     """Write every Fig. 5-24/25/26 that has data into each of `directories`; returns {(engine,
     group): file name}."""
-    written = {}
-    for engine in engines:
-        for group in SEED_BONDED_FIGURE:
-            fig = bonded_figure(found, engine, group)
-            if fig is None:
-                continue
-            for d in directories:
-                fig.savefig(os.path.join(d, bonded_figure_name(engine, group)))
-            plt.close(fig)
-            written[(engine, group)] = bonded_figure_name(engine, group)
-    return written
+    return write_figures(lambda e, g: bonded_figure(found, e, g), bonded_figure_name, engines,
+                         SEED_BONDED_FIGURE, directories)
