@@ -19,10 +19,6 @@ import numpy as np
 from scripts.mixing import breakage, deposit, energy, params, plots, stats, structure
 from scripts.mixing_views import frame_index, scene_geometry
 
-# Table 5-2: points 1-27, y = 0.25 (1-9), 0.5 (10-18, the middle clip), 0.75 (19-27)
-POINTS_TABLE_5_2 = np.array([[x, y, z] for y in (0.25, 0.5, 0.75) for z in (0.2, 0.3, 0.4)
-                             for x in (0.25, 0.5, 0.75)])
-MIDDLE_CLIP = slice(9, 18)
 SNAPSHOTS = (1.0, 3.0, 9.0)   # [s] the seed's snapshot times (Figs 5-5 to 5-22), then the end
 BLOCK = 32                    # spheres in a whole 2 x 2 x 8 block (spec §4.1)
 # fragment sizes (spheres) counted over time: single spheres, pieces, half blocks, whole blocks
@@ -61,9 +57,9 @@ def result(path):
     """The fill's measures (summary.json's entry); "_breaks" and "_rec" are for the pictures."""
     dep = deposit.read_frame(path)
     box, _, _ = scene_geometry(path)
-    phi = [float(p["phi_v"]) for p in params.at_points(dep, POINTS_TABLE_5_2)]
+    phi = [float(p["phi_v"]) for p in params.at_points(dep, params.POINTS_TABLE_5_2)]
     out = {"particles": int(len(dep.radius)), "time": dep.time, "phi_v": phi,
-           "middle_clip": stats.summary(phi[MIDDLE_CLIP]),
+           "middle_clip": stats.summary(phi[params.MIDDLE_CLIP]),
            "surface": structure.free_surface(dep, *box), "packing": structure.packing(dep, *box),
            "energy": energy.balance(path), "bond_steps": bond_steps(path),
            "built_by": deposit.built_by(path)}

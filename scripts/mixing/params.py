@@ -15,6 +15,13 @@ from .lens import lens_volume
 # Table 4-2: the nine measuring points (x, y, z) [m]; spheres r = 0.1 m, cubes 0.2 m.
 POINTS_TABLE_4_2 = np.array([[x, 0.5, z] for z in (0.2, 0.5, 0.7) for x in (0.25, 0.5, 0.75)])
 MEASURING_RADIUS = 0.1
+# Table 5-2: the 27 points of Ch. 5, three rows of 9 at y = 0.25, 0.5 and 0.75 m (points 1-9,
+# 10-18, 19-27), each row's z = 0.2, 0.3, 0.4 m by x = 0.25, 0.5, 0.75 m; the middle row is the
+# seed's middle clip (Table 5-3, the compression cubes' centres).
+TABLE_5_2_ROWS = ((0.25, slice(0, 9)), (0.5, slice(9, 18)), (0.75, slice(18, 27)))
+POINTS_TABLE_5_2 = np.array([[x, y, z] for y, _ in TABLE_5_2_ROWS for z in (0.2, 0.3, 0.4)
+                             for x in (0.25, 0.5, 0.75)])
+MIDDLE_CLIP = TABLE_5_2_ROWS[1][1]
 IDEAL_PHI_V = 4 * 0.03 ** 3 / (512 * 0.015 ** 3)  # 0.0625
 
 

@@ -29,7 +29,7 @@ from matplotlib.collections import EllipseCollection  # noqa: E402
 from matplotlib.patches import Circle, Rectangle  # noqa: E402
 
 from . import stats  # noqa: E402
-from .params import IDEAL_PHI_V, big_mask  # noqa: E402
+from .params import IDEAL_PHI_V, MIDDLE_CLIP, TABLE_5_2_ROWS, big_mask  # noqa: E402
 
 BIG_COLOUR, SMALL_COLOUR = "#d62728", "#1f4fb4"
 VIEWS = {"front": (0, 2, 1), "side": (1, 2, 0)}  # (horizontal axis, vertical axis, depth axis)
@@ -227,10 +227,8 @@ def write_mixing_figures(results, engines, directory):
                          SEED_FIGURE, [directory])
 
 
-# Figs 5-24 to 5-26, one per group; the 27 points of Table 5-2 are three rows of 9 at y = 0.25,
-# 0.5 and 0.75 m (points 1-9, 10-18, 19-27), the middle clip the second.
+# Figs 5-24 to 5-26, one per group.
 SEED_BONDED_FIGURE = {1: "5-24", 2: "5-25", 3: "5-26"}
-Y_SEGMENTS = ((0.25, 0, 9), (0.5, 9, 18), (0.75, 18, 27))
 
 
 def bonded_figure_name(engine, group):
@@ -252,13 +250,14 @@ def bonded_figure(found, engine, group):
     fig = plt.figure(figsize=(13, 8), dpi=100)
     grid = fig.add_gridspec(2, 3)
     first = None
-    for k, (y, lo, hi) in enumerate(Y_SEGMENTS):
+    for k, (y, row) in enumerate(TABLE_5_2_ROWS):
         ax = fig.add_subplot(grid[0, k], sharey=first)
         first = first or ax
-        strip_panel(ax, {m: v[lo:hi] for m, v in fills.items()}, "φv", IDEAL_PHI_V,
-                    "(a) y = %.2f m, points %d–%d" % (y, lo + 1, hi))
-    strip_panel(fig.add_subplot(grid[1, :]), {m: v[9:18] for m, v in fills.items()}, "φv",
-                IDEAL_PHI_V, "(b) the middle clip, points 10–18 (Table 5-3)")
+        strip_panel(ax, {m: v[row] for m, v in fills.items()}, "φv", IDEAL_PHI_V,
+                    "(a) y = %.2f m, points %d–%d" % (y, row.start + 1, row.stop))
+    strip_panel(fig.add_subplot(grid[1, :]), {m: v[MIDDLE_CLIP] for m, v in fills.items()}, "φv",
+                IDEAL_PHI_V, "(b) the middle clip, points %d–%d (Table 5-3)"
+                % (MIDDLE_CLIP.start + 1, MIDDLE_CLIP.stop))
     fig.suptitle("Fig. %s: φv at the points of Table 5-2, Group %d, %s %s"
                  % (SEED_BONDED_FIGURE[group], group, engine, STRIP_KEY), fontsize=9)
     fig.tight_layout()

@@ -17,18 +17,17 @@ import os
 import subprocess
 import sys
 
-import numpy as np
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
-from scripts.mixing import cube_scene, deposit
+from scripts.mixing import cube_scene, deposit, params
 
 MODELS = os.path.join(HERE, "models.yaml")
 SERVO_TARGET = 5000.0     # [TEXT] spec §2.4: sigma_zz = 5 kPa
-# Table 5-2's middle clip, points 10-18 (scripts/mixing/report_ch5.py's POINTS_TABLE_5_2[9:18])
-MIDDLE_CLIP = np.array([[x, 0.5, z] for z in (0.2, 0.3, 0.4) for x in (0.25, 0.5, 0.75)])
-FIRST_POINT = 10
+# Table 5-2's middle clip, points 10-18 (scripts/mixing/params.py)
+MIDDLE_CLIP = params.POINTS_TABLE_5_2[params.MIDDLE_CLIP]
+FIRST_POINT = params.MIDDLE_CLIP.start + 1
 
 
 def case_scene(case):
