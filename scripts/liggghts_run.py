@@ -182,6 +182,7 @@ def write_deck(a, text, deck_dir, out, resume=None):
                            *(["--resume", resume] if resume else []),
                            *(["--processors", *a.processors] if a.processors else []),
                            *(["--skin", repr(a.skin)] if a.skin is not None else []),
+                           *(["--sort-every", str(a.sort_every)] if a.sort_every else []),
                            *(["--inlet-record", os.path.abspath(a.inlet_record)] if a.inlet_record else []))
     if r.returncode != 0:
         say("deck generation failed (exit %d):\n%s" % (r.returncode, r.stderr))
@@ -343,6 +344,8 @@ def main():
     ap.add_argument("--force", action="store_true", help="run even if the time step is unsafe")
     ap.add_argument("--skin", type=float, metavar="F",
                     help="the neighbour skin over the largest radius (scene_to_liggghts.py --skin)")
+    ap.add_argument("--sort-every", type=int, default=0, metavar="N",
+                    help="LIGGGHTS sorts the atoms every N steps (scene_to_liggghts.py --sort-every)")
     ap.add_argument("--checkpoint-every", type=int, default=0, metavar="N",
                     help="write a restart file every N steps (restart.STEP in the deck directory)")
     ap.add_argument("--resume", action="store_true",

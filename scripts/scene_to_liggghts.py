@@ -20,6 +20,8 @@ no particle reaches an edge, a rim or the far side.  A material with E < 5e6 Pa 
 `soft_particles yes` (LIGGGHTS' own models refuse it in SI units otherwise).
 
 --skin F sets LIGGGHTS' neighbour skin to F times the largest radius (default 0.2, jdem's skin).
+--sort-every N lets LIGGGHTS sort the atoms in space every N steps (default 0: never, which keeps
+the standalone engine's pair order); with --restart-every M, N must divide M.
 
 Inlets (the resolved scene's `inlets:`) become one `fix jdem/inlet` each, with the section in
 `inlet_NAME.txt` beside the deck; --inlet-record FILE makes them write the insertion record of
@@ -483,14 +485,22 @@ def progress_lines(inlet_fixes):
 # often and runs a Chapter 4 fill faster at 0.5 (--skin; docs/performance.md).
 SKIN_FACTOR = 0.2
 
+# LIGGGHTS' spatial sort of the atoms, every N steps (0: none, the standalone engine's pair order).
+# On a large deposit it shortens LIGGGHTS' neighbour builds and pair loop by a quarter
+# (docs/performance.md "LIGGGHTS' atom sorting on a deposit"); a run continued from a restart
+# file stays bit for bit only if the sorts fall on the restart steps (N divides their cadence).
+SORT_EVERY = 0
+
 
 def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=False, particles=None,
-               inlet_record=None, restart=None, processors=None, skin_factor=SKIN_FACTOR):
+               inlet_record=None, restart=None, processors=None, skin_factor=SKIN_FACTOR,
+               sort_every=SORT_EVERY):
     """The deck of SCENE.  PARTICLES: its particles, gathered by a ParticleStream while
     resolved_stream.read_resolved read the scene; None: SCENE["particles"] is their list.
     RESTART: None, or a Restart (restart files every N steps; the deck continuing from one).
     PROCESSORS: None, or the rank grid [PX, PY, PZ] (strings: counts or '*').  SKIN_FACTOR: the
-    neighbour skin in units of the largest radius."""
+    neighbour skin in units of the largest radius.  SORT_EVERY: LIGGGHTS' atom sort every N
+    steps (0: none)."""
     deck_dir = os.path.dirname(os.path.abspath(deck_path))
     os.makedirs(deck_dir, exist_ok=True)
     if particles is None:
@@ -503,7 +513,7 @@ def write_deck(scene, resolved_path, deck_path, traj_path, builtin=False, force=
             raise
     try:
         write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
-                         inlet_record, restart or Restart(), processors, skin_factor)
+                         inlet_record, restart or Restart(), processors, skin_factor, sort_every)
     finally:
         particles.remove()
 
@@ -527,7 +537,7 @@ def restart_lines(restart):
 
 
 def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
-                     inlet_record, restart, processors, skin_factor):
+                     inlet_record, restart, processors, skin_factor, sort_every):
     mats = scene["materials"]
     names = list(mats.keys())
     ntypes = len(names)
@@ -581,7 +591,7 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
     if min(prop(n, "youngs_modulus") for n in elastic) < 5e6:  # LIGGGHTS' own SI range (--builtin)
         L.append("soft_particles  yes\n")
     L.append("atom_style      granular\n")
-    L.append("atom_modify     map array sort 0 0.0\n")
+    L.append("atom_modify     map array sort %d 0.0\n" % sort_every)   # bin: half the neighbour cutoff
     L.append("newton          off\n")
     skin = skin_factor * rmax
     blines, ghost_cut = bond_lines(scene, tid, deck_dir, particles, skin) if not builtin else ([], None)
@@ -719,7 +729,16 @@ def main():
     ap.add_argument("--skin", type=float, default=SKIN_FACTOR, metavar="F",
                     help="the neighbour skin in units of the largest radius (default %s, jdem's)"
                     % SKIN_FACTOR)
+    ap.add_argument("--sort-every", type=int, default=SORT_EVERY, metavar="N",
+                    help="LIGGGHTS sorts the atoms in space every N steps (default 0: never, the "
+                    "standalone engine's pair order); N must divide --restart-every")
     a = ap.parse_args()
+    if a.sort_every < 0:
+        fail("--sort-every %d: valid: 0 (no sorting) or a positive number of steps" % a.sort_every)
+    if a.sort_every and a.restart_every > 0 and a.restart_every % a.sort_every:
+        fail("--sort-every %d does not divide --restart-every %d: a run continued from a restart file "
+             "would not be the uninterrupted run; valid: a divisor of %d" % (a.sort_every, a.restart_every,
+                                                                             a.restart_every))
     if not (math.isfinite(a.skin) and a.skin > 0):
         fail("--skin %s: valid: a positive number (the skin over the largest radius)" % a.skin)
     for c in a.processors or []:
@@ -748,7 +767,7 @@ def main():
         if "*" not in pattern:
             fail("--restart-pattern %r: the name needs a '*' for the step" % pattern)
         write_deck(scene, resolved_copy, a.output, a.trajectory, a.builtin, a.force, particles, a.inlet_record,
-                   Restart(a.restart_every, pattern, a.resume), a.processors, a.skin)
+                   Restart(a.restart_every, pattern, a.resume), a.processors, a.skin, a.sort_every)
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
         fail("%s: cannot read the resolved scene: %s" % (source, e))
     except (KeyError, TypeError, ValueError, AttributeError, IndexError, RecursionError, OverflowError) as e:

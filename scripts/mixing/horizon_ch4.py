@@ -59,7 +59,7 @@ def run_engines(scene, directory, force):
     runs = {}
     for engine in plan_ch4.ENGINES:
         out = os.path.join(directory, "fill.%s.h5" % engine)
-        cmd = plan_ch4.run_command(engine, scene, out, force, skin=None)   # jdem's lists
+        cmd = plan_ch4.run_command(engine, scene, out, force, skin=None, sort_every=0)  # jdem's lists, order
         r, times = engines.cpu_timed_run(cmd)
         if r.returncode == WATCHDOG_STOP and os.path.exists(out + ".part"):
             times["stopped"] = next((line.strip() for line in r.stderr.splitlines()

@@ -148,7 +148,7 @@ def realisation(a):
     scene, _ = write_scene(a.case, a.end_time, a.frame_every, os.path.join(directory, "fill.yaml"),
                            a.jitter)
     out = os.path.join(directory, "fill.%s.h5" % a.engine)
-    cmd = plan_ch4.run_command(a.engine, scene, out, False, skin=None)   # jdem's lists
+    cmd = plan_ch4.run_command(a.engine, scene, out, False, skin=None, sort_every=0)  # jdem's lists, order
     r, times = engines.cpu_timed_run(cmd)
     if r.returncode != 0:
         raise engines.failure(cmd, r.returncode, r.stdout, r.stderr)

@@ -62,6 +62,9 @@ LIGGGHTS_SKIN = 0.5      # liggghts-jdem's neighbour skin over R_max in the fill
                           # jdem's per-particle skins LIGGGHTS rebuilds its lists every 6 steps at
                           # jdem's 0.2 and runs a fill 20 % faster at 0.5 (docs/performance.md);
                           # the horizons keep 0.2, the lists of jdem
+LIGGGHTS_SORT_EVERY = 1000   # [steps] liggghts-jdem's spatial sort of the atoms in the fills and cubes:
+                             # a quarter off a pass-2 fill's loop (docs/performance.md); a divisor of
+                             # RESTART_STEPS (bit-for-bit continuations); the horizons keep jdem's order
 HORIZON_TIME, HORIZON_FRAME_TIME = 4.0, 0.02      # [s] the cross-engine horizon's fill and frames
 HORIZON_COST = 3.3        # both engines: liggghts-jdem takes 2.3 x jdem's CPU (47 s and 106 s, model1, 4 s)
 
@@ -221,14 +224,16 @@ def fill_ranks(engine, ranks):
     return ranks if engine == "liggghts-jdem" else 1
 
 
-def run_command(engine, scene, out, force, ranks=1, skin=LIGGGHTS_SKIN):
+def run_command(engine, scene, out, force, ranks=1, skin=LIGGGHTS_SKIN, sort_every=LIGGGHTS_SORT_EVERY):
     """argv running `scene` (a path or a "{...}" placeholder) into `out`; liggghts-jdem on
-    `ranks` MPI ranks with the neighbour skin `skin` R_max (None: the deck generator's, jdem's)."""
+    `ranks` MPI ranks with the neighbour skin `skin` R_max (None: the deck generator's, jdem's)
+    and its atoms sorted every `sort_every` steps (0: never, jdem's pair order)."""
     extra = ["--force"] if force else []
     if engine == "jdem":
         return [jdem(), "run", scene, "-o", out, *extra]   # its progress line shows in the log
     return [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), scene, "-o", out, *extra,
-            *(["--skin", repr(skin)] if skin is not None else []), *rank_args(ranks)]
+            *(["--skin", repr(skin)] if skin is not None else []),
+            *(["--sort-every", str(sort_every)] if sort_every else []), *rank_args(ranks)]
 
 
 def resumable(engine):

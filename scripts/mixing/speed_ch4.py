@@ -9,7 +9,9 @@ them: `jdem-energy`, output.energy: true), by liggghts-jdem (our law and walls, 
 ranks, and by LIGGGHTS' own hertz/history pair and primitive walls (the deck generator's
 --builtin mode) with our inlet on 1 and 2 ranks, at jdem's neighbour skin (0.2 R_max) and at
 0.5 R_max (`liggghts-skin0.5`), where LIGGGHTS runs the fill faster (liggghts-jdem runs at the
-campaign's, plan_ch4.LIGGGHTS_SKIN); the ratio to stock LIGGGHTS takes its faster skin.
+campaign's, plan_ch4.LIGGGHTS_SKIN); the ratio to stock LIGGGHTS takes its faster skin.  Every
+LIGGGHTS configuration sorts its atoms every 1000 steps, LIGGGHTS' default and the campaign's
+(plan_ch4.LIGGGHTS_SORT_EVERY).
 --only ENGINE,... times a subset.  The engines are run in turn, so they see the
 same spell of the shared machine, in ROUNDS rounds, every other one in the reverse order, so that
 no engine always runs first or last in a spell; the report gives each configuration's median and
@@ -30,7 +32,7 @@ import subprocess
 import yaml
 
 from scripts import engines
-from scripts.mixing.plan_ch4 import LIGGGHTS_SKIN
+from scripts.mixing.plan_ch4 import LIGGGHTS_SKIN, LIGGGHTS_SORT_EVERY
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "generate.py")
@@ -64,7 +66,8 @@ def run_liggghts(resolved, d, engine, ranks):
     engines.write_deck(resolved, deck, "--force", "--trajectory",   # every run: never a stale deck
                        os.path.join(d, f"{engine}.h5"),
                        *(["--builtin"] if engine in STOCK else []),
-                       *(["--skin", repr(SKIN[engine])] if SKIN[engine] is not None else []), check=True)
+                       *(["--skin", repr(SKIN[engine])] if SKIN[engine] is not None else []),
+                       "--sort-every", str(LIGGGHTS_SORT_EVERY), check=True)
     log = f"log.{ranks}"
     engines.run_deck(deck_dir, ranks=ranks, log=log, mpi_flags=("--bind-to", "none"), check=True)
     text = open(os.path.join(deck_dir, log), errors="replace").read()

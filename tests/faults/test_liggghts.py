@@ -415,12 +415,38 @@ def skin(c, d):
                 and not os.path.exists(deck), repr(r))
 
 
+def sort_every(c, d):
+    """--sort-every N: LIGGGHTS sorts the atoms every N steps (default: never, the standalone
+    engine's pair order); N < 0, or N not dividing --restart-every (a continued run would not be
+    the uninterrupted one), is refused with exit 2 and no deck."""
+    res = os.path.join(d, "resolved.yaml")
+    with open(res, "w") as f:
+        f.write(resolved_text(resting(d)))
+    for label, extra, want in (("default", [], "atom_modify     map array sort 0 0.0"),
+                               ("every_500", ["--sort-every", "500", "--restart-every", "2000"],
+                                "atom_modify     map array sort 500 0.0")):
+        deck = os.path.join(d, label, "in.jdem")
+        r = run([PY, GEN, res, "-o", deck, "--trajectory", os.path.join(d, "o.h5"), *extra])
+        text = open(deck).read() if os.path.exists(deck) else ""
+        c.check("sort_" + label, r.rc == 0 and want in text, "%r; want %r" % (r, want))
+    for label, extra, msg in (
+            ("negative", ["--sort-every", "-1"], "--sort-every -1: valid: 0 (no sorting) or a positive number of steps"),
+            ("not_a_divisor", ["--sort-every", "300", "--restart-every", "2000"],
+             "--sort-every 300 does not divide --restart-every 2000: a run continued from a restart file "
+             "would not be the uninterrupted run; valid: a divisor of 2000")):
+        deck = os.path.join(d, "bad_" + label, "in.jdem")
+        r = run([PY, GEN, res, "-o", deck, "--trajectory", os.path.join(d, "o.h5"), *extra])
+        c.check("sort_refused_" + label, r.rc == EXIT["input"] and msg in r.err and not os.path.exists(deck),
+                repr(r))
+
+
 def main():
     c = Checks()
     d = scratch("jdem_faults_liggghts_")
     for name, case in (("injection", injection), ("paths", paths), ("concurrent", concurrent),
                        ("typo", typo_keeps_result), ("watchdog", watchdog_class), ("sigterm", sigterm), ("rank_errors", rank_errors),
-                       ("bad_files", bad_files), ("setup_watchdog", setup_watchdog), ("skin", skin)):
+                       ("bad_files", bad_files), ("setup_watchdog", setup_watchdog), ("skin", skin),
+                       ("sort_every", sort_every)):
         sub = os.path.join(d, name)
         os.makedirs(sub)
         case(c, sub)

@@ -19,6 +19,9 @@ and a big sphere, falling onto a floor where bonds break); the deck is the gener
 * restart: the run killed (SIGKILL) once its LIGGGHTS restart file of step 9000 exists, and
   continued from the file of step 8000 (after the first breaks) with scripts/liggghts_run.py --resume equals the uninterrupted
   run with the same restart cadence bit for bit (every dataset but /h5md), on 1 and 2 ranks;
+* sorting: with LIGGGHTS sorting the atoms every 500 steps (--sort-every, as the campaigns'
+  fills), the bonds travel with their atoms: on 1 rank the bonds, breaks and states are again
+  jdem's, and on 2 ranks the continued run is again the uninterrupted one bit for bit;
 * energy: both engines write the inflow (observables/inlet_energy) alike (1e-12), and in each the
   balance, with the bonds' elastic, damping and breakage energy booked, closes to 1e-3 of the
   inflow (the time discretisation of the floor impacts; some breakage energy is booked);
@@ -126,8 +129,8 @@ def check_breakage_records(c, path, who):
             not wrong and end["broken"] > 0, "differ at steps %s" % wrong[:5])
 
 
-def compare(c, jd, lg, ranks, scales):
-    tag = "%d rank(s)" % ranks
+def compare(c, jd, lg, ranks, scales, tag=None):
+    tag = tag or "%d rank(s)" % ranks
     c.check("bonds: the same 120 bonds, formation steps and types as jdem (%s)" % tag,
             len(jd["bonds"]) == 120 and all(np.array_equal(jd[k], lg[k]) for k in ("bonds", "formed", "type")),
             "jdem %d bonds, liggghts-jdem %d" % (len(jd["bonds"]), len(lg["bonds"])))
@@ -144,17 +147,21 @@ def compare(c, jd, lg, ranks, scales):
 
 
 RESTART_EVERY, KILL_AFTER = 1000, 9000   # it continues from step 8000, after the first breaks (7184)
+SORT = ["--sort-every", "500"]
 
 
-def check_restart(c, tmp, ranks):
+def check_restart(c, tmp, ranks, *extra):
+    """EXTRA: more runner options (SORT), named in the checks and the files."""
     runner = [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), SCENE, "--np", str(ranks),
-              "--checkpoint-every", str(RESTART_EVERY)]
-    ref = os.path.join(tmp, "restart_ref_np%d.h5" % ranks)
+              "--checkpoint-every", str(RESTART_EVERY), *extra]
+    tag = "%d rank(s)%s" % (ranks, ", sorted every %s steps" % extra[-1] if extra else "")
+    name = "np%d%s" % (ranks, "_sorted" if extra else "")
+    ref = os.path.join(tmp, "restart_ref_%s.h5" % name)
     r = subprocess.run(runner + ["-o", ref], capture_output=True, text=True)
-    if not c.check("restart: the uninterrupted run with restart files (%d rank(s))" % ranks, r.returncode == 0,
+    if not c.check("restart: the uninterrupted run with restart files (%s)" % tag, r.returncode == 0,
                    r.stderr[-800:]):
         return
-    out = os.path.join(tmp, "restart_cont_np%d.h5" % ranks)
+    out = os.path.join(tmp, "restart_cont_%s.h5" % name)
     deck = out[:-3] + ".deck"
     proc = subprocess.Popen(runner + ["-o", out], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                             start_new_session=True)
@@ -164,7 +171,7 @@ def check_restart(c, tmp, ranks):
     subprocess.run(["pkill", "-KILL", "-s", str(proc.pid)])
     rc = proc.wait()
     r = subprocess.run(runner + ["-o", out, "--resume"], capture_output=True, text=True)
-    if not c.check("restart: killed after step %d (exit %s), continued from step %d (%d rank(s))" % (KILL_AFTER, rc, KILL_AFTER - RESTART_EVERY, ranks),
+    if not c.check("restart: killed after step %d (exit %s), continued from step %d (%s)" % (KILL_AFTER, rc, KILL_AFTER - RESTART_EVERY, tag),
                    rc == -signal.SIGKILL and r.returncode == 0 and
                    "--resume: continuing from %s/restart.%d" % (deck, KILL_AFTER - RESTART_EVERY) in r.stderr,
                    r.stderr[-800:]):
@@ -172,7 +179,7 @@ def check_restart(c, tmp, ranks):
     a, b = datasets(ref), datasets(out)
     differ = sorted(n for n in a if n not in b or not same_bits(a[n], b[n]))
     c.check("restart: the continued run equals the uninterrupted one bit for bit (%d datasets, bonds "
-            "and breaks included; %d rank(s))" % (len(a), ranks),
+            "and breaks included; %s)" % (len(a), tag),
             not differ and sorted(a) == sorted(b) and "connectivity/broken_bonds" in a, differ[:8])
 
 
@@ -275,8 +282,13 @@ def main():
             check_energy(c, jd_h5, lg_h5, ranks)
             if ranks == 2:
                 check_breakage_records(c, lg_h5, "liggghts-jdem on 2 ranks")
+        lg_h5 = os.path.join(tmp, "lig_sorted.h5")
+        rc, log = run_liggghts(SCENE, lg_h5, 1, *SORT)
+        if c.check("liggghts-jdem runs the deck sorting its atoms every %s steps" % SORT[-1], rc == 0, log[-1500:]):
+            compare(c, jd, read(lg_h5), 1, scales, "1 rank, sorted every %s steps" % SORT[-1])
         for ranks in (1, 2):
             check_restart(c, tmp, ranks)
+        check_restart(c, tmp, 2, *SORT)
         check_guard(c, tmp)
         check_bad_sections(c, tmp)
         check_rigid(c, tmp)

@@ -16,6 +16,10 @@ of its trajectory but /h5md (the file's author and creator), on 1 and 2 MPI rank
   stopped  the runner sent SIGTERM once that file exists: LIGGGHTS stops at its next step and
            keeps OUT.h5.part with a last frame after the restart file's step, which the
            continued trajectory must leave out.
+  sorted   as killed, with LIGGGHTS sorting the atoms in space every 1000 steps (--sort-every,
+           a divisor of the cadence): the sorts fall on the restart steps, so the continued
+           run is again the uninterrupted one (which must differ from the unsorted run: the
+           sums' order changed).
 Also: a completed run leaves no restart file; a --resume after the scene changed starts from
 the beginning and says so; --resume without --checkpoint-every is refused (exit 2).
 Prints one PASS/FAIL line per check; exit 1 if any fails.
@@ -38,6 +42,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 SCENE = os.path.join(ROOT, "tests", "checkpoint", "scenes", "inlet_stream.yaml")
 RUNNER = [sys.executable, os.path.join(ROOT, "scripts", "liggghts_run.py")]
 EVERY, KILL_AFTER = 6000, 60000
+SORT = ["--sort-every", "1000"]
 
 checks = Checks()
 check = checks.check
@@ -52,11 +57,11 @@ def restart_steps(deck_dir):
     return sorted(int(n.split(".")[1]) for n in names if n.startswith("restart.") and n.split(".")[1].isdigit())
 
 
-def interrupted(out, np_, how):
+def interrupted(out, np_, how, *extra):
     """The run into OUT, interrupted (`kill`: SIGKILL to the runner and everything it started;
     `term`: SIGTERM to the runner) once the restart file of step KILL_AFTER exists."""
     deck = out[:-3] + ".deck"
-    proc = subprocess.Popen(runner(SCENE, out, np_), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    proc = subprocess.Popen(runner(SCENE, out, np_, *extra), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                             start_new_session=True)
     deadline = time.time() + 300
     while proc.poll() is None and time.time() < deadline and max(restart_steps(deck) or [0]) < KILL_AFTER:
@@ -85,6 +90,13 @@ def same_bits(a, b):
     return np.array_equal(a, b)
 
 
+def positions_equal(a, b):
+    """Whether the two trajectories' particle positions are the same bits in every frame."""
+    pa, pb = datasets(a), datasets(b)
+    names = [n for n in pa if n.endswith("position/value") and n.startswith("particles")]
+    return bool(names) and all(n in pb and same_bits(pa[n], pb[n]) for n in names)
+
+
 def same_trajectory(name, ref, cont):
     if not check(name + "_complete", os.path.exists(cont), "no %s" % cont):
         return
@@ -96,15 +108,15 @@ def same_trajectory(name, ref, cont):
           "%d datasets compared, differing: %s" % (len(a), differ[:8]))
 
 
-def continued(tmp, np_, how, ref):
-    name = "%s_np%d" % (how, np_)
+def continued(tmp, np_, how, ref, *extra):
+    name = "%s_np%d" % (how if not extra else "sorted", np_)
     out = os.path.join(tmp, name + ".h5")
-    rc, steps = interrupted(out, np_, how)
+    rc, steps = interrupted(out, np_, how, *extra)
     want = -signal.SIGKILL if how == "kill" else 128 + signal.SIGTERM
     if not check(name + "_was_interrupted", rc == want and len(steps) >= 2 and not os.path.exists(out),
                  "exit %s (want %s), restart files at steps %s" % (rc, want, steps)):
         return
-    r = subprocess.run(runner(SCENE, out, np_, "--resume"), capture_output=True, text=True)
+    r = subprocess.run(runner(SCENE, out, np_, "--resume", *extra), capture_output=True, text=True)
     expect = "--resume: continuing from %s/restart.%d" % (out[:-3] + ".deck", steps[-2])
     check(name + "_continues_from_the_older_file", r.returncode == 0 and expect in r.stderr,
           "exit %d, want %r in:\n%s" % (r.returncode, expect, r.stderr[-1500:]))
@@ -150,6 +162,12 @@ def main():
                   "left: %s" % restart_steps(ref[:-3] + ".deck"))
             for how in ("kill", "term"):
                 continued(tmp, np_, how, ref)
+            sorted_ref = os.path.join(tmp, "ref_sorted_np%d.h5" % np_)
+            r = subprocess.run(runner(SCENE, sorted_ref, np_, *SORT), capture_output=True, text=True)
+            if check("reference_sorted_np%d_runs" % np_, r.returncode == 0, r.stderr[-1500:]):
+                check("sorted_np%d_differs_from_unsorted" % np_, not positions_equal(ref, sorted_ref),
+                      "the sorted run is the unsorted one bit for bit: did LIGGGHTS sort?")
+                continued(tmp, np_, "kill", sorted_ref, *SORT)
         changed_scene(tmp)
     finally:
         if args.keep:

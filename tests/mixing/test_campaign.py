@@ -357,6 +357,9 @@ def test_ch4_ranks():
     check("ch4_liggghts_skin", "--skin 0.5" in lig and "--skin" not in jd
           and "--skin" in cube and cube[cube.index("--skin") + 1] == "0.5",
           f"liggghts-jdem: {lig}; jdem: {jd}; cube: {cube}")
+    check("ch4_liggghts_sort", "--sort-every 1000 " in lig and "--checkpoint-every 2000" in lig
+          and "--sort-every" not in jd and cube[cube.index("--sort-every") + 1] == "1000",
+          f"liggghts-jdem: {lig}; jdem: {jd}; cube: {cube}")
     r = subprocess.run([sys.executable, CAMPAIGN, os.path.join(ROOT, "scripts", "mixing", "plan_ch4.py"),
                         "--unit", "liggghts-jdem/model1/fill1", "--list", "--", "--ranks", "2"],
                        capture_output=True, text=True)
