@@ -538,6 +538,11 @@ def restart_lines(restart):
 
 def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_path, builtin, force,
                      inlet_record, restart, processors, skin_factor, sort_every):
+    # before any file: a deck whose continuations could not be bit for bit is refused whole
+    if sort_every and restart.every > 0 and restart.every % sort_every:
+        fail("--sort-every %d does not divide --restart-every %d: a run continued from a restart file "
+             "would not be the uninterrupted run; valid: a divisor of %d" % (sort_every, restart.every,
+                                                                             restart.every))
     mats = scene["materials"]
     names = list(mats.keys())
     ntypes = len(names)
@@ -735,10 +740,6 @@ def main():
     a = ap.parse_args()
     if a.sort_every < 0:
         fail("--sort-every %d: valid: 0 (no sorting) or a positive number of steps" % a.sort_every)
-    if a.sort_every and a.restart_every > 0 and a.restart_every % a.sort_every:
-        fail("--sort-every %d does not divide --restart-every %d: a run continued from a restart file "
-             "would not be the uninterrupted run; valid: a divisor of %d" % (a.sort_every, a.restart_every,
-                                                                             a.restart_every))
     if not (math.isfinite(a.skin) and a.skin > 0):
         fail("--skin %s: valid: a positive number (the skin over the largest radius)" % a.skin)
     for c in a.processors or []:

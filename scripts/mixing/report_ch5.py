@@ -272,14 +272,15 @@ def hours(seconds):
 def campaign_time_table(found):
     """The time of the campaign so far per engine: its finished fills' and compressions' wall and
     CPU times summed, and the campaign's fills projected from the mean fill."""
+    n_fills = len(CASES + RIGID_CASES)
     lines = ["### Time of the campaign per engine", "",
              "the units' wall and CPU times summed over the finished fills and their 9 compressions "
              "each (the units run one after another on a lane, so the sums are the campaign's time "
              "on one lane; wall times include any pause, and units timed before the CPU time was "
              "recorded have a wall time only); the whole campaign's %d fills projected from the "
-             "mean CPU time per fill" % len(CASES + RIGID_CASES), "",
+             "mean CPU time per fill" % n_fills, "",
              "| engine | fills timed | fills' wall [h] | fills' CPU [h] | cube sets timed "
-             "| cubes' wall [h] | cubes' CPU [h] | %d fills projected [CPU h] |" % len(CASES + RIGID_CASES),
+             "| cubes' wall [h] | cubes' CPU [h] | %d fills projected [CPU h] |" % n_fills,
              "|---|---|---|---|---|---|---|---|"]
     for engine in ENGINES:
         es = [e for n, e in sorted(found.items()) if n.split("/")[0] == engine]
@@ -293,7 +294,7 @@ def campaign_time_table(found):
         lines.append("| %s | %d (%d with CPU) | %s | %s | %d (%d with CPU) | %s | %s | %s |" % (
             engine, len(fills), len(cpu), hours([e["seconds"] for e in fills]), hours(cpu),
             len(cubes), len(cube_cpu), hours([e["cube_seconds"] for e in cubes]), hours(cube_cpu),
-            "%.1f" % (len(CASES + RIGID_CASES) * sum(cpu) / len(cpu) / 3600.0) if cpu else "—"))
+            "%.1f" % (n_fills * sum(cpu) / len(cpu) / 3600.0) if cpu else "—"))
     return lines
 
 
