@@ -142,6 +142,10 @@ build/plugin/%.o: %.cpp
 	$(CXX) $(PLUGIN_CXXFLAGS) $(DEPFLAGS) -c $< -o $@
 # The bond loop, as in the stepper (build/obj/stepper/bonds.o; docs/performance.md).
 build/plugin/liggghts_plugin/fix_bond_jiang.o: PLUGIN_CXXFLAGS += -fno-tree-slp-vectorize
+# The pair style's SIMD lanes (pair_gran_jiang_lanes.h): sqrt as the instruction alone, as in the
+# stepper (OMPFLAGS), or the lane loop keeps a libm call per lane and is not vectorised.  The same
+# bits (sqrt is correctly rounded either way); the pair style never reads errno.
+build/plugin/liggghts_plugin/pair_gran_jiang.o: PLUGIN_CXXFLAGS += -fno-math-errno
 build/liggghts-jdem: $(patsubst %.cpp,build/plugin/%.o,$(PLUGIN_SRC)) \
                      $(patsubst %.c,build/pic/%.o,$(KERNEL_SRC) $(IO_SRC))
 	$(CXX) $^ -o $@ -lliggghts $(PKG_LIBS) -ldl

@@ -23,6 +23,7 @@
 #include "fix_jdem_inlet.h"
 #include "fix_wall_jiang.h"
 #include "jdem_dispatch.h"
+#include "pair_gran_jiang_lanes.h"
 #include "jdem_laws.h"
 #include "jdem_history.h"
 #include "jdem_observables.h"
@@ -243,53 +244,72 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
   if (eflag || vflag) ev_setup(eflag, vflag);
   else evflag = vflag_fdotr = 0;
 
+  const unsigned laws = jd_law_set_of_loop(F, features_); /* with the run-time laws */
+  /* LIGGGHTS evaluates forces without advancing the history at set-up (shearupdate 0) and for
+   * compute pair/gran/local (computeflag 0): evaluate on a copy then. */
+  const bool commit = shearupdate_ != 0;
+  const bool apply = computeflag_ != 0;
+  const bool report = addflag && cpl();
+  LoopSums sums;
+  overlap_trip = JdOverlapTrip();
+  if (laws == F && commit && apply && !report) lane_loop<F>(sums);
+  else plain_loop<F>(laws, commit, apply, report, sums);
+
+  if (commit) {
+    e_damp_cum += sums.e_damp;
+    e_fric_cum += sums.e_fric;
+  }
+  e_elastic_now = sums.e_el;
+  contacts_now = sums.ncontacts;
+}
+
+/* Atom i's neighbours and their contact histories and touch flags (LIGGGHTS' lists). */
+PairGranJiang::NeighbourRow PairGranJiang::row_of(int i) const {
+  NeighbourRow r;
+  r.j = list->firstneigh[i];
+  r.n = list->numneigh[i];
+  r.touch = listgranhistory->firstneigh[i];
+  r.hist = listgranhistory->firstdouble[i];
+  return r;
+}
+
+/* A pair whose spheres no longer touch: our semantics reset its history now (the dissipation
+ * was harvested while it touched). */
+void PairGranJiang::forget_contact(int *touch, double *hist) const {
+  if (!*touch) return;
+  *touch = 0;
+  const int slen = state_len();
+  for (int k = 0; k < slen; k++) hist[k] = 0.0;
+}
+
+/* One pair at a time: LIGGGHTS' set-up evaluation, compute pair/gran/local and run-time laws. */
+template <unsigned F>
+void PairGranJiang::plain_loop(unsigned laws, bool commit, bool apply, bool report, LoopSums &sums) {
   double **x = atom->x, **v = atom->v, **f = atom->f;
   double **omega = atom->omega, **torque = atom->torque;
   const double *radius = atom->radius, *rmass = atom->rmass;
   const int *type = atom->type;
   const int nlocal = atom->nlocal;
-  const int inum = list->inum;
-  const int *ilist = list->ilist, *numneigh = list->numneigh;
-  int **firstneigh = list->firstneigh;
-  int **firsttouch = listgranhistory->firstneigh;
-  double **firsthist = listgranhistory->firstdouble;
-  const int dn = dnum();
-  const int slen = state_len(), roll_at = rolling_at();
+  const int dn = dnum(), roll_at = rolling_at();
   const double dt_run = update->dt;
-  /* LIGGGHTS evaluates forces without advancing the history at set-up (shearupdate 0) and for
-   * compute pair/gran/local (computeflag 0): evaluate on a copy then. */
-  const bool commit = shearupdate_ != 0;
-  const bool apply = computeflag_ != 0;
-
-  double e_damp = 0.0, e_fric = 0.0, e_el = 0.0, ncontacts = 0.0;
   const int *tag = atom->tag;
-  overlap_trip = JdOverlapTrip();
-
   const double *kp = pair_prefactors();
-  const unsigned laws = jd_law_set_of_loop(F, features_); /* with the run-time laws */
 
-  for (int ii = 0; ii < inum; ii++) {
-    const int i = ilist[ii];
-    const int *jlist = firstneigh[i];
-    const int jnum = numneigh[i];
-    int *touch = firsttouch[i];
-    double *allhist = firsthist[i];
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    const NeighbourRow row = row_of(i);
     const double Ri = radius[i], mi = rmass[i];
     const jd_pair_coeffs *coeffs_i = &coeffs_[type[i] * (ntypes_ + 1)];
     /* overlaps at most overlap_limit x R_i and x R_j are never excessive: skips the exact test
      * (jd_overlap_excessive, a libm fmin call) for almost every contact */
     const double olim_i = overlap_limit * Ri;
 
-    for (int jj = 0; jj < jnum; jj++) {
-      const int j = jlist[jj] & NEIGHMASK;
-      double *hist = &allhist[dn * jj];
+    for (int jj = 0; jj < row.n; jj++) {
+      const int j = row.j[jj] & NEIGHMASK;
+      double *hist = &row.hist[dn * jj];
       jd_contact_geom g;
       if (!jd_geom_spheres(x[i], Ri, x[j], radius[j], &g)) {
-        /* separated: our semantics reset the history now (the dissipation was harvested) */
-        if (commit && touch[jj]) {
-          touch[jj] = 0;
-          for (int k = 0; k < slen; k++) hist[k] = 0.0;
-        }
+        if (commit) forget_contact(&row.touch[jj], hist);
         continue;
       }
       const double Rj = radius[j], mj = rmass[j];
@@ -310,13 +330,13 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
       /* a pair with a ghost partner is evaluated on both ranks: count it half on each */
       const double w = j < nlocal ? 1.0 : 0.5;
       if (F & JD_F_ENERGY) {
-        jd_contact_harvest(h.st, w, &e_damp, &e_fric);
-        if (carries) e_el += w * jd_contact_elastic_energy(h.st);
+        jd_contact_harvest(h.st, w, &sums.e_damp, &sums.e_fric);
+        if (carries) sums.e_el += w * jd_contact_elastic_energy(h.st);
       }
-      if (carries) ncontacts += w;
-      touch[jj] = 1; /* keep the history across neighbour rebuilds while overlapping */
+      if (carries) sums.ncontacts += w;
+      row.touch[jj] = 1; /* keep the history across neighbour rebuilds while overlapping */
       h.finish();
-      if (addflag && cpl()) report_pair(i, j, carries, out, hist);
+      if (report) report_pair(i, j, carries, out, hist);
       if (!carries || !apply) continue;
 
       jd_sub3(f[i], out.f);
@@ -330,13 +350,124 @@ void PairGranJiang::loop(int eflag, int vflag, int addflag) {
                      x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]);
     }
   }
+}
 
-  if (commit) {
-    e_damp_cum += e_damp;
-    e_fric_cum += e_fric;
+/* A time step in SIMD lanes (pair_gran_jiang_lanes.h): the pairs that pass LIGGGHTS' sphere
+ * test are queued with copies of their inputs, evaluated JdPairLanes::N at a time, and applied
+ * in queue order. */
+template <unsigned F>
+void PairGranJiang::lane_loop(LoopSums &sums) {
+  double **x = atom->x, **v = atom->v;
+  double **omega = atom->omega;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  const int *type = atom->type;
+  const int dn = dnum(), roll_at = rolling_at();
+  const double dt_run = update->dt;
+  const double *kp = pair_prefactors();
+  typedef JdPairLanes<F> Lanes;
+  Lanes lanes;
+  lanes.n = 0;
+
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    const NeighbourRow row = row_of(i);
+    const double *xi = x[i];
+    const double Ri = radius[i];
+    const jd_pair_coeffs *coeffs_i = &coeffs_[type[i] * (ntypes_ + 1)];
+
+    for (int jj = 0; jj < row.n; jj++) {
+      const int j = row.j[jj] & NEIGHMASK;
+      double *hist = &row.hist[dn * jj];
+      /* LIGGGHTS' test, as jd_geom_spheres_contact writes it */
+      const double dx[3] = {x[j][0] - xi[0], x[j][1] - xi[1], x[j][2] - xi[2]};
+      const double rsq = jd_dot(dx, dx), radsum = Ri + radius[j];
+      if (rsq >= radsum * radsum) {
+        forget_contact(&row.touch[jj], hist);
+        continue;
+      }
+      const int b = lanes.n++;
+      lanes.i[b] = i;
+      lanes.j[b] = j;
+      lanes.hist[b] = hist;
+      lanes.touch[b] = &row.touch[jj];
+      for (int d = 0; d < 3; d++) {
+        lanes.dx[d][b] = dx[d];
+        lanes.va[d][b] = v[i][d];
+        lanes.wa[d][b] = omega[i][d];
+        lanes.vb[d][b] = v[j][d];
+        lanes.wb[d][b] = omega[j][d];
+      }
+      lanes.rsq[b] = rsq;
+      lanes.ri[b] = Ri;
+      lanes.rj[b] = radius[j];
+      lanes.kpi[b] = kp[i];
+      lanes.kpj[b] = kp[j];
+      lanes.mi[b] = rmass[i];
+      lanes.mj[b] = rmass[j];
+      const jd_pair_coeffs &co = coeffs_i[type[j]];
+      lanes.gamma[b] = co.gamma;
+      lanes.mu[b] = co.mu;
+      lanes.eta[b] = co.eta;
+      lanes.mu_r[b] = co.mu_r;
+      lanes.xi_limit[b] = co.xi_limit;
+      for (int q = 0; q < Lanes::HW; q++) lanes.rec[q][b] = hist[q];
+      for (int q = 0; q < Lanes::RW; q++) lanes.roll[q][b] = hist[roll_at + q];
+      if (lanes.n == Lanes::N) {
+        jd_pair_lanes_evaluate<F>(lanes, dt_run);
+        apply_lanes<F>(lanes, sums);
+        lanes.n = 0;
+      }
+    }
   }
-  e_elastic_now = e_el;
-  contacts_now = ncontacts;
+  jd_pair_lanes_evaluate<F>(lanes, dt_run);
+  apply_lanes<F>(lanes, sums);
+}
+
+/* The evaluated lanes in queue order, each as the plain loop applies one pair: the overlap
+ * check, the history, the energy sums, the touch flag, the forces and torques, the virial. */
+template <unsigned F>
+void PairGranJiang::apply_lanes(JdPairLanes<F> &L, LoopSums &sums) {
+  typedef JdPairLanes<F> Lanes;
+  double **x = atom->x, **f = atom->f, **torque = atom->torque;
+  const int nlocal = atom->nlocal;
+  const int *tag = atom->tag;
+  const int roll_at = rolling_at();
+  for (int b = 0; b < L.n; b++) {
+    const int i = L.i[b], j = L.j[b];
+    double *hist = L.hist[b];
+    if (!L.contact[b]) { /* jd_geom_spheres's verdict after the sphere test: separated */
+      forget_contact(L.touch[b], hist);
+      continue;
+    }
+    const double Ri = L.ri[b], Rj = L.rj[b], delta = L.delta[b];
+    if ((delta > overlap_limit * Ri || delta > overlap_limit * Rj) &&
+        jd_overlap_excessive(delta, Ri, Rj, overlap_limit))
+      overlap_trip.note(delta, std::fmin(Ri, Rj), tag[i], tag[j], NULL);
+    for (int q = 0; q < Lanes::HW; q++) hist[q] = L.rec[q][b];
+    for (int q = 0; q < Lanes::RW; q++) hist[roll_at + q] = L.roll[q][b];
+    const int carries = L.carries[b];
+    const double w = j < nlocal ? 1.0 : 0.5;
+    if (F & JD_F_ENERGY) { /* the record is the whole jd_contact_state (jdem_history.h) */
+      jd_contact_state *st = reinterpret_cast<jd_contact_state *>(hist);
+      jd_contact_harvest(st, w, &sums.e_damp, &sums.e_fric);
+      if (carries) sums.e_el += w * jd_contact_elastic_energy(st);
+    }
+    if (carries) sums.ncontacts += w;
+    *L.touch[b] = 1;
+    if (!carries) continue;
+    const double fb[3] = {L.f[0][b], L.f[1][b], L.f[2][b]};
+    const double ta[3] = {L.ta[0][b], L.ta[1][b], L.ta[2][b]};
+    const double tb[3] = {L.tb[0][b], L.tb[1][b], L.tb[2][b]};
+    jd_sub3(f[i], fb);
+    jd_add3(torque[i], ta);
+    if (j < nlocal) {
+      jd_add3(f[j], fb);
+      jd_add3(torque[j], tb);
+    }
+    if (evflag)
+      ev_tally_xyz(i, j, nlocal, 0, 0.0, 0.0, -fb[0], -fb[1], -fb[2], x[i][0] - x[j][0],
+                   x[i][1] - x[j][1], x[i][2] - x[j][2]);
+  }
 }
 
 /* compute pair/gran/local: a row for every pair whose spheres overlap (the rows it counts), with

@@ -26,6 +26,7 @@
 
 #include "jdem_dispatch.h"
 #include "jdem_history.h"
+#include "pair_gran_jiang_lanes.h"
 #include "jdem_overlap.h"
 
 namespace LAMMPS_NS {
@@ -85,7 +86,28 @@ class PairGranJiang : public PairGran {
 
  protected:
   virtual void compute_force(int eflag, int vflag, int addflag);
-  template <unsigned F> JD_SPECIALISED void loop(int eflag, int vflag, int addflag);
+  template <unsigned F> void loop(int eflag, int vflag, int addflag);
+
+ private:
+  /* The sums of one force evaluation (this rank's share: pairs with a ghost partner count 1/2). */
+  struct LoopSums {
+    double e_damp, e_fric, e_el, ncontacts;
+    LoopSums() : e_damp(0.0), e_fric(0.0), e_el(0.0), ncontacts(0.0) {}
+  };
+  template <unsigned F>
+  JD_SPECIALISED void plain_loop(unsigned laws, bool commit, bool apply, bool report, LoopSums &sums);
+  template <unsigned F> JD_SPECIALISED void lane_loop(LoopSums &sums);
+  template <unsigned F> void apply_lanes(JdPairLanes<F> &lanes, LoopSums &sums);
+  /* atom i's row of LIGGGHTS' lists: its neighbours, their histories (dnum() doubles each) and
+   * touch flags */
+  struct NeighbourRow {
+    const int *j;
+    int n;
+    int *touch;
+    double *hist;
+  };
+  NeighbourRow row_of(int i) const;
+  void forget_contact(int *touch, double *hist) const;
 
  private:
   void register_history();

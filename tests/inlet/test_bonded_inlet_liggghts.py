@@ -51,7 +51,7 @@ from scripts import engines
 from scripts.engines import JDEM, LIGGGHTS_JDEM, ROOT
 from scripts.mixing import breakage
 from tests.engine.engine_common import Checks
-from tests.liggghts.check_runner_resume import datasets, restart_steps, same_bits
+from tests.liggghts.check_runner_resume import datasets, kill_session, restart_steps, same_bits
 
 SCENE = os.path.join(ROOT, "tests", "inlet", "bonded_section.yaml")
 PY = "/usr/bin/python3"
@@ -168,8 +168,7 @@ def check_restart(c, tmp, ranks, *extra):
     deadline = time.time() + 300
     while proc.poll() is None and time.time() < deadline and max(restart_steps(deck) or [0]) < KILL_AFTER:
         time.sleep(0.001)
-    subprocess.run(["pkill", "-KILL", "-s", str(proc.pid)])
-    rc = proc.wait()
+    rc = kill_session(proc)
     r = subprocess.run(runner + ["-o", out, "--resume"], capture_output=True, text=True)
     if not c.check("restart: killed after step %d (exit %s), continued from step %d (%s)" % (KILL_AFTER, rc, KILL_AFTER - RESTART_EVERY, tag),
                    rc == -signal.SIGKILL and r.returncode == 0 and

@@ -57,6 +57,32 @@ def restart_steps(deck_dir):
     return sorted(int(n.split(".")[1]) for n in names if n.startswith("restart.") and n.split(".")[1].isdigit())
 
 
+def kill_session(proc):
+    """SIGKILL to every process of the session of PROC (started with start_new_session), then
+    PROC's exit status once no process of that session is left: the runner passes its deck lock
+    on to LIGGGHTS, which holds it until it has exited, and a SIGKILLed rank of a loaded machine
+    can outlive the runner by a moment (a resume started then is refused)."""
+    subprocess.run(["pkill", "-KILL", "-s", str(proc.pid)])
+    rc = proc.wait()
+    deadline = time.time() + 60
+    while session_alive(proc.pid) and time.time() < deadline:
+        time.sleep(0.01)
+    return rc
+
+
+def session_alive(sid):
+    """Whether a process of session SID is still running (zombies, which hold no files, aside)."""
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open("/proc/%s/stat" % pid) as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[3]) == sid and fields[0] != "Z":
+            return True
+    return False
+
+
 def interrupted(out, np_, how, *extra):
     """The run into OUT, interrupted (`kill`: SIGKILL to the runner and everything it started;
     `term`: SIGTERM to the runner) once the restart file of step KILL_AFTER exists."""
@@ -70,9 +96,8 @@ def interrupted(out, np_, how, *extra):
         # the runner was started in a session of its own, and everything it started is in it:
         # LIGGGHTS or mpirun (in a process group of its own) and Open MPI's ranks (each in one
         # of its own), so a kill of the session leaves no rank running on
-        subprocess.run(["pkill", "-KILL", "-s", str(proc.pid)])
-    else:
-        os.kill(proc.pid, signal.SIGTERM)
+        return kill_session(proc), restart_steps(deck)
+    os.kill(proc.pid, signal.SIGTERM)
     return proc.wait(), restart_steps(deck)
 
 
