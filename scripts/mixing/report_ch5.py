@@ -261,6 +261,9 @@ def energy_table(found):
             worst[0], worst[1], "within" if worst[1] <= 1e-3 else "**beyond**")]
     else:
         lines.append("(no fill measured since the balance was added)")
+    lines += ["", "liggghts-jdem's fills keep no energy accounts (scripts/mixing/plan_ch5.py, "
+              "NO_ENERGY_FILLS: the same trajectory bit for bit, 1.57x faster): the balance is "
+              "jdem's (docs/mixing.md §11)."]
     return lines
 
 

@@ -367,6 +367,29 @@ def test_ch4_ranks():
           r.stdout.split()[1:2] == ["liggghts-jdem/model1/fill1"], r.stdout + r.stderr)
 
 
+def test_ch5_fill_scenes():
+    """Chapter 5: liggghts-jdem's fills run the case without energy accounts (generate.py fill
+    --no-energy), jdem's the case itself; the written scene is the case, resolved by the engine,
+    in every line but output.energy."""
+    from scripts.mixing import plan_ch5
+    plan = {u.name: u for u in plan_ch5.units([])}
+    lig, jd = plan["liggghts-jdem/group2_model4/fill"].command[2], plan["jdem/group2_model4/fill"].command[2]
+    check("ch5_fill_scene_commands", "generate.py fill --case group2_model4 --no-energy" in lig
+          and " resolve " in jd and "--no-energy" not in jd, f"liggghts-jdem: {lig}; jdem: {jd}")
+    jdem = os.path.join(ROOT, "build", "jdem")
+    with tempfile.TemporaryDirectory() as d:
+        scene = os.path.join(d, "fill.yaml")
+        r = subprocess.run([sys.executable, plan_ch5.GENERATE, "fill", "--case", "group2_model4",
+                            "--no-energy", "-o", scene], capture_output=True, text=True,
+                           env=dict(os.environ, PYTHONPATH=ROOT))
+        got = subprocess.run([jdem, "resolve", scene], capture_output=True, text=True).stdout
+        case = subprocess.run([jdem, "resolve", plan_ch5.SCENE, "--case", "group2_model4"],
+                              capture_output=True, text=True).stdout
+    differ = [(a, b) for a, b in zip(case.splitlines(), got.splitlines()) if a != b]
+    check("ch5_fill_scene_no_energy", r.returncode == 0 and len(got.splitlines()) == len(case.splitlines())
+          and differ == [("  energy: true", "  energy: false")], r.stderr + repr(differ[:3]))
+
+
 test_validation_and_selection()
 test_committed_results()
 test_not_yet_runnable()
@@ -376,4 +399,5 @@ test_ch4_dt_variants()
 test_ch4_ranks()
 test_ch4_plan()
 test_ch4_fill_resumes()
+test_ch5_fill_scenes()
 finish()

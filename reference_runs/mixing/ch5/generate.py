@@ -1,8 +1,13 @@
 #!/usr/bin/python3
-"""generate.py — the Chapter 5 compression cubes, cut from a bonded fill's deposit (docs/mixing.md
-§11); every scene runs in both engines.
+"""generate.py — the Chapter 5 fills without energy accounts, and the compression cubes cut from a
+bonded fill's deposit (docs/mixing.md §11); every scene runs in both engines.
 
+    generate.py fill --case groupG_modelM --no-energy -o FILL.yaml
     generate.py cubes DEPOSIT.h5 --case groupG_modelM -o DIR   (writes DIR/cubeK.yaml, K = 10..18)
+
+`fill --no-energy` writes the resolved case with output.energy: false, the scene liggghts-jdem's
+fills run: the same trajectory bit for bit as with the accounts (suite cross-engine, the
+energy-off checks), at a contact history of 7 doubles instead of 23 (docs/mixing.md §11).
 
 A 0.2 m cube at each middle-clip point (points 10-18 of Table 5-2, y = 0.5 m) under a servo top
 wall at sigma_zz = 5 kPa [TEXT] +- 1 % [RECON] (the seed states no tolerance), with Table 5-1's
@@ -39,6 +44,13 @@ def case_scene(case):
     return yaml.load(r.stdout, Loader=yaml.CSafeLoader)
 
 
+def fill(args):
+    doc = case_scene(args.case)
+    doc["output"]["energy"] = False
+    cube_scene.write(args.out, doc, "reference_runs/mixing/ch5/generate.py",
+                     f"the fill of {args.case} without energy accounts")
+
+
 def cubes(args):
     dep = deposit.read_frame(args.deposit)
     base = case_scene(args.case)
@@ -58,6 +70,12 @@ def cubes(args):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="what", required=True)
+    f = sub.add_parser("fill")
+    f.add_argument("--case", required=True)
+    f.add_argument("--no-energy", action="store_true", required=True,
+                   help="output.energy: false (the only variant: with the accounts, jdem resolve "
+                   "writes the case)")
+    f.add_argument("-o", "--out", required=True)
     p = sub.add_parser("cubes")
     p.add_argument("deposit")
     p.add_argument("--case", required=True)
@@ -65,6 +83,8 @@ def main():
     p.add_argument("--scene-dir", help="the folder the scenes will be read from, against which "
                    "their deposit path is relative (default: --out)")
     args = ap.parse_args()
+    if args.what == "fill":
+        return fill(args)
     try:
         cubes(args)
     except deposit.DepositError as e:
