@@ -7,7 +7,7 @@
  *    (JD_CONTACT_STATE_LEN), then the whole jd_rolling_state when rolling is on;
  *  - without them (energy no): only what the laws carry from one step to the next, xi[3] and
  *    flags (JD_CONTACT_LAWS_LEN), then theta[3] with rolling (JD_ROLLING_LAWS_LEN): 4 or 7
- *    doubles instead of 11 or 17.  LIGGGHTS' fix contacthistory copies the history of every
+ *    doubles instead of 17 or 23.  LIGGGHTS' fix contacthistory copies the history of every
  *    neighbour pair at each neighbour build and the pair loop streams all of it every step, so
  *    the shorter record is less memory traffic (docs/liggghts.md, "Cost").
  * jd_contact() reads and writes the energy fields only under JD_F_ENERGY (jd_contact_separate

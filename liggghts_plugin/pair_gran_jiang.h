@@ -6,7 +6,7 @@
  *                         [energy yes|no] [tangential_stiffness jiang2021|mindlin]
  *   pair_coeff * *
  *
- * energy no: the contact history keeps no energy accounts (4 doubles per contact instead of 11,
+ * energy no: the contact history keeps no energy accounts (4 doubles per contact instead of 17,
  * jdem_history.h); then no dump h5md/jdem or fix jdem/watchdog may ask for the energies (their
  * own keyword `energy no` / `energy off`), or init stops with a message naming them.
  *

@@ -57,7 +57,8 @@ struct JdPairLanes {
 
 /* The lanes [0, L.n): geometry and law on the queued copies, dt [s].  No data-dependent branch:
  * a lane whose geometry is no contact (its centres exactly radsum apart after the rounding of
- * sqrt, or coincident) computes a meaningless law that apply_lanes discards. */
+ * sqrt, or coincident) computes a meaningless law, possibly NaN or infinite, that apply_lanes
+ * discards (no floating-point trap is ever enabled: the build's -fno-trapping-math). */
 template <unsigned F>
 static inline void jd_pair_lanes_evaluate(JdPairLanes<F> &__restrict L, double dt) {
   typedef JdPairLanes<F> Lanes;
