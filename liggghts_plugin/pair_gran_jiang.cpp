@@ -282,17 +282,52 @@ void PairGranJiang::forget_contact(int *touch, double *hist) const {
   for (int k = 0; k < slen; k++) hist[k] = 0.0;
 }
 
+/* The watchdog's overlap limit: overlaps at most overlap_limit x R_i and x R_j are never
+ * excessive, which skips the exact test (jd_overlap_excessive, a libm fmin call) for almost
+ * every contact. */
+void PairGranJiang::note_overlap(int i, int j, double delta, double Ri, double Rj) {
+  if ((delta > overlap_limit * Ri || delta > overlap_limit * Rj) &&
+      jd_overlap_excessive(delta, Ri, Rj, overlap_limit))
+    overlap_trip.note(delta, std::fmin(Ri, Rj), atom->tag[i], atom->tag[j], NULL);
+}
+
+/* A touching pair's share of the evaluation's sums (a pair with a ghost partner is evaluated on
+ * both ranks: it counts half on each); with JD_F_ENERGY its dissipation is harvested from st. */
+template <unsigned F>
+void PairGranJiang::book_contact(jd_contact_state *st, int j, int carries, LoopSums &sums) {
+  const double w = j < atom->nlocal ? 1.0 : 0.5;
+  if (F & JD_F_ENERGY) {
+    jd_contact_harvest(st, w, &sums.e_damp, &sums.e_fric);
+    if (carries) sums.e_el += w * jd_contact_elastic_energy(st);
+  }
+  if (carries) sums.ncontacts += w;
+}
+
+/* The force fb on j (-fb on i) and the torques ta, tb into LIGGGHTS' arrays (j's only when it is
+ * local: a ghost's are its owner's), and the virial. */
+void PairGranJiang::add_pair_forces(int i, int j, const double fb[3], const double ta[3],
+                                    const double tb[3]) {
+  double **x = atom->x, **f = atom->f, **torque = atom->torque;
+  const int nlocal = atom->nlocal;
+  jd_sub3(f[i], fb);
+  jd_add3(torque[i], ta);
+  if (j < nlocal) {
+    jd_add3(f[j], fb);
+    jd_add3(torque[j], tb);
+  }
+  if (evflag)
+    ev_tally_xyz(i, j, nlocal, 0, 0.0, 0.0, -fb[0], -fb[1], -fb[2], x[i][0] - x[j][0],
+                 x[i][1] - x[j][1], x[i][2] - x[j][2]);
+}
+
 /* One pair at a time: LIGGGHTS' set-up evaluation, compute pair/gran/local and run-time laws. */
 template <unsigned F>
 void PairGranJiang::plain_loop(unsigned laws, bool commit, bool apply, bool report, LoopSums &sums) {
-  double **x = atom->x, **v = atom->v, **f = atom->f;
-  double **omega = atom->omega, **torque = atom->torque;
+  double **x = atom->x, **v = atom->v, **omega = atom->omega;
   const double *radius = atom->radius, *rmass = atom->rmass;
   const int *type = atom->type;
-  const int nlocal = atom->nlocal;
   const int dn = dnum(), roll_at = rolling_at();
   const double dt_run = update->dt;
-  const int *tag = atom->tag;
   const double *kp = pair_prefactors();
 
   for (int ii = 0; ii < list->inum; ii++) {
@@ -300,9 +335,6 @@ void PairGranJiang::plain_loop(unsigned laws, bool commit, bool apply, bool repo
     const NeighbourRow row = row_of(i);
     const double Ri = radius[i], mi = rmass[i];
     const jd_pair_coeffs *coeffs_i = &coeffs_[type[i] * (ntypes_ + 1)];
-    /* overlaps at most overlap_limit x R_i and x R_j are never excessive: skips the exact test
-     * (jd_overlap_excessive, a libm fmin call) for almost every contact */
-    const double olim_i = overlap_limit * Ri;
 
     for (int jj = 0; jj < row.n; jj++) {
       const int j = row.j[jj] & NEIGHMASK;
@@ -313,9 +345,7 @@ void PairGranJiang::plain_loop(unsigned laws, bool commit, bool apply, bool repo
         continue;
       }
       const double Rj = radius[j], mj = rmass[j];
-      if ((g.delta > olim_i || g.delta > overlap_limit * Rj) &&
-          jd_overlap_excessive(g.delta, Ri, Rj, overlap_limit))
-        overlap_trip.note(g.delta, std::fmin(Ri, Rj), tag[i], tag[j], NULL);
+      note_overlap(i, j, g.delta, Ri, Rj);
       jd_geom_pair_material(F, &g, kp[i], kp[j], mi, mj, jd_sphere_inertia(mi, Ri),
                             jd_sphere_inertia(mj, Rj));
       jd_kinematics k;
@@ -328,26 +358,11 @@ void PairGranJiang::plain_loop(unsigned laws, bool commit, bool apply, bool repo
       jd_contact_result out;
       const int carries = jd_contact(laws, &coeffs_i[type[j]], &g, &k, dt_run, h.st, h.rs, &out);
       /* a pair with a ghost partner is evaluated on both ranks: count it half on each */
-      const double w = j < nlocal ? 1.0 : 0.5;
-      if (F & JD_F_ENERGY) {
-        jd_contact_harvest(h.st, w, &sums.e_damp, &sums.e_fric);
-        if (carries) sums.e_el += w * jd_contact_elastic_energy(h.st);
-      }
-      if (carries) sums.ncontacts += w;
+      book_contact<F>(h.st, j, carries, sums);
       row.touch[jj] = 1; /* keep the history across neighbour rebuilds while overlapping */
       h.finish();
       if (report) report_pair(i, j, carries, out, hist);
-      if (!carries || !apply) continue;
-
-      jd_sub3(f[i], out.f);
-      jd_add3(torque[i], out.ta);
-      if (j < nlocal) {
-        jd_add3(f[j], out.f);
-        jd_add3(torque[j], out.tb);
-      }
-      if (evflag)
-        ev_tally_xyz(i, j, nlocal, 0, 0.0, 0.0, -out.f[0], -out.f[1], -out.f[2],
-                     x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]);
+      if (carries && apply) add_pair_forces(i, j, out.f, out.ta, out.tb);
     }
   }
 }
@@ -428,9 +443,6 @@ void PairGranJiang::lane_loop(LoopSums &sums) {
 template <unsigned F>
 void PairGranJiang::apply_lanes(JdPairLanes<F> &L, LoopSums &sums) {
   typedef JdPairLanes<F> Lanes;
-  double **x = atom->x, **f = atom->f, **torque = atom->torque;
-  const int nlocal = atom->nlocal;
-  const int *tag = atom->tag;
   const int roll_at = rolling_at();
   for (int b = 0; b < L.n; b++) {
     const int i = L.i[b], j = L.j[b];
@@ -439,34 +451,17 @@ void PairGranJiang::apply_lanes(JdPairLanes<F> &L, LoopSums &sums) {
       forget_contact(L.touch[b], hist);
       continue;
     }
-    const double Ri = L.ri[b], Rj = L.rj[b], delta = L.delta[b];
-    if ((delta > overlap_limit * Ri || delta > overlap_limit * Rj) &&
-        jd_overlap_excessive(delta, Ri, Rj, overlap_limit))
-      overlap_trip.note(delta, std::fmin(Ri, Rj), tag[i], tag[j], NULL);
+    note_overlap(i, j, L.delta[b], L.ri[b], L.rj[b]);
     for (int q = 0; q < Lanes::HW; q++) hist[q] = L.rec[q][b];
     for (int q = 0; q < Lanes::RW; q++) hist[roll_at + q] = L.roll[q][b];
-    const int carries = L.carries[b];
-    const double w = j < nlocal ? 1.0 : 0.5;
-    if (F & JD_F_ENERGY) { /* the record is the whole jd_contact_state (jdem_history.h) */
-      jd_contact_state *st = reinterpret_cast<jd_contact_state *>(hist);
-      jd_contact_harvest(st, w, &sums.e_damp, &sums.e_fric);
-      if (carries) sums.e_el += w * jd_contact_elastic_energy(st);
-    }
-    if (carries) sums.ncontacts += w;
+    /* with JD_F_ENERGY the record is the whole jd_contact_state (jdem_history.h) */
+    book_contact<F>(reinterpret_cast<jd_contact_state *>(hist), j, L.carries[b], sums);
     *L.touch[b] = 1;
-    if (!carries) continue;
+    if (!L.carries[b]) continue;
     const double fb[3] = {L.f[0][b], L.f[1][b], L.f[2][b]};
     const double ta[3] = {L.ta[0][b], L.ta[1][b], L.ta[2][b]};
     const double tb[3] = {L.tb[0][b], L.tb[1][b], L.tb[2][b]};
-    jd_sub3(f[i], fb);
-    jd_add3(torque[i], ta);
-    if (j < nlocal) {
-      jd_add3(f[j], fb);
-      jd_add3(torque[j], tb);
-    }
-    if (evflag)
-      ev_tally_xyz(i, j, nlocal, 0, 0.0, 0.0, -fb[0], -fb[1], -fb[2], x[i][0] - x[j][0],
-                   x[i][1] - x[j][1], x[i][2] - x[j][2]);
+    add_pair_forces(i, j, fb, ta, tb);
   }
 }
 

@@ -108,6 +108,10 @@ class PairGranJiang : public PairGran {
   };
   NeighbourRow row_of(int i) const;
   void forget_contact(int *touch, double *hist) const;
+  /* what the plain loop and apply_lanes do with each evaluated pair */
+  void note_overlap(int i, int j, double delta, double Ri, double Rj);
+  template <unsigned F> void book_contact(jd_contact_state *st, int j, int carries, LoopSums &sums);
+  void add_pair_forces(int i, int j, const double fb[3], const double ta[3], const double tb[3]);
 
  private:
   void register_history();
