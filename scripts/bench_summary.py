@@ -139,12 +139,24 @@ def flatness(rows):
 
 
 def machine_info():
+    """The machine a timing was taken on: core count, the CPU's name, family and model (a virtual
+    machine may name only the vendor), and its widest SIMD extension, which sets how far jdem's
+    vectorised loops pull ahead of LIGGGHTS' scalar ones (docs/mixing.md §10)."""
     info = {"cpus": os.cpu_count()}
+    fields = {}
     try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                info["cpu"] = line.split(":", 1)[1].strip()
-                break
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if not line.strip():
+                    break                      # the first processor's block is enough
+                key, _, value = line.partition(":")
+                fields[key.strip()] = value.strip()
     except OSError:
-        pass
+        return info
+    if "model name" in fields:
+        info["cpu"] = fields["model name"]
+    if "cpu family" in fields and "model" in fields:
+        info["cpu_family_model"] = f"{fields['cpu family']}/{fields['model']}"
+    flags = set(fields.get("flags", "").split())
+    info["simd"] = next((f for f in ("avx512f", "avx2", "avx", "sse2") if f in flags), "none")
     return info

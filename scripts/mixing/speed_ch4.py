@@ -32,6 +32,7 @@ import subprocess
 import yaml
 
 from scripts import engines
+from scripts.bench_summary import machine_info
 from scripts.mixing.plan_ch4 import LIGGGHTS_SKIN, LIGGGHTS_SORT_EVERY
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -114,6 +115,15 @@ def table(summary):
     return "\n".join(rows) + "\n"
 
 
+def on_machine(summary):
+    """', on CPUS cores of CPU (family/model, SIMD)' where the summary records the machine."""
+    m = summary.get("machine")
+    if not m:
+        return ""
+    return (f", on {m['cpus']} cores of {m.get('cpu', 'an unnamed CPU')} "
+            f"(family/model {m.get('cpu_family_model', '?')}, {m.get('simd', '?')})")
+
+
 def describe(summary):
     """What was timed, in one paragraph."""
     return (f"Case {summary['case']}, the first {summary['end_time']} s of the fill at dt = "
@@ -121,7 +131,7 @@ def describe(summary):
             f"{summary['particle_steps']:.4g} particle-steps); {summary['rounds']} rounds, every "
             f"other one in the reverse order; load average before the runs "
             f"{summary['load_before']:.2f}, after {summary['load_after']:.2f}; commit "
-            f"{summary['commit']}.  `liggghts` is LIGGGHTS' own hertz/history pair and primitive "
+            f"{summary['commit']}{on_machine(summary)}.  `liggghts` is LIGGGHTS' own hertz/history pair and primitive "
             f"walls with our inlet; `jdem-energy` is jdem with the energy accounts (output.energy: "
             f"true), which the campaign's Ch. 4 fills leave out and stock LIGGGHTS does not keep.")
 
@@ -189,7 +199,7 @@ def main():
     summary = {"case": a.case, "end_time": a.end_time, "dt": 1e-4, "steps": steps,
                "inserted": inserted, "particle_steps": work, "rounds": a.rounds,
                "load_before": load_before,
-               "load_after": os.getloadavg()[0], "runs": runs,
+               "load_after": os.getloadavg()[0], "machine": machine_info(), "runs": runs,
                "commit": subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
                                         capture_output=True, text=True).stdout.strip()}
     with open(os.path.join(d, "summary.json"), "w") as f:
