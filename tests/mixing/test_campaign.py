@@ -368,14 +368,22 @@ def test_ch4_ranks():
 
 
 def test_ch5_fill_scenes():
-    """Chapter 5: liggghts-jdem's fills run the case without energy accounts (generate.py fill
-    --no-energy), jdem's the case itself; the written scene is the case, resolved by the engine,
-    in every line but output.energy."""
+    """Chapter 5: jdem's fills of Models 2 and 4 run the case itself, with its energy accounts;
+    every other fill (liggghts-jdem's, jdem's other models and the rigid cements) runs it without
+    them (generate.py fill --no-energy); the written scene is the case, resolved by the engine, in
+    every line but output.energy."""
     from scripts.mixing import plan_ch5
     plan = {u.name: u for u in plan_ch5.units([])}
-    lig, jd = plan["liggghts-jdem/group2_model4/fill"].command[2], plan["jdem/group2_model4/fill"].command[2]
-    check("ch5_fill_scene_commands", "generate.py fill --case group2_model4 --no-energy" in lig
-          and " resolve " in jd and "--no-energy" not in jd, f"liggghts-jdem: {lig}; jdem: {jd}")
+    command = {name: plan[f"{name}/fill"].command[2] for name in (
+        "jdem/group2_model4", "jdem/group3_model2", "jdem/group1_model5", "jdem/rigid_model3",
+        "liggghts-jdem/group2_model4")}
+    accounts = {name: " resolve " in c and "--no-energy" not in c for name, c in command.items()}
+    without = {name: f"generate.py fill --case {name.split('/')[1]} --no-energy" in c
+               for name, c in command.items()}
+    check("ch5_fill_scene_commands",
+          [n for n in command if accounts[n]] == ["jdem/group2_model4", "jdem/group3_model2"]
+          and [n for n in command if without[n]] == ["jdem/group1_model5", "jdem/rigid_model3",
+                                                     "liggghts-jdem/group2_model4"], repr(command))
     jdem = os.path.join(ROOT, "build", "jdem")
     with tempfile.TemporaryDirectory() as d:
         scene = os.path.join(d, "fill.yaml")

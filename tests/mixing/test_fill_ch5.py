@@ -160,9 +160,11 @@ def scene_text():
     return yaml.safe_dump({"name": "mixing_ch5", "walls": walls})
 
 
-def write_fill(path, dep, rec, residual):
-    """A one-frame trajectory of dep with the bonds of rec and a balance off by `residual` J."""
+def write_fill(path, dep, rec, residual, version):
+    """A one-frame trajectory of dep with the bonds of rec and a balance off by `residual` J,
+    written by the binary `version` (h5md/creator)."""
     with h5py.File(path, "w") as f:
+        f.create_group("h5md/creator").attrs["version"] = version
         f["parameters/scene"] = scene_text().encode()
         f["parameters"].attrs["dt"] = rec["dt"]
         p = f.create_group("particles/all")
@@ -182,9 +184,14 @@ def test_report(tmp):
     dep = bed(lambda x: 10 + int(x / (3 * PITCH)))
     rec = bonds_record()
     rec_rigid = dict(rec, broken=np.zeros((0, 2), np.int64), broken_step=np.zeros(0, np.int64))
-    for case, r, residual in (("group2_model3", rec, 0.25), ("rigid_model3", rec_rigid, 0.01)):
+    # the bonded fill by this binary, the rigid one by a binary from before the energy fix (a
+    # release without its commit): its larger residual is marked old and not the worst
+    head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                          text=True).stdout.strip()
+    for case, r, residual, version in (("group2_model3", rec, 0.25, "0.1.0+" + head),
+                                       ("rigid_model3", rec_rigid, 0.5, "0.1.0")):
         os.makedirs(os.path.join(out, "jdem", case))
-        write_fill(os.path.join(out, "jdem", case, "fill.h5"), dep, r, residual)
+        write_fill(os.path.join(out, "jdem", case, "fill.h5"), dep, r, residual, version)
     # the campaign's times: the bonded fill with its CPU time, the rigid one timed on the wall only
     os.makedirs(os.path.join(out, "jdem", "group1_model1"))
     with open(os.path.join(out, "jdem", "group1_model1", ".campaign_times.json"), "w") as f:
@@ -199,8 +206,11 @@ def test_report(tmp):
     slope = structure.free_surface(dep, LO, HI)
     check("report: the bonded fill's surface row", "| jdem | group2_model3 | %.1f | %+.1f |" % (
         slope["inclination"], slope["slope_x"]) in text)
-    check("report: the worst fill is the bonded one, 0.25 J of its 4 J in play",
-          "Worst fill: jdem/group2_model3, 6.25e-02 of the energy in play (**beyond**" in text)
+    check("report: the worst fill is the bonded one, 0.25 J of its 4 J in play, not the rigid "
+          "one's 0.5 J on the old bookkeeping",
+          "Worst fill on the current bookkeeping: jdem/group2_model3, 6.25e-02 of the energy in play "
+          "(**beyond**" in text and "| jdem | rigid_model3 | 1.25e-01 old |" in text
+          and "On the old bookkeeping: jdem/rigid_model3." in text)
     check("report: the rigid fill's bonds all intact (3 formed, 0 broken, 2 fragments), "
           "its wall time marked w",
           re.search(r"\| jdem \| rigid_model3 \| [^|]+ \| 3 \| 0 \| 2 \| 0 \| 777 w \|", text) is not None)

@@ -5,9 +5,10 @@ bonded fill's deposit (docs/mixing.md §11); every scene runs in both engines.
     generate.py fill --case groupG_modelM --no-energy -o FILL.yaml
     generate.py cubes DEPOSIT.h5 --case groupG_modelM -o DIR   (writes DIR/cubeK.yaml, K = 10..18)
 
-`fill --no-energy` writes the resolved case with output.energy: false, the scene liggghts-jdem's
-fills run: the same trajectory bit for bit as with the accounts (suite cross-engine, the
-energy-off checks), at a contact history of 7 doubles instead of 23 (docs/mixing.md §11).
+`fill --no-energy` writes the resolved case with output.energy: false, the scene of every fill
+that keeps no energy accounts (all but jdem's Models 2 and 4, plan_ch5.keeps_energy): the same
+trajectory bit for bit as with the accounts (suite cross-engine, the energy-off checks), at a
+contact history of 7 doubles instead of 23 (docs/mixing.md §11).
 
 A 0.2 m cube at each middle-clip point (points 10-18 of Table 5-2, y = 0.5 m) under a servo top
 wall at sigma_zz = 5 kPa [TEXT] +- 1 % [RECON] (the seed states no tolerance), with Table 5-1's
