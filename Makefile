@@ -67,7 +67,7 @@ UNIT_SRC    := $(wildcard tests/unit/*.c) stepper/hugepages.c # and the engine's
 HEADERS     := $(wildcard kernel/*.h io/*.h stepper/*.h)
 
 # ParaView for the paraview suite only (about 440 MB installed): kept out of `make deps` so that
-# `make demo` stays light; .ci/run installs it before `make test`.
+# `make demo` stays light; `make test` installs it (a fresh machine's `make test` runs every suite).
 PARAVIEW_PACKAGES := paraview python3-paraview xvfb xauth
 
 .PHONY: all deps paraview-deps test demo chung-ooi stability unit clean
@@ -177,7 +177,7 @@ unit: build/test_unit build/san/test_unit
 # JDEM_TEST_JOBS=N sets the cores of both.
 JDEM_TEST_JOBS ?= $(shell nproc)
 export JDEM_TEST_JOBS
-test: deps
+test: deps paraview-deps
 	$(MAKE) -j$(JDEM_TEST_JOBS) all build/san/jdem build/test_unit build/san/test_unit build/scene_check \
 	    build/san/scene_check
 	$(PY) tests/run_tests.py
