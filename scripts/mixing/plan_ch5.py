@@ -89,7 +89,7 @@ def committed_horizon(case, engine=None, k=None):
 # group, the energy balance over a whole bonded fill ("give the worst fill").  Every other
 # fill runs the case with output.energy: false: the same trajectory bit for bit (suite cross-engine,
 # the energy-off checks), and the pair loops then keep 7 doubles of history a contact instead of 23,
-# 1.57x faster in liggghts-jdem on a Group 2 deposit and 2.5x in jdem (docs/mixing.md §11).
+# 1.57x faster in liggghts-jdem on a Group 2 deposit and 1.9x in jdem (docs/mixing.md §11).
 ENERGY_MODELS = ("model2", "model4")
 
 

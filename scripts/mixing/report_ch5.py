@@ -292,7 +292,7 @@ def energy_table(found):
         lines += ["", "On the old bookkeeping: " + ", ".join(old) + "."]
     lines += ["", "Only jdem's fills of %s keep the energy accounts (scripts/mixing/plan_ch5.py, "
               "keeps_energy); every other fill, liggghts-jdem's included, runs without them: the "
-              "same trajectory bit for bit, 1.57x faster in liggghts-jdem and 2.5x in jdem "
+              "same trajectory bit for bit, 1.57x faster in liggghts-jdem and 1.9x in jdem "
               "(docs/mixing.md §11). The fills above from other models ran before that rule." % (
                   " and ".join("Model " + m[len("model"):] for m in ENERGY_MODELS))]
     return lines
