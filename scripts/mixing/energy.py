@@ -15,6 +15,7 @@ energy is a reference-dependent offset), and over the inflow.
 """
 import h5py
 import numpy as np
+import yaml
 
 STORED = ("kinetic_energy", "rotational_energy", "elastic_energy", "bond_elastic_energy")
 DISSIPATED = ("damping_dissipation", "friction_dissipation", "bond_damping_dissipation",
@@ -24,8 +25,13 @@ DISSIPATED = ("damping_dissipation", "friction_dissipation", "bond_damping_dissi
 def balance(path):
     """{"in_play", "inflow", "residual_in_play", "residual_inflow", "breakage", "damping",
     "friction", "samples"} [J and fractions] of the trajectory at path; None without an inlet
-    or the energy observables."""
+    or the energy observables, or for a run without the energy accounts (its scene's
+    output.energy: false; it still writes the kinetic, gravitational and inlet energies, but
+    books no dissipation)."""
     with h5py.File(path, "r") as f:
+        scene = yaml.safe_load(f["parameters/scene"][()]) if "parameters/scene" in f else None
+        if not ((scene or {}).get("output") or {}).get("energy", True):
+            return None
         o = {k: f["observables/%s/value" % k][()] for k in
              STORED + DISSIPATED + ("gravitational_energy", "wall_work", "inlet_energy",
                                            "lost_energy")

@@ -108,6 +108,13 @@ def test_energy(tmp):
     with h5py.File(os.path.join(tmp, "no_inlet.h5"), "w") as f:
         observables(f, {"kinetic_energy": ke})
     check("energy: a run without an inlet has no balance", energy.balance(os.path.join(tmp, "no_inlet.h5")) is None)
+    off = os.path.join(tmp, "energy_off.h5")
+    with h5py.File(off, "w") as f:   # the observables a run without the accounts still writes
+        f["parameters/scene"] = yaml.safe_dump({"name": "fill", "output": {"energy": False}}).encode()
+        observables(f, {"kinetic_energy": ke, "gravitational_energy": inflow - ke,
+                        "inlet_energy": inflow})
+    check("energy: a run without the energy accounts (output.energy: false) has no balance",
+          energy.balance(off) is None)
 
 
 def bonds_record():
