@@ -254,8 +254,9 @@ def current_bookkeeping(built_by):
 
 
 def energy_table(found):
-    """The energy balance of each fill that keeps the accounts; the worst over those whose
-    binaries all book the previous load through its lever arms (current_bookkeeping)."""
+    """The energy balance of each fill that keeps the accounts, and every fill's bond-steps per
+    second; the worst balance over the fills whose binaries all book the previous load through
+    its lever arms (current_bookkeeping)."""
     lines = ["### Energy balance and speed of the fills (scripts/mixing/energy.py)", "",
              "largest residual of KE + RE + elastic + gravitational + dissipated (the bonds' stored, "
              "damped and breakage energy included) − wall work − inflow, over the energy in play and "
@@ -269,10 +270,12 @@ def energy_table(found):
     worst, old = None, []
     for name, e in sorted(found.items()):
         b = e.get("energy")
-        if not b:
-            continue
         took, _ = cpu_or_wall(e)
         rate = e["bond_steps"] / took if took and e.get("bond_steps") else None
+        if not b:   # a fill without the accounts: its speed alone
+            lines.append("| %s | %s | no accounts | — | — | — | %.3g | %s | %s |" % (
+                *name.split("/"), e.get("bond_steps", 0.0), run_time(e), "%.3g" % rate if rate else "—"))
+            continue
         current = current_bookkeeping(e.get("built_by", []))
         lines.append("| %s | %s | %.2e%s | %.2e | %.3g | %.4g | %.3g | %s | %s |" % (
             *name.split("/"), b["residual_in_play"], "" if current else " old", b["residual_inflow"],
