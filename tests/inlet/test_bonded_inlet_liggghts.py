@@ -229,7 +229,7 @@ def check_rigid(c, tmp):
     trajectories, a growing particle set, within the tolerance (scripts/compare_trajectories.py)."""
     doc = yaml.safe_load(open(SCENE))
     doc["bond_types"]["weak"].update(tensile_strength=float("inf"), shear_strength=float("inf"))
-    doc["watchdog"] = {"max_overlap_fraction": 1.5}   # the Ch. 5 scene's: a big sphere lands on a block
+    doc["watchdog"] = {"max_overlap_fraction": 1.5}   # a big sphere lands on a block: beyond the default 0.5
     scene = os.path.join(tmp, "rigid.yaml")
     with open(scene, "w") as f:
         yaml.safe_dump(doc, f)
