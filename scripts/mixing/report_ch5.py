@@ -418,13 +418,14 @@ def report(found, rev, figures=None):
              "(commit %s); a row from an earlier commit names it. docs/mixing.md §11." % rev, "",
              "### Table 5-3: φv at the middle clip (points 10–18 of Table 5-2, y = 0.5 m)", "",
              "trimmed mean ± std (scripts/mixing/stats.py; the seed does not say how it trims); "
-             "ideal φv = 0.0625; " + RUN_TIME_NOTE, "",
+             "ideal φv = 0.0625; " + RUN_TIME_NOTE + "; \"e\" marks a fill that kept the energy "
+             "accounts (about 1.9x the time in jdem, 1.57x in liggghts-jdem; plan_ch5.keeps_energy)", "",
              "| group | model | seed | jdem | liggghts-jdem | run time jdem / liggghts-jdem [s] |",
              "|---|---|---|---|---|---|"]
     for g in GROUPS:
         for m in MODELS:
             a, b = (found.get("%s/%s" % (e, case(g, m))) for e in ENGINES)
-            t = " / ".join(run_time(x) for x in (a, b))
+            t = " / ".join(run_time(x) + (" e" if x and x.get("energy") else "") for x in (a, b))
             lines.append("| %d | %d | %.4f ± %.4f | %s | %s | %s |" % (g, m, *SEED_PHI_V[g][m - 1], cell(a), cell(b), t))
     lines += [""] + bonded_figures_section(figures)
     lines += ["", "### Breakage over the whole fill (the seed reports none, spec §4.3)", "",
