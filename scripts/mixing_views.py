@@ -16,7 +16,6 @@ import sys
 
 import h5py
 import numpy as np
-import yaml
 
 from scripts.mixing import deposit, plots
 
@@ -24,7 +23,7 @@ from scripts.mixing import deposit, plots
 def scene_geometry(path):
     """(box lo, box hi, [(x, z, radius)] of the cylinders along y) from the resolved scene."""
     with h5py.File(path, "r") as f:
-        scene = yaml.safe_load(f["/parameters/scene"][()].decode())
+        scene = deposit.scene_of(f)
     walls = scene.get("walls") or []
     corners = np.array([c for w in walls if w["type"] == "plane" for c in w["corners"]], float)
     lo, hi = corners.min(axis=0), corners.max(axis=0)

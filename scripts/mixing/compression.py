@@ -21,9 +21,9 @@ import sys
 
 import h5py
 import numpy as np
-import yaml
 
 from scripts.mixing import elastic
+from scripts.mixing.deposit import scene_of
 
 
 def series(obs, name):
@@ -67,9 +67,7 @@ def analyse(path, wall):
         x = f["particles/all/position/value"]
         x1, x2 = x[i], x[j]
         start = float(position[int(np.searchsorted(steps, frame_steps[i]))])
-        scene = yaml.safe_load(f["parameters/scene"][()].decode()
-                               if isinstance(f["parameters/scene"][()], bytes)
-                               else f["parameters/scene"][()])
+        scene = scene_of(f)
     h0 = wall_height(scene, wall) - start
     result = elastic.compression_result(sig, x1, x2, h0, h0 - (float(position[k]) - start))
     result.update({"trajectory": path, "completed_at_step": done, "first_contact_step": touched,

@@ -11,6 +11,7 @@ import os
 from dataclasses import dataclass
 
 import numpy as np
+import yaml
 
 
 class DepositError(ValueError):
@@ -63,6 +64,15 @@ def read_frame(path, frame=-1):
         return Deposit(ids[live], p["species"][()][live], p["radius"][()][live],
                        p["mass"][()][live], position[live], int(p["position/step"][frame]),
                        float(p["position/time"][frame]))
+
+
+def scene_of(f):
+    """The resolved scene a trajectory keeps (/parameters/scene, written by both engines) as a
+    dict, {} without one; f: the open h5py.File."""
+    if "parameters/scene" not in f:
+        return {}
+    text = f["parameters/scene"][()]
+    return yaml.safe_load(text.decode() if isinstance(text, bytes) else text) or {}
 
 
 def built_by(path):

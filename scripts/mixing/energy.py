@@ -15,7 +15,8 @@ energy is a reference-dependent offset), and over the inflow.
 """
 import h5py
 import numpy as np
-import yaml
+
+from scripts.mixing.deposit import scene_of
 
 STORED = ("kinetic_energy", "rotational_energy", "elastic_energy", "bond_elastic_energy")
 DISSIPATED = ("damping_dissipation", "friction_dissipation", "bond_damping_dissipation",
@@ -29,8 +30,7 @@ def balance(path):
     output.energy: false; it still writes the kinetic, gravitational and inlet energies, but
     books no dissipation)."""
     with h5py.File(path, "r") as f:
-        scene = yaml.safe_load(f["parameters/scene"][()]) if "parameters/scene" in f else None
-        if not ((scene or {}).get("output") or {}).get("energy", True):
+        if not (scene_of(f).get("output") or {}).get("energy", True):
             return None
         o = {k: f["observables/%s/value" % k][()] for k in
              STORED + DISSIPATED + ("gravitational_energy", "wall_work", "inlet_energy",

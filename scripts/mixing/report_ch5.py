@@ -19,6 +19,7 @@ is taken from the committed summary.json, with the commit it came from.  The see
 breakage at all (spec §4.3): those columns have no seed value.
 """
 import argparse
+import functools
 import json
 import os
 import subprocess
@@ -245,12 +246,17 @@ ENERGY_FIX = "9756717"
 def current_bookkeeping(built_by):
     """Whether every binary that wrote a fill (deposit.built_by: "release+commit") contains
     ENERGY_FIX; a version without its commit predates the recording, and the fix."""
-    def has_fix(version):
-        rev = version.partition("+")[2]
-        return bool(rev) and subprocess.run(
-            ["git", "-C", ROOT, "merge-base", "--is-ancestor", ENERGY_FIX, rev],
-            capture_output=True).returncode == 0
-    return bool(built_by) and all(has_fix(v) for v in built_by)
+    return bool(built_by) and all(version_has_fix(v) for v in built_by)
+
+
+@functools.lru_cache(maxsize=None)
+def version_has_fix(version):
+    """Whether the binary "release+commit" contains ENERGY_FIX (one git call per binary: the
+    fills share a few)."""
+    rev = version.partition("+")[2]
+    return bool(rev) and subprocess.run(
+        ["git", "-C", ROOT, "merge-base", "--is-ancestor", ENERGY_FIX, rev],
+        capture_output=True).returncode == 0
 
 
 def energy_table(found):
@@ -272,18 +278,16 @@ def energy_table(found):
         b = e.get("energy")
         took, _ = cpu_or_wall(e)
         rate = e["bond_steps"] / took if took and e.get("bond_steps") else None
-        if not b:   # a fill without the accounts: its speed alone
-            lines.append("| %s | %s | no accounts | — | — | — | %.3g | %s | %s |" % (
-                *name.split("/"), e.get("bond_steps", 0.0), run_time(e), "%.3g" % rate if rate else "—"))
-            continue
-        current = current_bookkeeping(e.get("built_by", []))
-        lines.append("| %s | %s | %.2e%s | %.2e | %.3g | %.4g | %.3g | %s | %s |" % (
-            *name.split("/"), b["residual_in_play"], "" if current else " old", b["residual_inflow"],
-            b["breakage"], b["inflow"], e.get("bond_steps", 0.0), run_time(e),
+        current = bool(b) and current_bookkeeping(e.get("built_by", []))
+        balance = ("%.2e%s | %.2e | %.3g | %.4g" % (
+            b["residual_in_play"], "" if current else " old", b["residual_inflow"], b["breakage"],
+            b["inflow"]) if b else "no accounts | — | — | —")   # without the accounts: speed alone
+        lines.append("| %s | %s | %s | %.3g | %s | %s |" % (
+            *name.split("/"), balance, e.get("bond_steps", 0.0), run_time(e),
             "%.3g" % rate if rate else "—"))
-        if not current:
+        if b and not current:
             old.append(name)
-        elif worst is None or b["residual_in_play"] > worst[1]:
+        elif current and (worst is None or b["residual_in_play"] > worst[1]):
             worst = (name, b["residual_in_play"])
     if worst:
         lines += ["", "Worst fill on the current bookkeeping: %s, %.2e of the energy in play (%s the "
