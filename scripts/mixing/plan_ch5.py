@@ -91,11 +91,19 @@ def committed_horizon(case, engine=None, k=None):
 # the energy-off checks), and the pair loops then keep 7 doubles of history a contact instead of 23,
 # 1.57x faster in liggghts-jdem on a Group 2 deposit and 1.9x in jdem (docs/mixing.md §11).
 ENERGY_MODELS = ("model2", "model4")
+# what the accounts multiply a jdem fill's time by, for the ETA (docs/performance.md, "The energy
+# accounts on an AMD EPYC of family 26": time loop 7.5 s against 4.0 s)
+ENERGY_COST = 1.9
 
 
 def keeps_energy(engine, case):
     """Whether ENGINE's fill of CASE keeps the energy accounts (ENERGY_MODELS)."""
     return engine == "jdem" and case in CASES and case.split("_")[1] in ENERGY_MODELS
+
+
+def fill_cost(engine, case):
+    """A fill's cost for the ETA: its particle-steps, times ENERGY_COST if it keeps the accounts."""
+    return FILL_PARTICLES * FILL_TIME / SEED_DT * (ENERGY_COST if keeps_energy(engine, case) else 1.0)
 
 
 def fill_unit(engine, case, ranks):
@@ -106,7 +114,7 @@ def fill_unit(engine, case, ranks):
                    f'-o "$1"')
     return Unit(f"{engine}/{case}/fill", [os.path.join(OUT, engine, case, "fill.h5")],
                 fill_command(engine, "{dir}/fill.yaml", False, resolve, ranks=ranks), case, engine,
-                validate=valid_trajectory, cost=FILL_PARTICLES * FILL_TIME / SEED_DT,
+                validate=valid_trajectory, cost=fill_cost(engine, case),
                 resumes=resumable(engine), ranks=fill_ranks(engine, ranks),
                 committed=committed_fill(engine, case))
 
