@@ -150,7 +150,8 @@ class Times:
         unit's earlier ones from its partial directory's SPENT)."""
         import fcntl
         entry = {"seconds": seconds, "cpu_seconds": cpu_seconds, "cost": unit.cost,
-                 "ranks": unit.ranks, "attempts": attempts}
+                 "ranks": unit.ranks, "threads": unit_threads(unit), "attempts": attempts,
+                 "machine": machine_name()}
         # beside the plan's first output, whose directory a selection without that unit never made
         os.makedirs(os.path.dirname(self.path), exist_ok=True)
         with open(self.path + ".lock", "a") as lock:
@@ -167,6 +168,25 @@ class Times:
         if not done or cost <= 0:
             return None
         return sum(u.cost for u in remaining) * sum(d["seconds"] for d in done) / cost
+
+
+def unit_threads(unit):
+    """The OpenMP threads a unit's jdem runs on: jdem's default, OMP_NUM_THREADS if set, else 1
+    (stepper/main.c); a liggghts-jdem unit's processes are its ranks."""
+    if unit.engine == "liggghts-jdem":
+        return 1
+    try:
+        return max(1, int(os.environ.get("OMP_NUM_THREADS", "1")))
+    except ValueError:
+        return 1
+
+
+def machine_name():
+    """The CPU a unit's times were taken on (bench_summary.machine_info), which a cost comparison
+    between units run in different sessions needs."""
+    from scripts.bench_summary import machine_info
+    info = machine_info()
+    return " ".join(str(info[k]) for k in ("cpu", "cpu_family_model", "simd") if k in info)
 
 
 def resuming(unit):

@@ -76,10 +76,15 @@ def move_text(move):
 
 def cpu_text(t):
     """A fill's CPU seconds over all its attempts; timed before the campaign added them up, a
-    resumed fill's figure is its last attempt's only, which the table cannot tell apart."""
+    resumed fill's figure is its last attempt's only, which the table cannot tell apart.  The
+    threads (their CPU seconds add up) and the machine where the campaign recorded them: the
+    variants ran in different sessions, on different machines."""
     if t.get("cpu_seconds") is None:
         return "not recorded"
-    return "%.0f" % t["cpu_seconds"] + ("" if "attempts" in t else " (last attempt, if resumed)")
+    notes = ([] if "attempts" in t else ["last attempt, if resumed"]) + \
+        (["%d threads" % t["threads"]] if t.get("threads", 1) > 1 else []) + \
+        ([t["machine"]] if t.get("machine") else [])
+    return "%.0f" % t["cpu_seconds"] + (" (%s)" % ", ".join(notes) if notes else "")
 
 
 def table(found, engines, models, passes):

@@ -339,18 +339,20 @@ def mixing_table(found, taken):
 def times_table(found, taken):
     lines = ["### Run times of the finished units", "",
              "wall time on the shared machine, the CPU time of the unit's processes, the MPI ranks "
-             "it ran on, and the attempts they add up (a unit resumed after an interruption; "
-             "\"not recorded\": timed before the campaign added up the attempts, so a resumed "
-             "unit's times are its last attempt's only)", "",
-             "| unit | wall [s] | CPU [s] | ranks | attempts |", "|---|---|---|---|---|"]
+             "it ran on, jdem's threads, and the attempts they add up (a unit resumed after an "
+             "interruption; \"not recorded\": timed before the campaign added up the attempts, so "
+             "a resumed unit's times are its last attempt's only); the machine, where recorded", "",
+             "| unit | wall [s] | CPU [s] | ranks | threads | attempts | machine |",
+             "|---|---|---|---|---|---|---|"]
     for engine in ENGINES:
         for model in MODELS:
             for name, t in sorted(found[engine][model]["times"].items()):
                 cpu, ranks = t.get("cpu_seconds"), t.get("ranks")
-                lines.append("| %s | %.0f | %s | %s | %s |" % (
+                lines.append("| %s | %.0f | %s | %s | %s | %s | %s |" % (
                     name, t["seconds"], "%.0f" % cpu if cpu is not None else "not recorded",
                     ranks if ranks is not None else 1,    # before ranks were recorded: all ran on one
-                    t.get("attempts", "not recorded")))
+                    t.get("threads", "not recorded"), t.get("attempts", "not recorded"),
+                    t.get("machine", "not recorded")))
     units = [(u.split("/")[0], "units", model_number(u.split("/")[1]), source)
              for k, source in taken.items() if k[2] == "times" for u in [k[3]]]
     return "\n".join(lines) + "\n" + earlier_note(units)

@@ -85,15 +85,15 @@ def measure(path, name, out, spent, directory, rev):
             if all(t is not None for t in took):
                 entry["cube_" + key] = float(sum(took))
     fill = spent.get(name + "/fill", {})
-    for key in ("seconds", "cpu_seconds", "ranks"):
+    for key in ("seconds", "cpu_seconds", "ranks", "threads", "machine"):
         if fill.get(key) is not None:
             entry[key] = fill[key]
     return entry
 
 
-RUN_TIME_NOTE = ("run times are the CPU time of the unit's processes (all ranks), since the wall "
-                 "clock of a shared machine also counts the pauses of the runs beside it; \"w\" marks "
-                 "a wall time, where a unit ran before its CPU time was recorded")
+RUN_TIME_NOTE = ("run times are the CPU time of the unit's processes (all ranks and threads), "
+                 "since the wall clock of a shared machine also counts the pauses of the runs beside "
+                 "it; \"w\" marks a wall time, where a unit ran before its CPU time was recorded")
 
 
 def cpu_or_wall(e, prefix=""):
@@ -112,7 +112,9 @@ def run_time(e, prefix=""):
     if t is None:
         return "—"
     ranks = e.get("ranks", 1) if not prefix else 1
-    return "%.0f" % t + ("" if cpu else " w") + (" (%d ranks)" % ranks if ranks > 1 else "")
+    threads = e.get("threads", 1) if not prefix else 1
+    return "%.0f" % t + ("" if cpu else " w") + (" (%d ranks)" % ranks if ranks > 1 else "") + \
+        (" (%d threads)" % threads if threads > 1 else "")
 
 
 def collect(out, committed, rev, directory):

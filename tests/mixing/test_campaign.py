@@ -150,7 +150,7 @@ def test_resumable_unit_continues():
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
     reset_log(here)
-    r = campaign(here, "--unit", "r", env={"WITH_R": "1"})
+    r = campaign(here, "--unit", "r", env={"WITH_R": "1", "OMP_NUM_THREADS": "3"})
     check("resumable_unit_sees_its_partial_run", r.returncode == 0 and runs(here) == ["r-again"],
           f"ran {runs(here)}: {r.stderr}")
     check("resumable_unit_says_it_continues",
@@ -160,6 +160,12 @@ def test_resumable_unit_continues():
     check("resumable_unit_time_counts_both_attempts",
           t["attempts"] == 2 and t["seconds"] >= 10.0 and t["cpu_seconds"] >= burned,
           f"recorded {t}; the killed attempt ran >= 10 s and its worker burned {burned:.2f} CPU s")
+    # the threads a jdem run takes from the environment (stepper/main.c), and the machine
+    cpu_name = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
+                     if line.startswith("model name")), None)
+    check("unit_time_records_threads_and_machine",
+          t.get("threads") == 3 and cpu_name is not None and t.get("machine", "").startswith(cpu_name),
+          f"recorded {t}; OMP_NUM_THREADS=3, /proc/cpuinfo's model name {cpu_name!r}")
 
 
 def test_validation_and_selection():
