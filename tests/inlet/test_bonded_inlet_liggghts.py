@@ -18,7 +18,9 @@ and a big sphere, falling onto a floor where bonds break); the deck is the gener
   contacts are not bitwise across the engines (docs/liggghts.md);
 * restart: the run killed (SIGKILL) once its LIGGGHTS restart file of step 9000 exists, and
   continued from the file of step 8000 (after the first breaks) with scripts/liggghts_run.py --resume equals the uninterrupted
-  run with the same restart cadence bit for bit (every dataset but /h5md), on 1 and 2 ranks;
+  run with the same restart cadence bit for bit (every dataset but /h5md), on 1 and 2 ranks; and
+  killed after step 3000, continued from step 2000, while the second copy's block is still on the
+  belt (its bonds formed by the continued run, as in a campaign fill resumed mid-stream);
 * sorting: with LIGGGHTS sorting the atoms every 500 steps (--sort-every, as the campaigns'
   fills), the bonds travel with their atoms: on 1 rank the bonds, breaks and states are again
   jdem's, and on 2 ranks the continued run is again the uninterrupted one bit for bit;
@@ -147,15 +149,20 @@ def compare(c, jd, lg, ranks, scales, tag=None):
 
 
 RESTART_EVERY, KILL_AFTER = 1000, 9000   # it continues from step 8000, after the first breaks (7184)
+# killed after step 3000, it continues from step 2000: the first copy's block is in the box with
+# its bonds (inserted at step 1330), the second copy's still on the belt (2730), so the continued
+# run forms a copy's bonds itself, as a campaign fill resumed mid-stream does
+KILL_MID_STREAM = 3000
 SORT = ["--sort-every", "500"]
 
 
-def check_restart(c, tmp, ranks, *extra):
-    """EXTRA: more runner options (SORT), named in the checks and the files."""
+def check_restart(c, tmp, ranks, *extra, kill_after=KILL_AFTER):
+    """EXTRA: more runner options (SORT), named in the checks and the files; killed once the
+    restart file of step kill_after exists."""
     runner = [PY, os.path.join(ROOT, "scripts", "liggghts_run.py"), SCENE, "--np", str(ranks),
               "--checkpoint-every", str(RESTART_EVERY), *extra]
     tag = "%d rank(s)%s" % (ranks, ", sorted every %s steps" % extra[-1] if extra else "")
-    name = "np%d%s" % (ranks, "_sorted" if extra else "")
+    name = "np%d%s_kill%d" % (ranks, "_sorted" if extra else "", kill_after)
     ref = os.path.join(tmp, "restart_ref_%s.h5" % name)
     r = subprocess.run(runner + ["-o", ref], capture_output=True, text=True)
     if not c.check("restart: the uninterrupted run with restart files (%s)" % tag, r.returncode == 0,
@@ -166,13 +173,13 @@ def check_restart(c, tmp, ranks, *extra):
     proc = subprocess.Popen(runner + ["-o", out], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                             start_new_session=True)
     deadline = time.time() + 300
-    while proc.poll() is None and time.time() < deadline and max(restart_steps(deck) or [0]) < KILL_AFTER:
+    while proc.poll() is None and time.time() < deadline and max(restart_steps(deck) or [0]) < kill_after:
         time.sleep(0.001)
     rc = kill_session(proc)
     r = subprocess.run(runner + ["-o", out, "--resume"], capture_output=True, text=True)
-    if not c.check("restart: killed after step %d (exit %s), continued from step %d (%s)" % (KILL_AFTER, rc, KILL_AFTER - RESTART_EVERY, tag),
+    if not c.check("restart: killed after step %d (exit %s), continued from step %d (%s)" % (kill_after, rc, kill_after - RESTART_EVERY, tag),
                    rc == -signal.SIGKILL and r.returncode == 0 and
-                   "--resume: continuing from %s/restart.%d" % (deck, KILL_AFTER - RESTART_EVERY) in r.stderr,
+                   "--resume: continuing from %s/restart.%d" % (deck, kill_after - RESTART_EVERY) in r.stderr,
                    r.stderr[-800:]):
         return
     a, b = datasets(ref), datasets(out)
@@ -285,8 +292,14 @@ def main():
         rc, log = run_liggghts(SCENE, lg_h5, 1, *SORT)
         if c.check("liggghts-jdem runs the deck sorting its atoms every %s steps" % SORT[-1], rc == 0, log[-1500:]):
             compare(c, jd, read(lg_h5), 1, scales, "1 rank, sorted every %s steps" % SORT[-1])
+        resumed_at = KILL_MID_STREAM - RESTART_EVERY
+        inserted = np.loadtxt(jd_rec, delimiter=",", skiprows=1, usecols=1)
+        c.check("restart mid-stream: at step %d copies are in the box and to come (insertion steps %s)"
+                % (resumed_at, sorted(set(inserted.astype(int).tolist()))),
+                (inserted < resumed_at).any() and (inserted > resumed_at).any())
         for ranks in (1, 2):
             check_restart(c, tmp, ranks)
+            check_restart(c, tmp, ranks, kill_after=KILL_MID_STREAM)
         check_restart(c, tmp, 2, *SORT)
         check_guard(c, tmp)
         check_bad_sections(c, tmp)
