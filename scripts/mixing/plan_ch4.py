@@ -40,6 +40,10 @@ PY = "/usr/bin/python3"
 SCENE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "models.yaml")
 GENERATE = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "generate.py")
 RESULTS = os.path.join(ROOT, "reference_runs", "mixing", "ch4", "results")
+# each time-step variant's committed results (make mixing-report DT=guard|half writes them)
+VARIANT_RESULTS = {"seed": RESULTS,
+                   "guard": os.path.join(ROOT, "reference_runs", "mixing", "ch4_dt_guard", "results"),
+                   "half": os.path.join(ROOT, "reference_runs", "mixing", "ch4_dt_half", "results")}
 OUT = {"seed": os.path.join(ROOT, "out", "mixing", "ch4"),
        "guard": os.path.join(ROOT, "out", "mixing", "ch4_dt_guard"),
        "half": os.path.join(ROOT, "out", "mixing", "ch4_dt_half")}
@@ -94,8 +98,8 @@ def read_committed(path):
 
 
 @functools.lru_cache(maxsize=None)
-def committed_ch4():
-    return read_committed(os.path.join(RESULTS, "summary.json")).get("results", {})
+def committed_ch4(variant="seed"):
+    return read_committed(os.path.join(VARIANT_RESULTS[variant], "summary.json")).get("results", {})
 
 
 @functools.lru_cache(maxsize=None)
@@ -104,17 +108,17 @@ def committed_horizons():
             .get("models", [])}
 
 
-def committed_entry(engine, model, key, count=1):
-    """f() for Unit.committed: where report_ch4.py's committed summary holds the result
-    key of the engine's model ("fill1", "fill2", "passP_cubes", "jitter"), a list of at least
-    `count` entries for the lists; None when it does not."""
+def committed_entry(engine, model, key, count=1, variant="seed"):
+    """f() for Unit.committed: where report_ch4.py's committed summary of the time-step variant
+    holds the result key of the engine's model ("fill1", "fill2", "passP_cubes", "jitter"), a
+    list of at least `count` entries for the lists; None when it does not."""
     def where():
-        entry = committed_ch4().get(engine, {}).get(model, {}).get(key)
+        entry = committed_ch4(variant).get(engine, {}).get(model, {}).get(key)
         if not entry or (isinstance(entry, list) and len(entry) < count):
             return None
         source = (entry[count - 1] if isinstance(entry, list) else entry).get("source", "?")
-        return "%s: %s of commit %s" % (os.path.relpath(os.path.join(RESULTS, "summary.json"), ROOT),
-                                       key, source)
+        summary = os.path.join(VARIANT_RESULTS[variant], "summary.json")
+        return "%s: %s of commit %s" % (os.path.relpath(summary, ROOT), key, source)
     return where
 
 
@@ -284,11 +288,11 @@ def spread_units(engine, model, variant, ranks):
             for k in range(1, SPREAD_REALISATIONS[engine].get(model, 0) + 1)]
 
 
-def pass_units(engine, model, p, deposit, base, dt_arg, dt, force, committed):
-    """The 9 cube scenes of one deposit and their compressions (committed: whether the seed
-    variant's committed results count)."""
+def pass_units(engine, model, p, deposit, base, dt_arg, dt, force, variant):
+    """The 9 cube scenes of one deposit and their compressions (variant: whose committed results
+    count)."""
     name = f"{engine}/{model}/pass{p}"
-    cubes_kept = committed_entry(engine, model, f"pass{p}_cubes", 9) if committed else None
+    cubes_kept = committed_entry(engine, model, f"pass{p}_cubes", 9, variant)
     cube_dir = os.path.join(base, f"pass{p}_cubes")
     scenes = [os.path.join(cube_dir, f"cube{k}.yaml") for k in range(1, 10)]
     units = [Unit(f"{name}_cubes", scenes, [PY, GENERATE, "cubes", deposit, "--case", model,
@@ -313,7 +317,7 @@ def model_units(engine, model, variant, ranks):
     dt_arg, dt = variant_dt(variant, model)
     force = variant == "seed"   # the guard refuses the seed's dt (docs/mixing.md §6)
     fill_cost = FILL_PARTICLES * FILL_TIME / dt
-    kept = (lambda key: committed_entry(engine, model, key)) if variant == "seed" else (lambda key: None)
+    kept = lambda key: committed_entry(engine, model, key, variant=variant)
     units = [
         Unit(f"{pre}/fill1", [fill1], fill1_command(engine, model, dt_arg, force, ranks=ranks), model, engine,
              validate=valid_trajectory, cost=fill_cost, blocked=gate(engine, "conveyor inlet"),
@@ -329,9 +333,8 @@ def model_units(engine, model, variant, ranks):
              blocked=gate(engine, "conveyor inlet", "inlet section from a deposit"),
              committed=kept("fill2")),
     ]
-    seed = variant == "seed"
-    return units + pass_units(engine, model, 1, fill1, base, dt_arg, dt, force, seed) \
-        + pass_units(engine, model, 2, fill2, base, dt_arg, dt, force, seed) \
+    return units + pass_units(engine, model, 1, fill1, base, dt_arg, dt, force, variant) \
+        + pass_units(engine, model, 2, fill2, base, dt_arg, dt, force, variant) \
         + spread_units(engine, model, variant, ranks)
 
 

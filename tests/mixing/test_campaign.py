@@ -349,6 +349,20 @@ def test_ch4_dt_variants():
               and int(hc[hc.index("--frame-every") + 1]) == round(0.02 / got)
               and horizon.outputs[0].startswith(plan_ch4.OUT[variant] + os.sep),
               f"command {hc}, output {horizon.outputs[0]}")
+        # a variant's committed results are its own summary's: Model 1's fills and cubes, where
+        # the summary has them, and no other model's (the dt study runs Model 1)
+        with open(os.path.join(plan_ch4.VARIANT_RESULTS[variant], "summary.json")) as f:
+            has = json.load(f)["results"]["jdem"]
+        units = {u.name: u for u in plan}
+        kept = {name: units[name].committed() for name in ("jdem/model1/fill1", "jdem/model1/pass2_cube9",
+                                                          "jdem/model2/fill1")}
+        summary = os.path.relpath(os.path.join(plan_ch4.VARIANT_RESULTS[variant], "summary.json"), ROOT)
+        want = {"jdem/model1/fill1": "fill1" in has.get("model1", {}),
+                "jdem/model1/pass2_cube9": len(has.get("model1", {}).get("pass2_cubes", [])) == 9,
+                "jdem/model2/fill1": "fill1" in has.get("model2", {})}
+        check(f"ch4_committed_{variant}", all((kept[n] or "").startswith(summary + ":") == want[n]
+                                              and (kept[n] is None) != want[n] for n in kept)
+              and want["jdem/model1/fill1"], f"committed {kept}; summary {summary} has {want}")
 
 
 def test_ch4_ranks():
