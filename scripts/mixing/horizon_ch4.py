@@ -164,17 +164,17 @@ def table(results):
     """The report's table: one row per model."""
     lines = ["| model | first touch seen at [s] | first non-zero at [s] (value) | horizon < %.0e [s] "
              "| growth rate [1/s] (fit window [s]) | e-folding time [s] | last common frame: "
-             "difference (t [s]) | particles then | CPU jdem / liggghts-jdem [s] |" % ROUNDOFF,
-             "|---|---|---|---|---|---|---|---|---|"]
+             "difference (t [s]) | particles then | CPU jdem / liggghts-jdem [s] | run at |" % ROUNDOFF,
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         d, g = r["divergence"], r["divergence"]["growth"]
-        lines.append("| %s | %s | %s (%s) | %s%s | %s | %s | %.2e (%s) | %d | %.0f / %.0f |" % (
+        lines.append("| %s | %s | %s (%s) | %s%s | %s | %s | %.2e (%s) | %d | %.0f / %.0f | %s |" % (
             r["case"], fmt(r["first_touch"]), fmt(d["first_nonzero"]), fmt(d["first_value"], "%.1e"), fmt(d["horizon"]),
             "" if d["reaches_roundoff_level"] else " (never reached)",
             "%.1f (%.2f–%.2f)" % (g["rate"], g["from"], g["to"]) if g else "—",
             fmt(1.0 / g["rate"], "%.3f") if g and g["rate"] > 0 else "—", d["final"],
             fmt(r["curve"]["time"][-1]), r["particles_at_end"], r["times"]["jdem"]["cpu"],
-            r["times"]["liggghts-jdem"]["cpu"]))
+            r["times"]["liggghts-jdem"]["cpu"], r.get("source", "—")))
     stops = ["- %s, %s: %s" % (r["case"], e, t["stopped"].split("; the trajectory")[0]) for r in results
              for e, t in r["times"].items() if "stopped" in t]
     return "\n".join(lines) + "\n" + ("\nStopped by the watchdog (compared up to the stop):\n\n"
@@ -205,15 +205,34 @@ def plot(results, path, title="Chapter 4 first fills", mark=None, mark_label="")
     plt.close(fig)
 
 
+def merged(a):
+    """The models' results, each with the commit it was run at (`source`): what was run under
+    a.out, else what the committed summary in a.results holds, so that a machine that ran a few
+    models keeps the others' (a summary written before the sources were recorded: its commit)."""
+    by_model = {}
+    committed = os.path.join(a.results or "", "summary.json")
+    if a.results and os.path.exists(committed):
+        doc = read_json(committed)
+        by_model = {r["case"]: dict(r, source=r.get("source", doc.get("commit", "not recorded")))
+                    for r in doc.get("models", [])}
+    here = commit()
+    for m in plan_ch4.MODELS:
+        path = os.path.join(a.out, "cross", m, RESULT)
+        if os.path.exists(path):
+            by_model[m] = dict(read_json(path), source=here)
+    return [by_model[m] for m in plan_ch4.MODELS if m in by_model], \
+        any(os.path.exists(os.path.join(a.out, "cross", m, RESULT)) for m in plan_ch4.MODELS)
+
+
 def summary(a):
-    found = [os.path.join(a.out, "cross", m, RESULT) for m in plan_ch4.MODELS]
-    results = [read_json(p) for p in found if os.path.exists(p)]
-    if not results:   # nothing run yet: the committed results stay as they are
+    results, ran_here = merged(a)
+    if not ran_here:   # nothing run yet: the committed results stay as they are
         print("horizon_ch4: no %s under %s/cross/modelM/; nothing written" % (RESULT, a.out))
         return 0
     target = os.path.join(a.out, "cross", "horizon")
     os.makedirs(target, exist_ok=True)
-    write_json(os.path.join(target, "summary.json"), {"commit": commit(), "models": results})
+    write_json(os.path.join(target, "summary.json"),
+               {"commits": sorted({r["source"] for r in results}), "models": results})
     with open(os.path.join(target, "horizon.md"), "w") as f:
         f.write(table(results))
     plot(results, os.path.join(target, "horizon.png"))

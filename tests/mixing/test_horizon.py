@@ -140,7 +140,26 @@ def main():
     check("touch-free-flight", touch_free is None, "first touch at %r in free flight" % touch_free)
     check("touch-kicked", touch_kick is not None and abs(touch_kick - KT * EVERY * DT) < 1e-12,
           "first touch at %r, the kick at %g" % (touch_kick, KT * EVERY * DT))
+    check_summary_merge()
     finish()
+
+
+def check_summary_merge():
+    """A machine that ran one model's horizon again keeps the committed summary's others, each
+    with the commit it was run at; the model run here replaces its committed result."""
+    import argparse
+    with tempfile.TemporaryDirectory() as d:
+        results, out = os.path.join(d, "results"), os.path.join(d, "out")
+        os.makedirs(results)
+        os.makedirs(os.path.join(out, "cross", "model2"))
+        horizon_ch4.write_json(os.path.join(results, "summary.json"), {"commit": "abc1234", "models": [
+            {"case": "model1", "mark": "committed"}, {"case": "model2", "mark": "committed"}]})
+        horizon_ch4.write_json(os.path.join(out, "cross", "model2", horizon_ch4.RESULT),
+                               {"case": "model2", "mark": "here"})
+        models, ran = horizon_ch4.merged(argparse.Namespace(out=out, results=results))
+    got = [(m["case"], m["mark"], m["source"]) for m in models]
+    check("horizon-summary-merge", ran and got == [("model1", "committed", "abc1234"),
+                                                   ("model2", "here", horizon_ch4.commit())], repr(got))
 
 
 if __name__ == "__main__":
