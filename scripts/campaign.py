@@ -22,6 +22,7 @@ wall and CPU time are its whole: an interrupted attempt's, written to its partia
 SPENT_EVERY seconds, are added to the attempt that finishes it.
 """
 import argparse
+import functools
 import importlib.util
 import json
 import os
@@ -181,6 +182,7 @@ def unit_threads(unit):
         return 1
 
 
+@functools.lru_cache(maxsize=None)
 def machine_name():
     """The CPU a unit's times were taken on (bench_summary.machine_info), which a cost comparison
     between units run in different sessions needs."""

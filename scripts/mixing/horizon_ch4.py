@@ -216,12 +216,10 @@ def merged(a):
         by_model = {r["case"]: dict(r, source=r.get("source", doc.get("commit", "not recorded")))
                     for r in doc.get("models", [])}
     here = commit()
-    for m in plan_ch4.MODELS:
-        path = os.path.join(a.out, "cross", m, RESULT)
-        if os.path.exists(path):
-            by_model[m] = dict(read_json(path), source=here)
-    return [by_model[m] for m in plan_ch4.MODELS if m in by_model], \
-        any(os.path.exists(os.path.join(a.out, "cross", m, RESULT)) for m in plan_ch4.MODELS)
+    ran = [m for m in plan_ch4.MODELS if os.path.exists(os.path.join(a.out, "cross", m, RESULT))]
+    for m in ran:
+        by_model[m] = dict(read_json(os.path.join(a.out, "cross", m, RESULT)), source=here)
+    return [by_model[m] for m in plan_ch4.MODELS if m in by_model], bool(ran)
 
 
 def summary(a):
