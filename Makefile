@@ -258,7 +258,8 @@ mixing: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,$(if $(MIXING_ENGINE),bu
 # Jiang's Chapter 5 bonded-block campaign (docs/mixing.md §11): the 18 fills of
 # reference_runs/mixing/ch5/models.yaml (Groups 1-3 x Models 1-6) and Chapter 6's two rigid-cement
 # fills (rigid_model1, rigid_model3) in both engines, the resumable units of
-# scripts/mixing/plan_ch5.py.  outputs: out/mixing/ch5/ENGINE/groupG_modelM/fill.h5
+# scripts/mixing/plan_ch5.py, and the realisations of a few fills (fill_jitterK: the run-to-run
+# spread of whole fills).  outputs: out/mixing/ch5/ENGINE/groupG_modelM/fill.h5
 #   make mixing-bonded [MODEL=group2_model3] [ENGINE=jdem|liggghts-jdem|cross] [UNIT=...] [NP=2] [LIST=1]
 #                      [RERUN=1]   (committed units: as `make mixing`)
 # (ENGINE=cross: the cross-engine horizons and first breaks, cross/groupG_modelM/horizon, and

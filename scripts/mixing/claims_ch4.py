@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from scripts.mixing import agreement_ch4, params, stats
+from scripts.mixing import agreement, agreement_ch4, params, stats
 
 MODELS = tuple("model%d" % m for m in range(1, 7))
 PASSES = (1, 2)
@@ -34,7 +34,7 @@ def phi_spread(found):
     it has two degrees of freedom, else the pool over every model; past the horizon the engines
     are realisations of one chaotic fill, so their spreads measure the same thing."""
     s = agreement_ch4.spreads(found)
-    return lambda model: agreement_ch4.spread_for(s, model, "φv")
+    return lambda model: agreement.spread_for(s, model, "φv")
 
 
 def ordered(phi, spread, pairs):

@@ -73,6 +73,16 @@ HORIZON_TIME, HORIZON_FRAME_TIME = 4.0, 0.02      # [s] the cross-engine horizon
 HORIZON_COST = 3.3        # both engines: liggghts-jdem takes 2.3 x jdem's CPU (47 s and 106 s, model1, 4 s)
 
 
+def shift_stream(doc, jitter):
+    """Move the scene doc's stream (its first inlet's origin) by jitter x JITTER in y, a
+    realisation of its fill (both chapters' generate.py --jitter); returns the words that say so
+    in the scene's description ("" for none)."""
+    if not jitter:
+        return ""
+    doc["inlets"][0]["origin"][1] += JITTER * jitter
+    return f", stream shifted by {jitter} x {JITTER} m in y (run-to-run spread)"
+
+
 def jdem():
     return os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
 

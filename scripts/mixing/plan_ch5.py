@@ -15,7 +15,9 @@ points 10-18 of Table 5-2 under 5 kPa, each with its own copy of the deposit and
 bonds), and `ENGINE/CASE/cubeK`, K = 10..18, their compressions, into
 out/mixing/ch5/ENGINE/CASE/cubeK.h5 (the 27 points' phi_v are read from the fill itself).
 Chapter 6's rigid cements add two fills per engine, rigid_model1 and rigid_model3 (Figs 6-1 and
-6-2), drawn but not compressed (the seed measures nothing in them).  Last, per bonded case
+6-2), drawn but not compressed (the seed measures nothing in them).  SPREAD_REALISATIONS's cases
+run their fill again with the stream shifted by K micrometres (`ENGINE/CASE/fill_jitterK`, not
+compressed): the run-to-run spread of whole fills (agreement_ch5.py).  Last, per bonded case
 (Groups 2 and 3), the cross-engine horizon (`cross/groupG_modelM/horizon`: the first
 HORIZON_TIME s of the fill in both engines, compared particle by particle and break by break,
 scripts/mixing/horizon_ch5.py), and each engine's runs of it with the stream shifted by K =
@@ -47,6 +49,13 @@ CASES = [f"group{g}_model{m}" for g in range(1, 4) for m in range(1, 7)]
 RIGID_CASES = ["rigid_model1", "rigid_model3"]   # Ch. 6, Figs 6-1 and 6-2: pictures, no cubes
 # the cross-engine horizons: the bonded groups (Group 1 has no bonds; its horizon is Ch. 4's)
 HORIZON_CASES = [c for c in CASES if not c.startswith("group1_")]
+# the run-to-run spread of whole fills, against which the engines' fills are weighed
+# (agreement_ch5.py): the fill again with the stream shifted by K micrometres, K = 1..N.  Model 3
+# (one obstacle: φv > 0 in every group) once per group in jdem, which the group's pool needs, and
+# Group 3's (the only one whose bonds neither all break nor none exist) in liggghts-jdem too,
+# which checks that the spread is the fill's, not an engine's
+SPREAD_REALISATIONS = {"jdem": {"group1_model3": 1, "group2_model3": 1, "group3_model3": 1},
+                       "liggghts-jdem": {"group3_model3": 1}}
 
 
 @functools.lru_cache(maxsize=None)
@@ -69,6 +78,18 @@ def committed_fill(engine, case, cubes=False):
         return "%s: %s/%s%s of commit %s" % (os.path.relpath(os.path.join(RESULTS, "summary.json"), ROOT),
                                             engine, case, ", cubes" if cubes else "",
                                             entry.get("source", "?"))
+    return where
+
+
+def committed_realisation(engine, case, k):
+    """f() for Unit.committed: where report_ch5.py's committed summary holds the engine's
+    realisation K of the case's fill."""
+    def where():
+        entry = committed_ch5().get(f"{engine}/{case}") or {}
+        if not any(r.get("jitter") == k for r in entry.get("realisations", [])):
+            return None
+        return "%s: %s/%s, realisation %d" % (os.path.relpath(os.path.join(RESULTS, "summary.json"), ROOT),
+                                              engine, case, k)
     return where
 
 
@@ -101,9 +122,9 @@ def keeps_energy(engine, case):
     return engine == "jdem" and case in CASES and case.split("_")[1] in ENERGY_MODELS
 
 
-def fill_cost(engine, case):
+def fill_cost(energy):
     """A fill's cost for the ETA: its particle-steps, times ENERGY_COST if it keeps the accounts."""
-    return FILL_PARTICLES * FILL_TIME / SEED_DT * (ENERGY_COST if keeps_energy(engine, case) else 1.0)
+    return FILL_PARTICLES * FILL_TIME / SEED_DT * (ENERGY_COST if energy else 1.0)
 
 
 def fill_unit(engine, case, ranks):
@@ -114,9 +135,24 @@ def fill_unit(engine, case, ranks):
                    f'-o "$1"')
     return Unit(f"{engine}/{case}/fill", [os.path.join(OUT, engine, case, "fill.h5")],
                 fill_command(engine, "{dir}/fill.yaml", False, resolve, ranks=ranks), case, engine,
-                validate=valid_trajectory, cost=fill_cost(engine, case),
+                validate=valid_trajectory, cost=fill_cost(keeps_energy(engine, case)),
                 resumes=resumable(engine), ranks=fill_ranks(engine, ranks),
                 committed=committed_fill(engine, case))
+
+
+def spread_units(engine, case, ranks):
+    """The case's fill again with the stream shifted by K micrometres (generate.py --jitter),
+    K = 1..SPREAD_REALISATIONS[engine][case], into out/mixing/ch5/ENGINE/CASE/fill_jitterK.h5;
+    without energy accounts, and not compressed: the deposit's statistics are what the spread
+    is of."""
+    return [Unit(f"{engine}/{case}/fill_jitter{k}", [os.path.join(OUT, engine, case, f"fill_jitter{k}.h5")],
+                 fill_command(engine, "{dir}/fill_jitter%d.yaml" % k, False,
+                              f'{shlex.quote(PY)} {shlex.quote(GENERATE)} fill --case {case} --no-energy '
+                              f'--jitter {k} -o "$1"', ranks=ranks),
+                 case, engine, validate=valid_trajectory, cost=fill_cost(False),
+                 resumes=resumable(engine), ranks=fill_ranks(engine, ranks),
+                 committed=committed_realisation(engine, case, k))
+            for k in range(1, SPREAD_REALISATIONS[engine].get(case, 0) + 1)]
 
 
 def cube_units(engine, case):
@@ -178,5 +214,5 @@ def units(argv):
         ap.error("--ranks %d: valid: a positive number of MPI ranks" % a.ranks)
     return [u for engine in ENGINES for case in CASES + RIGID_CASES
             for u in [fill_unit(engine, case, a.ranks)] +
-            (cube_units(engine, case) if case in CASES else [])] + \
+            (cube_units(engine, case) if case in CASES else []) + spread_units(engine, case, a.ranks)] + \
         [u for case in HORIZON_CASES for u in [horizon_unit(case)] + realisation_units(case)]

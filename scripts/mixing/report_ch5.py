@@ -12,8 +12,10 @@ below each obstacle (outflow.py); and when all 9 compressions of the middle clip
 (OUT/ENGINE/CASE/cubeK.h5, K = 10..18) Tables 5-4 and 5-5 (E, nu_xy, nu_xz of the orthotropic
 fit on the best-fit particle strain) and the unambiguous M and K0 (report_ch4.cube_result, the
 Ch. 4 analysis); the run times (CPU, else wall) from the campaign's .campaign_times.json; the
-seed's Figs 5-24 to 5-26 (plots.bonded_figure).  Then the seed's claims that the finished fills
-decide.  Writes OUT/report.md and OUT/summary.json, and with --results (default
+seed's Figs 5-24 to 5-26 (plots.bonded_figure); the realisations of a fill with the stream
+shifted (OUT/ENGINE/CASE/fill_jitterK.h5: its deposit and breakage, "realisations"), against whose
+spread the two engines' fills are weighed (agreement_ch5.py).  Then the seed's claims that the
+finished fills decide.  Writes OUT/report.md and OUT/summary.json, and with --results (default
 reference_runs/mixing/ch5/results for the default OUT) also there; a fill not under OUT
 is taken from the committed summary.json, with the commit it came from.  The seed reports no
 breakage at all (spec §4.3): those columns have no seed value.
@@ -24,9 +26,9 @@ import json
 import os
 import subprocess
 
-from scripts.mixing import fill_ch5, outflow, params, plots, stats, structure
+from scripts.mixing import agreement_ch5, fill_ch5, outflow, params, plots, stats, structure
 from scripts.mixing.fill_ch5 import FRAGMENT_BINS
-from scripts.mixing.plan_ch5 import CASES, ENERGY_MODELS, RIGID_CASES
+from scripts.mixing.plan_ch5 import CASES, ENERGY_MODELS, RIGID_CASES, SPREAD_REALISATIONS
 from scripts.mixing_views import scene_geometry
 from scripts.mixing.report_ch4 import commit, cube_result, provenance_section, write_atomic
 
@@ -117,6 +119,29 @@ def run_time(e, prefix=""):
         (" (%d threads)" % threads if threads > 1 else "")
 
 
+REALISATION_KEYS = ("particles", "time", "middle_clip", "surface", "packing", "breakage")
+
+
+def realisation(path, name, k, spent, rev):
+    """The summary entry of the fill's realisation K (fill_jitterK.h5): what agreement_ch5.py
+    compares, its run time and commit."""
+    r = fill_ch5.result(path)
+    entry = dict({key: r[key] for key in REALISATION_KEYS if key in r}, jitter=k, source=rev)
+    took = spent.get("%s/fill_jitter%d" % (name, k), {})
+    entry.update({key: took[key] for key in ("seconds", "cpu_seconds", "ranks", "threads", "machine")
+                  if took.get(key) is not None})
+    return entry
+
+
+def realisations(out, name, spent, rev, committed):
+    """The fill's realisations measured here, and the committed ones of the other K."""
+    engine, c = name.split("/")
+    here = [realisation(p, name, k, spent, rev) for k in range(1, SPREAD_REALISATIONS[engine].get(c, 0) + 1)
+            for p in [os.path.join(out, name, "fill_jitter%d.h5" % k)] if os.path.exists(p)]
+    ks = {r["jitter"] for r in here}
+    return sorted(here + [r for r in committed if r["jitter"] not in ks], key=lambda r: r["jitter"])
+
+
 def collect(out, committed, rev, directory):
     found, spent = {}, times(out)
     for engine in ENGINES:
@@ -126,7 +151,12 @@ def collect(out, committed, rev, directory):
             if os.path.exists(path):
                 found[name] = measure(path, name, out, spent, directory, rev)
             elif name in committed:
-                found[name] = committed[name]
+                found[name] = dict(committed[name])
+            else:
+                continue
+            reals = realisations(out, name, spent, rev, committed.get(name, {}).get("realisations", []))
+            if reals:
+                found[name]["realisations"] = reals
     return found
 
 
@@ -313,21 +343,23 @@ def hours(seconds):
 
 
 def campaign_time_table(found):
-    """The time of the campaign so far per engine: its finished fills' and compressions' wall and
-    CPU times summed, and the campaign's fills projected from the mean fill."""
-    n_fills = len(CASES + RIGID_CASES)
+    """The time of the campaign so far per engine: its finished fills' (with their realisations)
+    and compressions' wall and CPU times summed, and the campaign's fills projected from the mean
+    fill."""
+    planned = {e: len(CASES + RIGID_CASES) + sum(SPREAD_REALISATIONS[e].values()) for e in ENGINES}
     lines = ["### Time of the campaign per engine", "",
-             "the units' wall and CPU times summed over the finished fills and their 9 compressions "
-             "each (the units run one after another on a lane, so the sums are the campaign's time "
-             "on one lane; wall times include any pause, and units timed before the CPU time was "
-             "recorded have a wall time only); the whole campaign's %d fills projected from the "
-             "mean CPU time per fill" % n_fills, "",
+             "the units' wall and CPU times summed over the finished fills, their realisations with "
+             "the stream shifted and their 9 compressions each (the units run one after another on "
+             "a lane, so the sums are the campaign's time on one lane; wall times include any "
+             "pause, and units timed before the CPU time was recorded have a wall time only); the "
+             "whole campaign's fills (%s) projected from the mean CPU time per fill" %
+             ", ".join("%s %d" % (e, n) for e, n in planned.items()), "",
              "| engine | fills timed | fills' wall [h] | fills' CPU [h] | cube sets timed "
-             "| cubes' wall [h] | cubes' CPU [h] | %d fills projected [CPU h] |" % n_fills,
+             "| cubes' wall [h] | cubes' CPU [h] | all fills projected [CPU h] |",
              "|---|---|---|---|---|---|---|---|"]
     for engine in ENGINES:
         es = [e for n, e in sorted(found.items()) if n.split("/")[0] == engine]
-        fills = [e for e in es if e.get("seconds")]
+        fills = [f for e in es for f in [e] + e.get("realisations", []) if f.get("seconds")]
         cubes = [e for e in es if e.get("cube_seconds")]
         if not fills and not cubes:
             lines.append("| %s | 0 | — | — | 0 | — | — | — |" % engine)
@@ -337,7 +369,7 @@ def campaign_time_table(found):
         lines.append("| %s | %d (%d with CPU) | %s | %s | %d (%d with CPU) | %s | %s | %s |" % (
             engine, len(fills), len(cpu), hours([e["seconds"] for e in fills]), hours(cpu),
             len(cubes), len(cube_cpu), hours([e["cube_seconds"] for e in cubes]), hours(cube_cpu),
-            "%.1f" % (n_fills * sum(cpu) / len(cpu) / 3600.0) if cpu else "—"))
+            "%.1f" % (planned[engine] * sum(cpu) / len(cpu) / 3600.0) if cpu else "—"))
     return lines
 
 
@@ -466,6 +498,7 @@ def report(found, rev, figures=None):
         lines += ["", "Where the bonds broke (front view, the obstacles grey):", ""]
         lines += ["![%s](%s)" % m for m in maps]
     lines += [""] + horizon_section()
+    lines += [""] + agreement_ch5.section(found, CASES + RIGID_CASES)
     lines += [""] + structure_table(found) + [""] + energy_table(found) + [""] + campaign_time_table(found)
     lines += [""] + elastic_tables(found)
     lines += [""] + claims(found)

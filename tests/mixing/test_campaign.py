@@ -9,6 +9,8 @@ import sys
 import tempfile
 import time
 
+import yaml
+
 from tests.mixing.common import ROOT, check, finish
 
 CAMPAIGN = os.path.join(ROOT, "scripts", "campaign.py")
@@ -418,6 +420,32 @@ def test_ch5_fill_scenes():
           and differ == [("  energy: true", "  energy: false")], r.stderr + repr(differ[:3]))
 
 
+def test_ch5_realisation_scene():
+    """Chapter 5's realisations: the unit's command writes the case without accounts and with
+    --jitter K; that scene is the case, resolved by the engine, in every line but output.energy
+    and the inlet's origin, moved by K micrometres in y."""
+    from scripts.mixing import plan_ch5
+    plan = {u.name: u for u in plan_ch5.units([])}
+    unit = plan["liggghts-jdem/group3_model3/fill_jitter1"]
+    check("ch5_realisation_command", "--no-energy --jitter 1 " in unit.command[2]
+          and unit.outputs[0].endswith("liggghts-jdem/group3_model3/fill_jitter1.h5"), unit.command[2])
+    jdem = os.path.join(ROOT, "build", "jdem")
+    with tempfile.TemporaryDirectory() as d:
+        scene = os.path.join(d, "fill.yaml")
+        r = subprocess.run([sys.executable, plan_ch5.GENERATE, "fill", "--case", "group3_model3",
+                            "--no-energy", "--jitter", "2", "-o", scene], capture_output=True, text=True,
+                           env=dict(os.environ, PYTHONPATH=ROOT))
+        got = subprocess.run([jdem, "resolve", scene], capture_output=True, text=True).stdout
+        case = subprocess.run([jdem, "resolve", plan_ch5.SCENE, "--case", "group3_model3"],
+                              capture_output=True, text=True).stdout
+    differ = [(a, b) for a, b in zip(case.splitlines(), got.splitlines()) if a != b]
+    moved = [(yaml.safe_load(a)["origin"], yaml.safe_load(b)["origin"]) for a, b in differ if "origin:" in a]
+    check("ch5_realisation_scene", r.returncode == 0 and len(differ) == 2
+          and ("  energy: true", "  energy: false") in differ and len(moved) == 1
+          and moved[0][1][0] == moved[0][0][0] and moved[0][1][2] == moved[0][0][2]
+          and abs(moved[0][1][1] - moved[0][0][1] - 2e-6) < 1e-15, r.stderr + repr(differ[:3]))
+
+
 test_validation_and_selection()
 test_committed_results()
 test_not_yet_runnable()
@@ -428,4 +456,5 @@ test_ch4_ranks()
 test_ch4_plan()
 test_ch4_fill_resumes()
 test_ch5_fill_scenes()
+test_ch5_realisation_scene()
 finish()

@@ -13,7 +13,11 @@ fill_ch5}.py), on hand-made trajectories whose answers follow in closed form:
 * bond-steps: intact bonds held between the samples of observables/bonds;
 * the snapshot colours: big, whole block, fragment and single sphere apart;
 * the report: a bonded fill and a Ch. 6 rigid fill under --out appear in the new tables (the
-  worst fill named, the rigid fill's bonds all intact) with the numbers measured above.
+  worst fill named, the rigid fill's bonds all intact) with the numbers measured above; the
+  bonded fill's realisation (fill_jitter1.h5) with a bed one layer higher and liggghts-jdem's
+  fill give the bed height's bound 2 sqrt(2) s = 2 x 0.03 m, s the std of two beds 0.03 m apart;
+* the engines' agreement (agreement_ch5.py): own spreads from two degrees of freedom, else the
+  group's pool (never another group's), φv's floor, no breakage rows for unbonded fills.
 """
 import json
 import math
@@ -28,7 +32,7 @@ import numpy as np
 import yaml
 
 from tests.mixing.common import ROOT, check, close, finish
-from scripts.mixing import breakage, deposit, energy, fill_ch5, plots, structure
+from scripts.mixing import agreement_ch5, breakage, deposit, energy, fill_ch5, plots, structure
 
 R, PITCH, SIDE = 0.015, 0.03, 0.99          # 33 lattice periods across the box
 LO, HI = (0.0, 0.0, 0.0), (SIDE, SIDE, 2.0)
@@ -204,6 +208,11 @@ def test_report(tmp):
     with open(os.path.join(out, "jdem", "group1_model1", ".campaign_times.json"), "w") as f:
         json.dump({"jdem/group2_model3/fill": {"seconds": 5000.0, "cpu_seconds": 1200.0, "ranks": 1},
                    "jdem/rigid_model3/fill": {"seconds": 777.0}}, f)
+    # its realisation, a layer higher, and liggghts-jdem's fill of it
+    write_fill(os.path.join(out, "jdem", "group2_model3", "fill_jitter1.h5"),
+               bed(lambda x: 11 + int(x / (3 * PITCH))), rec, 0.25, "0.1.0+" + head)
+    os.makedirs(os.path.join(out, "liggghts-jdem", "group2_model3"))
+    write_fill(os.path.join(out, "liggghts-jdem", "group2_model3", "fill.h5"), dep, rec, 0.25, "0.1.0+" + head)
     run = subprocess.run([sys.executable, "-m", "scripts.mixing.report_ch5", "--out", out],
                          cwd=ROOT, capture_output=True, text=True)
     check("report: runs on a bonded and a rigid fill", run.returncode == 0, run.stderr[-800:])
@@ -223,10 +232,57 @@ def test_report(tmp):
           re.search(r"\| jdem \| rigid_model3 \| [^|]+ \| 3 \| 0 \| 2 \| 0 \| 777 w \|", text) is not None)
     check("report: the bond-steps, 3 x 100, per CPU second (300 / 1200 s, not the wall's 5000 s)",
           "| 300 | 1200 | 0.25 |" in text)
-    check("report: the campaign's time, 2 fills (1 with CPU): 5777 s wall, 1200 s CPU, 20 fills 6.7 CPU h",
-          "| jdem | 2 (1 with CPU) | 1.60 | 0.33 | 0 (0 with CPU) | — | — | 6.7 |" in text)
+    check("report: the campaign's time, 2 fills (1 with CPU): 5777 s wall, 1200 s CPU, 20 fills and "
+          "3 realisations 7.7 CPU h", "| jdem | 2 (1 with CPU) | 1.60 | 0.33 | 0 (0 with CPU) | — | — | 7.7 |" in text)
+    h = structure.free_surface(dep, LO, HI)["mean"]
+    check("report: the engines' bed heights agree, 0 against 2 sqrt(2) s = 2 x 0.03 m from the "
+          "realisation a layer higher", "| group2_model3 | bed height (mean surface) [m] | %.3f | %.3f "
+          "| 0.000 | 0.060 | pooled: jdem group2_model3 | held |" % (h, h) in text, h)
     for png in ("jdem_group2_model3_views.png", "jdem_rigid_model3_clip.png", "jdem_group2_model3_breaks.png"):
         check("report: draws %s" % png, os.path.exists(os.path.join(out, png)) and "(%s)" % png in text)
+
+
+def test_agreement_ch5():
+    """agreement_ch5.rows on hand-made summary entries: group3_model3 has two realisations in each
+    engine (two degrees of freedom: its own spread); group3_model1 takes Group 3's pool and not
+    Group 2's much wider one; φv of a segregated case measures no spread; Group 1 has no breakage
+    rows."""
+    def entry(phi, height, broken=None):
+        e = {"middle_clip": {"mean": phi}, "surface": {"mean": height},
+             "packing": {"interior": 0.70, "wall": 0.65}}
+        if broken is not None:
+            e["breakage"] = {"formed": 100, "total": broken, "tension": broken / 2, "shear": broken / 2,
+                             "fragments": 10, "singles": 5}
+        return e
+    found = {"jdem/group3_model3": dict(entry(0.02, 1.00, 0.40), realisations=[entry(0.03, 1.02, 0.42)]),
+             "liggghts-jdem/group3_model3": dict(entry(0.025, 1.01, 0.44), realisations=[entry(0.02, 1.01, 0.44)]),
+             "jdem/group3_model1": entry(0.0, 0.95, 0.50),
+             "liggghts-jdem/group3_model1": entry(0.0, 0.99, 0.52),
+             "jdem/group2_model3": dict(entry(0.001, 1.0, 0.9), realisations=[entry(0.002, 1.5, 0.1)]),
+             "liggghts-jdem/group2_model3": entry(0.001, 1.1, 0.9),
+             "jdem/group1_model3": entry(0.02, 1.0),
+             "liggghts-jdem/group1_model3": entry(0.03, 1.0)}
+    rows = {(r[0], r[1]): r for r in agreement_ch5.rows(found, ["group1_model3", "group2_model3",
+                                                                 "group3_model1", "group3_model3"])}
+    # Group 3's heights: jdem 1.00, 1.02 (ss 2e-4), liggghts-jdem 1.01, 1.01 (ss 0): s = 0.01
+    own = rows[("group3_model3", "bed height (mean surface) [m]")]
+    check("agreement_ch5: own spread of group3_model3 from two engines' pairs, 2 sqrt(2) x 0.01",
+          own[5] == "%.3f" % (2 * math.sqrt(2) * 0.01) and own[6].startswith("group3_model3, realisations")
+          and own[7] is True, own)
+    pool = rows[("group3_model1", "bed height (mean surface) [m]")]
+    check("agreement_ch5: group3_model1 pooled over Group 3 only, 0.04 beyond 0.028",
+          pool[5] == "0.028" and pool[6] == "pooled: jdem group3_model3, liggghts-jdem group3_model3"
+          and pool[4] == "0.040" and pool[7] is False, pool)
+    broken = rows[("group3_model1", "bonds broken (fraction)")]
+    check("agreement_ch5: breakage pooled the same way, s = sqrt((2e-4 + 0) / 2) = 0.01",
+          broken[5] == "0.028" and broken[7] is True, broken)
+    check("agreement_ch5: Group 2's φv below the floor measures no spread",
+          rows[("group2_model3", "φv at the middle clip")][6] == "no spread measured")
+    check("agreement_ch5: Group 2's wide realisation stays in Group 2's pool",
+          rows[("group2_model3", "bed height (mean surface) [m]")][5] == "%.3f" % (2 * 0.5))
+    check("agreement_ch5: Group 1 without bonds has no breakage rows and no spread",
+          ("group1_model3", "bonds broken (fraction)") not in rows
+          and rows[("group1_model3", "φv at the middle clip")][7] is None)
 
 
 with tempfile.TemporaryDirectory() as tmp:
@@ -235,4 +291,5 @@ with tempfile.TemporaryDirectory() as tmp:
     test_fragments()
     test_bond_steps(tmp)
     test_report(tmp)
+test_agreement_ch5()
 finish()

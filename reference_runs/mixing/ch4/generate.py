@@ -42,7 +42,7 @@ import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 from scripts.mixing import cube_scene, deposit, params
-from scripts.mixing.plan_ch4 import JITTER   # [m] one step of --jitter
+from scripts.mixing.plan_ch4 import shift_stream
 from scripts.stability_scenes import set_path  # the sweep's dotted-path override
 
 MODELS = os.path.join(HERE, "models.yaml")
@@ -87,10 +87,7 @@ def fill(args):
         doc["time"]["end_time"] = args.end_time
     if args.frame_every is not None:
         doc["output"]["every"] = args.frame_every
-    jitter = ""
-    if args.jitter:
-        doc["inlets"][0]["origin"][1] += JITTER * args.jitter
-        jitter = f", stream shifted by {args.jitter} x {JITTER} m in y (run-to-run spread)"
+    jitter = shift_stream(doc, args.jitter)
     write(args.out, doc, f"first pass, {args.case}, dt {doc['time']['dt']}, "
                          f"{doc['inlets'][0]['stop']['sections']} sections, "
                          f"{doc['time']['end_time']} s{jitter}")

@@ -2,13 +2,15 @@
 """generate.py — the Chapter 5 fills without energy accounts, and the compression cubes cut from a
 bonded fill's deposit (docs/mixing.md §11); every scene runs in both engines.
 
-    generate.py fill --case groupG_modelM --no-energy -o FILL.yaml
+    generate.py fill --case groupG_modelM --no-energy [--jitter K] -o FILL.yaml
     generate.py cubes DEPOSIT.h5 --case groupG_modelM -o DIR   (writes DIR/cubeK.yaml, K = 10..18)
 
 `fill --no-energy` writes the resolved case with output.energy: false, the scene of every fill
 that keeps no energy accounts (all but jdem's Models 2 and 4, plan_ch5.keeps_energy): the same
 trajectory bit for bit as with the accounts (suite cross-engine, the energy-off checks), at a
-contact history of 7 doubles instead of 23 (docs/mixing.md §11).
+contact history of 7 doubles instead of 23 (docs/mixing.md §11).  --jitter K shifts the stream
+by K x plan_ch4.JITTER in y, as Ch. 4's generate.py: one more realisation of the fill, for the
+run-to-run spread the two engines' fills are weighed against (scripts/mixing/agreement_ch5.py).
 
 A 0.2 m cube at each middle-clip point (points 10-18 of Table 5-2, y = 0.5 m) under a servo top
 wall at sigma_zz = 5 kPa [TEXT] +- 1 % [RECON] (the seed states no tolerance), with Table 5-1's
@@ -28,6 +30,7 @@ import yaml
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 from scripts.mixing import cube_scene, deposit, params
+from scripts.mixing.plan_ch4 import JITTER, shift_stream   # [m] one step of --jitter
 
 MODELS = os.path.join(HERE, "models.yaml")
 SERVO_TARGET = 5000.0     # [TEXT] spec §2.4: sigma_zz = 5 kPa
@@ -48,8 +51,9 @@ def case_scene(case):
 def fill(args):
     doc = case_scene(args.case)
     doc["output"]["energy"] = False
+    jitter = shift_stream(doc, args.jitter)
     cube_scene.write(args.out, doc, "reference_runs/mixing/ch5/generate.py",
-                     f"the fill of {args.case} without energy accounts")
+                     f"the fill of {args.case} without energy accounts{jitter}")
 
 
 def cubes(args):
@@ -76,6 +80,8 @@ def main():
     f.add_argument("--no-energy", action="store_true", required=True,
                    help="output.energy: false (the only variant: with the accounts, jdem resolve "
                    "writes the case)")
+    f.add_argument("--jitter", type=int, default=0,
+                   help="shift the stream by K x %g m in y: a realisation of the fill (default 0)" % JITTER)
     f.add_argument("-o", "--out", required=True)
     p = sub.add_parser("cubes")
     p.add_argument("deposit")

@@ -1,0 +1,90 @@
+"""agreement.py — two engines' fills against the run-to-run spread, the rule of both chapters'
+reports (agreement_ch4.py, agreement_ch5.py).
+
+Past the cross-engine horizon (under a second of a fill) jdem and liggghts-jdem are two
+realisations of the same chaotic fill, so their results can differ by what two realisations of
+one engine differ by.  Each statistic's difference |jdem - liggghts-jdem| is set against
+2 sqrt(2) s: s the sample standard deviation of that statistic over the realisations of one fill
+(the fill and its repeats with the stream shifted by K micrometres), sqrt(2) for the difference
+of two independent runs, 2 for two standard deviations.  s is the case's own, pooled over both
+engines' realisations of it, where that has at least OWN_SPREAD_DOF degrees of freedom (three
+realisations in one engine, or two in each), else pooled over the realisations of every case of
+its pool (a std from two runs has one degree of freedom, and its 95 % interval spans 0.03 to 2.2
+times the true one).  A statistic with a floor (φv: a tenth of the ideal) measures no spread in a
+case whose realisations all fall below it: a fill that separates the cohorts has no φv spread, and
+its zero std would shrink the pool of the fills that mix.
+"""
+import collections
+import math
+
+import numpy as np
+
+ENGINES = ("jdem", "liggghts-jdem")
+OWN_SPREAD_DOF = 2    # degrees of freedom from which a case's own std is used rather than the pool
+
+
+# label: the row's name; get(result) -> float or None (not measured); fmt: its format; floor:
+# realisations all below it measure no spread (None: every realisation counts)
+Statistic = collections.namedtuple("Statistic", "label get fmt floor", defaults=(None,))
+
+
+def spreads(runs, statistics, pool_of=lambda key: None):
+    """{(key, label): (s, source)} for each case key with OWN_SPREAD_DOF degrees of freedom of its
+    own, and {(("pool", pool), label): (s, source)} over every case of a pool with at least two
+    realisations in one engine.  runs: {key: {engine: [result, ...]}}, each engine's
+    realisations of the case; pool_of(key): the pool the case's realisations join."""
+    out, pooled = {}, {}
+    for key, by_engine in runs.items():
+        own = {}
+        for engine in ENGINES:
+            results = by_engine.get(engine, [])
+            if len(results) < 2:
+                continue
+            for st in statistics:
+                vals = [st.get(r) for r in results]
+                if None in vals or (st.floor is not None and max(vals) < st.floor):
+                    continue
+                ss = float(np.var(vals, ddof=1)) * (len(vals) - 1)
+                for acc, name in ((own.setdefault(st.label, [0.0, 0, []]), "%s, %d" % (engine, len(results))),
+                                  (pooled.setdefault((pool_of(key), st.label), [0.0, 0, []]),
+                                   "%s %s" % (engine, key))):
+                    acc[0] += ss
+                    acc[1] += len(vals) - 1
+                    acc[2].append(name)
+        for label, (ss, dof, names) in own.items():
+            if dof >= OWN_SPREAD_DOF:
+                out[(key, label)] = (math.sqrt(ss / dof), "%s, realisations: %s" % (key, "; ".join(names)))
+    for (pool, label), (ss, dof, names) in pooled.items():
+        out[(("pool", pool), label)] = (math.sqrt(ss / dof), "pooled: " + ", ".join(names))
+    return out
+
+
+def spread_for(s, key, label, pool=None):
+    """The case's own spread of the statistic, else its pool's, else None."""
+    return s.get((key, label)) or s.get((("pool", pool), label))
+
+
+def compare(a, b, statistics, spread, missing="not measured"):
+    """Rows (label, jdem, liggghts-jdem, |difference|, bound, spread source, held or None) of one
+    case's two fills a and b; spread(label) -> (s, source) or None.  A statistic neither fill
+    measures gives no row; one that only one measures gives a row saying `missing`."""
+    out = []
+    for st in statistics:
+        va, vb = st.get(a), st.get(b)
+        if va is None and vb is None:
+            continue
+        if va is None or vb is None:
+            out.append((st.label, "—" if va is None else st.fmt % va, "—" if vb is None else st.fmt % vb,
+                        "—", "—", missing, None))
+            continue
+        diff = abs(va - vb)
+        sp = spread(st.label)
+        bound = 2.0 * math.sqrt(2.0) * sp[0] if sp else None
+        out.append((st.label, st.fmt % va, st.fmt % vb, st.fmt % diff,
+                    st.fmt % bound if sp else "—", sp[1] if sp else "no spread measured",
+                    None if bound is None else diff <= bound))
+    return out
+
+
+def verdict(ok):
+    return "—" if ok is None else ("held" if ok else "not held")

@@ -1,0 +1,78 @@
+"""agreement_ch5.py — the two engines' whole Chapter 5 fills against the run-to-run spread
+(report_ch5.py; the issue's "after chaos sets in, the totals agree within the run-to-run
+spread"), by agreement.py's rule.
+
+For every case with both engines' fill, each statistic of the deposit and of its breakage is set
+against 2 sqrt(2) s, s the std over the realisations of the case's fill (the fill and its repeats
+with the stream shifted by K micrometres, plan_ch5.SPREAD_REALISATIONS): the case's own where it
+has two degrees of freedom, else pooled over the realisations of its group's cases.  The pool is
+the group's, not the campaign's: the bonds set the spread of the breakage (Group 2's all break,
+Group 3's about half), and Group 1 has none.  The horizon's spread of the bonds broken by 2 s
+(horizon_ch5.py) is the same comparison early in the fill; this one is at its end.
+"""
+from scripts.mixing import agreement, agreement_ch4
+from scripts.mixing.agreement import Statistic
+
+
+def bonded(key):
+    """A breakage statistic of a fill, None for a fill without bonds (Group 1)."""
+    return lambda e: float(e["breakage"][key]) if e.get("breakage", {}).get("formed") else None
+
+
+STATISTICS = (
+    Statistic("φv at the middle clip", lambda e: e["middle_clip"]["mean"], "%.4f", agreement_ch4.SEGREGATED),
+    Statistic("bed height (mean surface) [m]", lambda e: e["surface"]["mean"], "%.3f"),
+    Statistic("solid fraction, interior", lambda e: e["packing"]["interior"], "%.4f"),
+    Statistic("solid fraction near the walls", lambda e: e["packing"]["wall"], "%.4f"),
+    Statistic("bonds broken (fraction)", bonded("total"), "%.3f"),
+    Statistic("broken in tension (fraction)", bonded("tension"), "%.3f"),
+    Statistic("broken in shear (fraction)", bonded("shear"), "%.3f"),
+    Statistic("fragments at the end", bonded("fragments"), "%.0f"),
+    Statistic("single spheres at the end", bonded("singles"), "%.0f"))
+ENGINES = agreement.ENGINES
+
+
+def group(case):
+    """The pool of a case's realisations: its group (rigid_modelM: the rigid cements)."""
+    return case.split("_")[0]
+
+
+def realisations(entry):
+    """The fill and its realisations (report_ch5.py's "realisations") of one engine and case."""
+    return ([entry] if entry else []) + (entry or {}).get("realisations", [])
+
+
+def rows(found, cases):
+    """(case, label, jdem, liggghts-jdem, |difference|, bound, spread source, held or None) for
+    each case with both engines' fill; found: report_ch5.py's {"ENGINE/CASE": entry}."""
+    runs = {c: {e: realisations(found.get("%s/%s" % (e, c))) for e in ENGINES} for c in cases}
+    s, out = agreement.spreads(runs, STATISTICS, group), []
+    for c in cases:
+        a, b = (found.get("%s/%s" % (e, c)) for e in ENGINES)
+        if a and b:
+            out += [(c,) + r for r in agreement.compare(
+                a, b, STATISTICS, lambda label: agreement.spread_for(s, c, label, group(c)))]
+    return out
+
+
+def section(found, cases):
+    """The markdown lines of the report's section (a line saying what is missing when no case
+    has both engines' fill)."""
+    head = ["### Whole fills, jdem against liggghts-jdem, within the run-to-run spread", ""]
+    found_rows = rows(found, cases)
+    if not found_rows:
+        return head + ["(no case has both engines' fill yet)"]
+    held = [r[-1] for r in found_rows if r[-1] is not None]
+    lines = head + [
+        "past the horizon the engines are two realisations of one chaotic fill: |jdem − "
+        "liggghts-jdem| at the end of the fill against 2√2 s, s the std over the realisations of "
+        "one fill (the stream shifted by K µm; the case's own, else pooled over its group); "
+        "scripts/mixing/agreement_ch5.py", "",
+        "| case | statistic | jdem | liggghts-jdem | difference | 2√2 s | s from | agree |",
+        "|---|---|---|---|---|---|---|---|"]
+    for c, label, a, b, d, bound, source, ok in found_rows:
+        lines.append("| %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            c, label, a, b, d, bound, source, agreement.verdict(ok)))
+    lines += ["", "%d of %d statistics with a measured spread agree; %d have no spread measured yet." % (
+        sum(held), len(held), len(found_rows) - len(held))]
+    return lines
