@@ -19,11 +19,26 @@ def bonded(key):
     return lambda e: float(e["breakage"][key]) if e.get("breakage", {}).get("formed") else None
 
 
+def outflow_spread(k):
+    """The std of the outflow's direction below the fill's obstacle k (outflow.py), None for a
+    model with fewer obstacles."""
+    return lambda e: e["outflow"][k]["std"] if len(e.get("outflow", [])) > k else None
+
+
+PHI, PHI_STD, INCLINATION, VOIDS = ("φv at the middle clip", "std of φv at the middle clip",
+                                    "free-surface inclination [deg]",
+                                    "solid fraction interior − near the walls")
+OUTFLOW = ("outflow spread below obstacle 1 [deg]", "outflow spread below obstacle 2 [deg]")
 STATISTICS = (
-    Statistic("φv at the middle clip", lambda e: e["middle_clip"]["mean"], "%.4f", agreement_ch4.SEGREGATED),
+    Statistic(PHI, lambda e: e["middle_clip"]["mean"], "%.4f", agreement_ch4.SEGREGATED),
+    Statistic(PHI_STD, lambda e: e["middle_clip"]["std"], "%.4f", agreement_ch4.SEGREGATED),
     Statistic("bed height (mean surface) [m]", lambda e: e["surface"]["mean"], "%.3f"),
+    Statistic(INCLINATION, lambda e: e["surface"]["inclination"], "%.1f"),
     Statistic("solid fraction, interior", lambda e: e["packing"]["interior"], "%.4f"),
     Statistic("solid fraction near the walls", lambda e: e["packing"]["wall"], "%.4f"),
+    Statistic(VOIDS, lambda e: e["packing"]["interior"] - e["packing"]["wall"], "%.4f"),
+    Statistic(OUTFLOW[0], outflow_spread(0), "%.1f"),
+    Statistic(OUTFLOW[1], outflow_spread(1), "%.1f"),
     Statistic("bonds broken (fraction)", bonded("total"), "%.3f"),
     Statistic("broken in tension (fraction)", bonded("tension"), "%.3f"),
     Statistic("broken in shear (fraction)", bonded("shear"), "%.3f"),
@@ -42,16 +57,23 @@ def realisations(entry):
     return ([entry] if entry else []) + (entry or {}).get("realisations", [])
 
 
+def spread(found, cases):
+    """f(case, label) -> (s, source) or None: the run-to-run spread of a statistic of the case's
+    fill (agreement.spreads over every case's realisations in both engines, pooled per group);
+    found: report_ch5.py's {"ENGINE/CASE": entry}."""
+    runs = {c: {e: realisations(found.get("%s/%s" % (e, c))) for e in ENGINES} for c in cases}
+    s = agreement.spreads(runs, STATISTICS, group)
+    return lambda c, label: agreement.spread_for(s, c, label, group(c))
+
+
 def rows(found, cases):
     """(case, label, jdem, liggghts-jdem, |difference|, bound, spread source, held or None) for
-    each case with both engines' fill; found: report_ch5.py's {"ENGINE/CASE": entry}."""
-    runs = {c: {e: realisations(found.get("%s/%s" % (e, c))) for e in ENGINES} for c in cases}
-    s, out = agreement.spreads(runs, STATISTICS, group), []
+    each case with both engines' fill."""
+    s, out = spread(found, cases), []
     for c in cases:
         a, b = (found.get("%s/%s" % (e, c)) for e in ENGINES)
         if a and b:
-            out += [(c,) + r for r in agreement.compare(
-                a, b, STATISTICS, lambda label: agreement.spread_for(s, c, label, group(c)))]
+            out += [(c,) + r for r in agreement.compare(a, b, STATISTICS, lambda label: s(c, label))]
     return out
 
 

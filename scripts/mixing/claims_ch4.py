@@ -11,11 +11,11 @@ one fill per model cannot order them (docs/mixing.md §3).
 found[engine][model] holds "fillP" (fill_result: per-point parameters, their trimmed summary and
 the cohorts' sides) and "passP_cubes" (cube_result per cube) of report_ch4.py.
 """
-import math
 
 import numpy as np
 
 from scripts.mixing import agreement, agreement_ch4, params, stats
+from scripts.mixing.agreement import UNRESOLVED, ordered
 
 MODELS = tuple("model%d" % m for m in range(1, 7))
 PASSES = (1, 2)
@@ -25,9 +25,6 @@ def verdict(ok):
     return "held" if ok else "not held"
 
 
-UNRESOLVED = "not resolved (within the run-to-run spread)"
-
-
 def phi_spread(found):
     """model -> (s, source) of the trimmed mean phi_v over a fill's realisations, or None
     (agreement_ch4.spreads): the model's own, pooled over both engines' realisations of it, once
@@ -35,27 +32,6 @@ def phi_spread(found):
     are realisations of one chaotic fill, so their spreads measure the same thing."""
     s = agreement_ch4.spreads(found)
     return lambda model: agreement.spread_for(s, model, "φv")
-
-
-def ordered(phi, spread, pairs):
-    """Verdict and margin text of "a mixes better than b" for every (a, b) in pairs: held when
-    every difference phi_a - phi_b exceeds 2 sqrt(s_a² + s_b²), not held when one falls below
-    minus it, otherwise not resolved; plain signs when no spread is measured."""
-    signs, bounds = [], []
-    for a, b in pairs:
-        sa, sb = spread(a), spread(b)
-        if not (sa and sb):
-            signs.append(1 if phi[a] > phi[b] else -1)
-            continue
-        bound = 2.0 * math.hypot(sa[0], sb[0])
-        bounds.append(bound)
-        d = phi[a] - phi[b]
-        signs.append(1 if d > bound else (-1 if d < -bound else 0))
-    text = verdict(all(x > 0 for x in signs)) if all(x != 0 for x in signs) or -1 in signs \
-        else UNRESOLVED
-    if not bounds:
-        return text, "no run-to-run spread measured"
-    return text, "a difference counts beyond 2√(s_a² + s_b²) = %.4f" % max(bounds)
 
 
 def phi_means(found, engine, p):

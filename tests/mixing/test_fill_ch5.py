@@ -17,7 +17,9 @@ fill_ch5}.py), on hand-made trajectories whose answers follow in closed form:
   bonded fill's realisation (fill_jitter1.h5) with a bed one layer higher and liggghts-jdem's
   fill give the bed height's bound 2 sqrt(2) s = 2 x 0.03 m, s the std of two beds 0.03 m apart;
 * the engines' agreement (agreement_ch5.py): own spreads from two degrees of freedom, else the
-  group's pool (never another group's), φv's floor, no breakage rows for unbonded fills.
+  group's pool (never another group's), φv's floor, no breakage rows for unbonded fills;
+* the seed's claims against those spreads (report_ch5.claims): each verdict (held, not held, not
+  resolved) follows from hand-made fills and realisations whose stds are set in closed form.
 """
 import json
 import math
@@ -32,7 +34,7 @@ import numpy as np
 import yaml
 
 from tests.mixing.common import ROOT, check, close, finish
-from scripts.mixing import agreement_ch5, breakage, deposit, energy, fill_ch5, plots, structure
+from scripts.mixing import agreement, agreement_ch5, breakage, deposit, energy, fill_ch5, plots, structure
 
 R, PITCH, SIDE = 0.015, 0.03, 0.99          # 33 lattice periods across the box
 LO, HI = (0.0, 0.0, 0.0), (SIDE, SIDE, 2.0)
@@ -248,7 +250,7 @@ def test_agreement_ch5():
     Group 2's much wider one; φv of a segregated case measures no spread; Group 1 has no breakage
     rows."""
     def entry(phi, height, broken=None):
-        e = {"middle_clip": {"mean": phi}, "surface": {"mean": height},
+        e = {"middle_clip": {"mean": phi, "std": 0.01}, "surface": {"mean": height, "inclination": 3.0},
              "packing": {"interior": 0.70, "wall": 0.65}}
         if broken is not None:
             e["breakage"] = {"formed": 100, "total": broken, "tension": broken / 2, "shear": broken / 2,
@@ -285,6 +287,49 @@ def test_agreement_ch5():
           and rows[("group1_model3", "φv at the middle clip")][7] is None)
 
 
+def test_claims_ch5():
+    """report_ch5.claims on Model 3's three groups in jdem, each fill with one realisation: a std
+    of two values a and b is |a - b| / sqrt(2), so a difference of two groups counts beyond
+    2 sqrt(s_a² + s_b²) = 2 sqrt((a1 - b1)² + (a2 - b2)²) / sqrt(2)."""
+    from scripts.mixing import report_ch5
+
+    def fill(phi, phi_std, outflow_std, inclination, voids):
+        return {"middle_clip": {"mean": phi, "std": phi_std}, "surface": {"inclination": inclination, "mean": 1.0},
+                "packing": {"interior": 0.70, "wall": 0.70 - voids},
+                "outflow": [{"x": 0.3, "z": 1.5, "n": 100, "mean": 0.0, "std": outflow_std}]}
+
+    def with_realisation(a, b):
+        return dict(a, realisations=[b])
+    found = {"jdem/group1_model3": with_realisation(fill(0.02, 0.020, 20.0, 10.0, 0.03), fill(0.03, 0.022, 21.0, 12.0, 0.03)),
+             "jdem/group2_model3": with_realisation(fill(0.05, 0.008, 25.0, 10.0, 0.03), fill(0.04, 0.006, 24.0, 10.0, 0.03)),
+             "jdem/group3_model3": with_realisation(fill(0.025, 0.02, 20.0, 5.0, 0.08), fill(0.035, 0.02, 20.0, 6.0, 0.07))}
+    text = "\n".join(report_ch5.claims(found))
+
+    def verdict(start):
+        line = [x for x in text.splitlines() if x.startswith("- jdem Model 3: " + start)]
+        return (line[0].rsplit("**", 2)[1], line[0]) if len(line) == 1 else (None, line)
+    # φv: |0.05 - 0.0625| against |0.02 - 0.0625|, 0.03 beyond 2 sqrt(0.01² + 0.01²) / sqrt(2) = 0.02
+    v, line = verdict("Group 2 blocks mix better")
+    check("claims_ch5: Group 2 mixes better, 0.03 beyond 0.0200", v == "held" and "= 0.0200" in line, line)
+    v, line = verdict("Group 3 blocks mix better")
+    check("claims_ch5: Group 3 by 0.005 within 0.0200: not resolved", v == agreement.UNRESOLVED, line)
+    # std of φv: half of Group 1's (0.010) above Group 2's (0.008) by 0.002, within
+    # 2 sqrt((0.002 / 2)² + 0.002²) / sqrt(2) = 0.0032
+    v, line = verdict("the spread of φv drops")
+    check("claims_ch5: the φv spread's halving, 0.002 within 0.0032: not resolved",
+          v == agreement.UNRESOLVED and "= 0.0032" in line, line)
+    # outflow: 25 against 20, beyond 2 sqrt(1 + 1) / sqrt(2) = 2
+    v, line = verdict("weak blocks widen the outflow")
+    check("claims_ch5: the outflow widens by 5° beyond 2°", v == "held" and "= 2.0000" in line, line)
+    # inclination: 5 against 10, below minus 2 sqrt(4 + 1) / sqrt(2) = 3.16
+    v, line = verdict("strong bonds leave a more inclined")
+    check("claims_ch5: the surface less inclined by 5° beyond 3.16: not held",
+          v == "not held" and "= 3.1623" in line, line)
+    # voids: 0.08 against 0.03; Group 1's equal realisations give s = 0, Group 3's 0.01 / sqrt(2)
+    v, line = verdict("strong bonds leave more voids")
+    check("claims_ch5: more voids near the walls, 0.05 beyond 0.0141", v == "held" and "= 0.0141" in line, line)
+
+
 with tempfile.TemporaryDirectory() as tmp:
     test_structure()
     test_energy(tmp)
@@ -292,4 +337,5 @@ with tempfile.TemporaryDirectory() as tmp:
     test_bond_steps(tmp)
     test_report(tmp)
 test_agreement_ch5()
+test_claims_ch5()
 finish()
