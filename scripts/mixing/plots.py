@@ -17,6 +17,9 @@ strip plot over the models with a finished fill of that pass.
 bonded_figure: the seed's Fig. 5-24, 5-25 or 5-26 (Groups 1, 2, 3) of one engine from the fills
 of report_ch5.py: (a) phi_v at the 27 points of Table 5-2 in three segments, y = 0.25, 0.5 and
 0.75 m, and (b) at the 9 points of the middle clip, each a strip plot over the models.
+elastic_figure: the seed's Fig. 5-27, E at the middle clip per group over the six models, the
+seed's mean and std beside each engine's; and beneath it the confined modulus M, which the seed
+does not give but which a laterally confined cube determines (the E of the fit does not).
 """
 import os
 
@@ -269,3 +272,39 @@ def write_bonded_figures(found, engines, directories):
     group): file name}."""
     return write_figures(lambda e, g: bonded_figure(found, e, g), bonded_figure_name, engines,
                          SEED_BONDED_FIGURE, directories)
+
+
+# Fig. 5-27 and the M row beneath it: each source's marker and colour, side by side per model
+ELASTIC_SOURCES = (("seed", "s", "0.45"), ("jdem", "o", "tab:blue"), ("liggghts-jdem", "^", "tab:orange"))
+
+
+def elastic_figure(values, groups=(1, 2, 3), models=range(1, 7)):
+    """The open figure of Fig. 5-27 (top row, E) and of M (bottom row) per group, or None when no
+    source has a value.  values[(quantity, group, model, source)] = (mean, std), quantity "E" or
+    "M", source one of ELASTIC_SOURCES; a missing key draws nothing.  The error bars carry the
+    label "QUANTITY SOURCE group G" so that a test can read back what was drawn."""
+    if not values:
+        return None
+    fig, axes = plt.subplots(2, len(groups), figsize=(4.2 * len(groups), 7), dpi=100, sharey="row",
+                             squeeze=False)
+    for row, (quantity, unit) in enumerate((("E", "E [Pa] (orthotropic fit)"), ("M", "M [Pa] (wall strain)"))):
+        for ax, g in zip(axes[row], groups):
+            for k, (source, marker, colour) in enumerate(ELASTIC_SOURCES):
+                pts = [(m, values[(quantity, g, m, source)]) for m in models
+                       if (quantity, g, m, source) in values]
+                if not pts:
+                    continue
+                x = np.array([m for m, _ in pts]) + 0.2 * (k - 1)
+                ax.errorbar(x, [v[0] for _, v in pts], yerr=[v[1] for _, v in pts], fmt=marker,
+                            color=colour, capsize=3, label=f"{quantity} {source} group {g}")
+            ax.axhline(0.0, color="0.8", lw=0.8)
+            ax.set_xticks(list(models))
+            ax.set_xlabel("model")
+            ax.set_title("(%s) Group %d" % ("abc"[g - 1], g) if row == 0 else "M, Group %d" % g, fontsize=9)
+        axes[row][0].set_ylabel(unit)
+    handles = [plt.Line2D([], [], marker=mk, color=c, ls="none", label=src) for src, mk, c in ELASTIC_SOURCES]
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8)
+    fig.suptitle("Fig. 5-27: E at the middle clip (σzz = 5 kPa), mean ± std over the 9 cubes, the "
+                 "highest and lowest dropped; below, M, which the seed does not give", fontsize=9)
+    fig.tight_layout(rect=(0, 0.04, 1, 0.97))
+    return fig

@@ -19,7 +19,9 @@ fill_ch5}.py), on hand-made trajectories whose answers follow in closed form:
 * the engines' agreement (agreement_ch5.py): own spreads from two degrees of freedom, else the
   group's pool (never another group's), φv's floor, no breakage rows for unbonded fills;
 * the seed's claims against those spreads (report_ch5.claims): each verdict (held, not held, not
-  resolved) follows from hand-made fills and realisations whose stds are set in closed form.
+  resolved) follows from hand-made fills and realisations whose stds are set in closed form;
+* Fig. 5-27: the points drawn are the seed's Table 5-4 value and the trimmed mean of the cubes'
+  E and M (100, 200, ..., 900 Pa: 500 ± 216 without the highest and lowest).
 """
 import json
 import math
@@ -330,6 +332,24 @@ def test_claims_ch5():
     check("claims_ch5: more voids near the walls, 0.05 beyond 0.0141", v == "held" and "= 0.0141" in line, line)
 
 
+def test_elastic_figure():
+    from scripts.mixing import report_ch5
+    cubes = [{"E": 100.0 * k, "M_wall": 1000.0 * k} for k in range(1, 10)]
+    fig = plots.elastic_figure(report_ch5.elastic_values({"jdem/group2_model4": {"cubes": cubes}}))
+    drawn = {c.get_label(): (list(c.lines[0].get_xdata()), list(c.lines[0].get_ydata()))
+             for ax in fig.axes for c in ax.containers}
+    bars = {c.get_label(): c.lines[2][0].get_segments()[0] for ax in fig.axes for c in ax.containers}
+    plots.plt.close(fig)
+    trimmed = np.std(np.arange(200.0, 900.0, 100.0), ddof=1)
+    check("fig5-27: jdem's E of group2_model4 at model 4, the trimmed mean 500 (std %.0f)" % trimmed,
+          drawn.get("E jdem group 2") == ([4.0], [500.0])
+          and abs(bars["E jdem group 2"][1][1] - bars["E jdem group 2"][0][1] - 2 * trimmed) < 1e-9, drawn)
+    check("fig5-27: the seed's E beside it, Table 5-4's 3072 Pa", drawn.get("E seed group 2") == ([3.8], [3072.0]),
+          drawn)
+    check("fig5-27: M beneath, 5000 Pa; nothing else drawn",
+          drawn.get("M jdem group 2") == ([4.0], [5000.0]) and len(drawn) == 3, drawn)
+
+
 with tempfile.TemporaryDirectory() as tmp:
     test_structure()
     test_energy(tmp)
@@ -338,4 +358,5 @@ with tempfile.TemporaryDirectory() as tmp:
     test_report(tmp)
 test_agreement_ch5()
 test_claims_ch5()
+test_elastic_figure()
 finish()
