@@ -10,8 +10,9 @@ says where) is skipped too on a machine that lacks its outputs (a fresh clone), 
 that runs reads them: then it runs again, and so do the chosen units derived from it, so that no
 committed result stands beside a new source.  --rerun-committed ignores the committed results.  A unit runs with its outputs in a directory of its own next to the
 first output (DIR/.partial/UNIT/, the same file names), and they are moved to their final names
-(os.replace, atomic per file) only once all of them validate: a killed run never leaves a
-partial file under a final name, and its partial directory is cleared when the unit runs again.
+(os.replace, atomic per file) only once all of them validate, each trajectory with its XDMF
+sidecar: a killed run never leaves a partial file under a final name, and its partial directory
+is cleared when the unit runs again.
 --model, --engine and --unit run part of the campaign (a unit whose needs are neither done nor
 selected is an error).  A unit the engines cannot run yet (its `blocked` says why, e.g. a scene
 key not implemented) is reported as "not yet runnable: WHY" and skipped with the units that need
@@ -275,9 +276,20 @@ def run_unit(unit):
             return f"output {os.path.basename(s)} does not validate: {reason}", before
     for s, final in zip(staged, unit.outputs):
         os.makedirs(os.path.dirname(os.path.abspath(final)), exist_ok=True)
+        for side, final_side in zip(sidecars(s), sidecars(final)):   # before the output it reads
+            if os.path.exists(side):
+                os.replace(side, final_side)
         os.replace(s, final)
     shutil.rmtree(tmp, ignore_errors=True)
     return None, before
+
+
+def sidecars(path):
+    """The files an output carries beside it: a trajectory's XDMF sidecar (OUT.h5 -> OUT.xdmf,
+    docs/output.md), which reads it by its basename, so the two move together and ParaView
+    opens the campaign's trajectories where they land."""
+    stem, ext = os.path.splitext(path)
+    return [stem + ".xdmf"] if ext == ".h5" else []
 
 
 def children_cpu():

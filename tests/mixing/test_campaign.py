@@ -323,8 +323,29 @@ def test_ch4_fill_resumes():
     check("ch4_fill_resumed_equals_uninterrupted", not diffs and n > 10, "; ".join(diffs[:3]))
 
 
+def test_trajectory_lands_with_its_sidecar():
+    """A unit whose output is a trajectory (a jdem run of a small conveyor fill) lands with its
+    XDMF sidecar beside it, and the sidecar reads the trajectory by its basename there, as
+    ParaView opens it (docs/output.md)."""
+    from scripts import campaign
+    from scripts.mixing import plan_ch4
+    scene = os.path.join(ROOT, "tests", "checkpoint", "scenes", "inlet_stream.yaml")
+    d = tempfile.mkdtemp()
+    final = os.path.join(d, "runs", "fill.h5")
+    unit = campaign.Unit("t/fill", [final], [plan_ch4.jdem(), "run", scene, "-o", "{out0}", "--quiet"],
+                         validate=plan_ch4.valid_trajectory)
+    failed, _ = campaign.run_unit(unit)
+    side = os.path.join(d, "runs", "fill.xdmf")
+    text = open(side).read() if os.path.exists(side) else ""
+    landed = os.listdir(os.path.dirname(final)) if os.path.isdir(os.path.dirname(final)) else []
+    check("campaign_trajectory_lands_with_sidecar", failed is None and os.path.exists(final)
+          and "fill.h5:/jdem/vertex_index" in text and ".partial" not in text, "%s; %s" % (failed, landed))
+    check("campaign_partial_directory_cleared", not os.path.exists(campaign.partial_dir(unit)))
+
+
 test_killed_run_resumes()
 test_resumable_unit_continues()
+test_trajectory_lands_with_its_sidecar()
 def test_ch4_dt_variants():
     """The plan's time-step variants: the seed's 1e-4 s forced, the guard's dt as jdem states it
     when it refuses the seed's, and half of it, each in its own output tree."""
