@@ -271,6 +271,12 @@ mixing-bonded: $(if $(filter jdem,$(MIXING_ENGINE)),build/jdem,build/liggghts-jd
 	    $(if $(RERUN),--rerun-committed) \
 	    $(if $(NP),-- --ranks $(NP))
 
+# The seed's Fig. 5-4, the repeated section in 3D in both engines, drawn by ParaView from each
+# trajectory's sidecar: reference_runs/mixing/ch5/results/fig5-4.png (needs `make paraview-deps`).
+.PHONY: mixing-bonded-section
+mixing-bonded-section: build/jdem build/liggghts-jdem
+	$(PY) -m scripts.mixing.section_ch5
+
 # Table 5-3 (phi_v at the middle clip) and the breakage of the finished Ch. 5 fills, seed | jdem |
 # liggghts-jdem: out/mixing/ch5/report.md and reference_runs/mixing/ch5/results/; first the
 # cross-engine horizons and first breaks (reference_runs/mixing/ch5/results/horizon/).

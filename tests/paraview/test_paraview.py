@@ -16,7 +16,8 @@ the wall cells = 1 per plane + 32 per cylinder + 1 per mesh triangle (/jdem/wall
 /jdem/walls/mesh/wall); a growing set grows.  The
 PNG of the last frame (spheres blue, walls grey, bonds red, white background) has spheres, grey
 pixels over at least a tenth of the walls' extent and red ones in the bonds' extent.
-Needs `make paraview-deps`.  One line per check: "PASS name" / "FAIL name: detail".
+And the seed's Fig. 5-4 from both engines' sidecars holds the Ch. 5 section's spheres and
+bonds (scripts/mixing/section_ch5.py).  Needs `make paraview-deps`.  One line per check: "PASS name" / "FAIL name: detail".
 
     test_paraview.py [--pngs DIR]   (DIR: keep each PNG as DIR/{j,l}_CASE.png; the pour runs
                                       its full length then)
@@ -232,6 +233,19 @@ def refuses_without_grow(tmp):
           (r.stdout + r.stderr)[-300:])
 
 
+def ch5_section(tmp):
+    """The seed's Fig. 5-4 (scripts/mixing/section_ch5.py): ParaView draws the first section of
+    the Ch. 5 stream from each engine's sidecar with its 4 big and 512 small spheres and 16 x 60
+    bonds (a 2 x 2 x 8 block: 4 x 7 bonds along its axis, 4 x 8 across); the script stops with
+    the counts when they differ."""
+    out = os.path.join(tmp, "section")
+    r = subprocess.run([sys.executable, "-m", "scripts.mixing.section_ch5", "--out", out, "--results", out],
+                       cwd=ROOT, capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=ROOT))
+    check("ch5 section: ParaView draws 4 big, 512 small spheres and 960 bonds in both engines",
+          r.returncode == 0 and "4 big and 512 small spheres, 16 blocks of 2 x 2 x 8 and 960 bonds" in r.stdout
+          and os.path.exists(os.path.join(out, "fig5-4.png")), (r.stdout + r.stderr)[-500:])
+
+
 def main(argv):
     pngs = os.path.abspath(argv[argv.index("--pngs") + 1]) if "--pngs" in argv else None
     if not shutil.which("pvbatch") or not shutil.which("xvfb-run"):
@@ -245,6 +259,7 @@ def main(argv):
         for engine in case_engines:
             one(case, path, engine, tmp, pngs)
     refuses_without_grow(tmp)
+    ch5_section(tmp)
     if not failed:
         shutil.rmtree(tmp, ignore_errors=True)
     else:
