@@ -279,6 +279,8 @@ def run_unit(unit):
         for side, final_side in zip(sidecars(s), sidecars(final)):   # before the output it reads
             if os.path.exists(side):
                 os.replace(side, final_side)
+            elif os.path.exists(final_side):   # an earlier run's, which would describe another file
+                os.remove(final_side)
         os.replace(s, final)
     shutil.rmtree(tmp, ignore_errors=True)
     return None, before

@@ -10,9 +10,10 @@ of two independent runs, 2 for two standard deviations.  s is the case's own, po
 engines' realisations of it, where that has at least OWN_SPREAD_DOF degrees of freedom (three
 realisations in one engine, or two in each), else pooled over the realisations of every case of
 its pool (a std from two runs has one degree of freedom, and its 95 % interval spans 0.03 to 2.2
-times the true one).  A statistic with a floor (φv: a tenth of the ideal) measures no spread in a
-case whose realisations all fall below it: a fill that separates the cohorts has no φv spread, and
-its zero std would shrink the pool of the fills that mix.
+times the true one).  A statistic of the mixing (φv, its std) measures no spread in a case whose
+realisations all separate the cohorts (Statistic.segregated: φv under a tenth of the ideal):
+their zero std would shrink the pool of the fills that mix.  A value that is not finite (a
+packing band without spheres, an outflow of one particle) counts as not measured.
 """
 import collections
 import math
@@ -23,9 +24,17 @@ ENGINES = ("jdem", "liggghts-jdem")
 OWN_SPREAD_DOF = 2    # degrees of freedom from which a case's own std is used rather than the pool
 
 
-# label: the row's name; get(result) -> float or None (not measured); fmt: its format; floor:
-# realisations all below it measure no spread (None: every realisation counts)
-Statistic = collections.namedtuple("Statistic", "label get fmt floor", defaults=(None,))
+# label: the row's name; get(result) -> float or None (not measured); fmt: its format;
+# segregated(result) -> whether the fill separates the cohorts: a case whose realisations all
+# do measures no spread of the statistic (None: every realisation counts)
+Statistic = collections.namedtuple("Statistic", "label get fmt segregated", defaults=(None,))
+
+
+def value(st, result):
+    """The statistic of one result, None when it is not measured or not finite (a packing
+    band without spheres, an outflow of one particle)."""
+    v = st.get(result)
+    return None if v is None or not math.isfinite(v) else float(v)
 
 
 def spreads(runs, statistics, pool_of=lambda key: None):
@@ -41,8 +50,8 @@ def spreads(runs, statistics, pool_of=lambda key: None):
             if len(results) < 2:
                 continue
             for st in statistics:
-                vals = [st.get(r) for r in results]
-                if None in vals or (st.floor is not None and max(vals) < st.floor):
+                vals = [value(st, r) for r in results]
+                if None in vals or (st.segregated is not None and all(st.segregated(r) for r in results)):
                     continue
                 ss = float(np.var(vals, ddof=1)) * (len(vals) - 1)
                 for acc, name in ((own.setdefault(st.label, [0.0, 0, []]), "%s, %d" % (engine, len(results))),
@@ -64,14 +73,15 @@ def spread_for(s, key, label, pool=None):
     return s.get((key, label)) or s.get((("pool", pool), label))
 
 
-def compare(a, b, statistics, spread, missing="not measured"):
+def compare(a, b, statistics, spread, missing="not measured", skip_unmeasured=False):
     """Rows (label, jdem, liggghts-jdem, |difference|, bound, spread source, held or None) of one
-    case's two fills a and b; spread(label) -> (s, source) or None.  A statistic neither fill
-    measures gives no row; one that only one measures gives a row saying `missing`."""
+    case's two fills a and b; spread(label) -> (s, source) or None.  A statistic that a fill does
+    not measure gives a row saying `missing`, or none when neither does and skip_unmeasured (a
+    statistic the case does not have, such as the breakage of unbonded spheres)."""
     out = []
     for st in statistics:
-        va, vb = st.get(a), st.get(b)
-        if va is None and vb is None:
+        va, vb = value(st, a), value(st, b)
+        if va is None and vb is None and skip_unmeasured:
             continue
         if va is None or vb is None:
             out.append((st.label, "—" if va is None else st.fmt % va, "—" if vb is None else st.fmt % vb,

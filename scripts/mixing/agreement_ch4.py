@@ -21,7 +21,8 @@ SEGREGATED = 0.1 * params.IDEAL_PHI_V   # φv of a realisation that separates th
 PASSES = (1, 2)
 # packing fraction = 1 - n (porosity)
 STATISTICS = (Statistic("bed height [m]", lambda r: r.get("bed_height"), "%.3f"),
-              Statistic("φv", lambda r: r["summary"]["phi_v"]["mean"], "%.4f", SEGREGATED),
+              Statistic("φv", lambda r: r["summary"]["phi_v"]["mean"], "%.4f",
+                        lambda r: r["summary"]["phi_v"]["mean"] < SEGREGATED),
               Statistic("packing fraction", lambda r: 1.0 - r["summary"]["n"]["mean"], "%.4f"),
               Statistic("ρb [kg/m³]", lambda r: r["summary"]["rho_b"]["mean"], "%.0f"),
               Statistic("Z", lambda r: r["summary"]["Z"]["mean"], "%.3f"))

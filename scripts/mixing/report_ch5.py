@@ -26,6 +26,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 
 from scripts.mixing import agreement_ch5, fill_ch5, outflow, params, plots, section_ch5, stats, structure
 from scripts.mixing.agreement import ordered
@@ -121,7 +122,7 @@ def run_time(e, prefix=""):
         (" (%d threads)" % threads if threads > 1 else "")
 
 
-REALISATION_KEYS = ("particles", "time", "middle_clip", "surface", "packing", "breakage")
+REALISATION_KEYS = ("particles", "time", "middle_clip", "surface", "packing", "breakage", "built_by")
 
 
 def realisation(path, name, k, spent, rev):
@@ -156,6 +157,10 @@ def collect(out, committed, rev, directory):
             elif name in committed:
                 found[name] = dict(committed[name])
             else:
+                if any(os.path.exists(os.path.join(out, name, "fill_jitter%d.h5" % k))
+                       for k in range(1, SPREAD_REALISATIONS[engine].get(c, 0) + 1)):
+                    print("report_ch5.py: %s: its realisations wait for the fill itself "
+                          "(`make mixing-bonded UNIT=%s/fill`)" % (name, name), file=sys.stderr)
                 continue
             reals = realisations(out, name, spent, rev, committed.get(name, {}).get("realisations", []))
             if reals:
@@ -272,8 +277,9 @@ def claims(found):
                 text, margin = ordered({"half": 0.5 * a, 2: b},
                                        lambda k: halved(sp(1)) if k == "half" else sp(2), [("half", 2)])
                 lines.append("- %s Model 3: the spread of φv drops by more than 50 %% from Group 1 to Group 2 "
-                             "(std %.4f → %.4f, %+.0f %%; %s): **%s**" % (
-                                 engine, a, b, 100 * (b - a) / a, margin, text))
+                             "(std %.4f → %.4f, %s; %s): **%s**" % (
+                                 engine, a, b, "%+.0f %%" % (100 * (b - a) / a) if a else "from zero",
+                                 margin, text))
             for k, (o1, o2) in enumerate(zip(g1.get("outflow", []), (g2 or {}).get("outflow", []))):
                 text, margin = ordered({2: o2["std"], 1: o1["std"]}, within(agreement_ch5.OUTFLOW[k]), [(2, 1)])
                 lines.append("- %s Model %d: weak blocks widen the outflow below the obstacle at (%.2f, %.2f) "
@@ -575,11 +581,13 @@ def report(found, rev, figures=None, elastic=None, section=None):
                   "big spheres red, the small ones in whole blocks blue, in fragments of 2–31 green, "
                   "alone orange (Group 1: all small blue)", ""]
         lines += ["![%s](%s)" % v for v in views]
-    built = {n: list(dict.fromkeys(e.get("built_by", []) + [v for c in e.get("cubes", [])
-                                                             for v in c.get("built_by", [])]))
+    built = {n: list(dict.fromkeys(e.get("built_by", []) + [v for part in e.get("cubes", []) + e.get("realisations", [])
+                                                             for v in part.get("built_by", [])]))
              for n, e in found.items()}
     lines += ["", provenance_section(built)]
-    sources = sorted({(n, e["source"]) for n, e in found.items() if e.get("source") != rev})
+    sources = sorted({(n, e["source"]) for n, e in found.items() if e.get("source") != rev} |
+                     {("%s, realisation %d" % (n, r["jitter"]), r["source"]) for n, e in found.items()
+                      for r in e.get("realisations", []) if r.get("source") != rev})
     lines += ["", "From earlier commits: " + (", ".join("%s (%s)" % s for s in sources) if sources else "none"),
               "", "Not run: %d of %d fills." % (2 * len(CASES + RIGID_CASES) - len(found),
                                                 2 * len(CASES + RIGID_CASES)), ""]

@@ -39,7 +39,7 @@ FIGURE = "fig5-4.png"
 END_TIME = 0.3       # [s] the first section crosses the inlet plane by 0.25 s, the next at 0.264 s
 FRAME_EVERY = 100    # steps: a frame every 0.01 s at the seed's dt
 BIG_RADIUS = 0.0225  # [m] between the small (0.015) and the big (0.03) spheres, as pv_section.py
-BLOCK = 32           # spheres in a 2 x 2 x 8 block, every small sphere of a bonded section in one
+BLOCK = 32           # spheres in a 2 x 2 x 8 block; every small sphere of a bonded section is in one
 BONDS_PER_BLOCK = 4 * 7 + 4 * 8
 VIEWS = ("front", "side", "3d")
 
@@ -49,11 +49,14 @@ class SectionError(Exception):
 
 
 def section_of(scene):
-    """(first id, big spheres, small spheres) of the resolved scene's inlet section."""
+    """(first id, big spheres, small spheres, blocks) of the resolved scene's inlet section (no
+    blocks in an unbonded one)."""
     with open(scene) as f:
         inlet = yaml.load(f, Loader=yaml.CSafeLoader)["inlets"][0]
     radius = np.array([p["radius"] for p in inlet["section"]["particles"]])
-    return int(inlet.get("first_id", 0)), int(np.sum(radius > BIG_RADIUS)), int(np.sum(radius < BIG_RADIUS))
+    small = int(np.sum(radius < BIG_RADIUS))
+    return (int(inlet.get("first_id", 0)), int(np.sum(radius > BIG_RADIUS)), small,
+            small // BLOCK if inlet["section"].get("bonds") else 0)
 
 
 def whole_section_frame(path, first_id, count):
@@ -115,7 +118,7 @@ def main():
         sys.exit("section_ch5.py: pvbatch not found: install ParaView with `make paraview-deps`")
     os.makedirs(a.out, exist_ok=True)
     scene, _ = horizon_ch5.write_scene(a.case, END_TIME, FRAME_EVERY, os.path.join(a.out, "section.yaml"))
-    first_id, big, small = section_of(scene)
+    first_id, big, small, blocks = section_of(scene)
     panels, drawn = [], {}
     pictures = tempfile.mkdtemp(prefix="section_ch5.")
     try:
@@ -129,7 +132,7 @@ def main():
             prefix = os.path.join(pictures, engine)
             drawn[engine] = render(os.path.splitext(out)[0] + ".xdmf", when, prefix)
             panels.append((engine, prefix))
-        want = {"big": big, "small": small, "bonds": BONDS_PER_BLOCK * (small // BLOCK)}
+        want = {"big": big, "small": small, "bonds": BONDS_PER_BLOCK * blocks}
         for engine, d in drawn.items():
             got = {k: d[k] for k in want}
             if got != want:
@@ -137,7 +140,7 @@ def main():
                                    % (engine, got, d["time"], want))
         caption = ("the first section alone, at t = %g s (its columns of blocks leave the belt one after "
                    "another): %d big and %d small spheres, %d blocks of 2 x 2 x 8 and %d bonds, as drawn "
-                   "in each engine" % (drawn["jdem"]["time"], big, small, small // BLOCK, want["bonds"]))
+                   "in each engine" % (drawn["jdem"]["time"], big, small, blocks, want["bonds"]))
         for d in [a.out] + ([results] if results else []):
             os.makedirs(d, exist_ok=True)
             compose(panels, os.path.join(d, FIGURE), a.case, caption)

@@ -3,6 +3,7 @@
 finished units, validation, selection by model / engine / unit, needs, progress and ETA."""
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -341,6 +342,7 @@ def test_trajectory_lands_with_its_sidecar():
     check("campaign_trajectory_lands_with_sidecar", failed is None and os.path.exists(final)
           and "fill.h5:/jdem/vertex_index" in text and ".partial" not in text, "%s; %s" % (failed, landed))
     check("campaign_partial_directory_cleared", not os.path.exists(campaign.partial_dir(unit)))
+    shutil.rmtree(d, ignore_errors=True)
 
 
 test_killed_run_resumes()
@@ -447,9 +449,9 @@ def test_ch5_realisation_scene():
     and the inlet's origin, moved by K micrometres in y."""
     from scripts.mixing import plan_ch5
     plan = {u.name: u for u in plan_ch5.units([])}
-    unit = plan["liggghts-jdem/group3_model3/fill_jitter1"]
+    unit = plan["liggghts-jdem/group3_model5/fill_jitter1"]
     check("ch5_realisation_command", "--no-energy --jitter 1 " in unit.command[2]
-          and unit.outputs[0].endswith("liggghts-jdem/group3_model3/fill_jitter1.h5"), unit.command[2])
+          and unit.outputs[0].endswith("liggghts-jdem/group3_model5/fill_jitter1.h5"), unit.command[2])
     jdem = os.path.join(ROOT, "build", "jdem")
     with tempfile.TemporaryDirectory() as d:
         scene = os.path.join(d, "fill.yaml")

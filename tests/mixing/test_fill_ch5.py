@@ -203,20 +203,20 @@ def test_report(tmp):
     # release without its commit): its larger residual is marked old and not the worst
     head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
                           text=True).stdout.strip()
-    for case, r, residual, version in (("group2_model3", rec, 0.25, "0.1.0+" + head),
+    for case, r, residual, version in (("group2_model5", rec, 0.25, "0.1.0+" + head),
                                        ("rigid_model3", rec_rigid, 0.5, "0.1.0")):
         os.makedirs(os.path.join(out, "jdem", case))
         write_fill(os.path.join(out, "jdem", case, "fill.h5"), dep, r, residual, version)
     # the campaign's times: the bonded fill with its CPU time, the rigid one timed on the wall only
     os.makedirs(os.path.join(out, "jdem", "group1_model1"))
     with open(os.path.join(out, "jdem", "group1_model1", ".campaign_times.json"), "w") as f:
-        json.dump({"jdem/group2_model3/fill": {"seconds": 5000.0, "cpu_seconds": 1200.0, "ranks": 1},
+        json.dump({"jdem/group2_model5/fill": {"seconds": 5000.0, "cpu_seconds": 1200.0, "ranks": 1},
                    "jdem/rigid_model3/fill": {"seconds": 777.0}}, f)
     # its realisation, a layer higher, and liggghts-jdem's fill of it
-    write_fill(os.path.join(out, "jdem", "group2_model3", "fill_jitter1.h5"),
+    write_fill(os.path.join(out, "jdem", "group2_model5", "fill_jitter1.h5"),
                bed(lambda x: 11 + int(x / (3 * PITCH))), rec, 0.25, "0.1.0+" + head)
-    os.makedirs(os.path.join(out, "liggghts-jdem", "group2_model3"))
-    write_fill(os.path.join(out, "liggghts-jdem", "group2_model3", "fill.h5"), dep, rec, 0.25, "0.1.0+" + head)
+    os.makedirs(os.path.join(out, "liggghts-jdem", "group2_model5"))
+    write_fill(os.path.join(out, "liggghts-jdem", "group2_model5", "fill.h5"), dep, rec, 0.25, "0.1.0+" + head)
     run = subprocess.run([sys.executable, "-m", "scripts.mixing.report_ch5", "--out", out],
                          cwd=ROOT, capture_output=True, text=True)
     check("report: runs on a bonded and a rigid fill", run.returncode == 0, run.stderr[-800:])
@@ -224,11 +224,11 @@ def test_report(tmp):
         return
     text = open(os.path.join(out, "report.md")).read()
     slope = structure.free_surface(dep, LO, HI)
-    check("report: the bonded fill's surface row", "| jdem | group2_model3 | %.1f | %+.1f |" % (
+    check("report: the bonded fill's surface row", "| jdem | group2_model5 | %.1f | %+.1f |" % (
         slope["inclination"], slope["slope_x"]) in text)
     check("report: the worst fill is the bonded one, 0.25 J of its 4 J in play, not the rigid "
           "one's 0.5 J on the old bookkeeping",
-          "Worst fill on the current bookkeeping: jdem/group2_model3, 6.25e-02 of the energy in play "
+          "Worst fill on the current bookkeeping: jdem/group2_model5, 6.25e-02 of the energy in play "
           "(**beyond**" in text and "| jdem | rigid_model3 | 1.25e-01 old |" in text
           and "On the old bookkeeping: jdem/rigid_model3." in text)
     check("report: the rigid fill's bonds all intact (3 formed, 0 broken, 2 fragments), "
@@ -240,20 +240,24 @@ def test_report(tmp):
           "3 realisations 7.7 CPU h", "| jdem | 2 (1 with CPU) | 1.60 | 0.33 | 0 (0 with CPU) | — | — | 7.7 |" in text)
     h = structure.free_surface(dep, LO, HI)["mean"]
     check("report: the engines' bed heights agree, 0 against 2 sqrt(2) s = 2 x 0.03 m from the "
-          "realisation a layer higher", "| group2_model3 | bed height (mean surface) [m] | %.3f | %.3f "
-          "| 0.000 | 0.060 | pooled: jdem group2_model3 | held |" % (h, h) in text, h)
-    for png in ("jdem_group2_model3_views.png", "jdem_rigid_model3_clip.png", "jdem_group2_model3_breaks.png"):
+          "realisation a layer higher", "| group2_model5 | bed height (mean surface) [m] | %.3f | %.3f "
+          "| 0.000 | 0.060 | pooled: jdem group2_model5 | held |" % (h, h) in text, h)
+    for png in ("jdem_group2_model5_views.png", "jdem_rigid_model3_clip.png", "jdem_group2_model5_breaks.png"):
         check("report: draws %s" % png, os.path.exists(os.path.join(out, png)) and "(%s)" % png in text)
 
 
 def test_agreement_ch5():
     """agreement_ch5.rows on hand-made summary entries: group3_model3 has two realisations in each
     engine (two degrees of freedom: its own spread); group3_model1 takes Group 3's pool and not
-    Group 2's much wider one; φv of a segregated case measures no spread; Group 1 has no breakage
-    rows."""
-    def entry(phi, height, broken=None):
-        e = {"middle_clip": {"mean": phi, "std": 0.01}, "surface": {"mean": height, "inclination": 3.0},
-             "packing": {"interior": 0.70, "wall": 0.65}}
+    Group 2's much wider one; φv of a segregated case measures no spread; Group 1 (its breakage
+    as report_ch5 writes an unbonded fill's: nothing formed, NaN fractions) has no breakage rows,
+    measures the spread of its φv std although the std is below a tenth of the ideal (its φv is
+    not), and a NaN in a realisation measures no spread instead of a NaN bound."""
+    def entry(phi, height, broken=None, std=0.01, interior=0.70):
+        e = {"middle_clip": {"mean": phi, "std": std}, "surface": {"mean": height, "inclination": 3.0},
+             "packing": {"interior": interior, "wall": 0.65}}
+        e["breakage"] = {"formed": 0, "broken": 0, "total": math.nan, "tension": math.nan, "shear": math.nan,
+                         "fragments": 0, "singles": 0}
         if broken is not None:
             e["breakage"] = {"formed": 100, "total": broken, "tension": broken / 2, "shear": broken / 2,
                              "fragments": 10, "singles": 5}
@@ -264,7 +268,8 @@ def test_agreement_ch5():
              "liggghts-jdem/group3_model1": entry(0.0, 0.99, 0.52),
              "jdem/group2_model3": dict(entry(0.001, 1.0, 0.9), realisations=[entry(0.002, 1.5, 0.1)]),
              "liggghts-jdem/group2_model3": entry(0.001, 1.1, 0.9),
-             "jdem/group1_model3": entry(0.02, 1.0),
+             "jdem/group1_model3": dict(entry(0.02, 1.0, std=0.002),
+                                        realisations=[entry(0.03, 1.0, std=0.004, interior=math.nan)]),
              "liggghts-jdem/group1_model3": entry(0.03, 1.0)}
     rows = {(r[0], r[1]): r for r in agreement_ch5.rows(found, ["group1_model3", "group2_model3",
                                                                  "group3_model1", "group3_model3"])}
@@ -284,9 +289,15 @@ def test_agreement_ch5():
           rows[("group2_model3", "φv at the middle clip")][6] == "no spread measured")
     check("agreement_ch5: Group 2's wide realisation stays in Group 2's pool",
           rows[("group2_model3", "bed height (mean surface) [m]")][5] == "%.3f" % (2 * 0.5))
-    check("agreement_ch5: Group 1 without bonds has no breakage rows and no spread",
-          ("group1_model3", "bonds broken (fraction)") not in rows
-          and rows[("group1_model3", "φv at the middle clip")][7] is None)
+    phi = rows[("group1_model3", "φv at the middle clip")]
+    check("agreement_ch5: Group 1's φv, 0.01 apart, within 2 sqrt(2) std(0.02, 0.03) = 0.0200; no "
+          "breakage rows", ("group1_model3", "bonds broken (fraction)") not in rows
+          and phi[5] == "0.0200" and phi[7] is True, phi)
+    spread_std = rows[("group1_model3", "std of φv at the middle clip")]
+    check("agreement_ch5: Group 1's φv std of 0.002 and 0.004 measures a spread, 2 sqrt(2) x 0.0014",
+          spread_std[5] == "%.4f" % (2 * math.sqrt(2) * np.std([0.002, 0.004], ddof=1)), spread_std)
+    check("agreement_ch5: a NaN in a realisation measures no spread",
+          rows[("group1_model3", "solid fraction, interior")][6] == "no spread measured")
 
 
 def test_claims_ch5():
