@@ -241,14 +241,18 @@ def tree_cpu(pid):
 
 def run_command(argv, tmp, before, start):
     """Run argv, writing what this attempt has cost so far (added to before) into tmp every
-    SPENT_EVERY seconds: a campaign killed mid-unit loses at most that much of the count."""
-    proc = subprocess.Popen(argv)
+    SPENT_EVERY seconds: a campaign killed mid-unit loses at most that much of the count.
+    Returns (exit status, the CPU seconds of the process tree last sampled): a command whose
+    shell is killed before the engine under it ends (a session's SIGTERM) leaves the engine's
+    CPU out of the campaign's own count of its waited-for children, but not out of the sample."""
+    proc, sampled = subprocess.Popen(argv), 0.0
     while True:
         try:
-            return proc.wait(timeout=SPENT_EVERY)
+            return proc.wait(timeout=SPENT_EVERY), sampled
         except subprocess.TimeoutExpired:
+            sampled = tree_cpu(proc.pid)
             write_spent(tmp, {"seconds": before["seconds"] + time.monotonic() - start,
-                              "cpu_seconds": before["cpu_seconds"] + tree_cpu(proc.pid),
+                              "cpu_seconds": before["cpu_seconds"] + sampled,
                               "attempts": before["attempts"] + 1})
 
 
@@ -264,9 +268,9 @@ def run_unit(unit):
     subs = {f"out{i}": p for i, p in enumerate(staged)}
     subs["dir"] = tmp
     argv = [a.format(**subs) for a in unit.command]
-    rc = run_command(argv, tmp, before, start)
+    rc, sampled = run_command(argv, tmp, before, start)
     write_spent(tmp, {"seconds": before["seconds"] + time.monotonic() - start,
-                      "cpu_seconds": before["cpu_seconds"] + children_cpu() - cpu0,
+                      "cpu_seconds": before["cpu_seconds"] + max(children_cpu() - cpu0, sampled),
                       "attempts": before["attempts"] + 1})
     if rc != 0:
         return f"exit status {rc}", before

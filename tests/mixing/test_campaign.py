@@ -64,6 +64,9 @@ def units(argv):
     if os.environ.get("WITH_R"):  # r: the resumable unit's test only
         return plan + [Unit("r", [out("r")], WORKER + ["r", "{{out0}}"], model="m4", engine="e1",
                             validate=valid, resumes=True)]
+    if os.environ.get("WITH_S"):  # s: the worker under a shell, the killed shell's test only
+        return plan + [Unit("s", [out("s")], ["sh", "-c", '"$0" "$@" & wait'] + WORKER + ["s", "{{out0}}"],
+                            model="m6", engine="e1", validate=valid)]
     if os.environ.get("WITH_F"):  # f: its own directory, the times file's test only
         return plan + [Unit("f", [os.path.join(HERE, "out_f", "f.txt")], WORKER + ["f", "{{out0}}"],
                             model="m5", engine="e4", validate=valid)]
@@ -169,6 +172,33 @@ def test_resumable_unit_continues():
     check("unit_time_records_threads_and_machine",
           t.get("threads") == 3 and cpu_name is not None and t.get("machine", "").startswith(cpu_name),
           f"recorded {t}; OMP_NUM_THREADS=3, /proc/cpuinfo's model name {cpu_name!r}")
+
+
+def test_killed_shell_keeps_its_cpu():
+    """A unit's shell killed by SIGTERM while the worker under it runs on (as a session's end
+    kills the lanes): the attempt's recorded CPU time keeps what the worker had burned, as last
+    sampled from the process tree, although the campaign never waits for that worker."""
+    here = setup()
+    proc = campaign(here, "--unit", "s", env={"WITH_S": "1", "BURN_s": "1.5", "SLEEP_s": "14"}, wait=False)
+    partial = os.path.join(here, "out", ".partial", "s")
+    spent, deadline = os.path.join(partial, ".spent.json"), time.monotonic() + 40
+    while time.monotonic() < deadline and not (os.path.exists(spent) and
+                                                json.load(open(spent))["cpu_seconds"] >= 1.0):
+        time.sleep(0.1)
+    shells = [int(n) for n in os.listdir("/proc") if n.isdigit() and os.path.exists(f"/proc/{n}/stat")
+              and open(f"/proc/{n}/stat").read().rsplit(")", 1)[1].split()[1] == str(proc.pid)]
+    for pid in shells:
+        os.kill(pid, signal.SIGTERM)
+    proc.wait()
+    burned = float(open(os.path.join(partial, "s.txt.cpu")).read())
+    got = json.load(open(spent))
+    # /proc counts user and system time each in whole clock ticks, rounded down: 2 ticks at most
+    tick = 1.0 / os.sysconf("SC_CLK_TCK")
+    check("killed_shell_attempt_keeps_worker_cpu", len(shells) == 1 and "s: FAILED" in proc.stderr.read()
+          and got["cpu_seconds"] >= burned - 2 * tick,
+          f"shells {shells}, recorded {got}, the worker burned {burned:.2f} CPU s")
+    time.sleep(6)   # the orphaned worker sleeps past the first sample (campaign.SPENT_EVERY), then ends
+    shutil.rmtree(here, ignore_errors=True)
 
 
 def test_validation_and_selection():
@@ -348,6 +378,7 @@ def test_trajectory_lands_with_its_sidecar():
 test_killed_run_resumes()
 test_resumable_unit_continues()
 test_trajectory_lands_with_its_sidecar()
+test_killed_shell_keeps_its_cpu()
 def test_ch4_dt_variants():
     """The plan's time-step variants: the seed's 1e-4 s forced, the guard's dt as jdem states it
     when it refuses the seed's, and half of it, each in its own output tree."""
