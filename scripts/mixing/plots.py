@@ -17,6 +17,8 @@ strip plot over the models with a finished fill of that pass.
 bonded_figure: the seed's Fig. 5-24, 5-25 or 5-26 (Groups 1, 2, 3) of one engine from the fills
 of report_ch5.py: (a) phi_v at the 27 points of Table 5-2 in three segments, y = 0.25, 0.5 and
 0.75 m, and (b) at the 9 points of the middle clip, each a strip plot over the models.
+points_elastic_figure: the seed's Figs 5-28 to 5-30 (Groups 1-3), per model E (left axis) and
+νxy, νxz (right axis) against the point of the middle clip, each engine's line.
 elastic_figure: the seed's Fig. 5-27, E at the middle clip per group over the six models, the
 seed's mean and std beside each engine's; and beneath it the confined modulus M, which the seed
 does not give but which a laterally confined cube determines (the E of the fit does not).
@@ -306,5 +308,43 @@ def elastic_figure(values, groups=(1, 2, 3), models=range(1, 7)):
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8)
     fig.suptitle("Fig. 5-27: E at the middle clip (σzz = 5 kPa), mean ± std over the 9 cubes, the "
                  "highest and lowest dropped; below, M, which the seed does not give", fontsize=9)
+    fig.tight_layout(rect=(0, 0.04, 1, 0.97))
+    return fig
+
+
+# Figs 5-28 to 5-30, one per group: E and the Poisson ratios point by point
+SEED_POINTS_FIGURE = {1: "5-28", 2: "5-29", 3: "5-30"}
+ENGINE_LINES = {"jdem": "-", "liggghts-jdem": "--"}
+
+
+def points_elastic_figure(cubes, group, points, models=range(1, 7)):
+    """The open figure of Fig. 5-28, 5-29 or 5-30 for `group`, or None without data.
+    cubes[(model, engine)] = [{"E", "nu_xy", "nu_xz"} per point of `points`]; each model's panel
+    draws E on the left axis and νxy, νxz on the right, each engine in its ENGINE_LINES style.
+    The lines carry the label "QUANTITY ENGINE model M" so that a test can read them back."""
+    if not cubes:
+        return None
+    fig, axes = plt.subplots(2, 3, figsize=(13, 7.5), dpi=100)
+    for ax, m in zip(axes.flat, models):
+        right = ax.twinx()
+        for engine, style in ENGINE_LINES.items():
+            rows = cubes.get((m, engine))
+            if not rows:
+                continue
+            ax.plot(points, [r["E"] for r in rows], style, marker="o", color="tab:blue", label=f"E {engine} model {m}")
+            for key, colour, name in (("nu_xy", "tab:red", "νxy"), ("nu_xz", "tab:green", "νxz")):
+                right.plot(points, [r[key] for r in rows], style, marker="s", ms=3, color=colour,
+                           label=f"{name} {engine} model {m}")
+        ax.set_title("Model %d" % m, fontsize=9)
+        ax.set_xlabel("point (Table 5-2)")
+        ax.set_ylabel("E [Pa]", color="tab:blue")
+        right.set_ylabel("ν", color="0.3")
+    handles = [plt.Line2D([], [], color=c, marker=mk, label=l) for l, c, mk in
+               (("E", "tab:blue", "o"), ("νxy", "tab:red", "s"), ("νxz", "tab:green", "s"))] + \
+              [plt.Line2D([], [], color="k", ls=st, label=e) for e, st in ENGINE_LINES.items()]
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8)
+    fig.suptitle("Fig. %s: E and the Poisson ratios of the orthotropic fit at the middle clip, Group %d "
+                 "(σzz = 5 kPa; the fit of a confined cube is ill-posed)" % (SEED_POINTS_FIGURE[group], group),
+                 fontsize=9)
     fig.tight_layout(rect=(0, 0.04, 1, 0.97))
     return fig

@@ -202,15 +202,26 @@ def elastic_values(found):
     return values
 
 
-def write_elastic_figure(found, directories):
-    """Fig. 5-27 (and M beneath it) into each of directories; its file name, or None."""
-    fig = plots.elastic_figure(elastic_values(found))
+def save(fig, name, directories):
+    """Save an open figure (None: no data) as name into each of directories; name or None."""
     if fig is None:
         return None
     for d in directories:
-        fig.savefig(os.path.join(d, ELASTIC_FIGURE))
+        fig.savefig(os.path.join(d, name))
     plots.plt.close(fig)
-    return ELASTIC_FIGURE
+    return name
+
+
+def write_elastic_figures(found, directories):
+    """Fig. 5-27 (and M beneath it) and Figs 5-28 to 5-30 (point by point) into each of
+    directories; their file names (None: no data)."""
+    names = [save(plots.elastic_figure(elastic_values(found)), ELASTIC_FIGURE, directories)]
+    for g in GROUPS:
+        cubes = {(m, e): found["%s/%s" % (e, case(g, m))]["cubes"] for m in MODELS for e in ENGINES
+                 if "cubes" in found.get("%s/%s" % (e, case(g, m)), {})}
+        names.append(save(plots.points_elastic_figure(cubes, g, list(CUBES)),
+                          "fig%s.png" % plots.SEED_POINTS_FIGURE[g], directories))
+    return [n for n in names if n]
 
 
 def elastic_tables(found):
@@ -571,8 +582,9 @@ def report(found, rev, figures=None, elastic=None, section=None):
     lines += [""] + structure_table(found) + [""] + energy_table(found) + [""] + campaign_time_table(found)
     lines += [""] + elastic_tables(found)
     if elastic:
-        lines += ["", "Fig. 5-27 beside the seed's (E per group over the models), and M beneath it:", "",
-                  "![Fig. 5-27](%s)" % elastic]
+        lines += ["", "Fig. 5-27 beside the seed's (E per group over the models), and M beneath it; "
+                  "Figs 5-28 to 5-30, E and the Poisson ratios point by point (the seed's per-point "
+                  "values are not in the text):", ""] + ["![%s](%s)" % (n[:-4], n) for n in elastic]
     lines += [""] + claims(found)
     lines += [""] + rigid_section(found)
     views = [(n, e["views"]) for n, e in sorted(found.items()) if e.get("views")]
@@ -616,7 +628,7 @@ def main():
     for d in directories:
         os.makedirs(d, exist_ok=True)
     figures = plots.write_bonded_figures(found, ENGINES, directories)
-    elastic = write_elastic_figure(found, directories)
+    elastic = write_elastic_figures(found, directories)
     section = None
     if results and os.path.exists(os.path.join(results, section_ch5.FIGURE)):   # drawn by section_ch5.py
         section = section_ch5.FIGURE

@@ -359,6 +359,14 @@ def test_elastic_figure():
           drawn)
     check("fig5-27: M beneath, 5000 Pa; nothing else drawn",
           drawn.get("M jdem group 2") == ([4.0], [5000.0]) and len(drawn) == 3, drawn)
+    cubes = [{"E": 100.0 * k, "nu_xy": 0.1 * k, "nu_xz": -0.1 * k} for k in range(1, 10)]
+    fig = plots.points_elastic_figure({(4, "liggghts-jdem"): cubes}, 2, list(range(10, 19)))
+    lines = {ln.get_label(): (list(ln.get_xdata()), list(ln.get_ydata())) for ax in fig.axes for ln in ax.lines}
+    plots.plt.close(fig)
+    check("fig5-29: Model 4's panel draws liggghts-jdem's E, νxy and νxz at points 10-18, dashed",
+          lines.get("E liggghts-jdem model 4") == (list(range(10, 19)), [c["E"] for c in cubes])
+          and lines.get("νxz liggghts-jdem model 4") == (list(range(10, 19)), [c["nu_xz"] for c in cubes])
+          and len(lines) == 3, lines)
 
 
 with tempfile.TemporaryDirectory() as tmp:
