@@ -28,6 +28,8 @@ import shutil
 import subprocess
 import sys
 
+import numpy as np
+
 from scripts.mixing import agreement_ch5, fill_ch5, outflow, params, plots, section_ch5, stats, structure
 from scripts.mixing.agreement import ordered
 from scripts.mixing.fill_ch5 import FRAGMENT_BINS
@@ -308,9 +310,50 @@ def claims(found):
                              "%.3f for Groups 1-3; the fit is ill-posed, docs/model.md §10): **%s**" % (
                                  engine, m, *ratio, "held" if ratio[0] > ratio[1] > ratio[2] else "not held"))
             lines += surface_claim(engine, m, g1, g3, within)
+        lines += model_claims(engine, found, spread)
     if len(lines) == 4:
         lines.append("(none yet: each needs a Group 1 fill and a bonded fill of the same model)")
+    return lines[:4] + seed_table_claims() + lines[4:]
+
+
+def model_claims(engine, found, spread):
+    """The seed's claims that order the models of one group by their mixing (|φv − ideal| at the
+    middle clip, weighed as claims()): obstacles improve mixing (Models 2-6 against Model 1),
+    Model 5 mixes best in Group 1, Models 3 and 5 in Group 2."""
+    lines = []
+    for g in GROUPS:
+        near = {m: -abs(e["middle_clip"]["mean"] - params.IDEAL_PHI_V) for m in MODELS
+                for e in [found.get("%s/%s" % (engine, case(g, m)))] if e}
+        within = lambda m: spread(case(g, m), agreement_ch5.PHI)
+        listed = ", ".join("%d: %.4f" % (m, -v) for m, v in sorted(near.items()))
+        checks = []
+        if 1 in near and len(near) > 1:
+            checks.append(("obstacles improve mixing (Models %s against Model 1)" %
+                           ", ".join(str(m) for m in near if m != 1), [(m, 1) for m in near if m != 1]))
+        if g == 1 and len(near) == len(MODELS):
+            checks.append(("Model 5 mixes best", [(5, m) for m in MODELS if m != 5]))
+        if g == 2 and len(near) == len(MODELS):
+            checks.append(("Models 3 and 5 mix best", [(a, m) for a in (3, 5) for m in MODELS if m not in (3, 5)]))
+        for claim, pairs in checks:
+            text, margin = ordered(near, within, pairs)
+            lines.append("- %s Group %d: %s (|φv − %.4f| at the middle clip per model %s; %s): **%s**" % (
+                engine, g, claim, params.IDEAL_PHI_V, listed, margin, text))
     return lines
+
+
+def seed_table_claims():
+    """The seed's own Tables 5-4 and 5-5 against its text (spec §3.8): E falls "in the range of
+    25 percent" with bond strength, and νxy falls and νxz rises "about ten percent"."""
+    means = {k: [float(np.mean([v[0] for v in SEED_ELASTIC[k][g]])) for g in GROUPS] for k in SEED_ELASTIC}
+    e = means["E"]
+    change = lambda v: ", ".join("%+.0f %%" % (100 * (x - v[0]) / v[0]) for x in v[1:])
+    return ["- the seed's Table 5-4: E falls \"in the range of 25 percent\" as bond strength rises: "
+            "its group means over the six models %.0f, %.0f, %.0f Pa (%s against Group 1): **%s** "
+            "(the seed's own table does not show it, spec §3.8)" % (
+                *e, change(e), "held" if e[0] > e[1] > e[2] and e[2] <= 0.8 * e[0] else "not held"),
+            "- the seed's Table 5-5: νxy falls and νxz rises \"about ten percent\" with bond strength: "
+            "group means νxy %.3f, %.3f, %.3f (%s), νxz %.3f, %.3f, %.3f (%s)" % (
+                *means["nu_xy"], change(means["nu_xy"]), *means["nu_xz"], change(means["nu_xz"])), ""]
 
 
 def structure_table(found):

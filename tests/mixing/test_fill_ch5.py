@@ -343,6 +343,28 @@ def test_claims_ch5():
     check("claims_ch5: more voids near the walls, 0.05 beyond 0.0141", v == "held" and "= 0.0141" in line, line)
 
 
+def test_model_claims():
+    """report_ch5's claims that order the models, on hand-made Group 1 fills: Model 5 nearest the
+    ideal by 0.01 more than any other, against a pooled spread of 0.0025 (Model 5's fill and its
+    realisation 0.0025 sqrt(2) apart), so beyond 2 sqrt(2) x 0.0025 = 0.0071: held; that obstacles
+    improve mixing is not resolved: Model 2 at φv 0 like Model 1, a difference within the pool.  And the seed's Table 5-4 against its
+    own "25 percent": the group means spec §3.8 derives, 5755, 4720 and 5041 Pa."""
+    from scripts.mixing import report_ch5
+    phi = {1: 0.0, 2: 0.0, 3: 0.02, 4: 0.03, 5: 0.04, 6: 0.025}
+    found = {"jdem/group1_model%d" % m: {"middle_clip": {"mean": v, "std": 0.01}} for m, v in phi.items()}
+    found["jdem/group1_model5"]["realisations"] = [{"middle_clip": {"mean": 0.04 + 0.0025 * math.sqrt(2), "std": 0.01}}]
+    lines = report_ch5.model_claims("jdem", found, agreement_ch5.spread(found, report_ch5.CASES))
+    best = [x for x in lines if "Model 5 mixes best" in x]
+    check("claims_ch5: Model 5 mixes best, 0.01 beyond 0.0071", len(best) == 1 and best[0].endswith("**held**")
+          and "= 0.0071" in best[0], lines)
+    obstacles = [x for x in lines if "obstacles improve mixing" in x]
+    check("claims_ch5: obstacles improve mixing not resolved (Model 2 at φv 0 as Model 1, within the pool)",
+          len(obstacles) == 1 and obstacles[0].endswith("**%s**" % agreement.UNRESOLVED), lines)
+    seed = report_ch5.seed_table_claims()[0]
+    check("claims_ch5: the seed's table, 5755, 4720, 5041 Pa, does not show its 25 %",
+          "5755, 4720, 5041 Pa (-18 %, -12 %" in seed and "**not held**" in seed, seed)
+
+
 def test_elastic_figure():
     from scripts.mixing import report_ch5
     cubes = [{"E": 100.0 * k, "M_wall": 1000.0 * k} for k in range(1, 10)]
@@ -377,5 +399,6 @@ with tempfile.TemporaryDirectory() as tmp:
     test_report(tmp)
 test_agreement_ch5()
 test_claims_ch5()
+test_model_claims()
 test_elastic_figure()
 finish()
