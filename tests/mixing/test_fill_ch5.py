@@ -242,6 +242,8 @@ def test_report(tmp):
     check("report: the engines' bed heights agree, 0 against 2 sqrt(2) s = 2 x 0.03 m from the "
           "realisation a layer higher", "| group2_model5 | bed height (mean surface) [m] | %.3f | %.3f "
           "| 0.000 | 0.060 | pooled: jdem group2_model5 | held |" % (h, h) in text, h)
+    check("report: why ours differ, Group 2's weak bonds: 1 of the 3 formed broke, in its one fill",
+          "- jdem, Group 2: 1 of 3 weak bonds broke over its 1 fill:" in text)
     for png in ("jdem_group2_model5_views.png", "jdem_rigid_model3_clip.png", "jdem_group2_model5_breaks.png"):
         check("report: draws %s" % png, os.path.exists(os.path.join(out, png)) and "(%s)" % png in text)
 
