@@ -9,7 +9,8 @@ either engine's trajectory (docs/mixing.md §11):
 * the bond-steps (intact bonds x steps, from observables/bonds), for the bonds' speed;
 * the snapshot sheet: front and side views at t = 1, 3, 9 s and the end, the big spheres, the
   small ones in whole blocks, in fragments and alone in different colours; and the final
-  middle clip (Ch. 6's Figs 6-1 and 6-2 show it).
+  middle clip (Ch. 6's Figs 6-1 and 6-2 show it); for Model 1 of Groups 1 and 3, the layer
+  against the front wall beside the middle clip (the seed's Fig. 5-23, voids near the walls).
 """
 import os
 
@@ -20,6 +21,9 @@ from scripts.mixing import breakage, deposit, energy, params, plots, stats, stru
 from scripts.mixing_views import frame_index, scene_geometry
 
 SNAPSHOTS = (1.0, 3.0, 9.0)   # [s] the seed's snapshot times (Figs 5-5 to 5-22), then the end
+# the seed's Fig. 5-23 (voids near the walls) shows Group 3 Model 1; its Group 1 beside it
+WALL_PICTURE_CASES = ("group1_model1", "group3_model1")
+WALL_LAYER = 0.015   # [m] a small radius off the front wall: the plane that cuts the layer against it
 BLOCK = 32                    # spheres in a whole 2 x 2 x 8 block (spec §4.1)
 # fragment sizes (spheres) counted over time: single spheres, pieces, half blocks, whole blocks
 FRAGMENT_BINS = ((1, 1), (2, 7), (8, 15), (16, 31), (BLOCK, BLOCK))
@@ -104,6 +108,13 @@ def write_pictures(entry, name, path, directory):
                        colours=colours(deps[-1], rec),
                        title=f"{name}: middle clip y = 0.5 m, t = {deps[-1].time:g} s")
     entry["clip"] = os.path.basename(stem + "_clip.png")
+    if name.endswith(WALL_PICTURE_CASES):
+        plots.slab_sheet(deps[-1], stem + "_wall.png",
+                         [("the layer against the front wall (cut by y = %.3f m)" % (box[0][1] + WALL_LAYER),
+                           box[0][1] + WALL_LAYER, 0.0),
+                          ("the middle clip, y = 0.5 m", None, 0.0)], box, cylinders,
+                         colours(deps[-1], rec), title=f"{name}: the voids near the walls, t = {deps[-1].time:g} s")
+        entry["wall"] = os.path.basename(stem + "_wall.png")
 
 
 def frame_count(path):

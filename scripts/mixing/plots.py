@@ -41,14 +41,15 @@ VIEWS = {"front": (0, 2, 1), "side": (1, 2, 0)}  # (horizontal axis, vertical ax
 
 
 def draw_deposit(ax, dep, view="front", box=((0, 0, 0), (1, 1, 2)), cylinders=(), clip=None,
-                 colours=None, threshold=None):
+                 colours=None, threshold=None, at=None):
     """Draw the view on `ax`; returns the number of spheres drawn.  cylinders: (x, z, radius) of
-    horizontal cylinders along y [m]; clip: half-thickness of the slab around the middle plane to
-    keep (None: all spheres); colours: one colour per particle (default: red big, blue small)."""
+    horizontal cylinders along y [m]; clip: half-thickness of the slab to keep, around the plane
+    at depth `at` [m] (default: the middle plane; clip None: all spheres); colours: one colour
+    per particle (default: red big, blue small)."""
     h, v, depth = VIEWS[view]
     keep = np.ones(len(dep.radius), bool)
     if clip is not None:
-        mid = 0.5 * (box[0][depth] + box[1][depth])
+        mid = 0.5 * (box[0][depth] + box[1][depth]) if at is None else at
         keep = np.abs(dep.position[:, depth] - mid) <= dep.radius + clip
     if colours is None:
         colours = np.where(big_mask(dep.radius, threshold), BIG_COLOUR, SMALL_COLOUR)
@@ -84,6 +85,23 @@ def deposit_view(dep, path, view="front", box=((0, 0, 0), (1, 1, 2)), cylinders=
     fig.savefig(path)
     plt.close(fig)
     return n
+
+
+def slab_sheet(dep, path, slabs, box=((0, 0, 0), (1, 1, 2)), cylinders=(), colours=None, title=None):
+    """Front views of several slabs of one deposit side by side (the seed's Fig. 5-23: the band
+    against the front wall beside the middle clip); slabs: [(title, plane depth [m], half
+    thickness [m])].  Returns the number of spheres drawn per slab."""
+    fig, axes = plt.subplots(1, len(slabs), figsize=(4 * len(slabs), 7), dpi=100, squeeze=False)
+    drawn = []
+    for ax, (name, at, half) in zip(axes[0], slabs):
+        drawn.append(draw_deposit(ax, dep, "front", box, cylinders, clip=half, colours=colours, at=at))
+        ax.set_title(name, fontsize=9)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout(rect=(0, 0, 1, 0.97 if title else 1))
+    fig.savefig(path)
+    plt.close(fig)
+    return drawn
 
 
 def snapshot_sheet(frames, path, box=((0, 0, 0), (1, 1, 2)), cylinders=(), legend=(), title=None):

@@ -667,6 +667,13 @@ def report(found, rev, figures=None, elastic=None, section=None):
         lines += ["", "Fig. 5-27 beside the seed's (E per group over the models), and M beneath it; "
                   "Figs 5-28 to 5-30, E and the Poisson ratios point by point (the seed's per-point "
                   "values are not in the text):", ""] + ["![%s](%s)" % (n[:-4], n) for n in elastic]
+    walls = [(n, e["wall"]) for n, e in sorted(found.items()) if e.get("wall")]
+    lines += ["", "### Fig. 5-23: the voids near the walls (Model 1, Groups 1 and 3)", "",
+              "the final deposit's layer against the front wall (the spheres cut by the plane a small "
+              "radius off it) beside the middle clip; the solid fractions are in the structure table "
+              "above", ""]
+    lines += ["![%s](%s)" % w for w in walls] if walls else \
+        ["(not drawn yet: a Model 1 fill of Group 1 or 3 measured on this machine)"]
     lines += [""] + differences_section(found)
     lines += [""] + claims(found)
     lines += [""] + rigid_section(found)
@@ -704,7 +711,7 @@ def main():
     found = collect(a.out, committed, rev, results or a.out)
     if results and results != a.out:   # the maps beside both reports
         for e in found.values():
-            for png in (e.get("break_map"), e.get("views"), e.get("clip")):
+            for png in (e.get("break_map"), e.get("views"), e.get("clip"), e.get("wall")):
                 if png and os.path.exists(os.path.join(results, png)):
                     shutil.copy(os.path.join(results, png), os.path.join(a.out, png))
     directories = [a.out] + ([results] if results else [])

@@ -345,6 +345,29 @@ def test_claims_ch5():
     check("claims_ch5: more voids near the walls, 0.05 beyond 0.0141", v == "held" and "= 0.0141" in line, line)
 
 
+def test_wall_band_picture(tmp):
+    """Fig. 5-23's sheet (plots.slab_sheet, as fill_ch5 draws it): of spheres (R = 0.015 m) at
+    y = 0.02, 0.1, 0.3, 0.49 and 0.5 m, the plane a small radius off the front wall cuts the
+    first alone and the middle plane y = 0.5 m the last two."""
+    y = np.array([0.02, 0.1, 0.3, 0.49, 0.5])
+    dep = deposit.Deposit(np.arange(5), np.zeros(5, np.int32), np.full(5, R), np.ones(5),
+                          np.stack([np.full(5, 0.5), y, np.full(5, 0.5)], axis=1), step=1, time=1.0)
+    drawn = plots.slab_sheet(dep, os.path.join(tmp, "wall.png"),
+                             [("wall", fill_ch5.WALL_LAYER, 0.0), ("middle", None, 0.0)],
+                             (LO, HI))
+    check("fig5-23: the wall layer draws 1 sphere, the middle clip 2", drawn == [1, 2], drawn)
+    path = os.path.join(tmp, "g3m1.h5")
+    write_fill(path, bed(lambda x: 12), bonds_record(), 0.0, "0.1.0")
+    sheets = {}
+    for name in ("jdem/group3_model1", "jdem/group2_model1"):
+        entry = fill_ch5.result(path)
+        fill_ch5.write_pictures(entry, name, path, tmp)
+        sheets[name] = entry.get("wall")
+    check("fig5-23: drawn for Model 1 of Group 3, not of Group 2",
+          sheets == {"jdem/group3_model1": "jdem_group3_model1_wall.png", "jdem/group2_model1": None}
+          and os.path.exists(os.path.join(tmp, "jdem_group3_model1_wall.png")), sheets)
+
+
 def test_model_claims():
     """report_ch5's claims that order the models, on hand-made Group 1 fills: Model 5 nearest the
     ideal by 0.01 more than any other, against a pooled spread of 0.0025 (Model 5's fill and its
@@ -399,6 +422,7 @@ with tempfile.TemporaryDirectory() as tmp:
     test_fragments()
     test_bond_steps(tmp)
     test_report(tmp)
+    test_wall_band_picture(tmp)
 test_agreement_ch5()
 test_claims_ch5()
 test_model_claims()
