@@ -70,7 +70,9 @@ def result(path):
     try:
         rec = breakage.read_bonds(path)
     except breakage.BreakageError:
-        return out   # Group 1: no bonds
+        return out   # a trajectory without a bond table
+    if not len(rec["bonds"]):
+        return out   # Group 1: an empty bond table (both engines write one), drawn as unbonded
     end = int(max(rec["formed"].max(initial=0), rec["broken_step"].max(initial=0), dep.step))
     out["breakage"], out["breakage_over_time"] = breakage_result(rec, end)
     out["_breaks"], out["_rec"] = (rec["broken_at"], rec["mode"]), rec

@@ -633,7 +633,7 @@ def report(found, rev, figures=None, elastic=None, section=None):
               "|---|---|---|---|---|---|---|---|---|"]
     for name, e in sorted(found.items()):
         k = e.get("breakage")
-        if k:
+        if k and k.get("formed"):   # older Group 1 entries keep an empty one
             lines.append("| %s | %s | %d | %d | %.3f | %.3f | %d | %d | %d |" % (
                 *name.split("/"), k["formed"], k["broken"], k["tension"], k["shear"],
                 k["fragments"], k["whole_blocks"], k["singles"]))
@@ -644,7 +644,7 @@ def report(found, rev, figures=None, elastic=None, section=None):
               "| engine | case | t [s] | broken | tension | shear | fragments by size |",
               "|---|---|---|---|---|---|---|"]
     for name, e in sorted(found.items()):
-        for b in e.get("breakage_over_time", []):
+        for b in e.get("breakage_over_time", []) if e.get("breakage", {}).get("formed") else []:
             lines.append("| %s | %s | %.1f | %.3f | %.3f | %.3f | %s |" % (
                 *name.split("/"), b["time"], b["total"], b["tension"], b["shear"],
                 " / ".join(str(n) for n in b["fragments"])))

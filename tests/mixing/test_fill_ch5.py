@@ -363,6 +363,13 @@ def test_wall_band_picture(tmp):
         entry = fill_ch5.result(path)
         fill_ch5.write_pictures(entry, name, path, tmp)
         sheets[name] = entry.get("wall")
+    unbonded = os.path.join(tmp, "g1.h5")
+    empty = dict(bonds_record(), bonds=np.zeros((0, 2), np.int64), formed=np.zeros(0, np.int64),
+                 broken=np.zeros((0, 2), np.int64), broken_step=np.zeros(0, np.int64))
+    write_fill(unbonded, bed(lambda x: 12), empty, 0.0, "0.1.0")
+    g1 = fill_ch5.result(unbonded)
+    check("an empty bond table (a Group 1 fill, both engines write one) is an unbonded fill: no "
+          "breakage, drawn in the unbonded colours", "breakage" not in g1 and g1.get("_rec") is None, sorted(g1))
     check("fig5-23: drawn for Model 1 of Group 3, not of Group 2",
           sheets == {"jdem/group3_model1": "jdem_group3_model1_wall.png", "jdem/group2_model1": None}
           and os.path.exists(os.path.join(tmp, "jdem_group3_model1_wall.png")), sheets)
