@@ -491,6 +491,26 @@ def hours(seconds):
     return "%.2f" % (sum(seconds) / 3600.0) if seconds else "—"
 
 
+def speed_table(found):
+    """The same fill in both engines: their CPU times and jdem's speed-up over liggghts-jdem, for
+    each case both ran on one thread or rank and alike without (or with) the energy accounts."""
+    lines = ["### Speed: the same fill in both engines", "",
+             "CPU time of each engine's fill of the case on one core (jdem one thread, liggghts-jdem "
+             "one rank), both without the energy accounts or both with them; the ratio is "
+             "liggghts-jdem's over jdem's", "",
+             "| case | jdem [CPU s] | liggghts-jdem [CPU s] | jdem faster by |", "|---|---|---|---|"]
+    rows = []
+    for c in CASES + RIGID_CASES:
+        a, b = (found.get("%s/%s" % (e, c)) for e in ENGINES)
+        if not (a and b and a.get("cpu_seconds") and b.get("cpu_seconds")):
+            continue
+        if a.get("threads", 1) != 1 or b.get("ranks", 1) != 1 or bool(a.get("energy")) != bool(b.get("energy")):
+            continue
+        rows.append("| %s | %.0f | %.0f | %.2fx |" % (c, a["cpu_seconds"], b["cpu_seconds"],
+                                                     b["cpu_seconds"] / a["cpu_seconds"]))
+    return lines + (rows or ["| (no case yet with both engines' fill timed alike) | | | |"])
+
+
 def campaign_time_table(found):
     """The time of the campaign so far per engine: its finished fills' (with their realisations)
     and compressions' wall and CPU times summed, and the campaign's fills projected from the mean
@@ -662,6 +682,7 @@ def report(found, rev, figures=None, elastic=None, section=None):
     lines += [""] + horizon_section()
     lines += [""] + agreement_ch5.section(found, CASES + RIGID_CASES)
     lines += [""] + structure_table(found) + [""] + energy_table(found) + [""] + campaign_time_table(found)
+    lines += [""] + speed_table(found)
     lines += [""] + elastic_tables(found)
     if elastic:
         lines += ["", "Fig. 5-27 beside the seed's (E per group over the models), and M beneath it; "

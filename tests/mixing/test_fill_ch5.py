@@ -211,6 +211,7 @@ def test_report(tmp):
     os.makedirs(os.path.join(out, "jdem", "group1_model1"))
     with open(os.path.join(out, "jdem", "group1_model1", ".campaign_times.json"), "w") as f:
         json.dump({"jdem/group2_model5/fill": {"seconds": 5000.0, "cpu_seconds": 1200.0, "ranks": 1},
+                   "liggghts-jdem/group2_model5/fill": {"seconds": 4000.0, "cpu_seconds": 3000.0, "ranks": 1},
                    "jdem/rigid_model3/fill": {"seconds": 777.0}}, f)
     # its realisation, a layer higher, and liggghts-jdem's fill of it
     write_fill(os.path.join(out, "jdem", "group2_model5", "fill_jitter1.h5"),
@@ -242,6 +243,8 @@ def test_report(tmp):
     check("report: the engines' bed heights agree, 0 against 2 sqrt(2) s = 2 x 0.03 m from the "
           "realisation a layer higher", "| group2_model5 | bed height (mean surface) [m] | %.3f | %.3f "
           "| 0.000 | 0.060 | pooled: jdem group2_model5 | held |" % (h, h) in text, h)
+    check("report: the same fill in both engines, 3000 / 1200 CPU s: jdem faster by 2.50x",
+          "| group2_model5 | 1200 | 3000 | 2.50x |" in text)
     check("report: why ours differ, Group 2's weak bonds: 1 of the 3 formed broke, in its one fill",
           "- jdem, Group 2: 1 of 3 weak bonds broke over its 1 fill:" in text)
     for png in ("jdem_group2_model5_views.png", "jdem_rigid_model3_clip.png", "jdem_group2_model5_breaks.png"):
