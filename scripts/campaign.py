@@ -151,7 +151,7 @@ class Times:
         """seconds, cpu_seconds: the unit's wall and CPU time over all its attempts (a resumed
         unit's earlier ones from its partial directory's SPENT)."""
         import fcntl
-        entry = {"seconds": seconds, "cpu_seconds": cpu_seconds, "cost": unit.cost,
+        entry = {"seconds": seconds, "cpu_seconds": cpu_seconds, "cost": unit.cost, "engine": unit.engine,
                  "ranks": unit.ranks, "threads": unit_threads(unit), "attempts": attempts,
                  "machine": machine_name()}
         # beside the plan's first output, whose directory a selection without that unit never made
@@ -165,11 +165,21 @@ class Times:
             os.replace(tmp, self.path)
 
     def eta(self, remaining):
-        done = list(self.seconds.values())
-        cost = sum(d["cost"] for d in done)
-        if not done or cost <= 0:
+        """The remaining units' cost times the seconds per unit of cost measured so far: of the
+        units of the same engine where any is measured (one engine's fill can take twice
+        another's for the same cost), else of all."""
+        def rate(done):
+            cost = sum(d["cost"] for d in done)
+            return sum(d["seconds"] for d in done) / cost if cost > 0 else None
+        overall = rate(list(self.seconds.values()))
+        if overall is None:
             return None
-        return sum(u.cost for u in remaining) * sum(d["seconds"] for d in done) / cost
+        by_engine = {}
+        for d in self.seconds.values():
+            if d.get("engine") is not None:
+                by_engine.setdefault(d["engine"], []).append(d)
+        rates = {e: rate(done) for e, done in by_engine.items()}
+        return sum(u.cost * (rates.get(u.engine) or overall) for u in remaining)
 
 
 def unit_threads(unit):

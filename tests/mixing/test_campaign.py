@@ -286,6 +286,21 @@ def test_times_beside_unrun_first_unit():
           f"exit {r.returncode}, ran {runs(here)}: {r.stderr[-400:]}")
 
 
+def test_eta_per_engine():
+    """The ETA prices each remaining unit at its own engine's measured seconds per unit of cost:
+    e1 measured 10 s for cost 1, e2 30 s for cost 1; one unit of cost 2 of each remains:
+    2 x 10 + 2 x 30 = 80 s.  An engine not measured yet takes the overall rate, into which an
+    entry without an engine (recorded before 2026-12-07) counts too: 60 s / 4 = 15 s per cost."""
+    from scripts.campaign import Times, Unit
+    t = Times(os.path.join(tempfile.mkdtemp(), "times.json"))
+    t.seconds = {"a": {"seconds": 10.0, "cost": 1.0, "engine": "e1"},
+                 "b": {"seconds": 30.0, "cost": 1.0, "engine": "e2"}}
+    unit = lambda engine: Unit("u", ["x"], ["true"], engine=engine, cost=2.0)
+    check("eta_per_engine", t.eta([unit("e1"), unit("e2")]) == 80.0, t.eta([unit("e1"), unit("e2")]))
+    t.seconds["old"] = {"seconds": 20.0, "cost": 2.0}
+    check("eta_unmeasured_engine_overall", t.eta([unit("e3")]) == 2.0 * 60.0 / 4.0, t.eta([unit("e3")]))
+
+
 def test_times_shared_by_campaigns_at_once():
     """Two campaign processes that loaded the times file before either finished a unit (as two
     `make mixing-bonded UNIT=...` started together do) keep both units' times: each add merges
@@ -505,6 +520,7 @@ test_committed_results()
 test_not_yet_runnable()
 test_times_beside_unrun_first_unit()
 test_times_shared_by_campaigns_at_once()
+test_eta_per_engine()
 test_ch4_dt_variants()
 test_ch4_ranks()
 test_ch4_plan()
