@@ -17,8 +17,9 @@ is cleared when the unit runs again.
 selected is an error).  A unit the engines cannot run yet (its `blocked` says why, e.g. a scene
 key not implemented) is reported as "not yet runnable: WHY" and skipped with the units that need
 it; it does not count as a failure, and the closing line counts it.  Progress and the ETA go to stderr: the ETA is the remaining units'
-estimated cost times the measured seconds per unit of cost of the units finished so far (in this
-run and earlier ones: DIR/.campaign_times.json beside the first unit's output).  A unit's recorded
+estimated cost times the measured seconds per unit of cost of the units of its engine finished so
+far, else of all units (in this run and earlier ones: DIR/.campaign_times.json beside the first
+unit's output).  A unit's recorded
 wall and CPU time are its whole: an interrupted attempt's, written to its partial directory every
 SPENT_EVERY seconds, are added to the attempt that finishes it.
 """
@@ -174,10 +175,12 @@ class Times:
         overall = rate(list(self.seconds.values()))
         if overall is None:
             return None
+        engines = {u.engine for u in remaining}
         by_engine = {}
-        for d in self.seconds.values():
-            if d.get("engine") is not None:
-                by_engine.setdefault(d["engine"], []).append(d)
+        for name, d in self.seconds.items():   # an entry from before 2026-12-07: its name's engine
+            engine = d.get("engine") or next((e for e in engines if e and name.startswith(e + "/")), None)
+            if engine is not None:
+                by_engine.setdefault(engine, []).append(d)
         rates = {e: rate(done) for e, done in by_engine.items()}
         return sum(u.cost * (rates.get(u.engine) or overall) for u in remaining)
 
@@ -259,8 +262,8 @@ def run_command(argv, tmp, before, start):
     while True:
         try:
             return proc.wait(timeout=SPENT_EVERY), sampled
-        except subprocess.TimeoutExpired:
-            sampled = tree_cpu(proc.pid)
+        except subprocess.TimeoutExpired:   # a shell dying mid-scan samples low: keep the highest
+            sampled = max(sampled, tree_cpu(proc.pid))
             write_spent(tmp, {"seconds": before["seconds"] + time.monotonic() - start,
                               "cpu_seconds": before["cpu_seconds"] + sampled,
                               "attempts": before["attempts"] + 1})
@@ -268,7 +271,8 @@ def run_command(argv, tmp, before, start):
 
 def run_unit(unit):
     """Run one unit into its partial directory; returns (None or the reason it failed, what the
-    earlier attempts of an interrupted unit cost: {seconds, cpu_seconds, attempts})."""
+    earlier attempts of an interrupted unit cost: {seconds, cpu_seconds, attempts}, this
+    attempt's CPU seconds)."""
     tmp = partial_dir(unit)
     if not resuming(unit):
         shutil.rmtree(tmp, ignore_errors=True)
@@ -279,15 +283,15 @@ def run_unit(unit):
     subs["dir"] = tmp
     argv = [a.format(**subs) for a in unit.command]
     rc, sampled = run_command(argv, tmp, before, start)
+    cpu = max(children_cpu() - cpu0, sampled)
     write_spent(tmp, {"seconds": before["seconds"] + time.monotonic() - start,
-                      "cpu_seconds": before["cpu_seconds"] + max(children_cpu() - cpu0, sampled),
-                      "attempts": before["attempts"] + 1})
+                      "cpu_seconds": before["cpu_seconds"] + cpu, "attempts": before["attempts"] + 1})
     if rc != 0:
-        return f"exit status {rc}", before
+        return f"exit status {rc}", before, cpu
     for s in staged:
         reason = invalid_reason(unit, s)
         if reason:
-            return f"output {os.path.basename(s)} does not validate: {reason}", before
+            return f"output {os.path.basename(s)} does not validate: {reason}", before, cpu
     for s, final in zip(staged, unit.outputs):
         os.makedirs(os.path.dirname(os.path.abspath(final)), exist_ok=True)
         for side, final_side in zip(sidecars(s), sidecars(final)):   # before the output it reads
@@ -297,7 +301,7 @@ def run_unit(unit):
                 os.remove(final_side)
         os.replace(s, final)
     shutil.rmtree(tmp, ignore_errors=True)
-    return None, before
+    return None, before, cpu
 
 
 def sidecars(path):
@@ -348,9 +352,9 @@ def run(units, times, everything=None, log=sys.stderr, to_run=None):
         print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: "
               + ("continuing its interrupted run" if resuming(u) else "running")
               + (f"; ETA {fmt_seconds(eta)}" if eta is not None else ""), file=log, flush=True)
-        start, cpu0 = time.monotonic(), children_cpu()
-        reason, before = run_unit(u)
-        took, cpu = time.monotonic() - start, children_cpu() - cpu0
+        start = time.monotonic()
+        reason, before, cpu = run_unit(u)
+        took = time.monotonic() - start
         if reason:
             failed += 1
             print(f"campaign: [{i + 1}/{len(todo)}] {u.name}: FAILED after {fmt_seconds(took)}: "

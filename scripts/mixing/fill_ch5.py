@@ -57,6 +57,14 @@ def breakage_result(rec, end):
     return whole, over_time
 
 
+def bonded_scene(path):
+    """Whether the trajectory's scene asks for bonds (its own or its inlet section's): a bonded
+    fill that formed none is then reported so (0 formed), not taken for an unbonded one."""
+    with h5py.File(path, "r") as f:
+        scene = deposit.scene_of(f)
+    return bool(scene.get("bonds")) or any((i.get("section") or {}).get("bonds") for i in scene.get("inlets") or [])
+
+
 def result(path):
     """The fill's measures (summary.json's entry); "_breaks" and "_rec" are for the pictures."""
     dep = deposit.read_frame(path)
@@ -71,7 +79,7 @@ def result(path):
         rec = breakage.read_bonds(path)
     except breakage.BreakageError:
         return out   # a trajectory without a bond table
-    if not len(rec["bonds"]):
+    if not len(rec["bonds"]) and not bonded_scene(path):
         return out   # Group 1: an empty bond table (both engines write one), drawn as unbonded
     end = int(max(rec["formed"].max(initial=0), rec["broken_step"].max(initial=0), dep.step))
     out["breakage"], out["breakage_over_time"] = breakage_result(rec, end)

@@ -290,7 +290,8 @@ def test_eta_per_engine():
     """The ETA prices each remaining unit at its own engine's measured seconds per unit of cost:
     e1 measured 10 s for cost 1, e2 30 s for cost 1; one unit of cost 2 of each remains:
     2 x 10 + 2 x 30 = 80 s.  An engine not measured yet takes the overall rate, into which an
-    entry without an engine (recorded before 2026-12-07) counts too: 60 s / 4 = 15 s per cost."""
+    entry without an engine (recorded before 2026-12-07) counts too: 60 s / 4 = 15 s per cost;
+    such an entry named "ENGINE/..." prices its engine (e3/old: 50 s per cost)."""
     from scripts.campaign import Times, Unit
     t = Times(os.path.join(tempfile.mkdtemp(), "times.json"))
     t.seconds = {"a": {"seconds": 10.0, "cost": 1.0, "engine": "e1"},
@@ -299,6 +300,8 @@ def test_eta_per_engine():
     check("eta_per_engine", t.eta([unit("e1"), unit("e2")]) == 80.0, t.eta([unit("e1"), unit("e2")]))
     t.seconds["old"] = {"seconds": 20.0, "cost": 2.0}
     check("eta_unmeasured_engine_overall", t.eta([unit("e3")]) == 2.0 * 60.0 / 4.0, t.eta([unit("e3")]))
+    t.seconds["e3/old"] = {"seconds": 50.0, "cost": 1.0}   # recorded before entries named their engine
+    check("eta_engine_from_an_older_entry_name", t.eta([unit("e3")]) == 100.0, t.eta([unit("e3")]))
 
 
 def test_times_shared_by_campaigns_at_once():
@@ -380,7 +383,7 @@ def test_trajectory_lands_with_its_sidecar():
     final = os.path.join(d, "runs", "fill.h5")
     unit = campaign.Unit("t/fill", [final], [plan_ch4.jdem(), "run", scene, "-o", "{out0}", "--quiet"],
                          validate=plan_ch4.valid_trajectory)
-    failed, _ = campaign.run_unit(unit)
+    failed, _, _ = campaign.run_unit(unit)
     side = os.path.join(d, "runs", "fill.xdmf")
     text = open(side).read() if os.path.exists(side) else ""
     landed = os.listdir(os.path.dirname(final)) if os.path.isdir(os.path.dirname(final)) else []
