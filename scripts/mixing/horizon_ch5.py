@@ -65,7 +65,7 @@ def set_key(text, key, value):
 def shift_stream(text, origin, jitter):
     """The resolved scene `text` with its inlet's origin (given, [m]) moved by jitter x
     plan_ch4.JITTER in y: a realisation, as Ch. 4's generate.py --jitter."""
-    moved = [float(origin[0]), float(origin[1]) + plan_ch4.JITTER * jitter, float(origin[2])]
+    moved = plan_ch4.shifted_origin(origin, jitter)
     return set_key(text, "origin", "[%s]" % ", ".join(repr(x) for x in moved))
 
 

@@ -79,8 +79,13 @@ def shift_stream(doc, jitter):
     in the scene's description ("" for none)."""
     if not jitter:
         return ""
-    doc["inlets"][0]["origin"][1] += JITTER * jitter
+    doc["inlets"][0]["origin"] = shifted_origin(doc["inlets"][0]["origin"], jitter)
     return f", stream shifted by {jitter} x {JITTER} m in y (run-to-run spread)"
+
+
+def shifted_origin(origin, jitter):
+    """An inlet's origin [m] moved by jitter x JITTER in y: the stream of a realisation."""
+    return [float(origin[0]), float(origin[1]) + JITTER * jitter, float(origin[2])]
 
 
 def jdem():

@@ -129,12 +129,18 @@ def fill_cost(energy):
     return FILL_PARTICLES * FILL_TIME / SEED_DT * (ENERGY_COST if energy else 1.0)
 
 
+def no_energy_scene(case, jitter=0):
+    """The shell line writing the case without energy accounts (the stream shifted by jitter
+    micrometres) into "$1"."""
+    return (f'{shlex.quote(PY)} {shlex.quote(GENERATE)} fill --case {case} --no-energy '
+            + (f'--jitter {jitter} ' if jitter else '') + '-o "$1"')
+
+
 def fill_unit(engine, case, ranks):
     if keeps_energy(engine, case):
         resolve = f'{shlex.quote(jdem())} resolve {shlex.quote(SCENE)} --case {case} > "$1"'
     else:
-        resolve = (f'{shlex.quote(PY)} {shlex.quote(GENERATE)} fill --case {case} --no-energy '
-                   f'-o "$1"')
+        resolve = no_energy_scene(case)
     return Unit(f"{engine}/{case}/fill", [os.path.join(OUT, engine, case, "fill.h5")],
                 fill_command(engine, "{dir}/fill.yaml", False, resolve, ranks=ranks), case, engine,
                 validate=valid_trajectory, cost=fill_cost(keeps_energy(engine, case)),
@@ -148,9 +154,8 @@ def spread_units(engine, case, ranks):
     without energy accounts, and not compressed: the deposit's statistics are what the spread
     is of."""
     return [Unit(f"{engine}/{case}/fill_jitter{k}", [os.path.join(OUT, engine, case, f"fill_jitter{k}.h5")],
-                 fill_command(engine, "{dir}/fill_jitter%d.yaml" % k, False,
-                              f'{shlex.quote(PY)} {shlex.quote(GENERATE)} fill --case {case} --no-energy '
-                              f'--jitter {k} -o "$1"', ranks=ranks),
+                 fill_command(engine, "{dir}/fill_jitter%d.yaml" % k, False, no_energy_scene(case, k),
+                              ranks=ranks),
                  case, engine, validate=valid_trajectory, cost=fill_cost(False),
                  resumes=resumable(engine), ranks=fill_ranks(engine, ranks),
                  committed=committed_realisation(engine, case, k))

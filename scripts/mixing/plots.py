@@ -196,20 +196,23 @@ def strip_panel(ax, values_by_model, name, ideal, title):
     ax.set_title(title)
 
 
+def save_figure(fig, name, directories):
+    """Save an open figure as `name` into each of `directories` and close it; returns name, or
+    None for no figure (no data)."""
+    if fig is None:
+        return None
+    for d in directories:
+        fig.savefig(os.path.join(d, name))
+    plt.close(fig)
+    return name
+
+
 def write_figures(make, name, engines, keys, directories):
     """Save make(engine, key) (an open figure, or None: no data) as name(engine, key) into each
     of `directories`, for every engine and key; returns {(engine, key): file name}."""
-    written = {}
-    for engine in engines:
-        for key in keys:
-            fig = make(engine, key)
-            if fig is None:
-                continue
-            for d in directories:
-                fig.savefig(os.path.join(d, name(engine, key)))
-            plt.close(fig)
-            written[(engine, key)] = name(engine, key)
-    return written
+    written = {(engine, key): save_figure(make(engine, key), name(engine, key), directories)
+               for engine in engines for key in keys}
+    return {k: v for k, v in written.items() if v}
 
 
 # The panels (a)-(f) of Figs 4-11 and 4-12: (summary.json key, axis label); the ideal line on phi_v.

@@ -79,10 +79,23 @@ def times(out):
         return {}
 
 
+# a unit's times (.campaign_times.json) that its summary entry keeps
+TIMING = ("seconds", "cpu_seconds", "ranks", "threads", "machine", "attempts")
+
+
+def timing(took):
+    """The TIMING keys of a unit's recorded times that it has."""
+    return {key: took[key] for key in TIMING if took.get(key) is not None}
+
+
+def measured(path, rev):
+    """A fill's measures (fill_ch5.result) with its outflow and the commit that measured it."""
+    return dict(fill_ch5.result(path), source=rev, outflow=outflow.spread(path, scene_geometry(path)[1]))
+
+
 def measure(path, name, out, spent, directory, rev):
     """The summary entry of the finished fill at path, with its cubes when all 9 are done."""
-    entry = dict(fill_ch5.result(path), source=rev)
-    entry["outflow"] = outflow.spread(path, scene_geometry(path)[1])
+    entry = measured(path, rev)
     fill_ch5.write_pictures(entry, name, path, directory)
     cubes = [os.path.join(out, name, "cube%d.h5" % k) for k in CUBES]
     if all(os.path.exists(c) for c in cubes):
@@ -91,10 +104,7 @@ def measure(path, name, out, spent, directory, rev):
             took = [spent.get("%s/cube%d" % (name, k), {}).get(key) for k in CUBES]
             if all(t is not None for t in took):
                 entry["cube_" + key] = float(sum(took))
-    fill = spent.get(name + "/fill", {})
-    for key in ("seconds", "cpu_seconds", "ranks", "threads", "machine", "attempts"):
-        if fill.get(key) is not None:
-            entry[key] = fill[key]
+    entry.update(timing(spent.get(name + "/fill", {})))
     return entry
 
 
@@ -130,20 +140,21 @@ REALISATION_KEYS = ("particles", "time", "middle_clip", "surface", "packing", "b
 def realisation(path, name, k, spent, rev):
     """The summary entry of the fill's realisation K (fill_jitterK.h5): what agreement_ch5.py
     compares, its run time and commit."""
-    r = fill_ch5.result(path)
-    entry = dict({key: r[key] for key in REALISATION_KEYS if key in r}, jitter=k, source=rev,
-                 outflow=outflow.spread(path, scene_geometry(path)[1]))
-    took = spent.get("%s/fill_jitter%d" % (name, k), {})
-    entry.update({key: took[key] for key in ("seconds", "cpu_seconds", "ranks", "threads", "machine")
-                  if took.get(key) is not None})
-    return entry
+    r = measured(path, rev)
+    return dict({key: r[key] for key in REALISATION_KEYS if key in r}, jitter=k, source=rev,
+                outflow=r["outflow"], **timing(spent.get("%s/fill_jitter%d" % (name, k), {})))
+
+
+def realisations_here(out, name):
+    """[(K, path)] of the fill's realisations under out."""
+    engine, c = name.split("/")
+    return [(k, p) for k in range(1, SPREAD_REALISATIONS[engine].get(c, 0) + 1)
+            for p in [os.path.join(out, name, "fill_jitter%d.h5" % k)] if os.path.exists(p)]
 
 
 def realisations(out, name, spent, rev, committed):
     """The fill's realisations measured here, and the committed ones of the other K."""
-    engine, c = name.split("/")
-    here = [realisation(p, name, k, spent, rev) for k in range(1, SPREAD_REALISATIONS[engine].get(c, 0) + 1)
-            for p in [os.path.join(out, name, "fill_jitter%d.h5" % k)] if os.path.exists(p)]
+    here = [realisation(p, name, k, spent, rev) for k, p in realisations_here(out, name)]
     ks = {r["jitter"] for r in here}
     return sorted(here + [r for r in committed if r["jitter"] not in ks], key=lambda r: r["jitter"])
 
@@ -159,8 +170,7 @@ def collect(out, committed, rev, directory):
             elif name in committed:
                 found[name] = dict(committed[name])
             else:
-                if any(os.path.exists(os.path.join(out, name, "fill_jitter%d.h5" % k))
-                       for k in range(1, SPREAD_REALISATIONS[engine].get(c, 0) + 1)):
+                if realisations_here(out, name):
                     print("report_ch5.py: %s: its realisations wait for the fill itself "
                           "(`make mixing-bonded UNIT=%s/fill`)" % (name, name), file=sys.stderr)
                 continue
@@ -204,25 +214,15 @@ def elastic_values(found):
     return values
 
 
-def save(fig, name, directories):
-    """Save an open figure (None: no data) as name into each of directories; name or None."""
-    if fig is None:
-        return None
-    for d in directories:
-        fig.savefig(os.path.join(d, name))
-    plots.plt.close(fig)
-    return name
-
-
 def write_elastic_figures(found, directories):
     """Fig. 5-27 (and M beneath it) and Figs 5-28 to 5-30 (point by point) into each of
     directories; their file names (None: no data)."""
-    names = [save(plots.elastic_figure(elastic_values(found)), ELASTIC_FIGURE, directories)]
+    names = [plots.save_figure(plots.elastic_figure(elastic_values(found)), ELASTIC_FIGURE, directories)]
     for g in GROUPS:
         cubes = {(m, e): found["%s/%s" % (e, case(g, m))]["cubes"] for m in MODELS for e in ENGINES
                  if "cubes" in found.get("%s/%s" % (e, case(g, m)), {})}
-        names.append(save(plots.points_elastic_figure(cubes, g, list(CUBES)),
-                          "fig%s.png" % plots.SEED_POINTS_FIGURE[g], directories))
+        names.append(plots.save_figure(plots.points_elastic_figure(cubes, g, list(CUBES)),
+                                       "fig%s.png" % plots.SEED_POINTS_FIGURE[g], directories))
     return [n for n in names if n]
 
 
@@ -265,7 +265,7 @@ def claims(found):
     2 sqrt(s_a² + s_b²); plain signs where no spread is measured).  The stiffness and anisotropy
     claims have no such spread (the realisations are not compressed)."""
     spread = agreement_ch5.spread(found, CASES)
-    lines = ["### The seed's claims (spec §3.8)", "",
+    head = ["### The seed's claims (spec §3.8)", "",
              "each weighed against the run-to-run spread of the groups' fills where it is measured "
              "(the realisations with the stream shifted, scripts/mixing/agreement_ch5.py): a "
              "difference counts beyond 2√(s_a² + s_b²), else the claim is not resolved; \"mixes "
@@ -274,6 +274,7 @@ def claims(found):
              "models have φv of 0.32-0.47, far above the ideal, spec §3.8); in our fills φv stays under "
              "the ideal (%s), where \"nearer the ideal\" and \"more big spheres in the clip\" are one "
              "reading" % above_ideal(found), ""]
+    lines = []
     for engine in ENGINES:
         get = lambda g, m: found.get("%s/%s" % (engine, case(g, m)))
         for m in MODELS:
@@ -316,10 +317,10 @@ def claims(found):
                                  engine, m, *ratio, "held" if ratio[0] > ratio[1] > ratio[2] else "not held"))
             lines += surface_claim(engine, m, g1, g3, within)
         lines += model_claims(engine, found, spread)
-    if len(lines) == 4:
+    if not lines:
         lines.append("(none yet: each needs a Group 1 fill and a bonded fill of the same model)")
     seed = {"seed/%s" % case(g, m): {"middle_clip": {"mean": SEED_PHI_V[g][m - 1][0]}} for g in GROUPS for m in MODELS}
-    return lines[:4] + seed_table_claims() + model_claims("seed", seed, lambda c, label: None) + [""] + lines[4:]
+    return head + seed_table_claims() + model_claims("seed", seed, lambda c, label: None) + [""] + lines
 
 
 def above_ideal(found):
