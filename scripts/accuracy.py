@@ -94,7 +94,7 @@ def factor_name(f):
 
 def resolved(item):
     case = ITEMS[item][1]
-    return yaml.safe_load(engines.resolve(scene_of(item), case, check=True).stdout)
+    return yaml.load(engines.resolve(scene_of(item), case, check=True).stdout, Loader=yaml.CSafeLoader)
 
 
 def write_yaml(doc, path):
@@ -137,10 +137,10 @@ def scene_at(item, base, factor, steps=None):
 
 def seed_scene(out, base, factor, seed):
     """The bed with another lattice seed, at dt = factor x the guard dt of the original bed."""
-    src = yaml.safe_load(open(BED_SCENE))
+    src = yaml.load(open(BED_SCENE), Loader=yaml.CSafeLoader)
     src["generate"][0]["lattice"]["seed"] = seed
     tmp = write_yaml(src, os.path.join(out, "bed", "seeds", "seed%d.source.yaml" % seed))
-    doc = yaml.safe_load(engines.resolve(tmp, check=True).stdout)
+    doc = yaml.load(engines.resolve(tmp, check=True).stdout, Loader=yaml.CSafeLoader)
     return scene_at("bed", (doc,) + tuple(base[1:]), factor)
 
 

@@ -63,7 +63,7 @@ class BedRun:
             step = p["position/step"][()]
             time = p["position/time"][()]
             text = f["parameters/scene"][()]
-            scene = yaml.safe_load(text.decode() if isinstance(text, bytes) else text)
+            scene = yaml.load(text.decode() if isinstance(text, bytes) else text, Loader=yaml.CSafeLoader)
             keep = step % int(scene["output"]["every"]) == 0
             self.keys = np.rint(time[keep] / frame_interval).astype(int)
             self.x = p["position/value"][()][keep]

@@ -61,7 +61,7 @@ def compare_case(a, scene, case, tmp):
     r = engines.resolve(scene, case, binary=a.base, cwd=ROOT)
     if r.returncode != 0:
         return "SKIP", "the base does not resolve it: " + r.stderr.strip()[-200:]
-    doc = yaml.safe_load(r.stdout)
+    doc = yaml.load(r.stdout, Loader=yaml.CSafeLoader)
     if len(doc.get("particles") or []) > a.max_particles:
         return "SKIP", "%d particles" % len(doc["particles"])
     doc["time"]["steps"] = min(doc["time"]["steps"], a.max_steps)

@@ -57,7 +57,7 @@ def load(path):
             txt = f["parameters/scene"][()]
             if isinstance(txt, bytes):
                 txt = txt.decode()
-            scene = yaml.safe_load(str(txt)) or {}
+            scene = yaml.load(str(txt), Loader=yaml.CSafeLoader) or {}
         except Exception:  # the scene text is optional metadata
             scene = {}
     out["gravity"] = np.array(scene.get("gravity") or [0.0, 0.0, 0.0], dtype=float)

@@ -314,7 +314,7 @@ class Progress:
 
 def total_steps(text):
     try:
-        return int(yaml.safe_load(text)["time"]["steps"])
+        return int(yaml.load(text, Loader=yaml.CSafeLoader)["time"]["steps"])
     except (yaml.YAMLError, KeyError, TypeError, ValueError):
         return 0
 

@@ -49,7 +49,7 @@ def case_b_scenes(out, rule):
     path = os.path.join(out, rule, "scenes", "test8.yaml")
     os.makedirs(os.path.dirname(path), exist_ok=True)
     with open(os.path.join(ROOT, "reference_runs", "chung_ooi", "test8", "scene.yaml")) as f:
-        scene = yaml.safe_load(f)
+        scene = yaml.load(f, Loader=yaml.CSafeLoader)
     scene.setdefault("model", {})["tangential_stiffness"] = rule
     values = scene["sweep"][0]["values"]
     scene["sweep"][0]["values"] = {k: v for k, v in values.items() if k.endswith("caseB")}
@@ -127,7 +127,7 @@ def ratios(out):
     found = {}
     for test in (5, 8):
         with open(os.path.join(out, "mindlin", "scenes", f"test{test}.yaml")) as f:
-            scene = yaml.safe_load(f)
+            scene = yaml.load(f, Loader=yaml.CSafeLoader)
         for material, over in scene["sweep"][0]["values"].items():
             if test == 8 and not material.endswith("caseB"):
                 continue

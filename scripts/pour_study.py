@@ -51,7 +51,7 @@ SEED_EVERY = 2000         # output.every of the seed runs (statistics only)
 
 def write_scene(src, dst, overrides):
     """Copy a scene with dotted-path overrides, e.g. {"output.every": 100}."""
-    scene = yaml.safe_load(open(src))
+    scene = yaml.load(open(src), Loader=yaml.CSafeLoader)
     for path, value in overrides.items():
         node = scene
         keys = path.split(".")
@@ -267,7 +267,7 @@ def divergence(a, b):
 
 def analyze(out_dir):
     meta = json.load(open(os.path.join(out_dir, "runs.json")))
-    scene = yaml.safe_load(engines.resolve(meta["scene"], binary=JDEM, check=True).stdout)
+    scene = yaml.load(engines.resolve(meta["scene"], binary=JDEM, check=True).stdout, Loader=yaml.CSafeLoader)
     traj = {n: os.path.join(out_dir, n + ".h5") for n in meta["times"]}
     loaded = {n: load(traj[n]) for n in ENGINES}
     curves, div = {}, {}
@@ -489,7 +489,7 @@ def main():
                                  {"output.every": SEED_EVERY, "generate.0.lattice.seed": seed})
             meta["times"]["seed%d" % seed] = run_jdem(seeded, os.path.join(a.out, "seed%d.h5" % seed))
         meta.update(load_average=os.getloadavg(), scene=scene, every=a.every,
-                    dt=float(yaml.safe_load(open(SCENE))["time"]["dt"]))
+                    dt=float(yaml.load(open(SCENE), Loader=yaml.CSafeLoader)["time"]["dt"]))
         with open(runs, "w") as f:
             json.dump(meta, f, indent=1)
     if a.command in ("analyze", "all"):

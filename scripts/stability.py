@@ -69,7 +69,7 @@ def run_liggghts(scene, case, out, force=False):
 
 
 def resolve(jdem, scene, case):
-    return yaml.safe_load(engines.resolve(scene, case, binary=jdem, check=True).stdout)
+    return yaml.load(engines.resolve(scene, case, binary=jdem, check=True).stdout, Loader=yaml.CSafeLoader)
 
 
 def guard_summary(stderr):

@@ -193,6 +193,14 @@ LONG = ("law-sets", "chung-ooi", "paraview", "pour", "stability", "engine-neighb
         "engine-neighbour", "checkpoint")
 assert WIDE | set(LONG) <= {s[0] for s in SUITES}, (WIDE | set(LONG)) - {s[0] for s in SUITES}
 
+# Open MPI's start, for the suites' hundreds of short LIGGGHTS runs (each suite's environment;
+# a variable already set wins).  A one-rank run is an MPI singleton, which starts an orted of its
+# own unless isolated, and every run probed the fabrics' transports (PSM calibrates its timer for
+# 0.2 s) before settling on ob1, the one it uses on one machine: 0.88 s to start liggghts-jdem,
+# 0.30 s with both set (docs/performance.md, "make test on 2 cores").  Neither changes a result:
+# the same point-to-point layer is chosen, and a singleton sends no messages.
+MPI_STARTUP = {"OMPI_MCA_ess_singleton_isolated": "1", "OMPI_MCA_pml": "ob1"}
+
 CMOCKA_OK = re.compile(r"^\[\s+OK\s+\] (\S+)")
 CMOCKA_FAIL = re.compile(r"^\[\s+FAILED\s+\] (\S+)$")
 
@@ -222,7 +230,7 @@ def run_suite(name, cmd, style, env, report=print):
     # From the repository root, which is also the module path: scripts/ and tests/ are packages
     # (scripts/__init__.py), imported as scripts.NAME and tests.SUITE.NAME.
     proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=ROOT,
-                          env={"OMP_WAIT_POLICY": "passive", **os.environ, **env, "TMPDIR": tmp,
+                          env={**MPI_STARTUP, "OMP_WAIT_POLICY": "passive", **os.environ, **env, "TMPDIR": tmp,
                                "PYTHONPATH": ROOT})
     elapsed = time.monotonic() - start
     passed, failed = count(style, proc.stdout)

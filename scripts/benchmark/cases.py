@@ -51,7 +51,7 @@ def use_model_options(options, work):
         if not os.path.exists(path):
             os.makedirs(os.path.dirname(path), exist_ok=True)
             with open(reference(test)) as f:
-                scene = yaml.safe_load(f)
+                scene = yaml.load(f, Loader=yaml.CSafeLoader)
             scene.setdefault("model", {}).update(options)
             with open(path, "w") as f:
                 yaml.safe_dump(scene, f)

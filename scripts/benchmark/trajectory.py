@@ -36,7 +36,7 @@ class Run:
             self.radius = part["radius"][()]
             self.obs = {k: f["observables"][k]["value"][()] for k in f["observables"]}
             text = f["parameters/scene"][()]
-            self.scene = yaml.safe_load(text.decode() if isinstance(text, bytes) else text)
+            self.scene = yaml.load(text.decode() if isinstance(text, bytes) else text, Loader=yaml.CSafeLoader)
         self.two_spheres = len(self.mass) == 2
 
 

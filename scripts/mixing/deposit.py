@@ -72,7 +72,7 @@ def scene_of(f):
     if "parameters/scene" not in f:
         return {}
     text = f["parameters/scene"][()]
-    return yaml.safe_load(text.decode() if isinstance(text, bytes) else text) or {}
+    return yaml.load(text.decode() if isinstance(text, bytes) else text, Loader=yaml.CSafeLoader) or {}
 
 
 def built_by(path):

@@ -144,7 +144,7 @@ def run(a):
     trajectories = [load(runs[e][0]) for e in plan_ch4.ENGINES]
     curve = difference_by_id(*trajectories)
     with open(scene) as f:
-        doc = yaml.safe_load(f)
+        doc = yaml.load(f, Loader=yaml.CSafeLoader)
     touch = first_touch(trajectories[0], doc["inlets"][0]["velocity"], doc["gravity"])
     result = horizon_result(a.case, float(dt_arg), curve, {e: runs[e][1] for e in runs}, touch)
     write_json(a.out, result)

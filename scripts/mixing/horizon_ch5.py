@@ -76,7 +76,7 @@ def write_scene(case, end_time, frame_every, path, jitter=0, observables_every=N
     bit of the trajectory (suite engine-fastpaths)."""
     import yaml
     text = engines.resolve(MODELS, case, check=True).stdout
-    doc = yaml.safe_load(text)
+    doc = yaml.load(text, Loader=yaml.CSafeLoader)
     dt = float(doc["time"]["dt"])
     if jitter:
         text = shift_stream(text, doc["inlets"][0]["origin"], jitter)

@@ -140,7 +140,7 @@ def committed_entry(engine, model, key, count=1, variant="seed"):
 def valid_scene(path):
     try:
         with open(path) as f:
-            doc = yaml.safe_load(f)
+            doc = yaml.load(f, Loader=yaml.CSafeLoader)
     except (OSError, yaml.YAMLError) as e:
         return f"not a scene: {e}"
     return None if isinstance(doc, dict) and doc.get("jdem_scene") == 1 else "no jdem_scene: 1"
@@ -218,7 +218,7 @@ def guard_dt(model):
         subprocess.run([PY, GENERATE, "fill", "--case", model, "--dt", "auto", "-o", scene],
                        check=True)
         r = subprocess.run([jdem(), "resolve", scene], capture_output=True, text=True, check=True)
-        return float(yaml.safe_load(r.stdout)["time"]["dt"])
+        return float(yaml.load(r.stdout, Loader=yaml.CSafeLoader)["time"]["dt"])
 
 
 def variant_dt(variant, model):

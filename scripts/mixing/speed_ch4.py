@@ -82,7 +82,7 @@ def run_liggghts(resolved, d, engine, ranks):
 def with_energy_accounts(scene, d):
     """The resolved scene of `scene` with output.energy: true, written into d."""
     with open(scene) as f:
-        doc = yaml.safe_load(f)
+        doc = yaml.load(f, Loader=yaml.CSafeLoader)
     doc["output"]["energy"] = True
     path, resolved = os.path.join(d, "fill_energy.yaml"), os.path.join(d, "resolved_energy.yaml")
     with open(path, "w") as f:

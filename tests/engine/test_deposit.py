@@ -77,7 +77,7 @@ def resolved_particles(text):
 def source_frame(src):
     """The last frame of the source: ids, material names, radii, positions, velocities."""
     with h5py.File(src, "r") as f:
-        names = list(yaml.safe_load(f["parameters/scene"][()].decode())["materials"])
+        names = list(yaml.load(f["parameters/scene"][()].decode(), Loader=yaml.CSafeLoader)["materials"])
         p = f["particles/all"]
         return (p["id"][()], [names[s] for s in p["species"][()]], p["radius"][()],
                 p["position/value"][-1], p["velocity/value"][-1], p["angular_velocity/value"][-1])

@@ -21,7 +21,7 @@ DT_AUTO_FACTOR = 1.0  # the documented default: the guard's safe dt itself
 
 def resolve(path):
     p = engines.resolve(path, binary=JDEM)
-    return p, (yaml.safe_load(p.stdout) if p.returncode == 0 else None)
+    return p, (yaml.load(p.stdout, Loader=yaml.CSafeLoader) if p.returncode == 0 else None)
 
 
 def hertz_contact_time(E, nu, rho, R, v):

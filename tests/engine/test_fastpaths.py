@@ -306,7 +306,7 @@ c.check("deferred_kick_same_observables",
 # The block's generator numbers its spheres in lattice order, which is already cell order; the
 # resolved scene with the ids shuffled (bonds renamed alike) makes the renumbering non-trivial.
 gen = variant(yaml.safe_dump(bond_checks.block_scene(True), sort_keys=False), "block_drop_gen")
-resolved = yaml.safe_load(engines.resolve(gen, binary=JDEM, check=True).stdout)
+resolved = yaml.load(engines.resolve(gen, binary=JDEM, check=True).stdout, Loader=yaml.CSafeLoader)
 ids = [p["id"] for p in resolved["particles"]]
 rename = dict(zip(ids, np.random.default_rng(3).permutation(ids).tolist()))
 for p in resolved["particles"]:

@@ -109,7 +109,7 @@ def builds(stderr):
 
 tmp = tempfile.mkdtemp(prefix="jdem_shower_")
 with open(scene("shower")) as f:
-    one_skin = yaml.safe_load(f)
+    one_skin = yaml.load(f, Loader=yaml.CSafeLoader)
 one_skin["neighbour"] = {"skin_steps": 0}
 with open(os.path.join(tmp, "one_skin.yaml"), "w") as f:
     yaml.safe_dump(one_skin, f)

@@ -42,7 +42,7 @@ def refused(name, text, message, command="run", file_name=None, args=()):
 
 def scene_with(**fields):
     """small_scene with top-level keys replaced or added: name, case, materials, ..."""
-    doc = yaml.safe_load(small_scene())
+    doc = yaml.load(small_scene(), Loader=yaml.CSafeLoader)
     doc.update(fields)
     return yaml.safe_dump(doc, sort_keys=False, width=100000)
 
@@ -67,7 +67,7 @@ def hostile_names():
     refused("case_space", scene_with(case="my case"),
             f"36: key 'case': the name 'my' has byte 0x20 at character 3, not allowed in a name; "
             f"{VALID_NAME.replace('63', '127')}")
-    mats = yaml.safe_load(small_scene())["materials"]
+    mats = yaml.load(small_scene(), Loader=yaml.CSafeLoader)["materials"]
     refused("material_semicolon", scene_with(materials={"gl;ass": mats["glass"]}),
             f"9: key 'materials': the name 'gl' has ';' at character 3, not allowed in a name; "
             f"{VALID_NAME}")
@@ -237,7 +237,7 @@ def bond_rules_dt_auto():
     r = run([JDEM, "resolve", path])
     if not c.check("bond_rules_dt_auto_resolves", r.rc == 0, repr(r)):
         return
-    res = yaml.safe_load(r.out)
+    res = yaml.load(r.out, Loader=yaml.CSafeLoader)
     dt = res["time"]["dt"]
     steps = [rule["step"] for rule in res["bond_rules"]]
     want = sorted([2, math.ceil(1.0e-5 / dt - 1e-9)])
@@ -246,7 +246,7 @@ def bond_rules_dt_auto():
     fixed = write_scene(d, "fixed", BOND_SCENE.format(dt=repr(dt)))
     rf = run([JDEM, "resolve", fixed])
     c.check("bond_rules_dt_auto_equals_explicit_dt",
-            rf.rc == 0 and yaml.safe_load(rf.out)["bond_rules"] == res["bond_rules"], repr(rf))
+            rf.rc == 0 and yaml.load(rf.out, Loader=yaml.CSafeLoader)["bond_rules"] == res["bond_rules"], repr(rf))
     out = os.path.join(d, "rules.h5")
     r = run([JDEM, "run", path, "-o", out, "--quiet"])
     c.check("bond_rules_dt_auto_runs", r.rc == 0 and h5_readable(out) is None, repr(r))

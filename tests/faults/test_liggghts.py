@@ -126,7 +126,7 @@ def liggghts(deck, np_=1, timeout=120):
 def generator_refuses(c, d, label, path_in_scene, value, expect):
     """A resolved scene with VALUE at PATH_IN_SCENE (keys): the generator exits 2 with EXPECT in
     its message and writes no in.jdem; nothing named PWNED appears."""
-    scene = yaml.safe_load(resolved_text(resting(d, "inj_" + label)))
+    scene = yaml.load(resolved_text(resting(d, "inj_" + label)), Loader=yaml.CSafeLoader)
     node = scene
     for k in path_in_scene[:-1]:
         node = node[k]
@@ -188,7 +188,7 @@ def injection(c, d):
     c.check("odd_name_no_output", not os.path.exists(out) and not os.path.exists(out + ".part"), files(w))
     # ... and a resolved scene that holds one anyway (hand-edited) is written literally by the deck
     # generator, and stored as it is
-    resolved = yaml.safe_load(resolved_text(resting(w, "odd_ok", steps=20, every=10)))
+    resolved = yaml.load(resolved_text(resting(w, "odd_ok", steps=20, every=10)), Loader=yaml.CSafeLoader)
     resolved["name"] = name
     deck = os.path.join(w, "odd_deck")
     os.makedirs(deck)

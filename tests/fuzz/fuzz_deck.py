@@ -173,7 +173,7 @@ def main():
             os.remove(f)
         os.makedirs(deck_dir, exist_ok=True)
         src = os.path.join(tmp, "in%d.yaml" % (n % 4))
-        scene = yaml.safe_load(yaml.safe_dump(rng.choice(base)))
+        scene = yaml.load(yaml.safe_dump(rng.choice(base)), Loader=yaml.CSafeLoader)
         if rng.random() < 0.2:
             data = mutate_text(yaml.safe_dump(scene), rng)
         else:

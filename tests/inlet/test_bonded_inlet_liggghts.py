@@ -234,7 +234,7 @@ def check_bad_sections(c, tmp):
 def check_rigid(c, tmp):
     """Ch. 6's rigid cements (.inf strengths): every bond intact in both engines, and the two
     trajectories, a growing particle set, within the tolerance (scripts/compare_trajectories.py)."""
-    doc = yaml.safe_load(open(SCENE))
+    doc = yaml.load(open(SCENE), Loader=yaml.CSafeLoader)
     doc["bond_types"]["weak"].update(tensile_strength=float("inf"), shear_strength=float("inf"))
     doc["watchdog"] = {"max_overlap_fraction": 1.5}   # a big sphere lands on a block: beyond the default 0.5
     scene = os.path.join(tmp, "rigid.yaml")
@@ -259,7 +259,7 @@ def main():
     c = Checks()
     if not c.built(JDEM, LIGGGHTS_JDEM):
         return 1
-    sc = yaml.safe_load(engines.resolve(SCENE, check=True).stdout)
+    sc = yaml.load(engines.resolve(SCENE, check=True).stdout, Loader=yaml.CSafeLoader)
     inlet = sc["inlets"][0]
     R = max(p["radius"] for p in inlet["section"]["particles"])
     v = float(np.linalg.norm(inlet["velocity"]))

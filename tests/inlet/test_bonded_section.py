@@ -171,7 +171,7 @@ def check_fall_and_floor(sc, f, starts):
 
 
 def check_axis():
-    sc = yaml.safe_load(engines.resolve(AXIS_SCENE, binary=JDEM, check=True).stdout)
+    sc = yaml.load(engines.resolve(AXIS_SCENE, binary=JDEM, check=True).stdout, Loader=yaml.CSafeLoader)
     sec = sc["inlets"][0]["section"]
     x = np.array([q["position"] for q in sec["particles"]])
     parent = list(range(len(x)))
@@ -194,14 +194,14 @@ def check_axis():
 
 
 def main():
-    user = yaml.safe_load(open(SCENE))
+    user = yaml.load(open(SCENE), Loader=yaml.CSafeLoader)
     with tempfile.TemporaryDirectory() as tmp:
         traj, rec_path = os.path.join(tmp, "b.h5"), os.path.join(tmp, "rec.csv")
         run = engines.jdem("run", SCENE, "-o", traj, "--inlet-record", rec_path, "--quiet", binary=JDEM)
         check("run", run.returncode == 0, run.stderr.strip())
         if run.returncode:
             return
-        sc = yaml.safe_load(engines.resolve(SCENE, binary=JDEM, check=True).stdout)
+        sc = yaml.load(engines.resolve(SCENE, binary=JDEM, check=True).stdout, Loader=yaml.CSafeLoader)
         inlet, dt = sc["inlets"][0], sc["time"]["dt"]
         rec = read_record(rec_path)
         starts, abc, spacing = check_insertion(user, inlet, dt, rec)

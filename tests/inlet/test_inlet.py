@@ -73,7 +73,7 @@ def main():
         check("run", run.returncode == 0, run.stderr.strip())
         if run.returncode:
             return
-        sc = yaml.safe_load(engines.resolve(SCENE, binary=JDEM, check=True).stdout)
+        sc = yaml.load(engines.resolve(SCENE, binary=JDEM, check=True).stdout, Loader=yaml.CSafeLoader)
         inlet = sc["inlets"][0]
         steps = math.ceil(sc["time"]["end_time"] / sc["time"]["dt"] - 1e-9) \
             if "end_time" in sc["time"] else sc["time"]["steps"]
@@ -144,7 +144,7 @@ def chapter4_models():
         r = engines.resolve(scene, case, binary=JDEM)
         if not check(f"ch4-{case}-resolves", r.returncode == 0, r.stderr.strip()):
             continue
-        walls = yaml.safe_load(r.stdout).get("walls") or []
+        walls = yaml.load(r.stdout, Loader=yaml.CSafeLoader).get("walls") or []
         got = sorted((w["axis"][0][0], w["axis"][0][2]) for w in walls if w["type"] == "cylinder")
         check(f"ch4-{case}-cylinders", got == sorted(want) and len(walls) == 5 + len(want),
               f"cylinders {got}, expected {sorted(want)}; {len(walls)} walls")

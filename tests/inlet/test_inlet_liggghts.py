@@ -199,7 +199,7 @@ def cross_engine(tmp):
     resolved = os.path.join(tmp, "resolved.yaml")
     with open(resolved, "w") as f:
         f.write(engines.resolve(SCENE, check=True).stdout)
-    sc = yaml.safe_load(open(resolved))
+    sc = yaml.load(open(resolved), Loader=yaml.CSafeLoader)
     deck_dir = os.path.join(tmp, "deck")
     lig_rec = os.path.join(deck_dir, "lig.csv")
     r = engines.write_deck(resolved, os.path.join(deck_dir, "in.jdem"), "--trajectory", os.path.join(tmp, "fill.lig.h5"),
@@ -349,7 +349,7 @@ def bad_input(deck_dir, deck_text):
 def stop_rules(tmp):
     """The time and deposit-height stop rules: the same records in both engines, one section
     where the sections rule gives two by 0.2 s (copy 1 starts at step 2700: 0.135 s)."""
-    base = yaml.safe_load(open(SCENE))
+    base = yaml.load(open(SCENE), Loader=yaml.CSafeLoader)
     base["time"]["end_time"] = 0.2
     second = dict(base["inlets"][0], name="belt2", origin=[0.01, 0.1, 0.35], stop={"sections": 2}, first_id=1000)
     for name, stop, more in (("time", {"time": 0.125}, []),

@@ -43,7 +43,7 @@ check = checks.check
 
 def variant(tmp, name, limit, end_time=None):
     """The scene with max_insert_overlap LIMIT (None: the key removed, the default)."""
-    sc = yaml.safe_load(open(SCENE))
+    sc = yaml.load(open(SCENE), Loader=yaml.CSafeLoader)
     inlet = sc["inlets"][0]
     if limit is None:
         del inlet["max_insert_overlap"]
@@ -99,7 +99,7 @@ def jdem_run(tmp, scene, name):
 
 def default_rule(tmp):
     scene = variant(tmp, "default", None)
-    sc = yaml.safe_load(engines.resolve(scene, check=True).stdout)
+    sc = yaml.load(engines.resolve(scene, check=True).stdout, Loader=yaml.CSafeLoader)
     check("default-resolved", sc["inlets"][0]["max_insert_overlap"] == 0.0,
           repr(sc["inlets"][0]["max_insert_overlap"]))
     exp = expected(sc)
@@ -130,7 +130,7 @@ def default_rule(tmp):
 
 def scene_rule(tmp):
     scene = variant(tmp, "limit", 0.05)
-    sc = yaml.safe_load(engines.resolve(scene, check=True).stdout)
+    sc = yaml.load(engines.resolve(scene, check=True).stdout, Loader=yaml.CSafeLoader)
     exp = expected(sc)
     r, h5, rec = jdem_run(tmp, scene, "limit")
     if not check("limit-run", r.returncode == 0, r.stderr[-600:]):
@@ -149,7 +149,7 @@ def scene_rule(tmp):
 
 def literal_rule(tmp):
     scene = variant(tmp, "literal", float("inf"), end_time=0.0502)
-    sc = yaml.safe_load(engines.resolve(scene, check=True).stdout)
+    sc = yaml.load(engines.resolve(scene, check=True).stdout, Loader=yaml.CSafeLoader)
     exp = expected(sc)
     r, h5, rec = jdem_run(tmp, scene, "literal")
     copy0 = sorted(i for i, e in exp.items() if e[1] == 0)
@@ -164,7 +164,7 @@ def liggghts(tmp, name, scene, jdem_h5, jdem_rec, compare_frames):
     resolved = os.path.join(tmp, name + ".resolved.yaml")
     with open(resolved, "w") as f:
         f.write(engines.resolve(scene, check=True).stdout)
-    sc = yaml.safe_load(open(resolved))
+    sc = yaml.load(open(resolved), Loader=yaml.CSafeLoader)
     deck_dir = os.path.join(tmp, name + ".deck")
     for np_ in (1, 2):
         rec, traj = os.path.join(deck_dir, "np%d.csv" % np_), os.path.join(tmp, "%s.np%d.h5" % (name, np_))

@@ -141,7 +141,7 @@ CUTOFF = re.compile(r"fix bond/jiang: step (\d+): bond 1-2 is (\S+) m long, not 
 
 
 def check_ghost_cutoff(work):
-    scene = yaml.safe_load(open(os.path.join(SCENES, "ghost_cutoff.yaml")))
+    scene = yaml.load(open(os.path.join(SCENES, "ghost_cutoff.yaml")), Loader=yaml.CSafeLoader)
     p = scene["particles"]
     bt = scene["bond_types"]["rubber"]
     R = float(p[0]["radius"])  # (PyYAML reads 1.0e6 as a string: convert every number)

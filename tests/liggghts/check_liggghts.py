@@ -38,7 +38,7 @@ def energy_off_checks(scene, stem, label):
     failures = 0
     # reference path: the same scene with the energy bookkeeping (full contact history)
     with open(scene) as f:
-        doc = yaml.safe_load(f)
+        doc = yaml.load(f, Loader=yaml.CSafeLoader)
     doc.setdefault("output", {})["energy"] = True
     full = stem + ".energy_on.yaml"
     with open(full, "w") as f:
@@ -134,7 +134,7 @@ def main():
             failures += 1
             sys.stdout.write(indented(full))
         with open(scene) as f:
-            energy = ((yaml.safe_load(f) or {}).get("output") or {}).get("energy", True)
+            energy = ((yaml.load(f, Loader=yaml.CSafeLoader) or {}).get("output") or {}).get("energy", True)
         if not energy and case is None:
             failures += energy_off_checks(scene, stem, label)
         if name.startswith("mpi_"):

@@ -45,7 +45,7 @@ def check(c, tmp, source, steps, every, obs_every, ranks=1):
     label = "%s_observables_every_%d%s" % (os.path.basename(source)[:-5], obs_every,
                                            "_np%d" % ranks if ranks > 1 else "")
     with open(source) as f:
-        scene = yaml.safe_load(f)
+        scene = yaml.load(f, Loader=yaml.CSafeLoader)
     scene["time"]["steps"] = steps
     scene["output"] = {"every": every, "observables_every": obs_every}
     path = os.path.join(tmp, label + ".yaml")

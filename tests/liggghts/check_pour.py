@@ -90,7 +90,7 @@ def main():
         return 1
     traj = {n: pour_study.load(os.path.join(work, n + ".h5")) for n in RUNS}
     ok = all([check_horizon(traj, a_, b_, until) for (a_, b_), until in HORIZON.items()])
-    resolved = yaml.safe_load(engines.resolve(scene, binary=pour_study.JDEM, check=True).stdout)
+    resolved = yaml.load(engines.resolve(scene, binary=pour_study.JDEM, check=True).stdout, Loader=yaml.CSafeLoader)
     ok &= check_statistics({n: pour_study.settled_stats(os.path.join(work, n + ".h5"), resolved) for n in RUNS})
     if not a.out:
         shutil.rmtree(work, ignore_errors=True)

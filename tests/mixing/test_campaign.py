@@ -511,7 +511,7 @@ def test_ch5_realisation_scene():
         case = subprocess.run([jdem, "resolve", plan_ch5.SCENE, "--case", "group3_model3"],
                               capture_output=True, text=True).stdout
     differ = [(a, b) for a, b in zip(case.splitlines(), got.splitlines()) if a != b]
-    moved = [(yaml.safe_load(a)["origin"], yaml.safe_load(b)["origin"]) for a, b in differ if "origin:" in a]
+    moved = [(yaml.load(a, Loader=yaml.CSafeLoader)["origin"], yaml.load(b, Loader=yaml.CSafeLoader)["origin"]) for a, b in differ if "origin:" in a]
     check("ch5_realisation_scene", r.returncode == 0 and len(differ) == 2
           and ("  energy: true", "  energy: false") in differ and len(moved) == 1
           and moved[0][1][0] == moved[0][0][0] and moved[0][1][2] == moved[0][0][2]

@@ -48,7 +48,7 @@ def reduced_scene(tmp, sections=SECTIONS, end_time=END_TIME):
     subprocess.run([sys.executable, GENERATE, "fill", "--case", "model1", "--sections",
                     str(sections), "--end-time", str(end_time), "-o", path], check=True)
     with open(path) as f:
-        doc = yaml.safe_load(f)
+        doc = yaml.load(f, Loader=yaml.CSafeLoader)
     doc["output"] = {"every": EVERY, "observables_every": 100}
     with open(path, "w") as f:
         yaml.safe_dump(doc, f, sort_keys=False)
@@ -178,8 +178,8 @@ def run_fill(tmp, sections, end_time):
     check(f"fill-{sections}-sections-runs", run.returncode == 0, run.stderr.strip())
     if run.returncode:
         return None
-    sc = yaml.safe_load(subprocess.run([JDEM, "resolve", scene], capture_output=True,
-                                       text=True, check=True).stdout)
+    sc = yaml.load(subprocess.run([JDEM, "resolve", scene], capture_output=True,
+                                       text=True, check=True).stdout, Loader=yaml.CSafeLoader)
     return sc, read_record(rec), traj
 
 

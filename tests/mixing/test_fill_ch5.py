@@ -378,7 +378,7 @@ def test_wall_band_picture(tmp):
     g1 = fill_ch5.result(unbonded)
     check("an empty bond table (a Group 1 fill, both engines write one) is an unbonded fill: no "
           "breakage, drawn in the unbonded colours", "breakage" not in g1 and g1.get("_rec") is None, sorted(g1))
-    doc = yaml.safe_load(scene_text())
+    doc = yaml.load(scene_text(), Loader=yaml.CSafeLoader)
     doc["inlets"] = [{"name": "belt", "section": {"particles": [], "bonds": {"blocks": [{"size": [2, 2, 8]}]}}}]
     write_fill(unbonded, bed(lambda x: 12), empty, 0.0, "0.1.0", yaml.safe_dump(doc))
     lost = fill_ch5.result(unbonded)

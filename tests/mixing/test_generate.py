@@ -47,7 +47,7 @@ write_deposit(dep, 1.1)
 out = os.path.join(tmp, "pass2.yaml")
 r = gen("second-pass", dep, "--case", "model5", "-o", out)
 check("second_pass_runs", r.returncode == 0, r.stderr)
-doc = yaml.safe_load(open(out))
+doc = yaml.load(open(out), Loader=yaml.CSafeLoader)
 cells = doc["inlets"][0]["section"]["from_deposit"]
 los = [tuple(c["region"]["lo"]) for c in cells]
 want = [(0.0, 0.5 * (q % 2), 0.25 * (q // 2)) for q in range(8)]
@@ -70,7 +70,7 @@ check("second_pass_deposit_beside", {c["file"] for c in cells} == {"dep.h5"}, f"
 os.makedirs(os.path.join(tmp, "partial"))
 r = gen("second-pass", dep, "--case", "model5", "-o", os.path.join(tmp, "partial", "p.yaml"),
         "--scene-dir", os.path.join(tmp, "final", "model5"))
-moved = yaml.safe_load(open(os.path.join(tmp, "partial", "p.yaml"))) if r.returncode == 0 else {}
+moved = yaml.load(open(os.path.join(tmp, "partial", "p.yaml")), Loader=yaml.CSafeLoader) if r.returncode == 0 else {}
 check("second_pass_deposit_from_scene_dir", r.returncode == 0 and
       moved["inlets"][0]["section"]["from_deposit"][0]["file"] == "../../dep.h5", r.stderr)
 check("second_pass_inserted_once", doc["inlets"][0]["stop"] == {"sections": 1}, f"{doc['inlets'][0]}")
@@ -78,7 +78,7 @@ check("second_pass_keeps_model", doc["walls"][5]["present"] and doc["walls"][6][
       f"{doc['walls'][5:]}")
 r = gen("cubes", dep, "--case", "model2", "-o", os.path.join(tmp, "cubes"))
 check("cubes_run", r.returncode == 0, r.stderr)
-c5 = yaml.safe_load(open(os.path.join(tmp, "cubes", "cube5.yaml")))
+c5 = yaml.load(open(os.path.join(tmp, "cubes", "cube5.yaml")), Loader=yaml.CSafeLoader)
 region = c5["particles_from"][0]["region"]
 check("cube_deposit_relative", c5["particles_from"][0]["file"] == "../dep.h5",
       f"{c5['particles_from'][0]['file']}")
@@ -92,7 +92,7 @@ r = gen("cubes", dep, "--case", "group3_model2", "-o", os.path.join(tmp, "cubes5
 check("ch5_cubes_run", r.returncode == 0, r.stderr)
 names = sorted(os.listdir(os.path.join(tmp, "cubes5"))) if r.returncode == 0 else []
 check("ch5_cubes_middle_clip", names == ["cube%d.yaml" % k for k in range(10, 19)], f"{names}")
-docs = {k: yaml.safe_load(open(os.path.join(tmp, "cubes5", "cube%d.yaml" % k))) for k in (10, 14, 18)} \
+docs = {k: yaml.load(open(os.path.join(tmp, "cubes5", "cube%d.yaml" % k)), Loader=yaml.CSafeLoader) for k in (10, 14, 18)} \
     if names else {}
 regions = {k: d["particles_from"][0]["region"] for k, d in docs.items()}
 check("ch5_cube_regions", regions == {10: {"lo": [0.15, 0.4, 0.1], "hi": [0.35, 0.6, 0.3]},
@@ -126,17 +126,17 @@ check("case_unknown", r.returncode != 0 and "case 'model7' is not in" in r.stder
 fill = os.path.join(tmp, "fill.yaml")
 r = gen("fill", "--case", "model3", "--dt", "2.5e-05", "--sections", "4", "--end-time", "0.5",
         "-o", fill)
-doc = yaml.safe_load(open(fill)) if r.returncode == 0 else {}
+doc = yaml.load(open(fill), Loader=yaml.CSafeLoader) if r.returncode == 0 else {}
 check("fill_dt_cadence", doc.get("time", {}).get("dt") == 2.5e-05 and doc.get("output") ==
       {"every": 40000, "observables_every": 4000, "energy": False}, f"{r.stderr}{doc.get('time')} {doc.get('output')}")
 check("fill_reduced", doc.get("inlets", [{}])[0].get("stop") == {"sections": 4}
       and doc["time"]["end_time"] == 0.5 and doc["walls"][5]["present"], f"{doc.get('inlets')}")
 r = gen("fill", "--case", "model1", "--dt", "auto", "-o", fill)
-doc = yaml.safe_load(open(fill)) if r.returncode == 0 else {}
+doc = yaml.load(open(fill), Loader=yaml.CSafeLoader) if r.returncode == 0 else {}
 check("fill_dt_auto", doc.get("time", {}).get("dt") == "auto" and doc.get("output") ==
       {"every": 10000, "observables_every": 1000, "energy": False}, f"{r.stderr}{doc.get('output')}")
 r = gen("cubes", dep, "--case", "model2", "--dt", "5e-05", "-o", os.path.join(tmp, "cubes_dt"))
-c1 = yaml.safe_load(open(os.path.join(tmp, "cubes_dt", "cube1.yaml"))) if r.returncode == 0 else {}
+c1 = yaml.load(open(os.path.join(tmp, "cubes_dt", "cube1.yaml")), Loader=yaml.CSafeLoader) if r.returncode == 0 else {}
 check("cubes_dt_cadence", c1.get("time", {}).get("dt") == 5e-05 and c1.get("output") ==
       {"every": 2000, "observables_every": 200}, f"{r.stderr}{c1.get('output')}")
 r = gen("fill", "--case", "model1", "--dt", "-1", "-o", fill)
@@ -145,7 +145,7 @@ check("fill_dt_bad", r.returncode == 2 and r.stderr.strip().endswith(
       "auto"), r.stderr)
 # --frame-every: the horizon's dense frames, in steps of the scene's dt (after a --dt rescale)
 r = gen("fill", "--case", "model2", "--dt", "5e-05", "--frame-every", "400", "-o", fill)
-doc = yaml.safe_load(open(fill)) if r.returncode == 0 else {}
+doc = yaml.load(open(fill), Loader=yaml.CSafeLoader) if r.returncode == 0 else {}
 check("fill_frame_every", doc.get("output") == {"every": 400, "observables_every": 2000, "energy": False},
       f"{r.stderr}{doc.get('output')}")
 r = gen("fill", "--case", "model1", "--frame-every", "0", "-o", fill)

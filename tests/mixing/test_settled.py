@@ -115,7 +115,7 @@ def check_restart(tmp, src, largest):
     rc, out, err = resolve(scene)
     if not check("restart_resolves", rc == 0, err):
         return
-    parts = yaml.safe_load(out)["particles"]
+    parts = yaml.load(out, Loader=yaml.CSafeLoader)["particles"]
     check("restart_particles_settled", len(parts) == 64 and all(p.get("settled") for p in parts),
           "%d particles, %d settled" % (len(parts), sum(bool(p.get("settled")) for p in parts)))
     h5 = os.path.join(tmp, "restart.h5")
@@ -161,7 +161,7 @@ def check_section(tmp, src):
     if not check("section_resolves", rc == 0, err):
         return
     resolved = write(os.path.join(tmp, "inlet.resolved.yaml"), out)
-    parts = yaml.safe_load(out)["inlets"][0]["section"]["particles"]
+    parts = yaml.load(out, Loader=yaml.CSafeLoader)["inlets"][0]["section"]["particles"]
     order = np.argsort(ids)
     xs = x[order]
     a, b = xs[:, 0] < 0.0202, xs[:, 0] >= 0.0202

@@ -56,7 +56,7 @@ def case_scene(case, dt=None):
     """models.yaml with the overrides of one case applied and the sweep removed; dt (a number
     or "auto") replaces the time step."""
     with open(MODELS) as f:
-        doc = yaml.safe_load(f)
+        doc = yaml.load(f, Loader=yaml.CSafeLoader)
     values = doc.pop("sweep")[0]["values"]
     if case not in values:
         sys.exit(f"generate.py: case '{case}' is not in {MODELS}; valid: {', '.join(values)}")
