@@ -101,26 +101,33 @@ def verdict(ok):
 
 
 UNRESOLVED = "not resolved (within the run-to-run spread)"
+UNMEASURED = "not resolved (no run-to-run spread measured)"
 
 
-def ordered(value, spread, pairs):
+def ordered(value, spread, pairs, plain_signs=False):
     """Verdict and margin text of "a is above b" for every (a, b) in pairs (a claim such as "a
     mixes better than b", in the value that says it): held when every difference value_a -
     value_b exceeds 2 sqrt(s_a² + s_b²), two standard deviations of the difference of two
-    independent fills, not held when one falls below minus it, otherwise UNRESOLVED; plain signs
-    when no spread is measured.  spread(key) -> (s, source) or None."""
+    independent fills, not held when one falls below minus it, otherwise UNRESOLVED.  A pair
+    without a measured spread leaves the claim UNMEASURED, unless one of the other pairs already
+    falls below; plain_signs: the signs alone decide (a published table read against its own
+    text, where there is no spread to weigh).  spread(key) -> (s, source) or None."""
     signs, bounds = [], []
     for a, b in pairs:
         sa, sb = spread(a), spread(b)
         if not (sa and sb):
-            signs.append(1 if value[a] > value[b] else -1)
+            signs.append((1 if value[a] > value[b] else -1) if plain_signs else None)
             continue
         bound = 2.0 * math.hypot(sa[0], sb[0])
         bounds.append(bound)
         d = value[a] - value[b]
         signs.append(1 if d > bound else (-1 if d < -bound else 0))
-    text = ("held" if all(x > 0 for x in signs) else "not held") \
-        if all(x != 0 for x in signs) or -1 in signs else UNRESOLVED
+    if -1 in signs:
+        text = "not held"
+    elif None in signs:
+        text = UNMEASURED
+    else:
+        text = "held" if all(x > 0 for x in signs) else UNRESOLVED
     if not bounds:
         return text, "no run-to-run spread measured"
     return text, "a difference counts beyond 2√(s_a² + s_b²) = %.4f" % max(bounds)

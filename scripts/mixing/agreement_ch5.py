@@ -114,7 +114,9 @@ def section(found, cases):
     lines = head + [
         "past the horizon the engines are two realisations of one chaotic fill: |jdem − "
         "liggghts-jdem| at the end of the fill against 2√2 s, s the std over the realisations of "
-        "one fill (the stream shifted by K µm; the case's own, else pooled over its group); "
+        "one fill (the stream shifted by K µm; the case's own, else pooled over its group); a "
+        "pooled s has one degree of freedom for each case it names (a fill and its one shifted "
+        "realisation), so an s from one name is a rough one and a verdict near its bound is weak; "
         "scripts/mixing/agreement_ch5.py", "",
         "| case | statistic | jdem | liggghts-jdem | difference | 2√2 s | s from | agree |",
         "|---|---|---|---|---|---|---|---|"]

@@ -30,6 +30,7 @@ into OUT/cross/horizon/{summary.json, horizon.md, horizon.png} and, with --resul
 here is taken from the committed summary.json, each result naming the commit it was run at.
 """
 import argparse
+import collections
 import math
 import os
 import re
@@ -219,7 +220,36 @@ def spread_table(rows):
               "cases (%d above, %d below)." % (
                   sum(q["held"] for q in rows), len(rows), sum(q["pooled_held"] for q in rows), len(rows),
                   float(np.mean(signed)), sum(x > 0 for x in signed), sum(x < 0 for x in signed))]
+    lines += ["", repeats(rows)]
     return "\n".join(lines) + "\n"
+
+
+def repeats(rows):
+    """A sentence on how the runs' counts repeat: the pairs of runs of one case and engine with
+    equal counts, against the number independent draws from a smooth distribution of each set's
+    spread would give (two integer draws of std s coincide with probability 1 / (2 sqrt(pi) s)),
+    and the largest ratio of the engines' spreads of one case."""
+    equal = expected = 0.0
+    sd = {}
+    for q in rows:
+        for e in ENGINES:
+            c = q["counts"][e]
+            if len(c) < 2:
+                continue
+            sd[(q["case"], e)] = s = float(np.std(c, ddof=1))
+            equal += sum(m * (m - 1) // 2 for m in collections.Counter(c).values())
+            expected += len(c) * (len(c) - 1) / 2.0 / (2.0 * math.sqrt(math.pi) * max(s, 0.5))
+    ratios = [(max(sd[(q["case"], e)] for e in ENGINES) / max(min(sd[(q["case"], e)] for e in ENGINES), 0.5),
+               q["case"]) for q in rows if all((q["case"], e) in sd for e in ENGINES)]
+    text = ("Pairs of runs of one case and engine that end with the same count: %d, where independent "
+            "draws from a smooth distribution of each set's spread would give %.1f" % (equal, expected))
+    if equal > 2 * expected:
+        text += (": the count at 2 s takes few values (whether a given block breaks one way or "
+                 "another), so a std over seven runs is a rough measure and the degrees of freedom "
+                 "above overstate what the runs tell")
+    if ratios:
+        text += "; the engines' spreads of one case differ by up to %.1fx (%s)" % max(ratios)
+    return text + "."
 
 
 def run(a):

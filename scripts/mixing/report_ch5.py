@@ -23,6 +23,7 @@ breakage at all (spec §4.3): those columns have no seed value.
 import argparse
 import functools
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -110,7 +111,8 @@ def measure(path, name, out, spent, directory, rev):
 
 RUN_TIME_NOTE = ("run times are the CPU time of the unit's processes (all ranks and threads), "
                  "since the wall clock of a shared machine also counts the pauses of the runs beside "
-                 "it; \"w\" marks a wall time, where a unit ran before its CPU time was recorded")
+                 "it; \"w\" marks a wall time alone, of a unit timed before its CPU time was recorded (which "
+                 "may then be its last attempt only, if it was resumed) or whose CPU time was lost")
 
 
 def cpu_or_wall(e, prefix=""):
@@ -262,13 +264,14 @@ def claims(found):
     """The seed's claims (spec §3.8) that the finished fills can decide, per engine: held, not
     held, or not resolved, weighed as Chapter 4's against the run-to-run spread of each group's
     fill (agreement_ch5.spread: a difference of two groups' fills counts beyond
-    2 sqrt(s_a² + s_b²); plain signs where no spread is measured).  The stiffness and anisotropy
-    claims have no such spread (the realisations are not compressed)."""
+    2 sqrt(s_a² + s_b²); not resolved where no spread is measured).  The stiffness and anisotropy
+    claims have no such spread (the realisations are not compressed): cube_claims."""
     spread = agreement_ch5.spread(found, CASES)
     head = ["### The seed's claims (spec §3.8)", "",
-             "each weighed against the run-to-run spread of the groups' fills where it is measured "
-             "(the realisations with the stream shifted, scripts/mixing/agreement_ch5.py): a "
-             "difference counts beyond 2√(s_a² + s_b²), else the claim is not resolved; \"mixes "
+             "each weighed against the run-to-run spread of the groups' fills (the realisations with "
+             "the stream shifted, scripts/mixing/agreement_ch5.py): a difference counts beyond "
+             "2√(s_a² + s_b²), else the claim is not resolved, as it is while a group compared has no "
+             "spread measured yet; the seed's own table is read by its signs; \"mixes "
              "better\" is read as φv nearer the ideal 0.0625 at the middle clip, a reading the seed's "
              "own Table 5-3 does not bear out (its lines \"seed\" below, without a spread: its \"best\" "
              "models have φv of 0.32-0.47, far above the ideal, spec §3.8); in our fills φv stays under "
@@ -306,21 +309,37 @@ def claims(found):
                              "particles, scripts/mixing/outflow.py; %s): **%s**" % (
                                  engine, m, o1["x"], o1["z"], o2["std"], o1["std"], o2["n"], o1["n"], margin, text))
             if all(e and "cubes" in e for e in (g1, g2, g3)):
-                ms = [stats.summary([c["M_wall"] for c in e["cubes"]])["mean"] for e in (g1, g2, g3)]
-                lines.append("- %s Model %d: stiffness falls as bond strength rises (M %.0f, %.0f, %.0f Pa "
-                             "for Groups 1-3; no run-to-run spread measured): **%s**" % (
-                                 engine, m, *ms, "held" if ms[0] > ms[1] > ms[2] else "not held"))
-                ratio = [stats.summary([c["nu_xy"] for c in e["cubes"]])["mean"] /
-                         stats.summary([c["nu_xz"] for c in e["cubes"]])["mean"] for e in (g1, g2, g3)]
-                lines.append("- %s Model %d: the anisotropy νxy/νxz falls with bond strength (%.3f, %.3f, "
-                             "%.3f for Groups 1-3; the fit is ill-posed, docs/model.md §10): **%s**" % (
-                                 engine, m, *ratio, "held" if ratio[0] > ratio[1] > ratio[2] else "not held"))
+                lines += cube_claims(engine, m, (g1, g2, g3))
             lines += surface_claim(engine, m, g1, g3, within)
         lines += model_claims(engine, found, spread)
     if not lines:
         lines.append("(none yet: each needs a Group 1 fill and a bonded fill of the same model)")
     seed = {"seed/%s" % case(g, m): {"middle_clip": {"mean": SEED_PHI_V[g][m - 1][0]}} for g in GROUPS for m in MODELS}
-    return head + seed_table_claims() + model_claims("seed", seed, lambda c, label: None) + [""] + lines
+    return head + seed_table_claims() + model_claims("seed", seed, lambda c, label: None, plain_signs=True) + [""] + lines
+
+
+def cube_claims(engine, m, fills):
+    """Stiffness falls and the anisotropy νxy/νxz falls as bond strength rises (Groups 1-3 of
+    Model m).  M is weighed against the standard error of each fill's mean over its cubes (the
+    realisations are not compressed, so there is no run-to-run spread of M); the Poisson ratios
+    are not weighed at all: the fit that gives them is ill-posed (docs/model.md §10)."""
+    m_of = [stats.summary([c["M_wall"] for c in e["cubes"]]) for e in fills]
+    n_of = [len(e["cubes"]) for e in fills]
+    mean = {g: s_["mean"] for g, s_ in zip(GROUPS, m_of)}
+    # the trimmed mean's standard error: the std of the values the trim keeps, over their number
+    error = {g: (s_["std"] / math.sqrt(s_["n_kept"]), "cubes") for g, s_ in zip(GROUPS, m_of)}
+    text, _ = ordered(mean, error.get, [(1, 2), (2, 3)])
+    bound = max(2.0 * math.hypot(error[a][0], error[b][0]) for a, b in ((1, 2), (2, 3)))
+    ratio = [stats.summary([c["nu_xy"] for c in e["cubes"]])["mean"] /
+             stats.summary([c["nu_xz"] for c in e["cubes"]])["mean"] for e in fills]
+    return ["- %s Model %d: stiffness falls as bond strength rises (M %.0f, %.0f, %.0f Pa for Groups "
+            "1-3; a difference counts beyond 2√(e_a² + e_b²) = %.0f Pa, e the standard error of a "
+            "fill's trimmed mean of M over its %s cubes, there being no run-to-run spread of M): **%s**" % (
+                engine, m, *mean.values(), bound, "/".join(str(n) for n in sorted(set(n_of))),
+                text.replace("run-to-run spread", "cubes' spread")),
+            "- %s Model %d: the anisotropy νxy/νxz falls with bond strength (%.3f, %.3f, %.3f for "
+            "Groups 1-3): **not resolved (the fit that gives the Poisson ratios is ill-posed, "
+            "docs/model.md §10)**" % (engine, m, *ratio)]
 
 
 def above_ideal(found):
@@ -330,10 +349,11 @@ def above_ideal(found):
     return "every fill" if not above else "all but " + ", ".join(above)
 
 
-def model_claims(engine, found, spread):
+def model_claims(engine, found, spread, plain_signs=False):
     """The seed's claims that order the models of one group by their mixing (|φv − ideal| at the
     middle clip, weighed as claims()): obstacles improve mixing (Models 2-6 against Model 1),
-    Model 5 mixes best in Group 1, Models 3 and 5 in Group 2."""
+    Model 5 mixes best in Group 1, Models 3 and 5 in Group 2.  plain_signs: the seed's own table,
+    read by its signs (agreement.ordered)."""
     lines = []
     for g in GROUPS:
         near = {m: -abs(e["middle_clip"]["mean"] - params.IDEAL_PHI_V) for m in MODELS
@@ -349,7 +369,7 @@ def model_claims(engine, found, spread):
         if g == 2 and len(near) == len(MODELS):
             checks.append(("Models 3 and 5 mix best", [(a, m) for a in (3, 5) for m in MODELS if m not in (3, 5)]))
         for claim, pairs in checks:
-            text, margin = ordered(near, within, pairs)
+            text, margin = ordered(near, within, pairs, plain_signs)
             lines.append("- %s Group %d: %s (|φv − %.4f| at the middle clip per model %s; %s): **%s**" % (
                 engine, g, claim, params.IDEAL_PHI_V, listed, margin, text))
     return lines
@@ -374,17 +394,19 @@ def differences_section(found):
                      "(docs/mixing.md §1, §11 \"Why φv is low\")." % (
                          engine, " / ".join("%.4f" % np.mean(ours[g]) if ours[g] else "—" for g in GROUPS),
                          " / ".join("%.4f" % np.mean(seed[g]) if seed[g] else "—" for g in GROUPS),
-                         " The gap is there without bonds (Group 1, under half the seed's), as in Chapter 4: "
+                         " The gap is there without bonds (Group 1, %.0f %% of the seed's), as in Chapter 4: "
                          "our deposits put the big spheres against the walls and out of the middle clip, "
-                         "whatever the bonds do." if unbonded else ""))
+                         "whatever the bonds do." % (100 * np.mean(ours[1]) / np.mean(seed[1]))
+                         if unbonded else ""))
         if weak:
             broken, formed = sum(k["broken"] for k in weak), sum(k["formed"] for k in weak)
             lines.append("- %s, Group 2: %d of %d weak bonds broke over its %d fill%s%s" % (
                 engine, broken, formed, len(weak), "" if len(weak) == 1 else "s",
                 ": a 5 kPa bond of the reconstructed stiffness (k̄n = 1e6 Pa/m, spec §4.2) breaks in any "
                 "impact faster than 0.56 m/s and the blocks meet the first obstacle or the bed at 2.2 m/s "
-                "or faster, so they reach the bed as single spheres and mix as Group 1 (docs/mixing.md "
-                "§11)." if broken >= 0.99 * formed else "."))
+                "or faster, so they break on impact (in Model 1 on the bed: the first breaks, in the horizon section) and lie "
+                "in the deposit as single spheres; whether they mix otherwise than Group 1's is the claims' question below "
+                "(docs/mixing.md §11)." if broken >= 0.99 * formed else "."))
         if cubes:
             nu = [c["nu_xy"] for c in cubes]
             lines.append("- %s, Tables 5-4 and 5-5: the orthotropic fit of a laterally confined cube is "
@@ -428,10 +450,15 @@ def structure_table(found):
              "|---|---|---|---|---|---|---|---|"]
     for name, e in sorted(found.items()):
         s, p = e.get("surface"), e.get("packing")
-        if s and p:
+        if s and p and p["samples"]:
             lines.append("| %s | %s | %.1f | %+.1f | %.3f–%.3f | %.4f | %.4f | %+.4f |" % (
                 *name.split("/"), s["inclination"], s["slope_x"], s["lowest"], s["highest"],
                 p["wall"], p["interior"], p["wall"] - p["interior"]))
+        elif s and p:   # a column whose bed ends near the floor: no layer under the surface
+            lines.append("| %s | %s | %.1f | %+.1f | %.3f–%.3f | no layer: the lowest column's bed "
+                         "(a gap over %.2f m ends it) tops out at %.3f m, under the floor band | — | — |" % (
+                             *name.split("/"), s["inclination"], s["slope_x"], s["lowest"], s["highest"],
+                             structure.BED_GAP, p["top"] + structure.SURFACE_BAND))
     if len(lines) == 5:
         lines.append("(no fill measured since these measures were added)")
     return lines
@@ -468,17 +495,17 @@ def energy_table(found):
              "largest residual of KE + RE + elastic + gravitational + dissipated (the bonds' stored, "
              "damped and breakage energy included) − wall work − inflow, over the energy in play and "
              "over the inflow; the stability suite holds 1e-3 of the energy in play; bond-steps per "
-             "second of the run time (" + RUN_TIME_NOTE + "); \"old\" marks a fill run, at least in "
+             "second of the CPU time, none from a wall time (" + RUN_TIME_NOTE + "); \"old\" marks a fill run, at least in "
              "part, before " + ENERGY_FIX + " (the previous load booked through the current lever "
              "arms: first order in dt, docs/mixing.md §11), left out of the worst fill", "",
              "| engine | case | residual / in play | residual / inflow | breakage [J] | inflow [J] "
              "| bond-steps | run time [s] | bond-steps per second |",
              "|---|---|---|---|---|---|---|---|---|"]
-    worst, old = None, []
+    worst, old, worst_old = None, [], 0.0
     for name, e in sorted(found.items()):
         b = e.get("energy")
-        took, _ = cpu_or_wall(e)
-        rate = e["bond_steps"] / took if took and e.get("bond_steps") else None
+        took, cpu = cpu_or_wall(e)
+        rate = e["bond_steps"] / took if cpu and e.get("bond_steps") else None   # not from "w" times
         current = bool(b) and current_bookkeeping(e.get("built_by", []))
         balance = ("%.2e%s | %.2e | %.3g | %.4g" % (
             b["residual_in_play"], "" if current else " old", b["residual_inflow"], b["breakage"],
@@ -488,6 +515,7 @@ def energy_table(found):
             "%.3g" % rate if rate else "—"))
         if b and not current:
             old.append(name)
+            worst_old = max(worst_old, b["residual_in_play"])
         elif current and (worst is None or b["residual_in_play"] > worst[1]):
             worst = (name, b["residual_in_play"])
     if worst:
@@ -497,7 +525,9 @@ def energy_table(found):
     else:
         lines += ["", "(no fill on the current bookkeeping yet)"]
     if old:
-        lines += ["", "On the old bookkeeping: " + ", ".join(old) + "."]
+        lines += ["", "On the old bookkeeping: %s; the worst of them %.2e of the energy in play (%s the "
+                  "stability suite's 1e-3)." % (", ".join(old), worst_old,
+                                               "within" if worst_old <= 1e-3 else "beyond")]
     lines += ["", "Only jdem's fills of %s keep the energy accounts (scripts/mixing/plan_ch5.py, "
               "keeps_energy); every other fill, liggghts-jdem's included, runs without them: the "
               "same trajectory bit for bit, 1.57x faster in liggghts-jdem and 1.9x in jdem "
@@ -548,8 +578,9 @@ def campaign_time_table(found):
              "the stream shifted and their 9 compressions each (the units run one after another on "
              "a lane, so the sums are the campaign's time on one lane; wall times include any "
              "pause, and units timed before the CPU time was recorded have a wall time only); the "
-             "whole campaign's fills (%s) projected from the mean CPU time per fill" %
-             ", ".join("%s %d" % (e, n) for e, n in planned.items()), "",
+             "whole campaign's fills (%s: the %d cases, the %d rigid ones and the realisations) "
+             "projected from the mean CPU time per fill" %
+             (", ".join("%s %d" % (e, n) for e, n in planned.items()), len(CASES), len(RIGID_CASES)), "",
              "| engine | fills timed | fills' wall [h] | fills' CPU [h] | cube sets timed "
              "| cubes' wall [h] | cubes' CPU [h] | all fills projected [CPU h] |",
              "|---|---|---|---|---|---|---|---|"]
@@ -663,8 +694,11 @@ def report(found, rev, figures=None, elastic=None, section=None):
              "Generated by scripts/mixing/report_ch5.py from the finished fills of `make mixing-bonded` "
              "(commit %s); a row from an earlier commit names it. docs/mixing.md §11." % rev, "",
              "### Table 5-3: φv at the middle clip (points 10–18 of Table 5-2, y = 0.5 m)", "",
-             "trimmed mean ± std (scripts/mixing/stats.py; the seed does not say how it trims); "
-             "ideal φv = 0.0625; " + RUN_TIME_NOTE + "; \"e\" marks a fill that kept the energy "
+             "φv = V_big / V_small, the volumes of the big and the small spheres within a sampling "
+             "sphere of r = 0.1 m at each point (the parts of spheres that cross its surface counted, "
+             "scripts/mixing/lens.py); ideal φv = 0.0625 (4 big spheres to 512 small per section); "
+             "trimmed mean ± std of the points the trim keeps, of 9 (scripts/mixing/stats.py; the seed does not say how "
+             "it trims); " + RUN_TIME_NOTE + "; \"e\" marks a fill that kept the energy "
              "accounts (about 1.9x the time in jdem, 1.57x in liggghts-jdem; plan_ch5.keeps_energy)", "",
              "| group | model | seed | jdem | liggghts-jdem | run time jdem / liggghts-jdem [s] |",
              "|---|---|---|---|---|---|"]

@@ -5,7 +5,7 @@ follow from the claims' definitions: each check must say "held" on a case built 
 import copy
 
 from tests.mixing.common import check, finish
-from scripts.mixing import claims_ch4, stats
+from scripts.mixing import agreement, claims_ch4, stats
 
 MODELS = claims_ch4.MODELS
 
@@ -25,13 +25,16 @@ def spread(mean, half):
 
 
 def campaign():
-    """Model 2 worst and split, 3 and 4 above 1 and 2, 5 above 3; the second pass converges."""
+    """Model 2 worst and split, 3 and 4 above 1 and 2, 5 above 3; the second pass converges.
+    Model 3 has one shifted realisation, 0.001 above its fill: the run-to-run spread of every
+    model (pooled) is then 0.0007, and a difference counts beyond 0.002."""
     first = {"model1": 0.010, "model2": 0.002, "model3": 0.040, "model4": 0.045,
              "model5": 0.050, "model6": 0.030}
     found = {"jdem": {}}
     for m in MODELS:
         found["jdem"][m] = {"fill1": fill(spread(first[m], 0.004)),
                             "fill2": fill(spread(0.06, 0.002))}
+    found["jdem"]["model3"]["jitter"] = [fill(spread(0.041, 0.004))]
     return found
 
 
@@ -66,6 +69,16 @@ def test_each_fails():
         g["jdem"][m]["fill1"] = fill(spread(g["jdem"][m]["fill1"]["summary"]["phi_v"]["mean"], 0.004),
                                      rho=2000.0 + 100.0 * MODELS.index(m))
     check("rho_discriminates_not_held", verdicts(g, claims_ch4.phi_discriminates) == [False])
+
+
+def test_no_spread_measured():
+    """With no realisation anywhere there is no run-to-run spread: an ordering claim is not
+    resolved, whatever the signs say (5 above 3, 3 and 4 above 1 and 2 here)."""
+    g = campaign()
+    del g["jdem"]["model3"]["jitter"]
+    lines = claims_ch4.obstacles_left(g, "jdem")
+    check("no_spread_not_resolved", len(lines) == 2 and all(x.endswith(": " + agreement.UNMEASURED)
+                                                            for x in lines), lines)
 
 
 def test_discrimination_index():
@@ -133,7 +146,7 @@ def test_run_to_run_spread():
     check("own_spread_over_both_engines", line.endswith(": held") and "= 0.0075)" in line, line)
 
 
-for t in (test_all_hold, test_each_fails, test_discrimination_index, test_incomplete_is_silent,
-          test_run_to_run_spread):
+for t in (test_all_hold, test_each_fails, test_no_spread_measured, test_discrimination_index,
+          test_incomplete_is_silent, test_run_to_run_spread):
     t()
 finish()

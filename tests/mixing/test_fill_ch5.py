@@ -233,12 +233,15 @@ def test_report(tmp):
           "one's 0.5 J on the old bookkeeping",
           "Worst fill on the current bookkeeping: jdem/group2_model5, 6.25e-02 of the energy in play "
           "(**beyond**" in text and "| jdem | rigid_model3 | 1.25e-01 old |" in text
-          and "On the old bookkeeping: jdem/rigid_model3." in text)
+          and "On the old bookkeeping: jdem/rigid_model3; the worst of them 1.25e-01 of the energy in play "
+          "(beyond" in text)
     check("report: the rigid fill's bonds all intact (3 formed, 0 broken, 2 fragments), "
           "its wall time marked w",
           re.search(r"\| jdem \| rigid_model3 \| [^|]+ \| 3 \| 0 \| 2 \| 0 \| 777 w \|", text) is not None)
     check("report: the bond-steps, 3 x 100, per CPU second (300 / 1200 s, not the wall's 5000 s)",
           "| 300 | 1200 | 0.25 |" in text)
+    check("report: no bond-steps per second from a wall time alone (the rigid fill's 777 w)",
+          re.search(r"\| jdem \| rigid_model3 \| 1.25e-01 old \|[^\n]*\| 777 w \| — \|", text) is not None)
     check("report: the campaign's time, 2 fills (1 with CPU): 5777 s wall, 1200 s CPU, 20 fills and "
           "3 realisations 7.7 CPU h", "| jdem | 2 (1 with CPU) | 1.60 | 0.33 | 0 (0 with CPU) | — | — | 7.7 |" in text)
     h = structure.free_surface(dep, LO, HI)["mean"]
@@ -352,6 +355,38 @@ def test_claims_ch5():
     v, line = verdict("strong bonds leave more voids")
     check("claims_ch5: more voids near the walls, 0.05 beyond 0.0141", v == "held" and "= 0.0141" in line, line)
 
+    # M over 9 cubes each, M - 900, M and M + 900 Pa three times: the trim keeps 7 (std 734.8 Pa),
+    # the standard error is 734.8 / sqrt(7) = 277.7 Pa and a difference counts beyond
+    # 2 sqrt(2) 277.7 = 786 Pa; the Poisson ratios are never weighed
+    def cubes(m_mean, nu_xy):
+        return [{"M_wall": m_mean + d, "nu_xy": nu_xy, "nu_xz": 0.5} for d in (-900.0, 0.0, 900.0) * 3]
+    for g, m_mean in ((1, 40000.0), (2, 39000.0), (3, 38000.0)):
+        found["jdem/group%d_model3" % g]["cubes"] = cubes(m_mean, 0.5 - 0.1 * g)
+    text = "\n".join(report_ch5.claims(found))
+    v, line = verdict("stiffness falls")
+    check("claims_ch5: M falls by 1000 Pa a group, beyond 786 Pa", v == "held" and "= 786 Pa" in line, line)
+    v, line = verdict("the anisotropy")
+    check("claims_ch5: the anisotropy, from the ill-posed fit, not resolved", v.startswith("not resolved")
+          and "ill-posed" in v, line)
+    found["jdem/group3_model3"]["cubes"] = cubes(38500.0, 0.2)
+    text = "\n".join(report_ch5.claims(found))
+    v, line = verdict("stiffness falls")
+    check("claims_ch5: M falls by 500 Pa from Group 2 to 3, within 786 Pa: not resolved",
+          v == "not resolved (within the cubes' spread)", line)
+
+
+def test_structure_without_layer():
+    """A deposit whose lowest column's bed ends 0.058 m over the floor (rigid blocks leave a gap
+    taller than structure.BED_GAP) has no layer to sample under its surface: the row says so and
+    shows no solid fraction (NaN before)."""
+    from scripts.mixing import report_ch5
+    surface = {"inclination": 1.2, "slope_x": -0.6, "lowest": 0.867, "highest": 1.2}
+    found = {"jdem/rigid_model1": {"surface": surface, "packing": {"wall": float("nan"), "interior": float("nan"),
+                                                                   "top": 0.058 - structure.SURFACE_BAND, "samples": 0}}}
+    row = report_ch5.structure_table(found)[-1]
+    check("structure: no layer under the surface, its bed's top 0.058 m", "no layer" in row and "0.058 m" in row
+          and "nan" not in row and row.endswith("| — | — |"), row)
+
 
 def test_wall_band_picture(tmp):
     """Fig. 5-23's sheet (plots.slab_sheet, as fill_ch5 draws it): of spheres (R = 0.015 m) at
@@ -460,6 +495,7 @@ with tempfile.TemporaryDirectory() as tmp:
     test_wall_band_picture(tmp)
 test_agreement_ch5()
 test_claims_ch5()
+test_structure_without_layer()
 test_model_claims()
 test_speed_table()
 test_elastic_figure()

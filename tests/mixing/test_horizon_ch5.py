@@ -166,5 +166,16 @@ check("ch5_spread_pooled_same_group", q[1]["pooled_std"] == q[0]["pooled_std"] a
       and q[2]["pooled_std"] == 4.0 and q[2]["pooled_dof"] == 2, str(q))
 check("ch5_spread_pooled_verdicts", q[1]["held"] is False and q[1]["pooled_held"] is True,
       "11 against 9.24 (own) and 33.4 (pooled): " + str(q[1]))
+# repeated counts: jdem 10, 10, 10, 16 (3 equal pairs; std 3, so 6 pairs x 1/(2 sqrt(pi) 3) =
+# 0.564 expected) and liggghts-jdem 10, 12 (none; std sqrt(2), 1/(2 sqrt(pi) sqrt(2)) = 0.199):
+# 3 against 0.76, more than twice; the engines' spreads differ by 3 / sqrt(2) = 2.1x
+rows = [{"case": "group2_model1", "counts": {"jdem": [10, 10, 10, 16], "liggghts-jdem": [10, 12]}}]
+text = horizon_ch5.repeats(rows)
+check("ch5_repeats_equal_pairs", text.startswith("Pairs of runs of one case and engine that end with the same "
+                                                 "count: 3, where") and "would give 0.8:" in text
+      and text.endswith("differ by up to 2.1x (group2_model1)."), text)
+rows[0]["counts"]["jdem"] = [10, 13, 16, 19]
+text = horizon_ch5.repeats(rows)
+check("ch5_repeats_none", "count: 0, where" in text and "few values" not in text, text)
 
 finish()
