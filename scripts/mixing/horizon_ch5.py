@@ -164,24 +164,32 @@ def realisation(a):
     return 0
 
 
-def spread_rows(results, realisations):
-    """Per case with realisations: each engine's bonds broken by T over its runs (the horizon's,
-    K = 0, and those with the stream shifted by K), their mean and std, and whether the engines'
-    means differ by at most 2 s sqrt(1/n_jdem + 1/n_liggghts-jdem) (two standard deviations of a
-    difference of means), with s pooled over both engines' runs of the case and also over the
-    cases of the same group (whose counts are alike), since a few runs give few degrees of
-    freedom.  realisations: {case: {engine: [realisation results]}}."""
+# what a spread table counts at T: the bonds broken, or those broken in tension (the rest broke
+# in shear), from a run's totals (breakage.broken_fraction)
+MODES = {"broken": ("bonds broken by the end", lambda t: t["broken"]),
+         "tension": ("bonds broken in tension by the end", lambda t: int(round(t["tension"] * t["formed"])))}
+
+
+def spread_rows(results, realisations, mode="broken"):
+    """Per case with realisations: each engine's bonds broken by T (mode "tension": in tension)
+    over its runs (the horizon's, K = 0, and those with the stream shifted by K), their mean and
+    std, and whether the engines' means differ by at most 2 s sqrt(1/n_jdem + 1/n_liggghts-jdem)
+    (two standard deviations of a difference of means), with s pooled over both engines' runs of
+    the case and also over the cases of the same group (whose counts are alike), since a few runs
+    give few degrees of freedom.  realisations: {case: {engine: [realisation results]}}."""
+    count = MODES[mode][1]
     out = []
     for r in results:
         reals = realisations.get(r["case"], {})
         if not any(reals.values()):
             continue
         t = r["breaks"]["totals"]
-        q = {"case": r["case"], "group": r["case"].split("_")[0], "jitters": {}, "counts": {}, "mean": {}}
+        q = {"case": r["case"], "group": r["case"].split("_")[0], "mode": mode, "jitters": {}, "counts": {},
+             "mean": {}}
         for e in ENGINES:
             mine = sorted(reals.get(e, []), key=lambda x: x["jitter"])
             q["jitters"][e] = [0] + [x["jitter"] for x in mine]
-            q["counts"][e] = [t[e]["broken"]] + [x["totals"]["broken"] for x in mine]
+            q["counts"][e] = [count(t[e])] + [count(x["totals"]) for x in mine]
             q["mean"][e] = float(np.mean(q["counts"][e]))
         q["difference"] = q["mean"]["liggghts-jdem"] - q["mean"]["jdem"]
         out.append(q)
@@ -203,7 +211,8 @@ def spread_rows(results, realisations):
 def spread_table(rows):
     if not rows:
         return ""
-    lines = ["| case | bonds broken by the end, jdem (K µm: count) | liggghts-jdem (K µm: count) | "
+    what = MODES[rows[0].get("mode", "broken")][0]
+    lines = ["| case | " + what + ", jdem (K µm: count) | liggghts-jdem (K µm: count) | "
              "means jdem / liggghts-jdem | difference | s of the case (dof) | 2 s √(1/n + 1/n'): agree "
              "| s pooled over the group (dof) | 2 s √(1/n + 1/n'): agree |",
              "|---|---|---|---|---|---|---|---|---|"]
@@ -220,7 +229,8 @@ def spread_table(rows):
               "cases (%d above, %d below)." % (
                   sum(q["held"] for q in rows), len(rows), sum(q["pooled_held"] for q in rows), len(rows),
                   float(np.mean(signed)), sum(x > 0 for x in signed), sum(x < 0 for x in signed))]
-    lines += ["", repeats(rows)]
+    if what == MODES["broken"][0]:
+        lines += ["", repeats(rows)]
     return "\n".join(lines) + "\n"
 
 
@@ -383,14 +393,16 @@ def summary(a):
         print("horizon_ch5: no %s under %s/cross/CASE/; nothing written" % (RESULT, a.out))
         return 0
     spread = spread_rows(results, reals)
+    tension = spread_rows(results, reals, "tension")
     target = os.path.join(a.out, "cross", "horizon")
     os.makedirs(target, exist_ok=True)
     commits = sorted({x.get("commit", "not recorded") for x in results +
                       [y for by_engine in reals.values() for xs in by_engine.values() for y in xs]})
     horizon_ch4.write_json(os.path.join(target, "summary.json"),
-                           {"commits": commits, "cases": results, "realisations": reals, "spread": spread})
+                           {"commits": commits, "cases": results, "realisations": reals, "spread": spread,
+                            "spread_tension": tension})
     with open(os.path.join(target, "horizon.md"), "w") as f:
-        f.write(table(results) + "\n" + spread_table(spread))
+        f.write(table(results) + "\n" + spread_table(spread) + "\n" + spread_table(tension))
     plot(results, os.path.join(target, "horizon.png"))
     horizon_ch4.publish(target, a.results)
     print("horizon_ch5: %d case(s) into %s%s" % (len(results), target,
@@ -399,13 +411,13 @@ def summary(a):
 
 
 def read_summary(directory):
-    """(the cases' results, the spread rows, the commits they were run at) of a summary
-    directory, or (None, None, None) when it has none."""
+    """(the cases' results, the spread rows of the broken bonds and of those broken in tension,
+    the commits they were run at) of a summary directory, or four Nones when it has none."""
     path = os.path.join(directory, "summary.json")
     if not os.path.exists(path):
-        return None, None, None
+        return None, None, None, None
     doc = horizon_ch4.read_json(path)
-    return doc["cases"], doc.get("spread", []), doc.get("commits", [])
+    return doc["cases"], doc.get("spread", []), doc.get("spread_tension", []), doc.get("commits", [])
 
 
 def main(argv=None):

@@ -649,7 +649,7 @@ def horizon_section(results=os.path.join(ROOT, "reference_runs", "mixing", "ch5"
     `horizon_ch5.py summary` (the cross/CASE/horizon and cross/CASE/jitterK units), as committed
     in RESULTS (make mixing-bonded-report refreshes it first)."""
     from scripts.mixing import horizon_ch5
-    cases, spread, commits = horizon_ch5.read_summary(results)
+    cases, spread, tension, commits = horizon_ch5.read_summary(results)
     head = ["### Cross-engine horizon and first breaks of the bonded fills, jdem vs liggghts-jdem", ""]
     if not cases:
         return head + ["(not run yet: `make mixing-bonded ENGINE=cross`)"]
@@ -665,6 +665,9 @@ def horizon_section(results=os.path.join(ROOT, "reference_runs", "mixing", "ch5"
                   "stream shifted by K µm in y (`horizon_ch5.py realisation`); the engines' means "
                   "within two standard deviations of a difference of means (2 s √(1/n + 1/n'), n and "
                   "n' the runs of each engine):", "", horizon_ch5.spread_table(spread)]
+    if tension:
+        lines += ["The same for the failure mode: the bonds broken in tension by the end (the rest broke "
+                  "in shear):", "", horizon_ch5.spread_table(tension)]
     claims = horizon_ch5.free_fall_claims(cases)
     if claims:
         lines += ["The seed's claim that weak blocks stay whole in free fall, from the same runs:", ""] + claims

@@ -166,6 +166,18 @@ check("ch5_spread_pooled_same_group", q[1]["pooled_std"] == q[0]["pooled_std"] a
       and q[2]["pooled_std"] == 4.0 and q[2]["pooled_dof"] == 2, str(q))
 check("ch5_spread_pooled_verdicts", q[1]["held"] is False and q[1]["pooled_held"] is True,
       "11 against 9.24 (own) and 33.4 (pooled): " + str(q[1]))
+# the failure mode: of 7440 bonds, jdem's runs broke fractions 0.25, 0.2501 and 0.2499 in tension
+# (1860, 1860.744 -> 1861, 1859.256 -> 1859), liggghts-jdem's 0.26 (1934.4 -> 1934): the counts
+# rounded from the fractions, the table headed by what it counts
+t = lambda frac: {"formed": 7440, "broken": 5000, "tension": frac}
+q = horizon_ch5.spread_rows([{"case": "group2_model1", "breaks": {"totals": {"jdem": t(0.25), "liggghts-jdem": t(0.26)}}}],
+                            {"group2_model1": {"jdem": [{"jitter": 1, "totals": t(0.2501)},
+                                                        {"jitter": 2, "totals": t(0.2499)}]}}, "tension")
+check("ch5_spread_tension_counts", q[0]["counts"] == {"jdem": [1860, 1861, 1859], "liggghts-jdem": [1934]}
+      and q[0]["difference"] == 74.0, str(q[0]["counts"]))
+check("ch5_spread_tension_table", "| case | bonds broken in tension by the end, jdem (K µm: count) |"
+      in horizon_ch5.spread_table(q), horizon_ch5.spread_table(q)[:200])
+
 # repeated counts: jdem 10, 10, 10, 16 (3 equal pairs; std 3, so 6 pairs x 1/(2 sqrt(pi) 3) =
 # 0.564 expected) and liggghts-jdem 10, 12 (none; std sqrt(2), 1/(2 sqrt(pi) sqrt(2)) = 0.199):
 # 3 against 0.76, more than twice; the engines' spreads differ by 3 / sqrt(2) = 2.1x
