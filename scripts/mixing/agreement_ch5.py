@@ -49,6 +49,7 @@ def segregated(e):
     return phi is not None and phi < agreement_ch4.SEGREGATED
 
 
+BROKEN = "bonds broken (fraction)"
 PHI, PHI_STD, INCLINATION, VOIDS = ("φv at the middle clip", "std of φv at the middle clip",
                                     "free-surface inclination [deg]",
                                     "solid fraction interior − near the walls")
@@ -63,7 +64,7 @@ STATISTICS = (
     Statistic(VOIDS, voids, "%.4f"),
     Statistic(OUTFLOW[0], outflow_spread(0), "%.1f"),
     Statistic(OUTFLOW[1], outflow_spread(1), "%.1f"),
-    Statistic("bonds broken (fraction)", bonded("total"), "%.3f"),
+    Statistic(BROKEN, bonded("total"), "%.3f"),
     Statistic("broken in tension (fraction)", bonded("tension"), "%.3f"),
     Statistic("broken in shear (fraction)", bonded("shear"), "%.3f"),
     Statistic("fragments at the end", bonded("fragments"), "%.0f"),

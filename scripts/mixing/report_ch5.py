@@ -293,6 +293,11 @@ def claims(found):
                     lines.append("- %s Model %d: Group %d blocks mix better than unbonded ones (|φv − %.4f| "
                                  "at the middle clip %.4f against Group 1's %.4f; %s): **%s**" % (
                                      engine, m, g, params.IDEAL_PHI_V, -near[g], -near[1], margin, text))
+            if 2 in near and 3 in near:
+                text, margin = ordered(near, within(agreement_ch5.PHI), [(2, 3)])
+                lines.append("- %s Model %d: strong blocks mix worse than weak ones (|φv − %.4f| at the "
+                             "middle clip %.4f against Group 2's %.4f; %s): **%s**" % (
+                                 engine, m, params.IDEAL_PHI_V, -near[3], -near[2], margin, text))
             if m == 3 and g2:
                 a, b = g1["middle_clip"]["std"], g2["middle_clip"]["std"]
                 sp = within(agreement_ch5.PHI_STD)
@@ -311,11 +316,15 @@ def claims(found):
             if all(e and "cubes" in e for e in (g1, g2, g3)):
                 lines += cube_claims(engine, m, (g1, g2, g3))
             lines += surface_claim(engine, m, g1, g3, within)
-        lines += model_claims(engine, found, spread)
+        lines += model_claims(engine, found, spread) + crushing_claim(engine, found, spread)
     if not lines:
         lines.append("(none yet: each needs a Group 1 fill and a bonded fill of the same model)")
     seed = {"seed/%s" % case(g, m): {"middle_clip": {"mean": SEED_PHI_V[g][m - 1][0]}} for g in GROUPS for m in MODELS}
-    return head + seed_table_claims() + model_claims("seed", seed, lambda c, label: None, plain_signs=True) + [""] + lines
+    return head + seed_table_claims() + model_claims("seed", seed, lambda c, label: None, plain_signs=True) + [
+        "- not decided: Group 2's \"fewer extreme values\" and \"φv rises near the boundaries\", and "
+        "\"the earlier in the flow path that the obstacles are added, the better\": the seed defines "
+        "no extreme value, does not say which of its 27 points are near the boundaries, and orders "
+        "no models by how early their obstacles are met", ""] + lines
 
 
 def cube_claims(engine, m, fills):
@@ -349,6 +358,21 @@ def above_ideal(found):
     return "every fill" if not above else "all but " + ", ".join(above)
 
 
+def crushing_claim(engine, found, spread):
+    """Strong bonds: "little crushing without obstacles" (Group 3's Model 1 breaks fewer bonds
+    than each model with obstacles, by its broken fraction, weighed as claims())."""
+    broken = {m: e["breakage"]["total"] for m in MODELS
+              for e in [found.get("%s/%s" % (engine, case(3, m)))] if e and e.get("breakage", {}).get("formed")}
+    if 1 not in broken or len(broken) < 2:
+        return []
+    fewer = {m: -f for m, f in broken.items()}
+    text, margin = ordered(fewer, lambda m: spread(case(3, m), agreement_ch5.BROKEN),
+                           [(1, m) for m in broken if m != 1])
+    return ["- %s Group 3: little crushing without obstacles (the broken fraction of Model 1 under "
+            "each model's with obstacles: %s; %s): **%s**" % (
+                engine, ", ".join("%d: %.3f" % mf for mf in sorted(broken.items())), margin, text)]
+
+
 def model_claims(engine, found, spread, plain_signs=False):
     """The seed's claims that order the models of one group by their mixing (|φv − ideal| at the
     middle clip, weighed as claims()): obstacles improve mixing (Models 2-6 against Model 1),
@@ -366,6 +390,8 @@ def model_claims(engine, found, spread, plain_signs=False):
                            ", ".join(str(m) for m in near if m != 1), [(m, 1) for m in near if m != 1]))
         if g == 1 and len(near) == len(MODELS):
             checks.append(("Model 5 mixes best", [(5, m) for m in MODELS if m != 5]))
+        if g == 1 and 3 in near and 4 in near:
+            checks.append(("Model 3 mixes better than Model 4", [(3, 4)]))
         if g == 2 and len(near) == len(MODELS):
             checks.append(("Models 3 and 5 mix best", [(a, m) for a in (3, 5) for m in MODELS if m not in (3, 5)]))
         for claim, pairs in checks:
@@ -421,11 +447,13 @@ def differences_section(found):
 
 def seed_table_claims():
     """The seed's own Tables 5-4 and 5-5 against its text (spec §3.8): E falls "in the range of
-    25 percent" with bond strength, and νxy falls and νxz rises "about ten percent"."""
+    25 percent" with bond strength, and νxy falls and νxz rises "about ten percent"; "the range of
+    values decreases" with bond strength (read both as the range of the models' means and as the
+    cubes' std); νxy > νxz."""
     means = {k: [float(np.mean([v[0] for v in SEED_ELASTIC[k][g]])) for g in GROUPS] for k in SEED_ELASTIC}
     e = means["E"]
     change = lambda v: ", ".join("%+.0f %%" % (100 * (x - v[0]) / v[0]) for x in v[1:])
-    return ["- the seed's Table 5-4: E falls \"in the range of 25 percent\" as bond strength rises: "
+    lines = ["- the seed's Table 5-4: E falls \"in the range of 25 percent\" as bond strength rises: "
             "its group means over the six models %.0f, %.0f, %.0f Pa (%s against Group 1): **%s** "
             "(the seed's own table does not show it, spec §3.8)" % (
                 *e, change(e), "held" if e[0] > e[1] > e[2] and e[2] <= 0.8 * e[0] else "not held"),
@@ -434,7 +462,20 @@ def seed_table_claims():
             "ten percent from Group 1, but νxy not monotonically)" % (
                 *means["nu_xy"], change(means["nu_xy"]), *means["nu_xz"], change(means["nu_xz"]),
                 "held" if means["nu_xy"][0] > means["nu_xy"][1] > means["nu_xy"][2]
-                and means["nu_xz"][0] < means["nu_xz"][1] < means["nu_xz"][2] else "not held"), ""]
+                and means["nu_xz"][0] < means["nu_xz"][1] < means["nu_xz"][2] else "not held")]
+    stds = [float(np.mean([v[1] for v in SEED_ELASTIC["E"][g]])) for g in GROUPS]
+    ranges = [float(np.ptp([v[0] for v in SEED_ELASTIC["E"][g]])) for g in GROUPS]
+    falls = lambda v: v[0] > v[1] > v[2]
+    pairs = [(xy[0], xz[0]) for g in GROUPS for xy, xz in zip(SEED_ELASTIC["nu_xy"][g], SEED_ELASTIC["nu_xz"][g])]
+    return lines + [
+        "- the seed's Table 5-4: the range of E falls as bond strength rises: the range of the six "
+        "models' means %.0f, %.0f, %.0f Pa; the cubes' std, averaged over the models, %.0f, %.0f, "
+        "%.0f Pa: **%s**" % (*ranges, *stds, "held" if falls(ranges) and falls(stds) else
+                              "held on the models' range, not on the cubes' std" if falls(ranges) else
+                              "held on the cubes' std, not on the models' range" if falls(stds) else "not held"),
+        "- the seed's Table 5-5: νxy > νxz (anisotropy): in %d of its %d model means: **%s**" % (
+            sum(a > b for a, b in pairs), len(pairs), "held" if all(a > b for a, b in pairs) else "not held"),
+        ""]
 
 
 def structure_table(found):

@@ -355,6 +355,27 @@ def test_claims_ch5():
     v, line = verdict("strong bonds leave more voids")
     check("claims_ch5: more voids near the walls, 0.05 beyond 0.0141", v == "held" and "= 0.0141" in line, line)
 
+    # strong against weak: |0.025 - 0.0625| = 0.0375 against |0.05 - 0.0625| = 0.0125, worse by
+    # 0.025, beyond 2 sqrt(2 (0.01 / sqrt(2))²) = 0.02
+    v, line = verdict("strong blocks mix worse than weak ones")
+    check("claims_ch5: strong blocks mix worse, 0.025 beyond 0.0200", v == "held" and "= 0.0200" in line, line)
+
+    # little crushing without obstacles: Group 3's Model 1 breaks 0.40 against Models 3 and 5's
+    # 0.45 and 0.50; with a spread of 0.01 (bound 2 sqrt(2) 0.01 = 0.0283) held, with Model 3 at
+    # 0.42 not resolved, with none measured not resolved either
+    def broken(total):
+        return {"breakage": {"formed": 100, "total": total}}
+    crushed = {"jdem/group3_model1": broken(0.40), "jdem/group3_model3": broken(0.45), "jdem/group3_model5": broken(0.50)}
+    spread = lambda c, label: (0.01, "x") if label == agreement_ch5.BROKEN else None
+    line = report_ch5.crushing_claim("jdem", crushed, spread)[0]
+    check("claims_ch5: little crushing without obstacles, 0.05 beyond 0.0283", line.endswith("**held**")
+          and "1: 0.400, 3: 0.450, 5: 0.500" in line and "= 0.0283" in line, line)
+    crushed["jdem/group3_model3"] = broken(0.42)
+    line = report_ch5.crushing_claim("jdem", crushed, spread)[0]
+    check("claims_ch5: little crushing, 0.02 within 0.0283: not resolved", agreement.UNRESOLVED in line, line)
+    line = report_ch5.crushing_claim("jdem", crushed, lambda c, label: None)[0]
+    check("claims_ch5: little crushing without a spread: not resolved", agreement.UNMEASURED in line, line)
+
     # M over 9 cubes each, M - 900, M and M + 900 Pa three times: the trim keeps 7 (std 734.8 Pa),
     # the standard error is 734.8 / sqrt(7) = 277.7 Pa and a difference counts beyond
     # 2 sqrt(2) 277.7 = 786 Pa; the Poisson ratios are never weighed
