@@ -409,6 +409,23 @@ def test_structure_without_layer():
           and "nan" not in row and row.endswith("| — | — |"), row)
 
 
+def test_fit_note():
+    """The best fit's M over the wall's (30000/20000 = 1.5 and 20000/20000 = 1) and the condition
+    numbers (100, 1e5, 3e7: median 1e5) over every compressed cube, and the tables' 18 seed rows
+    with none of ours compressed."""
+    from scripts.mixing import report_ch5
+    cube = lambda fit, cond: {"M_best_fit": fit, "M_wall": 20000.0, "cond": cond}
+    found = {"jdem/group1_model1": {"cubes": [cube(30000.0, 100.0), cube(20000.0, 1e5)]},
+             "liggghts-jdem/group1_model1": {"cubes": [cube(25000.0, 3e7)]}}
+    note = report_ch5.fit_note(found)
+    check("fit note: 3 cubes, M ratio 1.00 to 1.50, condition 100 to 3e+07, median 1e+05",
+          "Over the 3 cubes" in note and "is 1.00 to 1.50 times" in note
+          and "runs from 100 to 3e+07 (median 1e+05)" in note, note)
+    rows = [x for x in report_ch5.elastic_tables({}) if re.match(r"\| \d \| \d \|", x)]
+    check("elastic tables: every seed row, ours empty", len(rows) == 18
+          and all(r.count("—") == 12 for r in rows), rows[:2])
+
+
 def test_wall_band_picture(tmp):
     """Fig. 5-23's sheet (plots.slab_sheet, as fill_ch5 draws it): of spheres (R = 0.015 m) at
     y = 0.02, 0.1, 0.3, 0.49 and 0.5 m, the plane a small radius off the front wall cuts the
@@ -517,6 +534,7 @@ with tempfile.TemporaryDirectory() as tmp:
 test_agreement_ch5()
 test_claims_ch5()
 test_structure_without_layer()
+test_fit_note()
 test_model_claims()
 test_speed_table()
 test_elastic_figure()
