@@ -605,17 +605,31 @@ def speed_table(found):
              "(a fill resumed after an interruption counts all its attempts)", "",
              "| case | jdem [CPU s] | liggghts-jdem [CPU s] | liggghts-jdem / jdem |", "|---|---|---|---|"]
     rows = []
-    for c in CASES + RIGID_CASES:
-        a, b = (found.get("%s/%s" % (e, c)) for e in ENGINES)
-        if not (a and b and a.get("cpu_seconds") and b.get("cpu_seconds")):
+    for label, a, b in same_scenes(found):
+        if not (a.get("cpu_seconds") and b.get("cpu_seconds")):
             continue
         if a.get("threads", 1) != 1 or b.get("ranks", 1) != 1 or bool(a.get("energy")) != bool(b.get("energy")) \
                 or not a.get("machine") or a.get("machine") != b.get("machine"):
             continue
         rows.append("| %s | %.0f%s | %.0f%s | %.2f |" % (
-            c, a["cpu_seconds"], attempts_note(a), b["cpu_seconds"], attempts_note(b),
+            label, a["cpu_seconds"], attempts_note(a), b["cpu_seconds"], attempts_note(b),
             b["cpu_seconds"] / a["cpu_seconds"]))
     return lines + (rows or ["| (no case yet with both engines' fill timed alike) | | | |"])
+
+
+def same_scenes(found):
+    """[(label, jdem's entry, liggghts-jdem's)] of every scene both engines ran: a case's fill,
+    and each realisation K both ran (the same stream shift)."""
+    pairs = []
+    for c in CASES + RIGID_CASES:
+        a, b = (found.get("%s/%s" % (e, c)) for e in ENGINES)
+        if not (a and b):
+            continue
+        pairs.append((c, a, b))
+        theirs = {r["jitter"]: r for r in b.get("realisations", [])}
+        pairs += [("%s, stream shifted %d µm" % (c, r["jitter"]), r, theirs[r["jitter"]])
+                  for r in a.get("realisations", []) if r["jitter"] in theirs]
+    return pairs
 
 
 def attempts_note(e):

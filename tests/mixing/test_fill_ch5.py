@@ -426,6 +426,20 @@ def test_fit_note():
           and all(r.count("—") == 12 for r in rows), rows[:2])
 
 
+def test_speed_of_realisations():
+    """The speed table pairs a realisation K that both engines ran (the same scene) as it pairs
+    the fills: 1000 and 2500 CPU s on one machine give 2.50; a K only one engine ran, or a pair
+    from two machines, gives no row."""
+    from scripts.mixing import report_ch5
+    timed = lambda cpu, k=None, machine="m": dict({"cpu_seconds": cpu, "machine": machine, "threads": 1, "ranks": 1},
+                                                  **({"jitter": k} if k else {}))
+    found = {"jdem/group3_model5": dict(timed(900.0, machine="other"), realisations=[timed(1000.0, 1), timed(1100.0, 2)]),
+             "liggghts-jdem/group3_model5": dict(timed(2600.0), realisations=[timed(2500.0, 1)])}
+    rows = report_ch5.speed_table(found)[6:]
+    check("speed: the shared realisation's row alone", rows == ["| group3_model5, stream shifted 1 µm | 1000 | 2500 | 2.50 |"],
+          rows)
+
+
 def test_wall_band_picture(tmp):
     """Fig. 5-23's sheet (plots.slab_sheet, as fill_ch5 draws it): of spheres (R = 0.015 m) at
     y = 0.02, 0.1, 0.3, 0.49 and 0.5 m, the plane a small radius off the front wall cuts the
@@ -535,6 +549,7 @@ test_agreement_ch5()
 test_claims_ch5()
 test_structure_without_layer()
 test_fit_note()
+test_speed_of_realisations()
 test_model_claims()
 test_speed_table()
 test_elastic_figure()
