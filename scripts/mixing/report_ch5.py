@@ -782,6 +782,12 @@ def report(found, rev, figures=None, elastic=None, section=None):
     lines += [""] + section_figure_section(section)
     lines += [""] + bonded_figures_section(figures)
     lines += ["", "### Breakage over the whole fill (the seed reports none, spec §4.3)", "",
+              "tension and shear: the fractions of the bonds formed that broke in each mode (a bond "
+              "breaks in tension when σmax = −Fn/A + |Mt| R̄/I reaches its tensile strength, in shear "
+              "when τmax = |Ft|/A + |Mn| R̄/J reaches its shear strength; when both do on one step, by "
+              "the larger ratio of stress to strength, tension on a tie: docs/model.md, kernel/jdem_bond.h); "
+              "fragments at the end: the connected components of the intact bonds, whole blocks (the "
+              "32 spheres of a block) and single spheres included", "",
               "| engine | case | bonds formed | broken | tension | shear | fragments at the end | whole blocks | single spheres |",
               "|---|---|---|---|---|---|---|---|---|"]
     for name, e in sorted(found.items()):
@@ -791,8 +797,10 @@ def report(found, rev, figures=None, elastic=None, section=None):
                 *name.split("/"), k["formed"], k["broken"], k["tension"], k["shear"],
                 k["fragments"], k["whole_blocks"], k["singles"]))
     lines += ["", "### Breakage over time: broken fraction (tension + shear) and fragments by size", "",
-              "at the seed's snapshot times and the end; fragments: connected components of the intact "
-              "bonds, counted by size in spheres (%s); the seed reports none" %
+              "at the seed's snapshot times and the end; broken, tension, shear: fractions of the bonds "
+              "formed by then (a block still entering adds bonds, so the fraction can fall); fragments: "
+              "connected components of the intact bonds, counted by size in spheres (%s); the seed "
+              "reports none" %
               ", ".join("%d" % a if a == b else "%d–%d" % (a, b) for a, b in FRAGMENT_BINS), "",
               "| engine | case | t [s] | broken | tension | shear | fragments by size |",
               "|---|---|---|---|---|---|---|"]
