@@ -532,14 +532,31 @@ def current_bookkeeping(built_by):
     return bool(built_by) and all(version_has_fix(v) for v in built_by)
 
 
-@functools.lru_cache(maxsize=None)
 def version_has_fix(version):
-    """Whether the binary "release+commit" contains ENERGY_FIX (one git call per binary: the
-    fills share a few)."""
-    rev = version.partition("+")[2]
-    return bool(rev) and subprocess.run(
-        ["git", "-C", ROOT, "merge-base", "--is-ancestor", ENERGY_FIX, rev],
-        capture_output=True).returncode == 0
+    """Whether the binary "release+commit" contains ENERGY_FIX."""
+    return has_commit(version.partition("+")[2], ENERGY_FIX)
+
+
+# The commit from which an unbonded fill (its empty bond table) is drawn blue, not as single
+# spheres in orange.
+UNBONDED_BLUE = "34e98d4"
+
+
+def orange_group1(found):
+    """"; ..." naming the Group 1 pictures drawn before UNBONDED_BLUE (their small spheres orange,
+    single spheres by the bonded rule), or ""."""
+    older = [n for n, e in sorted(found.items()) if e.get("views") and n.split("/")[1].startswith("group1_")
+             and not has_commit(e.get("source", ""), UNBONDED_BLUE)]
+    return "; the pictures of %s, drawn before %s, show their small spheres orange" % (
+        ", ".join(older), UNBONDED_BLUE) if older else ""
+
+
+@functools.lru_cache(maxsize=None)
+def has_commit(rev, commit):
+    """Whether rev contains commit (git merge-base --is-ancestor; one git call per pair: the fills
+    share a few binaries and commits)."""
+    return bool(rev) and subprocess.run(["git", "-C", ROOT, "merge-base", "--is-ancestor", commit, rev],
+                                        capture_output=True).returncode == 0
 
 
 def energy_table(found):
@@ -843,7 +860,7 @@ def report(found, rev, figures=None, elastic=None, section=None):
     if views:
         lines += ["", "### Snapshots (Figs 5-5 to 5-22): front and side views at t = 1, 3, 9 s and the end", "",
                   "big spheres red, the small ones in whole blocks blue, in fragments of 2–31 green, "
-                  "alone orange (Group 1: all small blue)", ""]
+                  "alone orange (Group 1: all small blue)%s" % orange_group1(found), ""]
         lines += ["![%s](%s)" % v for v in views]
     built = {n: list(dict.fromkeys(e.get("built_by", []) + [v for part in e.get("cubes", []) + e.get("realisations", [])
                                                              for v in part.get("built_by", [])]))

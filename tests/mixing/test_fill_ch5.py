@@ -440,6 +440,20 @@ def test_speed_of_realisations():
           rows)
 
 
+def test_orange_group1():
+    """Group 1's pictures drawn at a commit without UNBONDED_BLUE (its parent) are named; one
+    drawn at UNBONDED_BLUE itself, and a bonded group's, are not."""
+    from scripts.mixing import report_ch5
+    before = subprocess.run(["git", "-C", ROOT, "rev-parse", report_ch5.UNBONDED_BLUE + "^"],
+                            capture_output=True, text=True).stdout.strip()
+    found = {"jdem/group1_model1": {"views": "a.png", "source": before},
+             "jdem/group1_model5": {"views": "b.png", "source": report_ch5.UNBONDED_BLUE},
+             "jdem/group2_model1": {"views": "c.png", "source": before}}
+    note = report_ch5.orange_group1(found)
+    check("orange Group 1 pictures named", note == "; the pictures of jdem/group1_model1, drawn before %s, show "
+          "their small spheres orange" % report_ch5.UNBONDED_BLUE, note)
+
+
 def test_wall_band_picture(tmp):
     """Fig. 5-23's sheet (plots.slab_sheet, as fill_ch5 draws it): of spheres (R = 0.015 m) at
     y = 0.02, 0.1, 0.3, 0.49 and 0.5 m, the plane a small radius off the front wall cuts the
@@ -550,6 +564,7 @@ test_claims_ch5()
 test_structure_without_layer()
 test_fit_note()
 test_speed_of_realisations()
+test_orange_group1()
 test_model_claims()
 test_speed_table()
 test_elastic_figure()
