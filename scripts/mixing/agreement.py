@@ -38,8 +38,8 @@ def value(st, result):
 
 
 def spreads(runs, statistics, pool_of=lambda key: None):
-    """{(key, label): (s, source)} for each case key with OWN_SPREAD_DOF degrees of freedom of its
-    own, and {(("pool", pool), label): (s, source)} over every case of a pool with at least two
+    """{(key, label): (s, source, dof)} for each case key with OWN_SPREAD_DOF degrees of freedom
+    of its own, and {(("pool", pool), label): (s, source, dof)} over every case of a pool with at least two
     realisations in one engine.  runs: {key: {engine: [result, ...]}}, each engine's
     realisations of the case; pool_of(key): the pool the case's realisations join."""
     out, pooled = {}, {}
@@ -62,9 +62,9 @@ def spreads(runs, statistics, pool_of=lambda key: None):
                     acc[2].append(name)
         for label, (ss, dof, names) in own.items():
             if dof >= OWN_SPREAD_DOF:
-                out[(key, label)] = (math.sqrt(ss / dof), "%s, realisations: %s" % (key, "; ".join(names)))
+                out[(key, label)] = (math.sqrt(ss / dof), "%s, realisations: %s" % (key, "; ".join(names)), dof)
     for (pool, label), (ss, dof, names) in pooled.items():
-        out[(("pool", pool), label)] = (math.sqrt(ss / dof), "pooled: " + ", ".join(names))
+        out[(("pool", pool), label)] = (math.sqrt(ss / dof), "pooled: " + ", ".join(names), dof)
     return out
 
 

@@ -15,7 +15,7 @@ the cohorts' sides) and "passP_cubes" (cube_result per cube) of report_ch4.py.
 import numpy as np
 
 from scripts.mixing import agreement, agreement_ch4, params, stats
-from scripts.mixing.agreement import UNRESOLVED, ordered
+from scripts.mixing.agreement import UNMEASURED, UNRESOLVED, ordered
 
 MODELS = tuple("model%d" % m for m in range(1, 7))
 PASSES = (1, 2)
@@ -105,7 +105,7 @@ def second_pass(found, engine):
         # Noise alone scatters the models' means by about the run-to-run s of one mean, so a
         # change of their std within 2 s is not told from it (pass 1's s: pass 2 has no repeats).
         s = phi_spread(found)(None)
-        text = verdict(b < a) if not s or abs(a - b) > 2.0 * s[0] else UNRESOLVED
+        text = UNMEASURED if not s else verdict(b < a) if abs(a - b) > 2.0 * s[0] else UNRESOLVED
         margin = "a change counts beyond 2 s = %.4f, s of pass 1" % (2.0 * s[0]) if s else \
             "no run-to-run spread measured"
         out.append("%s: after the second pass the models' means agree better (std of the %d "

@@ -263,15 +263,27 @@ def fit_note(found):
     ratio = [c["M_best_fit"] / c["M_wall"] for c in cubes]
     cond = [c["cond"] for c in cubes]
     return ("Over the %d cubes compressed so far the best fit's M (its εzz from the particles' "
-            "translations, which underestimate the strain) is %.2f to %.2f times the wall's, and "
-            "the orthotropic fit's condition number runs from %.3g to %.3g (median %.3g): a "
-            "value of E or ν from a condition number of 1e4 or more carries little." % (
-                len(cubes), min(ratio), max(ratio), min(cond), max(cond), float(np.median(cond))))
+            "translations) is %.2f to %.2f times the wall's, above 1 in %d of them (there the "
+            "translations give the smaller strain), and the orthotropic fit's condition number "
+            "runs from %.3g to %.3g (median %.3g): a value of E or ν from a condition number of "
+            "1e4 or more carries little." % (
+                len(cubes), min(ratio), max(ratio), sum(r > 1 for r in ratio), min(cond), max(cond),
+                float(np.median(cond))))
 
 
 def halved(sp):
     """The spread of half a statistic."""
-    return (0.5 * sp[0], sp[1]) if sp else None
+    return (0.5 * sp[0],) + tuple(sp[1:]) if sp else None
+
+
+def weighed(value, spread, pairs, plain_signs=False):
+    """agreement.ordered, its margin saying how many degrees of freedom the roughest spread it
+    used has (a std from one or two is a rough one: its 95 % upper bound is 32 or 6 times it)."""
+    text, margin = ordered(value, spread, pairs, plain_signs)
+    dof = [sp[2] for a, b in pairs for sp in (spread(a), spread(b)) if sp and len(sp) > 2]
+    if dof and margin.startswith("a difference counts"):
+        margin += ", its s from %d degree%s of freedom" % (min(dof), "" if min(dof) == 1 else "s")
+    return text, margin
 
 
 def claims(found):
@@ -285,7 +297,8 @@ def claims(found):
              "each weighed against the run-to-run spread of the groups' fills (the realisations with "
              "the stream shifted, scripts/mixing/agreement_ch5.py): a difference counts beyond "
              "2√(s_a² + s_b²), else the claim is not resolved, as it is while a group compared has no "
-             "spread measured yet; the seed's own table is read by its signs; \"mixes "
+             "spread measured yet (the stiffness claim alone is weighed against the cubes' spread "
+             "within each deposit); the seed's own table is read by its signs; \"mixes "
              "better\" is read as φv nearer the ideal 0.0625 at the middle clip, a reading the seed's "
              "own Table 5-3 does not bear out (its lines \"seed\" below, without a spread: its \"best\" "
              "models have φv of 0.32-0.47, far above the ideal, spec §3.8); in our fills φv stays under "
@@ -296,33 +309,33 @@ def claims(found):
         get = lambda g, m: found.get("%s/%s" % (engine, case(g, m)))
         for m in MODELS:
             g1, g2, g3 = get(1, m), get(2, m), get(3, m)
-            if not g1 or not (g2 or g3):
+            if sum(e is not None for e in (g1, g2, g3)) < 2:
                 continue
             within = lambda label: (lambda g: spread(case(g, m), label))
             near = {g: -abs(e["middle_clip"]["mean"] - params.IDEAL_PHI_V)
                     for g, e in ((1, g1), (2, g2), (3, g3)) if e}
             for g in (2, 3):
-                if g in near:
-                    text, margin = ordered(near, within(agreement_ch5.PHI), [(g, 1)])
+                if g in near and 1 in near:
+                    text, margin = weighed(near, within(agreement_ch5.PHI), [(g, 1)])
                     lines.append("- %s Model %d: Group %d blocks mix better than unbonded ones (|φv − %.4f| "
                                  "at the middle clip %.4f against Group 1's %.4f; %s): **%s**" % (
                                      engine, m, g, params.IDEAL_PHI_V, -near[g], -near[1], margin, text))
             if 2 in near and 3 in near:
-                text, margin = ordered(near, within(agreement_ch5.PHI), [(2, 3)])
+                text, margin = weighed(near, within(agreement_ch5.PHI), [(2, 3)])
                 lines.append("- %s Model %d: strong blocks mix worse than weak ones (|φv − %.4f| at the "
                              "middle clip %.4f against Group 2's %.4f; %s): **%s**" % (
                                  engine, m, params.IDEAL_PHI_V, -near[3], -near[2], margin, text))
-            if m == 3 and g2:
+            if m == 3 and g1 and g2:
                 a, b = g1["middle_clip"]["std"], g2["middle_clip"]["std"]
                 sp = within(agreement_ch5.PHI_STD)
-                text, margin = ordered({"half": 0.5 * a, 2: b},
+                text, margin = weighed({"half": 0.5 * a, 2: b},
                                        lambda k: halved(sp(1)) if k == "half" else sp(2), [("half", 2)])
                 lines.append("- %s Model 3: the spread of φv drops by more than 50 %% from Group 1 to Group 2 "
                              "(std %.4f → %.4f, %s; %s): **%s**" % (
                                  engine, a, b, "%+.0f %%" % (100 * (b - a) / a) if a else "from zero",
                                  margin, text))
-            for k, (o1, o2) in enumerate(zip(g1.get("outflow", []), (g2 or {}).get("outflow", []))):
-                text, margin = ordered({2: o2["std"], 1: o1["std"]}, within(agreement_ch5.OUTFLOW[k]), [(2, 1)])
+            for k, (o1, o2) in enumerate(zip((g1 or {}).get("outflow", []), (g2 or {}).get("outflow", []))):
+                text, margin = weighed({2: o2["std"], 1: o1["std"]}, within(agreement_ch5.OUTFLOW[k]), [(2, 1)])
                 lines.append("- %s Model %d: weak blocks widen the outflow below the obstacle at (%.2f, %.2f) "
                              "(std of the direction from the vertical %.1f° against Group 1's %.1f°; %d and %d "
                              "particles, scripts/mixing/outflow.py; %s): **%s**" % (
@@ -346,18 +359,18 @@ def cube_claims(engine, m, fills):
     Model m).  M is weighed against the standard error of each fill's mean over its cubes (the
     realisations are not compressed, so there is no run-to-run spread of M); the Poisson ratios
     are not weighed at all: the fit that gives them is ill-posed (docs/model.md §10)."""
-    m_of = [stats.summary([c["M_wall"] for c in e["cubes"]]) for e in fills]
+    m_of = [[c["M_wall"] for c in e["cubes"]] for e in fills]
     n_of = [len(e["cubes"]) for e in fills]
-    mean = {g: s_["mean"] for g, s_ in zip(GROUPS, m_of)}
-    # the trimmed mean's standard error: the std of the values the trim keeps, over their number
-    error = {g: (s_["std"] / math.sqrt(s_["n_kept"]), "cubes") for g, s_ in zip(GROUPS, m_of)}
+    mean = {g: stats.trimmed_mean(v) for g, v in zip(GROUPS, m_of)}
+    error = {g: (stats.trimmed_mean_error(v), "cubes") for g, v in zip(GROUPS, m_of)}
     text, _ = ordered(mean, error.get, [(1, 2), (2, 3)])
     bound = max(2.0 * math.hypot(error[a][0], error[b][0]) for a, b in ((1, 2), (2, 3)))
     ratio = [stats.summary([c["nu_xy"] for c in e["cubes"]])["mean"] /
              stats.summary([c["nu_xz"] for c in e["cubes"]])["mean"] for e in fills]
     return ["- %s Model %d: stiffness falls as bond strength rises (M %.0f, %.0f, %.0f Pa for Groups "
             "1-3; a difference counts beyond 2√(e_a² + e_b²) = %.0f Pa, e the standard error of a "
-            "fill's trimmed mean of M over its %s cubes, there being no run-to-run spread of M): **%s**" % (
+            "fill's trimmed mean of M over its %s cubes (Tukey–McLaughlin), there being no run-to-run "
+            "spread of M): **%s**" % (
                 engine, m, *mean.values(), bound, "/".join(str(n) for n in sorted(set(n_of))),
                 text.replace("run-to-run spread", "cubes' spread")),
             "- %s Model %d: the anisotropy νxy/νxz falls with bond strength (%.3f, %.3f, %.3f for "
@@ -380,7 +393,7 @@ def crushing_claim(engine, found, spread):
     if 1 not in broken or len(broken) < 2:
         return []
     fewer = {m: -f for m, f in broken.items()}
-    text, margin = ordered(fewer, lambda m: spread(case(3, m), agreement_ch5.BROKEN),
+    text, margin = weighed(fewer, lambda m: spread(case(3, m), agreement_ch5.BROKEN),
                            [(1, m) for m in broken if m != 1])
     return ["- %s Group 3: little crushing without obstacles (the broken fraction of Model 1 under "
             "each model's with obstacles: %s; %s): **%s**" % (
@@ -409,7 +422,7 @@ def model_claims(engine, found, spread, plain_signs=False):
         if g == 2 and len(near) == len(MODELS):
             checks.append(("Models 3 and 5 mix best", [(a, m) for a in (3, 5) for m in MODELS if m not in (3, 5)]))
         for claim, pairs in checks:
-            text, margin = ordered(near, within, pairs, plain_signs)
+            text, margin = weighed(near, within, pairs, plain_signs)
             lines.append("- %s Group %d: %s (|φv − %.4f| at the middle clip per model %s; %s): **%s**" % (
                 engine, g, claim, params.IDEAL_PHI_V, listed, margin, text))
     return lines
@@ -510,10 +523,12 @@ def structure_table(found):
                 *name.split("/"), s["inclination"], s["slope_x"], s["lowest"], s["highest"],
                 p["wall"], p["interior"], p["wall"] - p["interior"]))
         elif s and p:   # a column whose bed ends near the floor: no layer under the surface
-            lines.append("| %s | %s | %.1f | %+.1f | %.3f–%.3f | no layer: the lowest column's bed "
-                         "(a gap over %.2f m ends it) tops out at %.3f m, under the floor band | — | — |" % (
+            lines.append("| %s | %s | %.1f | %+.1f | %.3f–%.3f | no layer: the lowest column's bed, wall "
+                         "columns included (a gap over %.2f m ends a bed), tops out at %.3f m, so nothing "
+                         "lies between %.2f m over the floor and %.2f m under it | — | — |" % (
                              *name.split("/"), s["inclination"], s["slope_x"], s["lowest"], s["highest"],
-                             structure.BED_GAP, p["top"] + structure.SURFACE_BAND))
+                             structure.BED_GAP, p["top"] + structure.SURFACE_BAND, structure.FLOOR_BAND,
+                             structure.SURFACE_BAND))
     if len(lines) == 5:
         lines.append("(no fill measured since these measures were added)")
     return lines
@@ -689,13 +704,13 @@ def campaign_time_table(found):
 def surface_claim(engine, m, g1, g3, within):
     """Strong bonds leave an inclined free surface and more voids near the walls (Group 3 against
     Group 1 of the same model); within(label)(group) -> its run-to-run spread or None."""
-    if not (g3 and g1.get("surface") and g3.get("surface")):
+    if not (g1 and g3 and g1.get("surface") and g3.get("surface")):
         return []
     who = "- %s Model %d" % (engine, m)
     s1, s3 = g1["surface"]["inclination"], g3["surface"]["inclination"]
     v1, v3 = ((e["packing"]["interior"] - e["packing"]["wall"]) for e in (g1, g3))
-    slope, slope_margin = ordered({3: s3, 1: s1}, within(agreement_ch5.INCLINATION), [(3, 1)])
-    voids, voids_margin = ordered({3: v3, 1: v1}, within(agreement_ch5.VOIDS), [(3, 1)])
+    slope, slope_margin = weighed({3: s3, 1: s1}, within(agreement_ch5.INCLINATION), [(3, 1)])
+    voids, voids_margin = weighed({3: v3, 1: v1}, within(agreement_ch5.VOIDS), [(3, 1)])
     return ["%s: strong bonds leave a more inclined free surface (%.1f° against Group 1's %.1f°; %s): "
             "**%s**" % (who, s3, s1, slope_margin, slope),
             "%s: strong bonds leave more voids near the walls (solid fraction interior − wall %.4f "

@@ -21,6 +21,20 @@ def trimmed_mean(values):
     return float(np.mean(kept(values)))
 
 
+def trimmed_mean_error(values):
+    """The standard error of trimmed_mean (Tukey & McLaughlin 1963): the std of the winsorised
+    values (the highest and the lowest replaced by their neighbours, as the trim drops them) over
+    (1 - 2g) sqrt(n), g = 1/n the fraction trimmed from each end; the plain std / sqrt(n) when
+    fewer than 3 values leave nothing trimmed."""
+    v = np.sort(np.asarray(values, dtype=float)[~np.isnan(values)])
+    n = len(v)
+    if n < 3:
+        return float(np.std(v, ddof=1) / math.sqrt(n)) if n > 1 else float("nan")
+    w = v.copy()
+    w[0], w[-1] = v[1], v[-2]
+    return float(np.std(w, ddof=1) / ((1.0 - 2.0 / n) * math.sqrt(n)))
+
+
 def trimmed_std(values):
     k = kept(values)
     return float(np.std(k, ddof=1)) if len(k) > 1 else float("nan")

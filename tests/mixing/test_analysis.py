@@ -199,6 +199,9 @@ def test_stats():
     close("trimmed_mean", stats.trimmed_mean(v), 5.0, 1e-15)
     close("trimmed_std_over_7", stats.trimmed_std(v), math.sqrt(28 / 6), 1e-15)
     close("std_over_9", stats.summary(v)["std_all"], math.sqrt(60 / 8), 1e-15)
+    # winsorised 2, 2, 3, ..., 8, 8: squared deviations 46, std sqrt(46 / 8), over (7/9) 3
+    close("trimmed_mean_error", stats.trimmed_mean_error(v), math.sqrt(46 / 8) / (7 / 3), 1e-15)
+    close("trimmed_mean_error_two_values", stats.trimmed_mean_error([1.0, 3.0]), 1.0, 1e-15)
     close("trimmed_mean_drops_one_each", stats.trimmed_mean([1, 1, 1, 10, 10]), 4.0, 1e-15)
     close("trimmed_mean_inf_phi_v", stats.trimmed_mean([0.1, 0.2, float("inf")] + [0.3] * 6),
           (0.2 + 0.3 * 6) / 7, 1e-15)

@@ -79,6 +79,8 @@ def test_no_spread_measured():
     lines = claims_ch4.obstacles_left(g, "jdem")
     check("no_spread_not_resolved", len(lines) == 2 and all(x.endswith(": " + agreement.UNMEASURED)
                                                             for x in lines), lines)
+    line = claims_ch4.second_pass(g, "jdem")[0]
+    check("no_spread_second_pass_not_resolved", line.endswith(": " + agreement.UNMEASURED), line)
 
 
 def test_discrimination_index():
