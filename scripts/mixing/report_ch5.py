@@ -31,7 +31,7 @@ import sys
 
 import numpy as np
 
-from scripts.mixing import agreement_ch5, fill_ch5, outflow, params, plots, section_ch5, stats, structure
+from scripts.mixing import agreement_ch5, fill_ch5, outflow, params, plan_ch4, plots, section_ch5, stats, structure
 from scripts.mixing.agreement import ordered
 from scripts.mixing.fill_ch5 import FRAGMENT_BINS
 from scripts.mixing.plan_ch5 import CASES, ENERGY_MODELS, RIGID_CASES, SPREAD_REALISATIONS
@@ -731,9 +731,39 @@ def rigid_section(found):
             run_time(e)))
     if not rigid:
         lines.append("(not run yet: `make mixing-bonded MODEL=rigid_model1`, `MODEL=rigid_model3`)")
-    lines += ["", "Final middle clips (the spheres cut by y = 0.5 m):", ""]
-    lines += ["![%s](%s)" % (n, e["clip"]) for n, e in sorted(found.items()) if e.get("clip")]
-    return lines
+    lines += [skipped_blocks(n, e) for n, e in rigid if skipped_blocks(n, e)]
+    clips = ["![%s](%s)" % (n, e["clip"]) for n, e in rigid if e.get("clip")]
+    return lines + (["", "Their final middle clips (the spheres cut by y = 0.5 m):", ""] + clips if clips else [])
+
+
+# the stream's blocks: 80 sections of 4 big and 512 small spheres, the small ones in 16 blocks
+SECTION_BIG, SECTION_SMALL = 4, 512
+STREAM_BLOCKS = plan_ch4.FILL_PARTICLES // (SECTION_BIG + SECTION_SMALL) * SECTION_SMALL // section_ch5.BLOCK
+
+
+def skipped_blocks(name, e):
+    """"" or, for a fill whose inlet skipped blocks (fewer bonds formed than the stream holds: a
+    block is inserted whole or not at all, and not where its place is still occupied), a line
+    with how many entered and the ideal φv of what entered."""
+    formed = e.get("breakage", {}).get("formed", 0)
+    entered, part = divmod(formed, section_ch5.BONDS_PER_BLOCK)
+    if not entered or part or entered >= STREAM_BLOCKS:   # not the campaign's stream of blocks
+        return ""
+    small = entered * section_ch5.BLOCK
+    big = e["particles"] - small
+    volume_ratio = params.IDEAL_PHI_V * SECTION_SMALL / SECTION_BIG   # of a big sphere to a small one
+    return ("\n%s: the inlet skipped %d of the %d blocks (a block is inserted whole or not at all, "
+            "and not while its place is occupied: docs/mixing.md §2.1), so %d blocks and %d big "
+            "spheres entered, whose own ideal φv is %.4f, not %.4f." % (
+                name, STREAM_BLOCKS - entered, STREAM_BLOCKS, entered, big,
+                volume_ratio * big / small, params.IDEAL_PHI_V))
+
+
+def clips_section(found):
+    """Every fill's final middle clip (the spheres cut by y = 0.5 m)."""
+    clips = ["![%s](%s)" % (n, e["clip"]) for n, e in sorted(found.items())
+             if e.get("clip") and n.split("/")[1] not in RIGID_CASES]
+    return ["### Final middle clips (the spheres cut by y = 0.5 m)", ""] + clips if clips else []
 
 
 def outflow_rows(found):
@@ -877,6 +907,8 @@ def report(found, rev, figures=None, elastic=None, section=None):
                   "big spheres red, the small ones in whole blocks blue, in fragments of 2–31 green, "
                   "alone orange (Group 1: all small blue)%s" % orange_group1(found), ""]
         lines += ["![%s](%s)" % v for v in views]
+    clips = clips_section(found)
+    lines += [""] + clips if clips else []
     built = {n: list(dict.fromkeys(e.get("built_by", []) + [v for part in e.get("cubes", []) + e.get("realisations", [])
                                                              for v in part.get("built_by", [])]))
              for n, e in found.items()}

@@ -468,6 +468,19 @@ def test_orange_group1():
           "their small spheres orange" % report_ch5.UNBONDED_BLUE, note)
 
 
+def test_skipped_blocks():
+    """A rigid fill with 1149 of the stream's 1280 blocks formed (68940 bonds, 60 a block) and
+    37088 spheres: 131 skipped, 320 big spheres with 36768 small, an ideal φv of
+    8 x 320 / 36768 = 0.0696 for what entered; a whole stream says nothing."""
+    from scripts.mixing import report_ch5
+    e = {"particles": 37088, "breakage": {"formed": 68940}}
+    line = report_ch5.skipped_blocks("jdem/rigid_model3", e)
+    check("skipped blocks: 131 of 1280, 1149 and 320 entered, ideal 0.0696", "skipped 131 of the 1280 blocks" in line
+          and "1149 blocks and 320 big spheres entered" in line and "%.4f, not 0.0625" % (8 * 320 / 36768) in line, line)
+    check("skipped blocks: none for a whole stream",
+          report_ch5.skipped_blocks("jdem/rigid_model1", {"particles": 41280, "breakage": {"formed": 76800}}) == "")
+
+
 def test_wall_band_picture(tmp):
     """Fig. 5-23's sheet (plots.slab_sheet, as fill_ch5 draws it): of spheres (R = 0.015 m) at
     y = 0.02, 0.1, 0.3, 0.49 and 0.5 m, the plane a small radius off the front wall cuts the
@@ -579,6 +592,7 @@ test_structure_without_layer()
 test_fit_note()
 test_speed_of_realisations()
 test_orange_group1()
+test_skipped_blocks()
 test_model_claims()
 test_speed_table()
 test_elastic_figure()
