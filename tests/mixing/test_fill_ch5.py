@@ -36,7 +36,7 @@ import numpy as np
 import yaml
 
 from tests.mixing.common import ROOT, check, close, finish
-from scripts.mixing import agreement, agreement_ch5, breakage, deposit, energy, fill_ch5, plots, structure
+from scripts.mixing import agreement, agreement_ch5, breakage, deposit, energy, fill_ch5, plan_ch5, plots, structure
 
 R, PITCH, SIDE = 0.015, 0.03, 0.99          # 33 lattice periods across the box
 LO, HI = (0.0, 0.0, 0.0), (SIDE, SIDE, 2.0)
@@ -242,8 +242,10 @@ def test_report(tmp):
           "| 300 | 1200 | 0.25 |" in text)
     check("report: no bond-steps per second from a wall time alone (the rigid fill's 777 w)",
           re.search(r"\| jdem \| rigid_model3 \| 1.25e-01 old \|[^\n]*\| 777 w \| — \|", text) is not None)
+    planned = 20 + sum(plan_ch5.SPREAD_REALISATIONS["jdem"].values())
     check("report: the campaign's time, 2 fills (1 with CPU): 5777 s wall, 1200 s CPU, 20 fills and "
-          "3 realisations 7.7 CPU h", "| jdem | 2 (1 with CPU) | 1.60 | 0.33 | 0 (0 with CPU) | — | — | 7.7 |" in text)
+          "%d realisations at 1200 CPU s each" % (planned - 20),
+          "| jdem | 2 (1 with CPU) | 1.60 | 0.33 | 0 (0 with CPU) | — | — | %.1f |" % (planned * 1200 / 3600) in text)
     h = structure.free_surface(dep, LO, HI)["mean"]
     check("report: the engines' bed heights agree, 0 against 2 sqrt(2) s = 2 x 0.03 m from the "
           "realisation a layer higher", "| group2_model5 | bed height (mean surface) [m] | %.3f | %.3f "
