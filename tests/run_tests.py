@@ -186,10 +186,10 @@ SUITES += [("mixing-settled", [PY, "tests/mixing/test_settled.py"], "lines", {})
 WIDE = {"inlet-bonded-cross-engine", "inlet-cross-engine", "inlet-occupied", "cross-engine",
         "observables-cadence", "mesh-liggghts", "mesh-motion", "mesh-motion-sanitized", "drum",
         "liggghts-watchdog", "liggghts-restart", "liggghts-runner-resume", "liggghts-signals",
-        "liggghts-bonds", "faults"}
+        "liggghts-bonds", "faults", "pour"}
 # The longest one-core suites (docs/performance.md, "make test on 2 cores"), started first among
 # them so that the last to end is a short one.
-LONG = ("law-sets", "chung-ooi", "paraview", "pour", "stability", "engine-neighbour-sanitized",
+LONG = ("law-sets", "chung-ooi", "paraview", "stability", "engine-neighbour-sanitized",
         "engine-neighbour", "checkpoint")
 assert WIDE | set(LONG) <= {s[0] for s in SUITES}, (WIDE | set(LONG)) - {s[0] for s in SUITES}
 
