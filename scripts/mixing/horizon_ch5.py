@@ -229,7 +229,7 @@ def spread_table(rows):
               "cases (%d above, %d below)." % (
                   sum(q["held"] for q in rows), len(rows), sum(q["pooled_held"] for q in rows), len(rows),
                   float(np.mean(signed)), sum(x > 0 for x in signed), sum(x < 0 for x in signed))]
-    if what == MODES["broken"][0]:
+    if rows[0].get("mode", "broken") == "broken":   # the clustering is the same story for the modes
         lines += ["", repeats(rows)]
     return "\n".join(lines) + "\n"
 

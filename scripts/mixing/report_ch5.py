@@ -518,15 +518,16 @@ def structure_table(found):
              "|---|---|---|---|---|---|---|---|"]
     for name, e in sorted(found.items()):
         s, p = e.get("surface"), e.get("packing")
-        if s and p and p["samples"]:
-            lines.append("| %s | %s | %.1f | %+.1f | %.3f–%.3f | %.4f | %.4f | %+.4f |" % (
-                *name.split("/"), s["inclination"], s["slope_x"], s["lowest"], s["highest"],
-                p["wall"], p["interior"], p["wall"] - p["interior"]))
-        elif s and p:   # a column whose bed ends near the floor: no layer under the surface
-            lines.append("| %s | %s | %.1f | %+.1f | %.3f–%.3f | no layer: the lowest column's bed, wall "
-                         "columns included (a gap over %.2f m ends a bed), tops out at %.3f m, so nothing "
-                         "lies between %.2f m over the floor and %.2f m under it | — | — |" % (
-                             *name.split("/"), s["inclination"], s["slope_x"], s["lowest"], s["highest"],
+        if not (s and p):
+            continue
+        surface = "| %s | %s | %.1f | %+.1f | %.3f–%.3f |" % (
+            *name.split("/"), s["inclination"], s["slope_x"], s["lowest"], s["highest"])
+        if p["samples"]:
+            lines.append(surface + " %.4f | %.4f | %+.4f |" % (p["wall"], p["interior"], p["wall"] - p["interior"]))
+        else:   # a column whose bed ends near the floor: no layer under the surface
+            lines.append(surface + " no layer: the lowest column's bed, wall columns included (a gap over "
+                         "%.2f m ends a bed), tops out at %.3f m, so nothing lies between %.2f m over the "
+                         "floor and %.2f m under it | — | — |" % (
                              structure.BED_GAP, p["top"] + structure.SURFACE_BAND, structure.FLOOR_BAND,
                              structure.SURFACE_BAND))
     if len(lines) == 5:
@@ -731,7 +732,7 @@ def rigid_section(found):
             run_time(e)))
     if not rigid:
         lines.append("(not run yet: `make mixing-bonded MODEL=rigid_model1`, `MODEL=rigid_model3`)")
-    lines += [skipped_blocks(n, e) for n, e in rigid if skipped_blocks(n, e)]
+    lines += [x for x in (skipped_blocks(n, e) for n, e in rigid) if x]
     clips = ["![%s](%s)" % (n, e["clip"]) for n, e in rigid if e.get("clip")]
     return lines + (["", "Their final middle clips (the spheres cut by y = 0.5 m):", ""] + clips if clips else [])
 
