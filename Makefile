@@ -230,6 +230,13 @@ bonds: all
 	$(PY) scripts/bond_bench.py --engines $(BONDS_ENGINES) --out out/bonds
 	$(PY) scripts/bond_checks.py --engines $(BONDS_ENGINES) --out out/bonds --bench out/bonds/bench.json
 
+# Del Cid's (2015) MEPA drop test (her Figs 4.5 and 4.6), n = 1 and 3/2, in both engines: the
+# force-overlap traces against the law's branches.  Report: out/mepa/report.md; its committed
+# copy: reference_runs/mepa/results/.
+.PHONY: mepa
+mepa: all
+	$(PY) scripts/mepa_drop.py --out out/mepa
+
 # Error against run time: Chung–Ooi tests 1, 3, 4 and a settling bed, dt swept over
 # factors of the time-step guard's dt, in jdem, liggghts-jdem and LIGGGHTS hertz/history; timings
 # medians of ACCURACY_REPEATS (default 3); its duration: docs/performance.md.  Report:

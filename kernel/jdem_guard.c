@@ -46,14 +46,36 @@ static side side_of(double R, double rho) {
     return (side){.m = m, .I = I, .mob = 1.0 / m + R * R / I};
 }
 
-/* Gershgorin row sum ||D_a|| + ||O|| of one contact of a (b NULL: a wall) with secant
- * stiffness K, tangential stiffness Kt and rolling arm r [1/s^2]. */
-static double row_sum(const side *a, const side *b, double K, double Kt, double r) {
-    const double Kr = K * r * r;
-    double s = fmax(1.5 * K / a->m, Kt * a->mob) + Kr / a->I;
-    if (b) s += fmax(1.5 * K / sqrt(a->m * b->m), Kt * sqrt(a->mob * b->mob)) + Kr / sqrt(a->I * b->I);
+/* The stiffnesses of one contact at the impact's peak overlap: normal tangent [N/m],
+ * tangential [N/m] and rolling [N m/rad]. */
+typedef struct springs {
+    double Kn, Kt, Kr;
+} springs;
+
+/* Gershgorin row sum ||D_a|| + ||O|| of one contact of a (b NULL: a wall) [1/s^2]. */
+static double row_sum(const side *a, const side *b, springs k) {
+    double s = fmax(k.Kn / a->m, k.Kt * a->mob) + k.Kr / a->I;
+    if (b)
+        s += fmax(k.Kn / sqrt(a->m * b->m), k.Kt * sqrt(a->mob * b->mob)) + k.Kr / sqrt(a->I * b->I);
     return s;
 }
+
+/* Jiang's Hertz contact at peak overlap d with secant stiffness K and rolling arm r: the normal
+ * tangent 3/2 K, the tangential spring Kt, the rolling spring K r^2. */
+static springs hertz_springs(double K, double Kt, double r) {
+    return (springs){.Kn = 1.5 * K, .Kt = Kt, .Kr = K * r * r};
+}
+
+/* A MEPA contact at peak overlap d: the unloading branch's tangent n k2 d^(n-1), the stiffest the
+ * contact has there; its tangential and rolling springs take the virgin secant k1 d^(n-1)
+ * (jd_law_mepa). */
+static springs mepa_springs(double k1, double k2, double n, double d, double r) {
+    const double s = pow(d, n - 1.0);
+    return (springs){.Kn = n * k2 * s, .Kt = k1 * s, .Kr = k1 * s * r * r};
+}
+
+/* MEPA's pair stiffness (jd_mepa_coeffs_of's series combination). */
+static double series(double ka, double kb) { return ka * kb / (ka + kb); }
 
 /* The tangential stiffness at overlap delta of a contact with secant stiffness K, effective
  * radius r_star and Mindlin's share of 1/G* of each side (jd_shear_compliance; a wall's is 0). */
@@ -96,20 +118,37 @@ void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
             if (!sb->count || (b == a && sa->count < 2)) continue;
             const side pb = side_of(sb->rmin, sb->density);
             const double m_eff = pa.m * pb.m / (pa.m + pb.m);
+            const double r = sa->rmin * sb->rmin / (sa->rmin + sb->rmin);
+            if (in->normal_law == JD_NORMAL_MEPA) {
+                const double k1 = series(sa->mepa_k1, sb->mepa_k1);
+                const double k2 = series(sa->mepa_k2, sb->mepa_k2);
+                double d;
+                out->contact_time = fmin(out->contact_time,
+                                         jd_mepa_impact_time(m_eff, k1, k2, in->mepa_n, v, &d));
+                omega2 = fmax(omega2, row_sum(&pa, &pb, mepa_springs(k1, k2, in->mepa_n, d, r)));
+                continue;
+            }
             const double kn = jd_kn_pair(kp_a, jd_hertz_prefactor(sb->E, sb->nu, sb->rmin));
             out->contact_time = fmin(out->contact_time, jd_hertz_contact_time(m_eff, kn, v));
             const double d = jd_hertz_peak_overlap(m_eff, kn, v), K = kn * sqrt(d);
-            const double r = sa->rmin * sb->rmin / (sa->rmin + sb->rmin);
             const double Kt = tangential_k(in->tangential_rule, K, share_a,
                                            jd_shear_compliance(sb->E, sb->nu), r, d);
-            omega2 = fmax(omega2, row_sum(&pa, &pb, K, Kt, r));
+            omega2 = fmax(omega2, row_sum(&pa, &pb, hertz_springs(K, Kt, r)));
         }
-        if (in->has_walls) {
+        if (in->has_walls && in->normal_law == JD_NORMAL_MEPA) {
+            /* the wall's own stiffness only softens the series: taken as rigid */
+            double d;
+            out->contact_time = fmin(out->contact_time,
+                                     jd_mepa_impact_time(pa.m, sa->mepa_k1, sa->mepa_k2,
+                                                         in->mepa_n, v, &d));
+            omega2 = fmax(omega2, row_sum(&pa, NULL, mepa_springs(sa->mepa_k1, sa->mepa_k2,
+                                                                  in->mepa_n, d, sa->rmin)));
+        } else if (in->has_walls) {
             const double kw = jd_kn_wall(in->wall_rule, sa->E, sa->nu, sa->rmin);
             out->contact_time = fmin(out->contact_time, jd_hertz_contact_time(pa.m, kw, v));
             const double d = jd_hertz_peak_overlap(pa.m, kw, v), K = kw * sqrt(d);
             const double Kt = tangential_k(in->tangential_rule, K, share_a, 0.0, sa->rmin, d);
-            omega2 = fmax(omega2, row_sum(&pa, NULL, K, Kt, sa->rmin));
+            omega2 = fmax(omega2, row_sum(&pa, NULL, hertz_springs(K, Kt, sa->rmin)));
         }
     }
     out->contact_bound = out->contact_time / JD_GUARD_STEPS_PER_CONTACT;
@@ -128,6 +167,8 @@ void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
 
 /* "BOUND (V s)", with the coordination number where it is that bound. */
 static int describe(const jd_guard_input *in, int bound, double value, char *buf, size_t len) {
+    if (bound == JD_GUARD_CONTACT_TIME && in->normal_law == JD_NORMAL_MEPA)
+        return snprintf(buf, len, "1/50 of the shortest MEPA contact time (%.6g s)", value);
     if (bound == JD_GUARD_COORDINATION)
         return snprintf(buf, len, "%s %g (%.6g s)", jd_guard_bound_name(bound), in->coordination,
                         value);

@@ -9,7 +9,8 @@
  *                 §2.6, "typical 20 %");
  *   contact_time  the shortest Hertz contact (any pair of species, any species against a wall)
  *                 at the scene's max_impact_speed spans JD_GUARD_STEPS_PER_CONTACT steps
- *                 (accuracy of the force curve; erratum 18);
+ *                 (accuracy of the force curve; erratum 18); with MEPA, its impact
+ *                 (jd_mepa_impact_time);
  *   coordination  stability of velocity Verlet, omega_max dt <= 2, with omega_max bounded for a
  *                 particle with C contacts (Otsubo, O'Sullivan & Shire 2017: the critical step
  *                 depends on m, K_max and the maximum coordination number; see docs/model.md);
@@ -39,6 +40,8 @@ typedef struct jd_guard_species {
     double density; /* [kg/m^3] */
     double E;       /* Young's modulus [Pa] */
     double nu;      /* Poisson's ratio [-] */
+    double mepa_k1; /* MEPA's virgin-loading stiffness of the material (normal_law MEPA) [N/m^n] */
+    double mepa_k2; /* its unloading stiffness [N/m^n] */
 } jd_guard_species;
 
 typedef struct jd_guard_input {
@@ -48,6 +51,9 @@ typedef struct jd_guard_input {
     int wall_rule;           /* jd_wall_rule (jdem_kernel.h) */
     int tangential_rule;     /* jd_tangential_rule (jdem_kernel.h): which K_t the tangential
                                 spring has */
+    int normal_law;          /* jd_normal_law (jdem_kernel.h): Hertz, or MEPA with the species'
+                                mepa_k1, mepa_k2 (a wall taken as rigid: the particle's own) */
+    double mepa_n;           /* MEPA's exponent [-] (normal_law MEPA) */
     double max_impact_speed; /* fastest relative impact to resolve [m/s]; 0: nothing moves */
     double coordination;     /* expected maximum contacts of one particle [-], >= 1 */
     double damping_ratio;    /* largest viscous damping ratio gamma of any pair [-], >= 0 */

@@ -103,6 +103,22 @@ double jd_hertz_peak_overlap(double m_eff, double k_n, double v) {
     return pow(1.25 * m_eff * v * v / k_n, 0.4); /* 1/2 m v^2 = 2/5 k d^2.5 */
 }
 
+/* Loading along k1 d^n from speed v: 1/2 m v^2 = k1 d^(n+1)/(n+1) at the peak, reached after
+ * d_pk/v times the integral of (1 - x^(n+1))^(-1/2) over [0, 1], (1/(n+1)) B(1/(n+1), 1/2).
+ * Unloading along k2 is taken as a quarter period at the branch's tangent stiffness at the
+ * peak, n k2 d_pk^(n-1), its stiffest: exact for n = 1, shorter than the true unloading for
+ * n > 1.  The peak ignores the k2 branch past the virgin branch's end (a deeper, hence for
+ * n > 1 stiffer, estimate). */
+double jd_mepa_impact_time(double m_eff, double k1, double k2, double n, double v,
+                           double *peak_overlap) {
+    const double p = 1.0 / (n + 1.0);
+    const double d = pow((n + 1.0) * m_eff * v * v / (2.0 * k1), p);
+    const double load = d / v * p * tgamma(p) * tgamma(0.5) / tgamma(p + 0.5);
+    const double unload = 0.5 * JD_PI * sqrt(m_eff / (n * k2 * pow(d, n - 1.0)));
+    *peak_overlap = d;
+    return load + unload;
+}
+
 double jd_hertz_peak_force(double m_eff, double k_n, double v) {
     const double d = jd_hertz_peak_overlap(m_eff, k_n, v);
     return k_n * d * sqrt(d);

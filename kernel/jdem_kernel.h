@@ -56,12 +56,15 @@ enum {
     JD_F_ROLLING = 1u << 2,  /* rolling resistance spring with cap (eta > 0)                     */
     JD_F_MU_R = 1u << 3,     /* mu_R != 1: reduced rotational slip while sliding (eq. 76)        */
     JD_F_ENERGY = 1u << 4,   /* accumulate the dissipated energies in the contact state          */
-    JD_F_MINDLIN = 1u << 5   /* Mindlin's K_t = 8 G* sqrt(R* delta) instead of K_t = K_n (§4.5)   */
+    JD_F_MINDLIN = 1u << 5,  /* Mindlin's K_t = 8 G* sqrt(R* delta) instead of K_t = K_n (§4.5)   */
+    JD_F_MEPA = 1u << 6      /* Del Cid's (2015) MEPA normal law instead of Hertz (§13): virgin
+                                loading, elastic un/reloading and adhesion, with plastic history */
 };
 
 /* The laws that read jd_contact_geom.r_roll (the rolling radius, which is also R* of Mindlin's
- * K_t): an engine fills it when the law set has one of these bits. */
-#define JD_F_READS_R_STAR (JD_F_ROLLING | JD_F_MINDLIN)
+ * K_t and of MEPA's plasticity depth): an engine fills it when the law set has one of these
+ * bits. */
+#define JD_F_READS_R_STAR (JD_F_ROLLING | JD_F_MINDLIN | JD_F_MEPA)
 
 /* Tangential stiffness rule (§4.5). */
 typedef enum {
@@ -82,12 +85,35 @@ typedef enum {
     JD_WALL_JIANG2021 = 1 /* the seed's literal K_n = 2 K_p, which is 1/sqrt(2) of Hertz          */
 } jd_wall_rule;
 
+/* The normal law (§3, §13). */
+typedef enum {
+    JD_NORMAL_HERTZ = 0, /* Jiang's secant Hertz with Luding's end of collision (default)      */
+    JD_NORMAL_MEPA = 1   /* Del Cid's (2015) elasto-plastic adhesive law (JD_F_MEPA)            */
+} jd_normal_law;
+
 /* Mapping from the input restitution coefficient e to the damping ratio gamma (§7). */
 typedef enum {
     JD_DAMP_JIANG2021 = 0, /* gamma = -ln e / sqrt(pi^2 + ln^2 e) (eq. 30), the seed's default   */
     JD_DAMP_EXACT = 1      /* gamma chosen so that a Hertz impact with Luding's end rule
                               rebounds with exactly e (solved once, jd_gamma_exact)             */
 } jd_damping_map;
+
+/* ------------------------------------------------------------------------------------------ */
+/* MEPA's normal law (Del Cid 2015, Ch. 4.2, as her LIGGGHTS code computes it; docs/model.md    */
+/* §13): F = k1 d^n on virgin loading, k2 (d^n - dp^n) on un/reloading, -kadh d^n on the       */
+/* adhesive bound, with the plastic overlap dp <= depth R* carried by the contact.             */
+/* ------------------------------------------------------------------------------------------ */
+typedef struct jd_mepa_coeffs {
+    double k1;      /* virgin-loading stiffness of the pair                               [N/m^n] */
+    double k2;      /* unloading/reloading stiffness of the pair, > k1                    [N/m^n] */
+    double kadh;    /* adhesive stiffness of the pair, >= 0                               [N/m^n] */
+    double n;       /* the law's exponent (1: linear; Del Cid's runs: 3/2)                [-]     */
+    double depth;   /* the plastic overlap's cap dp_max as a fraction of R* (Del Cid: 0.1) [-]    */
+    /* derived by jd_mepa_coeffs_of, so that a contact evaluates no power but d^n and dp^n:    */
+    double x_virgin; /* dp/d on the virgin branch, ((k2 - k1)/k2)^(1/n)                    [-]    */
+    double x_adh;    /* dp/d on the adhesive branch, ((k2 + kadh)/k2)^(1/n)                [-]    */
+    double x_end;    /* the virgin branch's end as a multiple of dp_max, (k2/(k2 - k1))^(1/n) [-] */
+} jd_mepa_coeffs;
 
 /* ------------------------------------------------------------------------------------------ */
 /* Coefficients of one interaction (species pair, or species–wall), fixed for a run.           */
@@ -102,6 +128,7 @@ typedef struct jd_pair_coeffs {
                       of materials, or, in the copy jd_wall_coeffs makes, of the particle's
                       material against a rigid wall                                              */
     double g_wall; /* G* of the first material against a rigid wall [Pa]                         */
+    jd_mepa_coeffs mepa; /* MEPA's normal law (JD_F_MEPA; all zero otherwise)                     */
 } jd_pair_coeffs;
 
 /* The coefficients of a sphere–wall contact from its entry (particle material, wall material):
@@ -154,15 +181,18 @@ typedef struct jd_contact_state {
      * force works through the levers it was applied with                                     */
     double ts_prev[3]; /* T_a + T_b                                                         [N m]  */
     double td_prev[3]; /* T_b - T_a                                                         [N m]  */
+    /* MEPA's history (JD_F_MEPA), last so that the records of the other laws keep their length */
+    double dp;         /* plastic overlap, in [0, depth R*]                                 [m]    */
 } jd_contact_state;
 
 /* Phases of a contact (jd_contact_state.flags; one at a time, compared as doubles). */
 enum { JD_S_ENDED = 1, JD_S_SLIDING = 2 };
 
-#define JD_CONTACT_STATE_LEN 17 /* doubles in jd_contact_state */
+#define JD_CONTACT_STATE_LEN 18  /* doubles in jd_contact_state */
+#define JD_CONTACT_ENERGY_LEN 17 /* the leading ones, up to td_prev: all but MEPA's */
 /* 1 where the entry is a vector component that changes sign when a and b swap, else 0. */
 static const int jd_contact_state_newton[JD_CONTACT_STATE_LEN] = {1, 1, 1, 0, 1, 1, 1, 0, 0,
-                                                                  0, 0, 0, 0, 0, 1, 1, 1};
+                                                                  0, 0, 0, 0, 0, 1, 1, 1, 0};
 
 /* Rolling history, only allocated by scenes with rolling resistance. */
 typedef struct jd_rolling_state {
@@ -178,7 +208,7 @@ typedef struct jd_contact_result {
     double f[3];  /* force on b (on a: -f)                                                 [N]    */
     double ta[3]; /* torque on a about its centre                                          [N m]  */
     double tb[3]; /* torque on b about its centre (walls: ignore)                          [N m]  */
-    double fn;    /* normal force magnitude, >= 0                                          [N]    */
+    double fn;    /* normal force, >= 0 but for MEPA's adhesion (JD_F_MEPA)                [N]    */
 } jd_contact_result;
 
 /* ------------------------------------------------------------------------------------------ */
@@ -260,6 +290,12 @@ double jd_hertz_contact_time(double m_eff, double k_n, double v);
 double jd_hertz_peak_overlap(double m_eff, double k_n, double v);
 double jd_hertz_peak_force(double m_eff, double k_n, double v);
 
+/* A MEPA impact (jd_law_mepa, undamped, no adhesion) of effective mass m_eff [kg] at speed
+ * v [m/s] with pair stiffnesses k1 < k2 [N/m^n] and exponent n: its duration [s] (the virgin
+ * loading exactly, the unloading at the stiffest tangent of its branch) and *peak_overlap [m]. */
+double jd_mepa_impact_time(double m_eff, double k1, double k2, double n, double v,
+                           double *peak_overlap);
+
 /* ------------------------------------------------------------------------------------------ */
 /* The contact laws.                                                                           */
 /* ------------------------------------------------------------------------------------------ */
@@ -270,7 +306,7 @@ double jd_hertz_peak_force(double m_eff, double k_n, double v);
  * contact step returns to the bodies during the separating step. */
 static inline void jd_contact_separate(jd_contact_state *s, jd_rolling_state *r) {
     for (int d = 0; d < 3; d++) s->xi[d] = s->f_prev[d] = s->ts_prev[d] = s->td_prev[d] = 0.0;
-    s->flags = s->fd_prev = s->u_prev = 0.0;
+    s->flags = s->fd_prev = s->u_prev = s->dp = 0.0;
     if (r)
         for (int d = 0; d < 3; d++) r->theta[d] = r->m_prev[d] = 0.0;
 }
@@ -370,6 +406,7 @@ typedef struct jd_contact_step {
     double flags;        /* phase the step starts from (jd_contact_state.flags)          [-]    */
     double xi[3];        /* tangential displacement, updated by jd_law_tangential        [m]    */
     double theta[3];     /* rolling rotation, updated by jd_law_rolling (JD_F_ROLLING)   [rad]  */
+    double dp;           /* MEPA's plastic overlap before the step (JD_F_MEPA; else zero) [m]   */
     /* the energy bookkeeping's starting values (JD_F_ENERGY; else zero) */
     double f_prev[3], m_prev[3];          /* force [N] and rolling moment [N m] of the last step */
     double ts_prev[3], td_prev[3];        /* its lever torques' sum and difference [N m]         */
@@ -389,6 +426,7 @@ static JD_ALWAYS_INLINE void jd_contact_begin(const unsigned features, const jd_
     for (int d = 0; d < 3; d++) h->theta[d] = 0.0;
     if (rolling)
         for (int d = 0; d < 3; d++) h->theta[d] = restart ? 0.0 : r->theta[d];
+    h->dp = (features & JD_F_MEPA) ? s->dp : 0.0; /* a MEPA contact never ends: no restart */
     for (int d = 0; d < 3; d++) h->f_prev[d] = h->m_prev[d] = h->ts_prev[d] = h->td_prev[d] = 0.0;
     h->fd_prev = h->u_prev = h->e_damp = h->e_fric = 0.0;
     if (features & JD_F_ENERGY) {
@@ -412,22 +450,95 @@ static JD_ALWAYS_INLINE void jd_contact_begin(const unsigned features, const jd_
 /* What the normal law gives the other laws. */
 typedef struct jd_normal {
     double fn;   /* normal force, unclamped (jd_normal_force)                          [N]    */
-    double Kn;   /* secant stiffness k_n sqrt(delta)                                   [N/m]  */
-    double Cn;   /* dashpot coefficient 2 gamma sqrt(m_eff K_n)                        [N s/m] */
-    int ends;    /* Luding's end of collision this step                                 [-]    */
+    double fcap; /* the normal force the Coulomb and rolling caps scale: fn, or |fn| with
+                    MEPA (Del Cid's code: an adhesive contact resists sliding too)      [N]    */
+    double Kn;   /* secant stiffness k_n sqrt(delta); MEPA: the virgin secant k1 d^(n-1) [N/m] */
+    double Cn;   /* dashpot coefficient 2 gamma sqrt(m_eff K_n); MEPA: with k2 d^(n-1)  [N s/m] */
+    int ends;    /* Luding's end of collision this step (never with MEPA)               [-]    */
     int carries; /* the contact carries force after this step                           [-]    */
+    /* MEPA only (JD_F_MEPA; else zero) */
+    double dp;        /* plastic overlap after the step                                 [m]    */
+    double u;         /* energy stored in the normal spring (jd_mepa_energy)            [J]    */
+    double e_plastic; /* energy the plastic overlap's change dissipated this step       [J]    */
 } jd_normal;
 
+/* The energy stored in a MEPA contact [J]: the work of its un/reloading branch
+ * k2 (x^n - dp^n) from the branch's zero, x = dp, to x = delta, which is >= 0 on both sides;
+ * dn = delta^n, dpn = dp^n. */
+static JD_ALWAYS_INLINE double jd_mepa_energy(const jd_mepa_coeffs *c, double delta, double dn,
+                                              double dp, double dpn) {
+    return c->k2 * ((delta * dn - dp * dpn) / (c->n + 1.0) - dpn * (delta - dp));
+}
+
+/* MEPA's hysteretic force [N] (Del Cid 2015 §4.3.1; her LudingForce, docs/model.md §13) at
+ * overlap delta > 0 [m], the overlap rate ddelta [m/s] choosing loading (>= 0) or unloading, the
+ * plasticity radius r_star [m] and the plastic overlap dp_old [m] before the step.  On the
+ * virgin bound (a new contact starts there, k2 > k1) dp follows x_virgin delta, and past the
+ * branch's end x_end dp_max the contact reloads along k2 with dp = dp_max; below the adhesive
+ * bound while unloading dp follows x_adh delta; inside the bounds dp stays.  *dp, *dn, *dpn:
+ * dp after the step, delta^n and dp^n.  Written with selects. */
+static JD_ALWAYS_INLINE double jd_mepa_force(const jd_mepa_coeffs *c, double delta, double ddelta,
+                                             double r_star, double dp_old, double *dp, double *dn,
+                                             double *dpn) {
+    const double dp_max = c->depth * r_star;
+    const double up = dp_old < dp_max ? dp_old : dp_max;
+    *dn = pow(delta, c->n);
+    const double f1 = c->k1 * *dn, f2 = c->k2 * (*dn - pow(up, c->n)), f3 = -c->kadh * *dn;
+    const int loading = ddelta >= 0.0;
+    const int virgin = loading & (f2 - f1 > 0.0);
+    const int beyond = delta > c->x_end * dp_max;
+    const int adhesive = !loading & (f2 - f3 < 0.0);
+    double q = virgin ? (beyond ? dp_max : c->x_virgin * delta) : (adhesive ? c->x_adh * delta : up);
+    q = q < dp_max ? q : dp_max;
+    *dp = q > 0.0 ? q : 0.0;
+    *dpn = pow(*dp, c->n);
+    return (virgin & !beyond) ? f1 : (adhesive ? f3 : c->k2 * (*dn - *dpn));
+}
+
+/* MEPA's normal law (JD_F_MEPA, §13): the hysteretic force plus the dashpot C_n ddelta with
+ * C_n = 2 gamma sqrt(m_eff k2 delta^(n-1)) (with JD_F_DAMPING).  The contact never ends while
+ * the bodies overlap: it carries tension on the adhesive bound, and the engines end it when the
+ * overlap does (jd_contact_separate).  With JD_F_ENERGY also the stored energy and what the
+ * change of dp dissipated (the stored energy at today's overlap before and after it). */
+static JD_ALWAYS_INLINE void jd_law_mepa(const unsigned features, const jd_pair_coeffs *c,
+                                         const jd_contact_geom *g, double ddelta, double dp_old,
+                                         jd_normal *nl) {
+    const jd_mepa_coeffs *mc = &c->mepa;
+    double dn, dpn;
+    const double f = jd_mepa_force(mc, g->delta, ddelta, g->r_roll, dp_old, &nl->dp, &dn, &dpn);
+    nl->Kn = mc->k1 * dn / g->delta;
+    nl->Cn = (features & JD_F_DAMPING) ? 2.0 * c->gamma * sqrt(g->m_eff * mc->k2 * dn / g->delta)
+                                       : 0.0;
+    nl->fn = f + nl->Cn * ddelta;
+    nl->fcap = fabs(nl->fn);
+    nl->ends = 0;
+    nl->carries = 1;
+    nl->u = nl->e_plastic = 0.0;
+    if (features & JD_F_ENERGY) {
+        const double dp_max = mc->depth * g->r_roll;
+        const double up = dp_old < dp_max ? dp_old : dp_max;
+        nl->u = jd_mepa_energy(mc, g->delta, dn, nl->dp, dpn);
+        nl->e_plastic = jd_mepa_energy(mc, g->delta, dn, up, pow(up, mc->n)) - nl->u;
+    }
+}
+
 /* Normal law with damping and Luding's end of contact (§3, §7, §8): with JD_F_DAMPING the
- * contact ends, never pulling, once the total normal force reaches zero while unloading. */
+ * contact ends, never pulling, once the total normal force reaches zero while unloading.  With
+ * JD_F_MEPA, MEPA's law instead (jd_law_mepa); dp_old is its plastic overlap. */
 static JD_ALWAYS_INLINE void jd_law_normal(const unsigned features, const jd_pair_coeffs *c,
                                     const jd_contact_geom *g, double ddelta, int still_ended,
-                                    jd_normal *nl) {
+                                    double dp_old, jd_normal *nl) {
+    if (features & JD_F_MEPA) {
+        jd_law_mepa(features, c, g, ddelta, dp_old, nl);
+        return;
+    }
     const int damping = (features & JD_F_DAMPING) != 0;
     nl->fn = jd_normal_force(g->k_n, g->delta, ddelta, damping, damping ? c->gamma : 0.0, g->m_eff,
                              &nl->Kn, &nl->Cn);
+    nl->fcap = nl->fn;
     nl->ends = damping ? !still_ended & (nl->fn <= 0.0) : 0;
     nl->carries = !still_ended & !nl->ends;
+    nl->dp = nl->u = nl->e_plastic = 0.0;
 }
 
 /* Tangential stiffness K_t [N/m] (§4.5): the seed's K_t = K_n (Sec. 2.3.2), or with
@@ -441,12 +552,12 @@ static JD_ALWAYS_INLINE double jd_tangential_stiffness(const unsigned features,
 }
 
 /* Tangential dashpot C_t = 2 gamma sqrt(m_eff K_t) (eq. 29) [N s/m]: C_n itself when K_t = K_n
- * (the same expression), zero without JD_F_DAMPING. */
+ * (the same expression; not with MEPA, whose C_n is k2's), zero without JD_F_DAMPING. */
 static JD_ALWAYS_INLINE double jd_tangential_damping(const unsigned features,
                                                      const jd_pair_coeffs *c,
                                                      const jd_contact_geom *g,
                                                      const jd_normal *nl, double Kt) {
-    if (!(features & JD_F_MINDLIN)) return nl->Cn;
+    if (!(features & (JD_F_MINDLIN | JD_F_MEPA))) return nl->Cn;
     return (features & JD_F_DAMPING) ? 2.0 * c->gamma * sqrt(g->m_eff * Kt) : 0.0;
 }
 
@@ -474,7 +585,7 @@ static JD_ALWAYS_INLINE void jd_law_tangential(const unsigned features, const jd
     const double Kt = jd_tangential_stiffness(features, c, g, nl);
     const double Ct = jd_tangential_damping(features, c, g, nl, Kt);
     double ft[3];
-    const int sliding = jd_capped_spring(h->xi, vt_law, Kt, Ct, c->mu * nl->fn, dt, c->xi_limit, ft);
+    const int sliding = jd_capped_spring(h->xi, vt_law, Kt, Ct, c->mu * nl->fcap, dt, c->xi_limit, ft);
     h->flags = sliding ? (double)JD_S_SLIDING : 0.0;
     for (int d = 0; d < 3; d++) f[d] += ft[d];
     if (features & JD_F_ENERGY) {
@@ -497,7 +608,7 @@ static JD_ALWAYS_INLINE void jd_law_rolling(const unsigned features, const jd_pa
     /* K_r = K_t r^2 with the seed's K_t = K_n, whatever the tangential rule (§4.5) */
     const double Kr = nl->Kn * g->r_roll * g->r_roll;
     const double Cr = (features & JD_F_DAMPING) ? 2.0 * c->gamma * sqrt(g->i_eff * Kr) : 0.0;
-    const int rsl = jd_capped_spring(h->theta, m->wrel, Kr, Cr, c->eta * g->r_roll * nl->fn, dt,
+    const int rsl = jd_capped_spring(h->theta, m->wrel, Kr, Cr, c->eta * g->r_roll * nl->fcap, dt,
                                      c->xi_limit, m_roll);
     if (features & JD_F_ENERGY) {
         double ms[3];
@@ -594,6 +705,7 @@ static JD_ALWAYS_INLINE void jd_contact_commit(const unsigned features, const jd
     if (rolling)
         for (int d = 0; d < 3; d++)
             r->theta[d] = carries ? h->theta[d] : (still_ended ? r->theta[d] : 0.0);
+    if (features & JD_F_MEPA) s->dp = nl->dp; /* a MEPA contact always carries */
     if (features & JD_F_ENERGY) {
         for (int d = 0; d < 3; d++) {
             s->f_prev[d] = carries ? f[d] : (still_ended ? s->f_prev[d] : 0.0);
@@ -662,12 +774,15 @@ static JD_ALWAYS_INLINE int jd_contact(const unsigned features, const jd_pair_co
     jd_contact_step h;
     jd_contact_begin(features, g, s, r, m.ddelta, &h);
     jd_normal nl;
-    jd_law_normal(features, c, g, m.ddelta, h.still_ended, &nl);
+    jd_law_normal(features, c, g, m.ddelta, h.still_ended, h.dp, &nl);
 
     double f[3] = {nl.fn * g->n[0], nl.fn * g->n[1], nl.fn * g->n[2]};
     double m_roll[3] = {0.0, 0.0, 0.0};
-    double u_new = energy ? jd_normal_energy(g->k_n, g->delta) : 0.0;
-    double dash = 0.0; /* the tangential and rolling dashpots' share of the dissipation [J] */
+    const int mepa = (features & JD_F_MEPA) != 0;
+    double u_new = energy ? (mepa ? nl.u : jd_normal_energy(g->k_n, g->delta)) : 0.0;
+    /* the share of the dissipation booked as damping besides the normal dashpot: the tangential
+     * and rolling dashpots', and MEPA's plastic work [J] */
+    double dash = mepa ? nl.e_plastic : 0.0;
     if (features & JD_F_FRICTION) jd_law_tangential(features, c, g, &m, &nl, dt, &h, f, &u_new, &dash);
     if (features & JD_F_ROLLING) jd_law_rolling(features, c, g, &m, &nl, dt, &h, m_roll, &u_new, &dash);
     jd_contact_energy e = {0.0, h.e_damp, h.e_fric};

@@ -4,6 +4,7 @@
  */
 #include "jdem_laws.h"
 
+#include <math.h>
 #include <string.h>
 
 _Static_assert(sizeof(jd_contact_state) == JD_CONTACT_STATE_LEN * sizeof(double) &&
@@ -20,9 +21,11 @@ _Static_assert(sizeof(jd_bond_state) == JD_BOND_STATE_LEN * sizeof(double) &&
                    JD_AT(jd_bond_state, e_break) == JD_BOND_STATE_LEN - 1,
                "the kernel's bond state is a plain array of doubles, the law's fields first");
 
-const char *const jd_law_names[JD_N_LAWS] = {"damping", "friction", "rolling",
-                                             "mu_r",    "energy",   "mindlin"};
-_Static_assert(JD_F_MINDLIN == 1u << (JD_N_LAWS - 1), "one name per JD_F_* bit, in bit order");
+const char *const jd_law_names[JD_N_LAWS] = {"damping", "friction", "rolling", "mu_r",
+                                             "energy",  "mindlin",  "mepa"};
+_Static_assert(JD_F_MEPA == 1u << (JD_N_LAWS - 1), "one name per JD_F_* bit, in bit order");
+_Static_assert(JD_AT(jd_contact_state, dp) == JD_CONTACT_ENERGY_LEN,
+               "MEPA's history follows the energy record's fields");
 
 #define JD_LAW_SET_CASE(bits) \
     case (bits):              \
@@ -57,7 +60,7 @@ char *jd_law_set_describe(unsigned bits, char *buf, size_t len) {
 unsigned jd_law_set_select(size_t nm, const double *restitution, const double *friction,
                            const double *rolling_friction, const unsigned char *in_particles,
                            const unsigned char *in_walls, double mu_r, int tangential_rule,
-                           int energy) {
+                           int normal_law, int energy) {
     unsigned laws = 0u;
     for (size_t a = 0; a < nm; a++) {
         if (!in_particles[a]) continue;
@@ -69,6 +72,7 @@ unsigned jd_law_set_select(size_t nm, const double *restitution, const double *f
     }
     if ((laws & JD_F_FRICTION) && mu_r != 1.0) laws |= JD_F_MU_R;
     if ((laws & JD_F_FRICTION) && tangential_rule == JD_KT_MINDLIN) laws |= JD_F_MINDLIN;
+    if (normal_law == JD_NORMAL_MEPA) laws |= JD_F_MEPA;
     if (energy) laws |= JD_F_ENERGY;
     return laws;
 }
@@ -82,9 +86,22 @@ static double g_star_of(double share_a, double share_b) {
     return s > 0.0 ? 1.0 / s : 0.0;
 }
 
+/* Del Cid's series combination, 0 for two zeros (her code's 0/0; spec §7.12). */
+static double series(double ka, double kb) { return ka + kb > 0.0 ? ka * kb / (ka + kb) : 0.0; }
+
+jd_mepa_coeffs jd_mepa_coeffs_of(const jd_mepa_inputs *in, size_t a, size_t b) {
+    const double k1 = series(in->k1[a], in->k1[b]), k2 = series(in->k2[a], in->k2[b]);
+    const double kadh = series(in->kadh[a], in->kadh[b]), inv_n = 1.0 / in->n;
+    return (jd_mepa_coeffs){.k1 = k1, .k2 = k2, .kadh = kadh, .n = in->n, .depth = in->depth,
+                            .x_virgin = pow((k2 - k1) / k2, inv_n),
+                            .x_adh = pow((k2 + kadh) / k2, inv_n),
+                            .x_end = pow(k2 / (k2 - k1), inv_n)};
+}
+
 void jd_pair_coeffs_table(size_t nm, const double *restitution, const double *friction,
                           const double *rolling_friction, const double *E, const double *nu,
-                          int damping_map, double mu_r, int xi_limit, jd_pair_coeffs *out) {
+                          int damping_map, double mu_r, int xi_limit, const jd_mepa_inputs *mepa,
+                          jd_pair_coeffs *out) {
     const size_t nn = nm * nm;
     for (size_t k = 0; k < nn; k++) {
         size_t q = 0;
@@ -96,5 +113,6 @@ void jd_pair_coeffs_table(size_t nm, const double *restitution, const double *fr
                                   .mu_r = mu_r, .xi_limit = xi_limit,
                                   .g_star = g_star_of(share_a, share_b),
                                   .g_wall = g_star_of(share_a, 0.0)};
+        if (mepa) out[k].mepa = jd_mepa_coeffs_of(mepa, k / nm, k % nm);
     }
 }

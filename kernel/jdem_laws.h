@@ -44,32 +44,39 @@ extern "C" {
     X((E) | JD_F_DAMPING | JD_F_ROLLING)                                       \
     JD_LAW_SETS_TANGENTIAL(X, E)
 #define JD_LAW_LOOPS(X) JD_LAW_SETS_WITH(X, 0u) JD_LAW_SETS_WITH(X, JD_F_ENERGY)
+#define JD_LAW_SETS_RUN_TIME(X, M)                                             \
+    JD_LAW_SETS_TANGENTIAL(X, (M) | JD_F_MINDLIN)                              \
+    JD_LAW_SETS_TANGENTIAL(X, (M) | JD_F_ENERGY | JD_F_MINDLIN)
 #define JD_LAW_SETS(X)                                                         \
     JD_LAW_LOOPS(X)                                                            \
-    JD_LAW_SETS_TANGENTIAL(X, JD_F_MINDLIN)                                    \
-    JD_LAW_SETS_TANGENTIAL(X, JD_F_ENERGY | JD_F_MINDLIN)
+    JD_LAW_SETS_RUN_TIME(X, 0u)                                                \
+    JD_LAW_SETS_WITH(X, JD_F_MEPA)                                             \
+    JD_LAW_SETS_WITH(X, JD_F_MEPA | JD_F_ENERGY)                               \
+    JD_LAW_SETS_RUN_TIME(X, JD_F_MEPA)
 
 /* The laws no compiled loop is specialised for: Mindlin's K_t changes one scalar per contact
  * (jd_tangential_stiffness), so compiling the tangential copies twice is not worth it
- * (docs/performance.md, "Build time").  The plugin's scalar loops take the bit as a branch
- * (jd_law_set_of_loop); the stepper's SIMD lanes would turn it into a select that every run
- * pays, so a run with it takes the stepper's reference loops.  JD_LAW_LOOPS holds every law set
- * without these bits. */
-#define JD_F_RUN_TIME JD_F_MINDLIN
+ * (docs/performance.md, "Build time"); MEPA's normal law is a model choice few runs make, and
+ * compiling every set once more for it would double the build.  The plugin's scalar loops take
+ * the bits as a branch (jd_law_set_of_loop); the stepper's SIMD lanes would turn them into
+ * selects that every run pays, so a run with one takes the stepper's reference loops.
+ * JD_LAW_LOOPS holds every law set without these bits. */
+#define JD_F_RUN_TIME (JD_F_MINDLIN | JD_F_MEPA)
 
 /* The compiled loop that runs law set bits: a dispatcher switches on this and expands
  * JD_LAW_LOOPS; the loop then passes jd_law_set_of_loop to the kernel. */
 static inline unsigned jd_law_set_loop(unsigned bits) { return bits & ~(unsigned)JD_F_RUN_TIME; }
 
 /* The law set inside the compiled loop `loop` (a literal of JD_LAW_LOOPS) of a run whose law
- * set is bits: the loop's constant bits and the run-time ones of bits.  A loop without friction
- * has no run-time law (JD_F_MINDLIN comes with JD_F_FRICTION), so that its law set stays a
- * compile-time constant. */
-#define jd_law_set_of_loop(loop, bits) \
-    ((loop) | (((loop) & JD_F_FRICTION) ? (bits) & (unsigned)JD_F_RUN_TIME : 0u))
+ * set is bits: the loop's constant bits and the run-time ones of bits (JD_F_MINDLIN only in a
+ * loop with friction, which it comes with). */
+#define jd_law_set_of_loop(loop, bits)                                           \
+    ((loop) | ((bits) & (unsigned)JD_F_MEPA) |                                   \
+     (((loop) & JD_F_FRICTION) ? (bits) & (unsigned)JD_F_MINDLIN : 0u))
 
 /* Every JD_F_* bit, for masking a law set. */
-#define JD_F_ALL (JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY | JD_F_MINDLIN)
+#define JD_F_ALL \
+    (JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY | JD_F_MINDLIN | JD_F_MEPA)
 
 /* The bond law's sets (kernel/jdem_bond.h, JD_B_*), expanded the same way by the bond loops. */
 #define JD_BOND_LAW_SETS(X) X(0u) X(JD_B_DAMPING) X(JD_B_ENERGY) X(JD_B_DAMPING | JD_B_ENERGY)
@@ -78,8 +85,8 @@ static inline unsigned jd_law_set_loop(unsigned bits) { return bits & ~(unsigned
 int jd_law_set_valid(unsigned bits);
 
 /* The names of the JD_F_* bits, in bit order, as the engines report a law set ("damping",
- * "friction", "rolling", "mu_r", "energy", "mindlin"). */
-#define JD_N_LAWS 6
+ * "friction", "rolling", "mu_r", "energy", "mindlin", "mepa"). */
+#define JD_N_LAWS 7
 extern const char *const jd_law_names[JD_N_LAWS];
 
 /* The law set as text: the names of its bits joined by '+', or "elastic" for none; into buf
@@ -105,27 +112,45 @@ static inline unsigned jd_interaction_laws(double restitution, double friction,
  * material b that some particle or wall has (in_particles[b] or in_walls[b]; in_walls may be
  * NULL: no walls); restitution, friction and rolling_friction are nm x nm, row-major.  Then,
  * when the run has friction, JD_F_MU_R if mu_r != 1 and JD_F_MINDLIN if tangential_rule is
- * JD_KT_MINDLIN (jd_tangential_rule); JD_F_ENERGY when energy is set.  The result is always one
- * of JD_LAW_SETS. */
+ * JD_KT_MINDLIN (jd_tangential_rule); JD_F_MEPA if normal_law is JD_NORMAL_MEPA
+ * (jd_normal_law); JD_F_ENERGY when energy is set.  The result is always one of JD_LAW_SETS. */
 unsigned jd_law_set_select(size_t nm, const double *restitution, const double *friction,
                            const double *rolling_friction, const unsigned char *in_particles,
                            const unsigned char *in_walls, double mu_r, int tangential_rule,
-                           int energy);
+                           int normal_law, int energy);
+
+/* MEPA's inputs as both engines read them (Del Cid's LIGGGHTS inputs LoadingStiffness,
+ * UnloadingStiffness, CohesiveStiffness per material, NPower, and her hard-coded plasticity
+ * depth 0.1). */
+typedef struct jd_mepa_inputs {
+    const double *k1;   /* per material, > 0                                            [N/m^n] */
+    const double *k2;   /* per material, > k1                                            [N/m^n] */
+    const double *kadh; /* per material, >= 0                                            [N/m^n] */
+    double n;           /* exponent, > 0                                                 [-]     */
+    double depth;       /* plastic overlap cap as a fraction of R*, > 0                  [-]     */
+} jd_mepa_inputs;
+
+/* The MEPA coefficients of a pair of materials a, b: each stiffness the series combination
+ * k_a k_b/(k_a + k_b) of Del Cid's code (0 when both are 0), and the derived ratios. */
+jd_mepa_coeffs jd_mepa_coeffs_of(const jd_mepa_inputs *in, size_t a, size_t b);
 
 /* The coefficients of every ordered pair of nm materials into out (nm x nm, row-major, like the
  * three input tables): gamma from the restitution by the damping map (jd_gamma_for, mapped once
  * per distinct value: the exact mapping costs up to ~50 ms), mu, eta, the run's mu_r and
  * xi_limit, and Mindlin's G* from the materials' Young's moduli E [Pa] and Poisson's ratios nu
- * (nm each): g_star of the pair, g_wall of the first material against a rigid wall.  A material
+ * (nm each): g_star of the pair, g_wall of the first material against a rigid wall; MEPA's
+ * coefficients (jd_mepa_coeffs_of) when mepa is not NULL, else zero.  A material
  * with E <= 0 (no elastic properties: a wall-only material) counts as rigid; G* of two rigid
  * materials is 0 (no such contact exists). */
 void jd_pair_coeffs_table(size_t nm, const double *restitution, const double *friction,
                           const double *rolling_friction, const double *E, const double *nu,
-                          int damping_map, double mu_r, int xi_limit, jd_pair_coeffs *out);
+                          int damping_map, double mu_r, int xi_limit, const jd_mepa_inputs *mepa,
+                          jd_pair_coeffs *out);
 
 /* ------------------------------------------------------------------------------------------ */
 /* The history record a law set keeps per contact.                                             */
-/* A contact record is jd_contact_state whole with JD_F_ENERGY, else only the fields the laws  */
+/* A contact record is jd_contact_state whole with JD_F_MEPA (its plastic overlap comes last), */
+/* its first JD_CONTACT_ENERGY_LEN doubles with JD_F_ENERGY, else only the fields the laws     */
 /* carry from step to step, which lead the struct (xi[3], flags); a rolling record (only with  */
 /* JD_F_ROLLING) is jd_rolling_state whole with JD_F_ENERGY, else its leading theta[3].  The   */
 /* stepper keeps the two in separate arrays; LIGGGHTS in one per-contact array, the rolling    */
@@ -138,7 +163,9 @@ void jd_pair_coeffs_table(size_t nm, const double *restitution, const double *fr
 #define JD_AT(type, field) ((int)(offsetof(type, field) / sizeof(double)))
 
 static inline int jd_contact_record_len(unsigned features) {
-    return (features & JD_F_ENERGY) ? JD_CONTACT_STATE_LEN : JD_CONTACT_LAWS_LEN;
+    return (features & JD_F_MEPA)     ? JD_CONTACT_STATE_LEN
+           : (features & JD_F_ENERGY) ? JD_CONTACT_ENERGY_LEN
+                                      : JD_CONTACT_LAWS_LEN;
 }
 static inline int jd_rolling_record_len(unsigned features) {
     return (features & JD_F_ROLLING)

@@ -173,6 +173,8 @@ void FixJdemGuard::setup(int) {
     sp[t].density = g_rho[t];
     sp[t].E = pair->youngs(t + 1);
     sp[t].nu = pair->poisson(t + 1);
+    sp[t].mepa_k1 = pair->mepa() ? pair->mepa_k1(t + 1) : 0.0;
+    sp[t].mepa_k2 = pair->mepa() ? pair->mepa_k2(t + 1) : 0.0;
   }
   bool walls = false;
   for (int k = 0; k < modify->nfix; k++) walls = walls || dynamic_cast<FixWallJiang *>(modify->fix[k]);
@@ -183,6 +185,8 @@ void FixJdemGuard::setup(int) {
   in.has_walls = walls;
   in.wall_rule = pair->wall_rule;
   in.tangential_rule = pair->tangential_rule;
+  in.normal_law = pair->normal_law;
+  in.mepa_n = pair->mepa_exponent;
   in.max_impact_speed = vmax > insertion_speed ? vmax : insertion_speed;
   in.coordination = coordination;
   in.damping_ratio = jd_guard_damping_ratio(sp.data(), (size_t)nt, pair->restitution_table(),

@@ -60,7 +60,8 @@ void FixJdemRestart::write_restart(FILE *fp) {
     const double shared[NPAIR] = {(double)pair->wall_rule, (double)pair->damping_map,
                                   (double)pair->xi_limit, (double)pair->tangential_rule,
                                   pair->mu_r, pair->rolling ? 1.0 : 0.0,
-                                  pair->energy_accounts ? 1.0 : 0.0};
+                                  pair->energy_accounts ? 1.0 : 0.0, (double)pair->normal_law,
+                                  pair->mepa_exponent, pair->mepa_plastic_depth};
     const double sums[NSUMS] = {pair->e_damp_cum, pair->e_fric_cum, pair->e_elastic_now,
                                 pair->contacts_now};
     st.shared.assign(shared, shared + NPAIR);
@@ -97,15 +98,15 @@ std::string FixJdemRestart::describe_pair_options(LAMMPS *lmp, const char *state
   const JdemRestartState st = jdem_restart_read_state(lmp, state, "fix jdem_restart (jdem/restart)",
                                                       NSHARED, NSUMS);
   const double *o = st.shared.data();
-  char text[256];
+  char text[512];
   std::snprintf(text, sizeof text,
                 "wall_rule %s damping %s tangential_limit %s tangential_stiffness %s mu_r %.17g "
-                "rolling %s energy %s",
+                "rolling %s energy %s normal_law %s mepa_exponent %.17g mepa_plastic_depth %.17g",
                 o[0] == JD_WALL_HERTZ ? "hertz" : "jiang2021",
                 o[1] == JD_DAMP_JIANG2021 ? "jiang2021" : "exact_restitution",
                 o[2] == JD_XI_COULOMB ? "coulomb" : "unconstrained",
                 o[3] == JD_KT_JIANG2021 ? "jiang2021" : "mindlin", o[4], o[5] != 0.0 ? "on" : "off",
-                o[6] != 0.0 ? "yes" : "no");
+                o[6] != 0.0 ? "yes" : "no", o[7] == JD_NORMAL_MEPA ? "mepa" : "hertz", o[8], o[9]);
   return text;
 }
 

@@ -53,7 +53,7 @@ class FixJdemRestart : public Fix {
 
  private:
   enum { SAVED = 6 };                 /* force [N] and torque [N m] */
-  enum { NPAIR = 7 };                 /* the pair style's options */
+  enum { NPAIR = 10 };                /* the pair style's options */
   enum { NSHARED = NPAIR + 2, NSUMS = 4 }; /* the global state's counts: options, clock, sums */
   bool resuming_;
   double **saved;

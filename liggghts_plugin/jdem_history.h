@@ -2,12 +2,14 @@
  * the run has rolling) between LIGGGHTS' flat per-contact history arrays and the kernel.  Shared
  * by the pair style and the wall fix.
  *
- * Two layouts of the stored history (doubles per contact):
- *  - with the energy accounts (pair_style gran/jiang energy yes): the whole jd_contact_state
- *    (JD_CONTACT_STATE_LEN), then the whole jd_rolling_state when rolling is on;
+ * Two layouts of the stored history (doubles per contact), the kernel's records (jdem_laws.h,
+ * jd_contact_record_len):
+ *  - with the energy accounts (pair_style gran/jiang energy yes): jd_contact_state up to its
+ *    energy fields (JD_CONTACT_ENERGY_LEN; the whole of it, JD_CONTACT_STATE_LEN, with MEPA's
+ *    plastic overlap), then the whole jd_rolling_state when rolling is on;
  *  - without them (energy no): only what the laws carry from one step to the next, xi[3] and
- *    flags (JD_CONTACT_LAWS_LEN), then theta[3] with rolling (JD_ROLLING_LAWS_LEN): 4 or 7
- *    doubles instead of 17 or 23.  LIGGGHTS' fix contacthistory copies the history of every
+ *    flags (JD_CONTACT_LAWS_LEN; with MEPA the whole state), then theta[3] with rolling
+ *    (JD_ROLLING_LAWS_LEN): 4 or 7 doubles instead of 17 or 23.  LIGGGHTS' fix contacthistory copies the history of every
  *    neighbour pair at each neighbour build and the pair loop streams all of it every step, so
  *    the shorter record is less memory traffic (docs/liggghts.md, "Cost").
  * jd_contact() reads and writes the energy fields only under JD_F_ENERGY (jd_contact_separate
@@ -22,42 +24,43 @@
 #include "jdem_laws.h"
 
 /* The laws whose records a contact's history holds: the energy bookkeeping's (keyword energy
- * yes) and the rolling law's (keyword rolling on).  The layout of each record is the kernel's
- * (jdem_laws.h): the contact record, then the rolling record. */
-static inline unsigned jd_history_laws(bool energy, bool rolling) {
-  return (energy ? (unsigned)JD_F_ENERGY : 0u) | (rolling ? (unsigned)JD_F_ROLLING : 0u);
+ * yes), the rolling law's (keyword rolling on) and MEPA's (keyword normal_law mepa).  The layout
+ * of each record is the kernel's (jdem_laws.h): the contact record, then the rolling record. */
+static inline unsigned jd_history_laws(bool energy, bool rolling, bool mepa) {
+  return (energy ? (unsigned)JD_F_ENERGY : 0u) | (rolling ? (unsigned)JD_F_ROLLING : 0u) |
+         (mepa ? (unsigned)JD_F_MEPA : 0u);
 }
-/* Doubles of the contact record, and where the rolling part starts in it. */
-static inline int jd_history_contact_len(bool energy) {
-  return jd_contact_record_len(jd_history_laws(energy, false));
+/* Doubles of the contact record, which is where the rolling part starts. */
+static inline int jd_history_contact_len(bool energy, bool mepa) {
+  return jd_contact_record_len(jd_history_laws(energy, false, mepa));
 }
-static inline int jd_history_len(bool energy, bool rolling) {
-  const unsigned laws = jd_history_laws(energy, rolling);
+static inline int jd_history_len(bool energy, bool rolling, bool mepa) {
+  const unsigned laws = jd_history_laws(energy, rolling, mepa);
   return jd_contact_record_len(laws) + jd_rolling_record_len(laws);
 }
 /* LIGGGHTS' sign-flip flag of entry k of the record (the kernel's). */
-static inline int jd_history_newton(bool energy, int k) {
-  return jd_record_newton(jd_history_contact_len(energy), k);
+static inline int jd_history_newton(bool energy, bool mepa, int k) {
+  return jd_record_newton(jd_history_contact_len(energy, mepa), k);
 }
 
-/* Read the full state stored at h (rs: NULL without rolling; energy-accounts layout). */
-static inline void jd_load_history(const double *h, jd_contact_state &st, jd_rolling_state *rs) {
-  std::memcpy(&st, h, sizeof st);
-  if (rs) std::memcpy(rs, h + JD_CONTACT_STATE_LEN, sizeof *rs);
+/* Read the state stored at h, whose contact record holds hw doubles (the rest of st zero; rs:
+ * NULL without rolling; energy-accounts layout). */
+static inline void jd_load_history(const double *h, int hw, jd_contact_state &st,
+                                   jd_rolling_state *rs) {
+  jd_record_load(h, hw, h + hw, rs ? JD_ROLLING_STATE_LEN : 0, &st, rs);
 }
 
-/* Write an evaluated state back to h (energy-accounts layout): all of it after a time step;
- * after LIGGGHTS' set-up evaluation (commit false), which must not advance the history, only
- * the energy reference (jd_contact_keep_reference). */
-static inline void jd_store_history(double *h, const jd_contact_state &st,
+/* Write an evaluated state back to h (energy-accounts layout, hw doubles of contact record):
+ * all of it after a time step; after LIGGGHTS' set-up evaluation (commit false), which must not
+ * advance the history, only the energy reference (jd_contact_keep_reference). */
+static inline void jd_store_history(double *h, int hw, const jd_contact_state &st,
                                     const jd_rolling_state *rs, bool commit) {
   jd_contact_state out = st;
   jd_rolling_state rout;
   if (rs) rout = *rs;
-  if (!commit) jd_load_history(h, out, rs ? &rout : NULL);
+  if (!commit) jd_load_history(h, hw, out, rs ? &rout : NULL);
   if (!commit) jd_contact_keep_reference(&out, &st, rs ? &rout : NULL, rs);
-  std::memcpy(h, &out, sizeof out);
-  if (rs) std::memcpy(h + JD_CONTACT_STATE_LEN, &rout, sizeof rout);
+  jd_record_store(h, hw, h + hw, rs ? JD_ROLLING_STATE_LEN : 0, &out, rs ? &rout : NULL);
 }
 
 /* The state of one contact during an evaluation by a loop with feature bits F.
@@ -73,30 +76,33 @@ struct JdHistory {
   jd_contact_state *st;
   jd_rolling_state *rs; /* NULL without rolling */
 
-  /* h: the record; roll_at: offset of its rolling part (unused with JD_F_ENERGY) */
+  /* h: the record; roll_at: offset of its rolling part, the contact record's length.  With the
+   * energy accounts in a time step the kernel works on the record in place: it reads and writes
+   * a field of jd_contact_state beyond the record (MEPA's dp) only when the run has MEPA, whose
+   * record holds the whole state. */
   JdHistory(double *h, int roll_at, bool commit)
       : st(&st_copy_), rs((F & JD_F_ROLLING) ? &rs_copy_ : NULL), h_(h), roll_at_(roll_at),
         commit_(commit) {
     if (F & JD_F_ENERGY) {
       if (commit) {
         st = reinterpret_cast<jd_contact_state *>(h);
-        if (F & JD_F_ROLLING) rs = reinterpret_cast<jd_rolling_state *>(h + JD_CONTACT_STATE_LEN);
+        if (F & JD_F_ROLLING) rs = reinterpret_cast<jd_rolling_state *>(h + roll_at);
       } else {
-        jd_load_history(h, st_copy_, rs);
+        jd_load_history(h, roll_at, st_copy_, rs);
       }
       return;
     }
-    jd_record_load(h, JD_CONTACT_LAWS_LEN, h + roll_at, (F & JD_F_ROLLING) ? JD_ROLLING_LAWS_LEN : 0,
+    jd_record_load(h, roll_at, h + roll_at, (F & JD_F_ROLLING) ? JD_ROLLING_LAWS_LEN : 0,
                    &st_copy_, rs);
   }
   void finish() {
     if (F & JD_F_ENERGY) {
-      if (!commit_) jd_store_history(h_, st_copy_, rs, false);
+      if (!commit_) jd_store_history(h_, roll_at_, st_copy_, rs, false);
       return;
     }
     if (!commit_) return;
-    jd_record_store(h_, JD_CONTACT_LAWS_LEN, h_ + roll_at_,
-                    (F & JD_F_ROLLING) ? JD_ROLLING_LAWS_LEN : 0, &st_copy_, rs);
+    jd_record_store(h_, roll_at_, h_ + roll_at_, (F & JD_F_ROLLING) ? JD_ROLLING_LAWS_LEN : 0,
+                    &st_copy_, rs);
   }
 
  private:

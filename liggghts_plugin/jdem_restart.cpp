@@ -204,8 +204,8 @@ void jdem_restart_check_pair_style(LAMMPS *lmp, const char *style, int history_l
       std::snprintf(text, sizeof text, " (%d values of history per contact); this pair_style "
                     "keeps %d: ", file_len, history_len);
       lmp->error->all(FLERR, ("pair_style gran/jiang: the restart file was written with "
-                              "pair_style gran/jiang " + file + text + "give the rolling and "
-                              "energy options of the run that wrote it").c_str());
+                              "pair_style gran/jiang " + file + text + "give the rolling, "
+                              "energy and normal_law options of the run that wrote it").c_str());
     }
     return;
   }

@@ -37,7 +37,8 @@ using namespace LAMMPS_NS;
 
 PairGranJiang::PairGranJiang(LAMMPS *lmp)
     : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
-      xi_limit(JD_XI_COULOMB), tangential_rule(JD_KT_JIANG2021), mu_r(1.0), rolling(false), energy_accounts(true), energy(false),
+      xi_limit(JD_XI_COULOMB), tangential_rule(JD_KT_JIANG2021), normal_law(JD_NORMAL_HERTZ),
+      mu_r(1.0), mepa_exponent(1.5), mepa_plastic_depth(0.1), rolling(false), energy_accounts(true), energy(false),
       e_damp_cum(0.0), e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
       features_(0), ntypes_(0), kp_ncalls_(-1), kp_nall_(-1), script_checked_(false) {}
 
@@ -64,6 +65,15 @@ void PairGranJiang::settings(int narg, char **arg) {
       else if (val == "mindlin") tangential_rule = JD_KT_MINDLIN;
       else error->all(FLERR, ("pair_style gran/jiang: tangential_stiffness must be jiang2021 or mindlin, not '" +
                               val + "'").c_str());
+    } else if (k == "normal_law") {
+      if (val == "hertz") normal_law = JD_NORMAL_HERTZ;
+      else if (val == "mepa") normal_law = JD_NORMAL_MEPA;
+      else error->all(FLERR, ("pair_style gran/jiang: normal_law must be hertz or mepa, not '" + val +
+                              "'").c_str());
+    } else if (k == "mepa_exponent" || k == "mepa_plastic_depth") {
+      const double x = force->numeric(FLERR, arg[i + 1]);
+      if (!(x > 0.0)) error->all(FLERR, ("pair_style gran/jiang: " + k + " must be > 0").c_str());
+      (k == "mepa_exponent" ? mepa_exponent : mepa_plastic_depth) = x;
     } else if (k == "mu_r") {
       mu_r = force->numeric(FLERR, arg[i + 1]);
       if (!(mu_r >= 0.0 && mu_r <= 1.0)) error->all(FLERR, "pair_style gran/jiang: mu_r must be in [0, 1]");
@@ -78,7 +88,7 @@ void PairGranJiang::settings(int narg, char **arg) {
     } else {
       error->all(FLERR, ("pair_style gran/jiang: unknown option '" + k +
                          "' (valid: wall_rule, damping, tangential_limit, mu_r, rolling, energy, "
-                         "tangential_stiffness)").c_str());
+                         "tangential_stiffness, normal_law, mepa_exponent, mepa_plastic_depth)").c_str());
     }
   }
 
@@ -97,7 +107,7 @@ void PairGranJiang::register_history() {
   for (int k = 0; k < state_len(); k++) {
     std::snprintf(name, sizeof name, k < rolling_at() ? "jd_state_%d" : "jd_rolling_%d",
                   k < rolling_at() ? k : k - rolling_at());
-    add_history_value(name, jd_history_newton(energy_accounts, k) ? "1" : "0");
+    add_history_value(name, jd_history_newton(energy_accounts, mepa(), k) ? "1" : "0");
   }
 }
 
@@ -153,9 +163,13 @@ void PairGranJiang::init_granular() {
       if (friction_[k] < 0.0 || rolling_friction_[k] < 0.0)
         error->all(FLERR, "gran/jiang: friction coefficients must be >= 0");
     }
+  read_mepa_stiffnesses();
+  const jd_mepa_inputs mepa_in = {mepa() ? &mepa_k_[0][1] : NULL, mepa() ? &mepa_k_[1][1] : NULL,
+                                  mepa() ? &mepa_k_[2][1] : NULL, mepa_exponent,
+                                  mepa_plastic_depth};
   std::vector<jd_pair_coeffs> table(nt * nt);
   jd_pair_coeffs_table(nt, &restitution_[0], &friction_[0], &rolling_friction_[0], &E_[1],
-                       &nu_[1], damping_map, mu_r, xi_limit, &table[0]);
+                       &nu_[1], damping_map, mu_r, xi_limit, mepa() ? &mepa_in : NULL, &table[0]);
   coeffs_.assign((nt + 1) * (nt + 1), jd_pair_coeffs());
   for (int i = 1; i <= nt; i++)
     for (int j = 1; j <= nt; j++) coeffs_[i * (nt + 1) + j] = table[(i - 1) * nt + (j - 1)];
@@ -172,6 +186,33 @@ void PairGranJiang::init_granular() {
   update_law_set(true);
   if (!script_checked_) jdem_warn_script(lmp); /* at the first run's set-up only */
   script_checked_ = true;
+}
+
+/* MEPA's per-type stiffnesses (normal_law mepa): LoadingStiffness and UnloadingStiffness
+ * required, k2 > k1 > 0; CohesiveStiffness optional (0).  Without MEPA, giving them is an error
+ * (a script that means MEPA but forgot the keyword). */
+void PairGranJiang::read_mepa_stiffnesses() {
+  const int nt = atom->ntypes;
+  static const char *const names[3] = {"LoadingStiffness", "UnloadingStiffness",
+                                       "CohesiveStiffness"};
+  for (int q = 0; q < 3; q++) {
+    mepa_k_[q].assign(nt + 1, 0.0);
+    FixPropertyGlobal *f = static_cast<FixPropertyGlobal *>(modify->find_fix_property(
+        names[q], "property/global", "peratomtype", nt, 0, "gran/jiang", mepa() && q < 2));
+    if (f && !mepa())
+      error->all(FLERR, (std::string("gran/jiang: fix property/global ") + names[q] +
+                         " is MEPA's, but pair_style gran/jiang has no 'normal_law mepa'").c_str());
+    for (int t = 1; f && t <= nt; t++) mepa_k_[q][t] = f->compute_vector(t - 1);
+  }
+  for (int t = 1; mepa() && t <= nt; t++)
+    if (!(mepa_k_[0][t] > 0.0 && mepa_k_[1][t] > mepa_k_[0][t] && mepa_k_[2][t] >= 0.0)) {
+      char msg[256];
+      std::snprintf(msg, sizeof msg, "gran/jiang: type %d has LoadingStiffness %g, "
+                    "UnloadingStiffness %g, CohesiveStiffness %g; valid: UnloadingStiffness > "
+                    "LoadingStiffness > 0, CohesiveStiffness >= 0", t, mepa_k_[0][t],
+                    mepa_k_[1][t], mepa_k_[2][t]);
+      error->all(FLERR, msg);
+    }
 }
 
 /* The law set of the interactions that can occur (jd_law_set_select, the stepper's rule): the
@@ -198,7 +239,8 @@ void PairGranJiang::update_law_set(bool report) {
     if (w && w->wall_type() >= 1 && w->wall_type() <= nt) walls[w->wall_type() - 1] = 1;
   }
   features_ = jd_law_set_select(nt, &restitution_[0], &friction_[0], &rolling_friction_[0],
-                                &types_in_use_[0], &walls[0], mu_r, tangential_rule, energy);
+                                &types_in_use_[0], &walls[0], mu_r, tangential_rule, normal_law,
+                                energy);
   if ((features_ & JD_F_ROLLING) && !rolling)
     error->all(FLERR, "pair_style gran/jiang: coefficientRollingFriction is > 0 for a pair of types "
                       "in use, which needs the rolling law and its history: add 'rolling on' to "
@@ -498,42 +540,48 @@ void PairGranJiang::compute(int eflag, int vflag) {
 
 /* The pair section of the file (rank 0): our hashcode, a layout version, the options. */
 namespace {
-enum { PAIR_RESTART_VERSION = 1, PAIR_RESTART_OPTIONS = 6 };
+enum { PAIR_RESTART_VERSION = 2, PAIR_RESTART_OPTIONS = 7 }; /* 2: MEPA's options */
 }
 
 void PairGranJiang::write_restart_settings(FILE *fp) {
   const int64_t mark = hashcode();
   const int version = PAIR_RESTART_VERSION;
   const int options[PAIR_RESTART_OPTIONS] = {wall_rule, damping_map, xi_limit, tangential_rule,
-                                             rolling ? 1 : 0, energy_accounts ? 1 : 0};
+                                             rolling ? 1 : 0, energy_accounts ? 1 : 0, normal_law};
+  const double values[3] = {mu_r, mepa_exponent, mepa_plastic_depth};
   std::fwrite(&mark, sizeof mark, 1, fp);
   std::fwrite(&version, sizeof version, 1, fp);
   std::fwrite(options, sizeof(int), PAIR_RESTART_OPTIONS, fp);
-  std::fwrite(&mu_r, sizeof mu_r, 1, fp);
+  std::fwrite(values, sizeof(double), 3, fp);
 }
 
 void PairGranJiang::read_restart_settings(FILE *fp, const int, const int) {
   int64_t mark = 0;
   int version = 0, options[PAIR_RESTART_OPTIONS] = {0};
+  double values[3] = {0.0, 0.0, 0.0};
   int ok = 1;
   if (comm->me == 0)
     ok = std::fread(&mark, sizeof mark, 1, fp) == 1 && std::fread(&version, sizeof version, 1, fp) == 1 &&
+         mark == hashcode() && version == PAIR_RESTART_VERSION &&
          std::fread(options, sizeof(int), PAIR_RESTART_OPTIONS, fp) == PAIR_RESTART_OPTIONS &&
-         std::fread(&mu_r, sizeof mu_r, 1, fp) == 1 && mark == hashcode() &&
-         version == PAIR_RESTART_VERSION;
+         std::fread(values, sizeof(double), 3, fp) == 3;
   MPI_Bcast(&ok, 1, MPI_INT, 0, world);
   if (!ok)
     error->all(FLERR, "read_restart: the pair section of the restart file is not one of "
                       "pair_style gran/jiang (another version of liggghts-jdem wrote it, or the "
                       "file is truncated)");
   MPI_Bcast(options, PAIR_RESTART_OPTIONS, MPI_INT, 0, world);
-  MPI_Bcast(&mu_r, 1, MPI_DOUBLE, 0, world);
+  MPI_Bcast(values, 3, MPI_DOUBLE, 0, world);
+  mu_r = values[0];
+  mepa_exponent = values[1];
+  mepa_plastic_depth = values[2];
   wall_rule = options[0];
   damping_map = options[1];
   xi_limit = options[2];
   tangential_rule = options[3];
   rolling = options[4] != 0;
   energy_accounts = options[5] != 0;
+  normal_law = options[6];
   register_history();
   present_as_gran();
 }

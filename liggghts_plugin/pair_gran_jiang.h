@@ -4,6 +4,7 @@
  *   pair_style gran/jiang [wall_rule hertz|jiang2021] [damping jiang2021|exact_restitution]
  *                         [tangential_limit coulomb|unconstrained] [mu_r X] [rolling on|off]
  *                         [energy yes|no] [tangential_stiffness jiang2021|mindlin]
+ *                         [normal_law hertz|mepa] [mepa_exponent N] [mepa_plastic_depth X]
  *   pair_coeff * *
  *
  * energy no: the contact history keeps no energy accounts (4 doubles per contact instead of 17,
@@ -12,7 +13,10 @@
  *
  * Materials come from fix property/global youngsModulus, poissonsRatio (peratomtype) and
  * coefficientRestitution, coefficientFriction, coefficientRollingFriction (peratomtypepair; the
- * last one only with rolling on), exactly like LIGGGHTS' own models.  Thin glue only: the
+ * last one only with rolling on), exactly like LIGGGHTS' own models; with normal_law mepa also
+ * LoadingStiffness, UnloadingStiffness and CohesiveStiffness (peratomtype, [N/m^n]), Del Cid's
+ * (2015) names for MEPA's k1, k2 and kadh, combined per pair in series as her code does.
+ * Thin glue only: the
  * geometry is kernel/jdem_geometry.h, the laws kernel/jdem_kernel.h.
  *
  * The style registers itself as "gran" (FixContactHistory and check/timestep/gran look the pair
@@ -49,8 +53,8 @@ class PairGranJiang : public PairGran {
   virtual double stressStrainExponent() { return 1.5; }
 
   /* Model options (kernel enums) and the feature bits of the force loop. */
-  int wall_rule, damping_map, xi_limit, tangential_rule;
-  double mu_r;
+  int wall_rule, damping_map, xi_limit, tangential_rule, normal_law;
+  double mu_r, mepa_exponent, mepa_plastic_depth;
   bool rolling;
   bool energy_accounts; /* keyword energy: the history has room for the energy bookkeeping */
   bool energy; /* JD_F_ENERGY: set when a dump h5md/jdem or fix jdem/watchdog wants energies */
@@ -59,6 +63,9 @@ class PairGranJiang : public PairGran {
   /* Per-type data (types 1..ntypes), valid after init. */
   double youngs(int t) const { return E_[t]; }
   double poisson(int t) const { return nu_[t]; }
+  /* MEPA's per-type stiffnesses k1 (loading) and k2 (unloading) [N/m^n] (normal_law mepa) */
+  double mepa_k1(int t) const { return mepa_k_[0][t]; }
+  double mepa_k2(int t) const { return mepa_k_[1][t]; }
   const jd_pair_coeffs &coeffs(int it, int jt) const { return coeffs_[it * (ntypes_ + 1) + jt]; }
   /* coefficientRestitution, ntypes x ntypes, 0-based, row-major (the kernel's tables) */
   const double *restitution_table() const { return &restitution_[0]; }
@@ -71,8 +78,9 @@ class PairGranJiang : public PairGran {
   const double *wall_prefactors() const { return &kw_[0]; }
   /* Contact-history layout (jdem_history.h): doubles per contact, and where the rolling part
    * starts; the same for the pair and the wall records. */
-  int state_len() const { return jd_history_len(energy_accounts, rolling); }
-  int rolling_at() const { return jd_history_contact_len(energy_accounts); }
+  bool mepa() const { return normal_law == JD_NORMAL_MEPA; }
+  int state_len() const { return jd_history_len(energy_accounts, rolling, mepa()); }
+  int rolling_at() const { return jd_history_contact_len(energy_accounts, mepa()); }
 
   /* Observables of this rank (pairs with a ghost partner count 1/2, so that the sums over ranks
    * count every pair once): cumulative dissipation [J], and at the last force evaluation the
@@ -121,6 +129,8 @@ class PairGranJiang : public PairGran {
   unsigned features_;
   int ntypes_;
   std::vector<double> E_, nu_;
+  std::vector<double> mepa_k_[3]; /* LoadingStiffness, UnloadingStiffness, CohesiveStiffness */
+  void read_mepa_stiffnesses();
   /* type-pair tables (ntypes x ntypes, 0-based): restitution, friction, rolling friction */
   std::vector<double> restitution_, friction_, rolling_friction_;
   std::vector<unsigned char> types_in_use_; /* 1 for a type some atom had (update_law_set) */

@@ -27,7 +27,8 @@ template <unsigned F>
 struct JdPairLanes {
   enum {
     N = 32, /* contacts per batch: a multiple of the widest vector; the batch stays in L1 */
-    HW = (F & JD_F_ENERGY) ? JD_CONTACT_STATE_LEN : JD_CONTACT_LAWS_LEN, /* contact record */
+    HW = (F & JD_F_ENERGY) ? JD_CONTACT_ENERGY_LEN : JD_CONTACT_LAWS_LEN, /* contact record
+                                                                       (never MEPA's) */
     RW = (F & JD_F_ROLLING) ? ((F & JD_F_ENERGY) ? JD_ROLLING_STATE_LEN : JD_ROLLING_LAWS_LEN) : 0,
     RW_ROWS = RW > 0 ? RW : 1
   };

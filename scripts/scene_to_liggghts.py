@@ -265,7 +265,27 @@ BENDING = {"potyondy_cundall": "I", "jiang2021_literal": "J_literal"}
 # the keywords of pair_style gran/jiang (docs/liggghts.md), as the resolved scene names them
 MODEL_CHOICES = {"wall_rule": ("hertz", "jiang2021"), "damping": ("jiang2021", "exact_restitution"),
                  "tangential_limit": ("coulomb", "unconstrained"),
-                 "tangential_stiffness": ("jiang2021", "mindlin")}
+                 "tangential_stiffness": ("jiang2021", "mindlin"), "normal_law": ("hertz", "mepa")}
+# MEPA's per-material stiffnesses and Del Cid's (2015) names for them in LIGGGHTS
+MEPA_PROPERTIES = (("loading_stiffness", "LoadingStiffness"),
+                   ("unloading_stiffness", "UnloadingStiffness"),
+                   ("cohesive_stiffness", "CohesiveStiffness"))
+
+
+def mepa_lines(mats, names):
+    """MEPA's stiffnesses as fix property/global lines (one value per atom type); a material the
+    scene gives none (used by nothing: the scene reader requires them of every material that
+    meets another) takes the first one's, which no contact reads."""
+    given = [n for n in names if "loading_stiffness" in mats[n]]
+    if not given:
+        return []
+    ref = mats[given[0]]
+    out = ["\n# MEPA's stiffnesses [N/m^n] (Del Cid 2015; pair values in series)\n"]
+    for k, (key, name) in enumerate(MEPA_PROPERTIES):
+        vals = [float(mats[n].get(key, 0.0) if n in given else ref.get(key, 0.0)) for n in names]
+        out.append("fix mepa%d all property/global %s peratomtype %s\n"
+                   % (k + 1, name, " ".join(num(v) for v in vals)))
+    return out
 
 
 def dump_path(path):
@@ -624,6 +644,10 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
     if rolling:
         L.append("fix m5 all property/global coefficientRollingFriction peratomtypepair %d %s\n"
                  % (ntypes, pairs_line(2)))
+    mepa = choice(model.get("normal_law", "hertz"), MODEL_CHOICES["normal_law"], "model.normal_law") == "mepa"
+    if mepa and builtin:
+        fail("--builtin: LIGGGHTS has no MEPA normal law (model.normal_law: mepa)")
+    L += mepa_lines(mats, names)
     builtin_model = "model hertz tangential history" + (" rolling_friction epsd2" if rolling else "")
     if builtin:
         L.append("\n# LIGGGHTS' built-in contact law (--builtin), not jdem's\n")
@@ -638,7 +662,9 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
             num(model.get("mu_r", 1.0)), "on" if rolling else "off",
             choice(model.get("tangential_stiffness", "jiang2021"), MODEL_CHOICES["tangential_stiffness"],
                    "model.tangential_stiffness"),
-            "" if energy_bookkeeping(scene) else " energy no"))
+            ("" if energy_bookkeeping(scene) else " energy no") +
+            ("" if not mepa else " normal_law mepa mepa_exponent %s mepa_plastic_depth %s" % (
+                num(model.get("mepa_exponent", 1.5)), num(model.get("mepa_plastic_depth", 0.1))))))
     L.append("pair_coeff      * *\n")
     L.append("neighbor        %s bin\n" % num(skin))
     L.append("neigh_modify    delay 0\n")

@@ -78,8 +78,7 @@ static void ck_particles(ck_io *io, jd_particles *ps, size_t capacity) {
 }
 
 static void ck_lists(ck_io *io, jd_neighbour_lists *l, unsigned features, size_t n) {
-    const unsigned kind = ((features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) |
-                          ((features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u);
+    const unsigned kind = sim_list_kind(features);
     ck_list(io, "lists/pairs", &l->pairs, kind);
     ck_list(io, "lists/wall_pairs", &l->wall_pairs, kind);
     ck_doubles(io, "lists/x_build", 3 * n, l->x_build);

@@ -33,7 +33,8 @@ int sim_guard(const jd_scene *sc, jd_guard_input *in, jd_guard_species **species
     for (size_t a = 0; a < sc->n_materials; a++) {
         const jd_material *m = &sc->materials[a];
         sp[a] = (jd_guard_species){.density = m->density, .E = m->youngs_modulus,
-                                   .nu = m->poisson_ratio};
+                                   .nu = m->poisson_ratio, .mepa_k1 = m->loading_stiffness,
+                                   .mepa_k2 = m->unloading_stiffness};
     }
     for (size_t i = 0; i < sc->n_particles; i++) add_particle(&sp[sc->material[i]], sc->radius[i]);
     for (size_t k = 0; k < sc->n_inlets; k++) /* the sections' particles take part once inserted */
@@ -42,6 +43,7 @@ int sim_guard(const jd_scene *sc, jd_guard_input *in, jd_guard_species **species
     *in = (jd_guard_input){.species = sp, .n_species = sc->n_materials,
                            .has_walls = sc->n_walls > 0, .wall_rule = sc->wall_rule,
                            .tangential_rule = sc->tangential_rule,
+                           .normal_law = sc->normal_law, .mepa_n = sc->mepa_exponent,
                            .max_impact_speed = sc->max_impact_speed,
                            .coordination = sc->coordination_number,
                            .damping_ratio = damping_ratio(sc, sp),

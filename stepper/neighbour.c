@@ -73,7 +73,9 @@ static int list_resize(jd_contact_list *l, size_t cap, int hw, int rw) {
  * capacity. */
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
     const int rolling = (kind & JD_LIST_ROLLING) != 0;
-    const unsigned laws = (rolling ? JD_F_ROLLING : 0u) | ((kind & JD_LIST_ENERGY) ? JD_F_ENERGY : 0u);
+    const unsigned laws = (rolling ? JD_F_ROLLING : 0u) |
+                          ((kind & JD_LIST_ENERGY) ? JD_F_ENERGY : 0u) |
+                          ((kind & JD_LIST_MEPA) ? JD_F_MEPA : 0u);
     const int hw = jd_contact_record_len(laws), rw = jd_rolling_record_len(laws);
     const int complete = l->hw == hw && l->rw == rw && (!rolling || l->rhist);
     if (need <= l->cap && complete) return 0;
@@ -129,7 +131,7 @@ static int key_less(const jd_contact_list *a, size_t p, const jd_contact_list *b
 /* The dissipation accumulated by entry c (energy bookkeeping only), harvested into the run's
  * totals when the entry is dropped (jd_contact_harvest). */
 static void drop_entry(jd_accounts *accounts, const jd_contact_list *l, size_t c) {
-    if (l->hw < JD_CONTACT_STATE_LEN) return;
+    if (l->hw < JD_CONTACT_ENERGY_LEN) return; /* no accounts (a MEPA record without them holds zeros) */
     jd_contact_state st;
     sim_hist_get(l, c, &st, NULL);
     jd_contact_harvest(&st, 1.0, &accounts->e_damp_dropped, &accounts->e_fric_dropped);
@@ -196,11 +198,6 @@ static int wall_candidate(const jd_sim_wall *w, const double *x, double R, doubl
                                     : jd_geom_cylinder_near(&w->cyl, x, R, margin);
 }
 
-/* The kind of list the run's history needs. */
-static unsigned list_kind(unsigned features) {
-    return ((features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) |
-           ((features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u);
-}
 
 /* Entry c of `from` into entry d of `to` (same kind of list). */
 
@@ -840,7 +837,7 @@ int sim_neighbour_build(jd_sim *s, char *err, size_t errlen) {
     }
     const int sorted = !partial && !s->opt.allpairs && !s->opt.no_sort && ps->n > 1;
     if (sorted && sort_into_cells(s, err, errlen) != 0) return -1;
-    const unsigned kind = list_kind(s->run.features);
+    const unsigned kind = sim_list_kind(s->run.features);
     jd_contact_list *nw = &lists->spare;
     nw->n = 0;
     if (sim_list_reserve(nw, lists->pairs.n + lists->pairs.n / 8 + 1, kind) != 0) {

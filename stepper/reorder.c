@@ -96,8 +96,11 @@ static int rekey(jd_contact_list *l, int pairs, const int32_t *new_of_old, size_
 static int reorder_list(jd_contact_list *l, jd_contact_list *spare, int pairs,
                         const int32_t *new_of_old, size_t n) {
     if (l->n == 0) return 0;
-    const unsigned kind =
-        (l->rw ? JD_LIST_ROLLING : 0u) | (l->hw == JD_CONTACT_STATE_LEN ? JD_LIST_ENERGY : 0u);
+    /* the record lengths tell the kind (jd_contact_record_len): MEPA's whole state, the energy
+     * accounts' leading part, or the laws' */
+    const unsigned kind = (l->rw ? JD_LIST_ROLLING : 0u) |
+                          (l->hw == JD_CONTACT_STATE_LEN ? JD_LIST_MEPA : 0u) |
+                          (l->hw == JD_CONTACT_ENERGY_LEN ? JD_LIST_ENERGY : 0u);
     if (sim_list_reserve(spare, l->n, kind) != 0 ||
         rekey(l, pairs, new_of_old, n, spare) != 0)
         return -1;

@@ -29,8 +29,9 @@ static const char *const TIME_KEYS[] = {"dt", "steps", "end_time", "max_impact_s
                                          "coordination_number", NULL};
 static const char *const OUTPUT_KEYS[] = {"every", "observables_every", "compare_tolerance",
                                           "energy", NULL};
-static const char *const MODEL_KEYS[] = {"wall_rule", "damping", "tangential_limit", "mu_r",
-                                         "tangential_stiffness", NULL};
+static const char *const MODEL_KEYS[] = {"wall_rule",  "damping",       "tangential_limit",
+                                         "mu_r",       "tangential_stiffness", "normal_law",
+                                         "mepa_exponent", "mepa_plastic_depth", NULL};
 static const char *const NEIGHBOUR_KEYS[] = {"skin_steps", NULL};
 static const char *const WATCHDOG_KEYS[] = {"enabled", "max_overlap_fraction", "max_energy_jump",
                                             NULL};
@@ -40,11 +41,13 @@ static const char *const WALL_RULES[] = {"hertz", "jiang2021", NULL};
 static const char *const DAMPING_MAPS[] = {"jiang2021", "exact_restitution", NULL};
 static const char *const XI_LIMITS[] = {"coulomb", "unconstrained", NULL};
 static const char *const TANGENTIAL_RULES[] = {"jiang2021", "mindlin", NULL};
+static const char *const NORMAL_LAWS[] = {"hertz", "mepa", NULL};
 static const char *const BOOLEANS[] = {"false", "true", NULL};
 _Static_assert(JD_WALL_HERTZ == 0 && JD_WALL_JIANG2021 == 1, "WALL_RULES order");
 _Static_assert(JD_DAMP_JIANG2021 == 0 && JD_DAMP_EXACT == 1, "DAMPING_MAPS order");
 _Static_assert(JD_XI_COULOMB == 0 && JD_XI_UNCONSTRAINED == 1, "XI_LIMITS order");
 _Static_assert(JD_KT_JIANG2021 == 0 && JD_KT_MINDLIN == 1, "TANGENTIAL_RULES order");
+_Static_assert(JD_NORMAL_HERTZ == 0 && JD_NORMAL_MEPA == 1, "NORMAL_LAWS order");
 
 /* ---------------------------------------------------------------------------------------- */
 /* Small helpers                                                                             */
@@ -224,7 +227,14 @@ static int read_model(loader *L) {
     s->xi_limit = JD_XI_COULOMB;
     s->mu_r = 1.0;
     s->tangential_rule = JD_KT_JIANG2021;
+    s->normal_law = JD_NORMAL_HERTZ;
+    s->mepa_exponent = 1.5;       /* Del Cid's production runs */
+    s->mepa_plastic_depth = 0.1;  /* her code's dmax = 0.1 R* */
     if (rc || sd_opt_enum(&L->c, m, "model", "wall_rule", WALL_RULES, &s->wall_rule) ||
+        sd_opt_enum(&L->c, m, "model", "normal_law", NORMAL_LAWS, &s->normal_law) ||
+        sd_opt_num(&L->c, m, "model", "mepa_exponent", SD_POSITIVE, &s->mepa_exponent) ||
+        sd_opt_num(&L->c, m, "model", "mepa_plastic_depth", SD_POSITIVE,
+                   &s->mepa_plastic_depth) ||
         sd_opt_enum(&L->c, m, "model", "damping", DAMPING_MAPS, &s->damping_map) ||
         sd_opt_enum(&L->c, m, "model", "tangential_limit", XI_LIMITS, &s->xi_limit) ||
         sd_opt_enum(&L->c, m, "model", "tangential_stiffness", TANGENTIAL_RULES,

@@ -26,6 +26,11 @@ typedef struct jd_material {
     double restitution;       /* (0, 1] */
     double friction;          /* >= 0 */
     double rolling_friction;  /* >= 0, dimensionless eta */
+    /* MEPA's stiffnesses (model.normal_law mepa; all three given, or none) */
+    int has_mepa;             /* 1 when the material gives them */
+    double loading_stiffness;   /* k1 > 0 [N/m^n] */
+    double unloading_stiffness; /* k2 > k1 [N/m^n] */
+    double cohesive_stiffness;  /* kadh >= 0 [N/m^n] */
 } jd_material;
 
 /* Coefficients of an (unordered) pair of materials, after the interaction rules. */
@@ -188,6 +193,9 @@ typedef struct jd_scene {
     int xi_limit;             /* jd_xi_limit */
     double mu_r;
     int tangential_rule;      /* jd_tangential_rule (model.tangential_stiffness) */
+    int normal_law;           /* jd_normal_law (model.normal_law) */
+    double mepa_exponent;     /* MEPA's n (model.mepa_exponent) [-] */
+    double mepa_plastic_depth; /* MEPA's cap of the plastic overlap / R* (model.mepa_plastic_depth) */
 
     size_t n_materials;
     jd_material *materials;

@@ -117,6 +117,7 @@ static const char *const WALL_RULES[] = {"hertz", "jiang2021"};
 static const char *const DAMPING_MAPS[] = {"jiang2021", "exact_restitution"};
 static const char *const XI_LIMITS[] = {"coulomb", "unconstrained"};
 static const char *const TANGENTIAL_RULES[] = {"jiang2021", "mindlin"};
+static const char *const NORMAL_LAWS[] = {"hertz", "mepa"};
 
 static int emit_watchdog(yaml_emitter_t *e, const jd_watchdog_limits *w) {
     return str(e, "watchdog") || map_start(e, 0) || str(e, "enabled") ||
@@ -148,7 +149,9 @@ static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
            key_str(e, "damping", DAMPING_MAPS[s->damping_map]) ||
            key_str(e, "tangential_limit", XI_LIMITS[s->xi_limit]) || key_num(e, "mu_r", s->mu_r) ||
            key_str(e, "tangential_stiffness", TANGENTIAL_RULES[s->tangential_rule]) ||
-           map_end(e) || emit_watchdog(e, &s->watchdog) || str(e, "neighbour") ||
+           key_str(e, "normal_law", NORMAL_LAWS[s->normal_law]) ||
+           key_num(e, "mepa_exponent", s->mepa_exponent) ||
+           key_num(e, "mepa_plastic_depth", s->mepa_plastic_depth) || map_end(e) || emit_watchdog(e, &s->watchdog) || str(e, "neighbour") ||
            map_start(e, 0) || key_int(e, "skin_steps", s->skin_steps) || map_end(e);
 }
 
@@ -157,6 +160,10 @@ static int emit_material(yaml_emitter_t *e, const jd_material *m) {
     if (m->has_elastic &&
         (key_num(e, "youngs_modulus", m->youngs_modulus) ||
          key_num(e, "poisson_ratio", m->poisson_ratio) || key_num(e, "density", m->density)))
+        return 1;
+    if (m->has_mepa && (key_num(e, "loading_stiffness", m->loading_stiffness) ||
+                        key_num(e, "unloading_stiffness", m->unloading_stiffness) ||
+                        key_num(e, "cohesive_stiffness", m->cohesive_stiffness)))
         return 1;
     return key_num(e, "restitution", m->restitution) || key_num(e, "friction", m->friction) ||
            key_num(e, "rolling_friction", m->rolling_friction) || map_end(e);

@@ -13,8 +13,11 @@
 
 #include "scene_internal.h"
 
-static const char *const MATERIAL_KEYS[] = {"youngs_modulus", "poisson_ratio", "density",
-                                            "restitution", "friction", "rolling_friction", NULL};
+static const char *const MATERIAL_KEYS[] = {"youngs_modulus",      "poisson_ratio",
+                                            "density",             "restitution",
+                                            "friction",            "rolling_friction",
+                                            "loading_stiffness",   "unloading_stiffness",
+                                            "cohesive_stiffness",  NULL};
 static const char *const INTERACTION_KEYS[] = {"materials", "restitution", "friction",
                                                "rolling_friction", NULL};
 
@@ -85,6 +88,43 @@ static int read_elastic(loader *L, const yaml_node_t *m, const char *path, jd_ma
                : 0;
 }
 
+/* MEPA's stiffnesses (model.normal_law mepa, read before the materials): loading and unloading
+ * together, unloading above loading, cohesive optional (default 0). */
+static int read_mepa(loader *L, const yaml_node_t *m, const char *path, jd_material *mat) {
+    static const char *const keys[] = {"loading_stiffness", "unloading_stiffness",
+                                       "cohesive_stiffness"};
+    const yaml_node_t *first = NULL;
+    for (int k = 0; k < 3 && !first; k++) first = sd_get(&L->c, m, keys[k]);
+    mat->has_mepa = first != NULL;
+    if (!first) return 0;
+    char sub[SD_PATH_MAX];
+    if (L->s->normal_law != JD_NORMAL_MEPA) {
+        for (int k = 0; k < 3; k++)
+            if (sd_get(&L->c, m, keys[k]) == first) sd_join(sub, path, keys[k]);
+        return sd_fail(&L->c, first, sub, "MEPA's stiffness without MEPA's law; valid: "
+                       "model.normal_law: mepa, or no loading/unloading/cohesive_stiffness");
+    }
+    if (!sd_get(&L->c, m, "loading_stiffness") || !sd_get(&L->c, m, "unloading_stiffness"))
+        return sd_missing(&L->c, m, path, sd_get(&L->c, m, "loading_stiffness")
+                                              ? "unloading_stiffness" : "loading_stiffness",
+                          "a number > 0 [N/m^n] (loading_stiffness and unloading_stiffness go "
+                          "together, unloading above loading)");
+    if (sd_req_num(&L->c, m, path, "loading_stiffness", SD_POSITIVE, &mat->loading_stiffness) ||
+        sd_req_num(&L->c, m, path, "unloading_stiffness", SD_POSITIVE,
+                   &mat->unloading_stiffness) ||
+        sd_opt_num(&L->c, m, path, "cohesive_stiffness", SD_NONNEGATIVE,
+                   &mat->cohesive_stiffness))
+        return -1;
+    if (!(mat->unloading_stiffness > mat->loading_stiffness)) {
+        sd_join(sub, path, "unloading_stiffness");
+        return sd_fail(&L->c, sd_get(&L->c, m, "unloading_stiffness"), sub,
+                       "%g is not above loading_stiffness %g; valid: k2 > k1 (MEPA's virgin "
+                       "branch ends where the two meet; k1 = k2 divides by zero)",
+                       mat->unloading_stiffness, mat->loading_stiffness);
+    }
+    return 0;
+}
+
 static int read_material(loader *L, const yaml_node_pair_t *p, jd_material *mat) {
     const yaml_node_t *key = sd_node(&L->c, p->key);
     const char *name = sd_scalar(key);
@@ -95,7 +135,9 @@ static int read_material(loader *L, const yaml_node_pair_t *p, jd_material *mat)
     sd_join(path, "materials", name);
     snprintf(mat->name, sizeof mat->name, "%s", name);
     mat->restitution = 1.0;
-    if (sd_keys(&L->c, m, path, MATERIAL_KEYS) || read_elastic(L, m, path, mat)) return -1;
+    if (sd_keys(&L->c, m, path, MATERIAL_KEYS) || read_elastic(L, m, path, mat) ||
+        read_mepa(L, m, path, mat))
+        return -1;
     return sd_opt_num(&L->c, m, path, "restitution", RESTITUTION, &mat->restitution) ||
                    sd_opt_num(&L->c, m, path, "friction", SD_NONNEGATIVE, &mat->friction) ||
                    sd_opt_num(&L->c, m, path, "rolling_friction", SD_NONNEGATIVE,
@@ -184,6 +226,22 @@ static int default_coef(loader *L, size_t a, size_t b, int k, double *out) {
                    ma->name, mb->name, COEF_KEYS[k], va, vb, ma->name, mb->name, COEF_KEYS[k]);
 }
 
+/* With MEPA's law every material that meets another needs its stiffnesses. */
+static int check_mepa(loader *L) {
+    const jd_scene *s = L->s;
+    for (size_t a = 0; s->normal_law == JD_NORMAL_MEPA && a < s->n_materials; a++) {
+        if (s->materials[a].has_mepa || !(L->by_particle[a] || L->by_wall[a])) continue;
+        char path[SD_PATH_MAX];
+        sd_join(path, "materials", s->materials[a].name);
+        const yaml_node_t *m = sd_get(&L->c, sd_get(&L->c, L->root, "materials"),
+                                      s->materials[a].name);
+        return sd_missing(&L->c, m, path, "loading_stiffness",
+                          "a number > 0 [N/m^n] for every material with model.normal_law: mepa "
+                          "(with unloading_stiffness, and optionally cohesive_stiffness)");
+    }
+    return 0;
+}
+
 int scene_read_interactions(loader *L) {
     jd_scene *s = L->s;
     size_t n = s->n_materials;
@@ -229,5 +287,5 @@ int scene_read_interactions(loader *L) {
         }
     free(given);
     free(first);
-    return rc;
+    return rc || check_mepa(L);
 }

@@ -24,20 +24,25 @@
 #endif
 
 /* The scene's interaction tables, as the kernel's rulebook reads them (jdem_laws.h): nm x nm
- * restitution, friction and rolling friction, row-major, then the materials' Young's moduli and
- * Poisson's ratios (nm each; a wall-only material's are 0), in one block (free the first). */
+ * restitution, friction and rolling friction, row-major, then the materials' Young's moduli,
+ * MEPA's loading, unloading and cohesive stiffnesses, and Poisson's ratios (nm each; what a
+ * material does not give is 0), in one block (free the first). */
 static double *interaction_tables(const jd_scene *sc, double **friction, double **rolling,
                                   double **youngs, double **poisson) {
     const size_t nm = sc->n_materials, nn = nm * nm;
-    double *e = malloc((3 * nn + 2 * nm + 1) * sizeof *e);
+    double *e = malloc((3 * nn + 5 * nm + 1) * sizeof *e);
     if (!e) return NULL;
     *friction = e + nn;
     *rolling = e + 2 * nn;
     *youngs = e + 3 * nn;
-    *poisson = e + 3 * nn + nm;
-    for (size_t a = 0; a < nm; a++) {
-        (*youngs)[a] = sc->materials[a].youngs_modulus;
-        (*poisson)[a] = sc->materials[a].poisson_ratio;
+    *poisson = e + 3 * nn + 4 * nm;
+    for (size_t a = 0; a < nm; a++) { /* E, then MEPA's k1, k2, kadh, then nu */
+        const jd_material *m = &sc->materials[a];
+        (*youngs)[a] = m->youngs_modulus;
+        (*youngs)[nm + a] = m->loading_stiffness;
+        (*youngs)[2 * nm + a] = m->unloading_stiffness;
+        (*youngs)[3 * nm + a] = m->cohesive_stiffness;
+        (*poisson)[a] = m->poisson_ratio;
     }
     for (size_t k = 0; k < nn; k++) {
         e[k] = sc->interactions[k].restitution;
@@ -60,18 +65,21 @@ static int init_laws(jd_sim *s) {
     s->run.coeffs = calloc(nn ? nn : 1, sizeof *s->run.coeffs);
     const int rc = (e && used && s->run.coeffs) ? 0 : -1;
     if (rc == 0) {
+        jd_mepa_inputs mepa = {.k1 = E + nm, .k2 = E + 2 * nm, .kadh = E + 3 * nm,
+                               .n = sc->mepa_exponent, .depth = sc->mepa_plastic_depth};
         jd_pair_coeffs_table(nm, e, mu, eta, E, nu, sc->damping_map, sc->mu_r, sc->xi_limit,
-                             s->run.coeffs);
+                             sc->normal_law == JD_NORMAL_MEPA ? &mepa : NULL, s->run.coeffs);
         for (size_t i = 0; i < sc->n_particles; i++) used[sc->material[i]] = 1;
         for (size_t k = 0; k < sc->n_inlets; k++)
             for (size_t p = 0; p < sc->inlets[k].n; p++) used[sc->inlets[k].material[p]] = 1;
         for (size_t w = 0; w < sc->n_walls; w++) wall_used[sc->walls[w].material] = 1;
         const unsigned mindlin = sc->tangential_rule == JD_KT_MINDLIN ? JD_F_MINDLIN : 0u;
+        const unsigned mepa_bit = sc->normal_law == JD_NORMAL_MEPA ? JD_F_MEPA : 0u;
         s->run.features = s->opt.all_laws
                           ? JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | mindlin |
-                                (sc->energy ? JD_F_ENERGY : 0u)
+                                mepa_bit | (sc->energy ? JD_F_ENERGY : 0u)
                           : jd_law_set_select(nm, e, mu, eta, used, wall_used, sc->mu_r,
-                                              sc->tangential_rule, sc->energy);
+                                              sc->tangential_rule, sc->normal_law, sc->energy);
     }
     free(e);
     free(used);

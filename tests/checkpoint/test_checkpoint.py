@@ -6,7 +6,8 @@ and rolling, a servo compression, an inlet stream, a bonded beam and an inlet of
 on a meshed conveyor (the mesh's moved corners, its contact history and candidates), spheres
 leaving the domain (the shrinking set, its bonds and loads), spheres raining onto a bed (each
 particle's half skin), a sparse rain (the partial builds' reference positions), the inlet
-stream again just before an insertion whose build is full (every half skin renewed); SIGTERM
+stream again just before an insertion whose build is full (every half skin renewed), cohesive
+MEPA contacts (their plastic overlaps); SIGTERM
 writes a checkpoint and exits 143; bad checkpoints are refused with their messages; a failed
 checkpoint write keeps the previous checkpoint and stops the run (exit 3)."""
 import math
@@ -46,6 +47,8 @@ CASES = [  # scene, case, checkpoint every N steps
     # a checkpoint just before an insertion whose build is full because most particles moved
     # (step 64000): every half skin renewed, the inserted particle's too
     ("tests/checkpoint/scenes/inlet_stream.yaml", None, 63162),
+    # MEPA's contacts mid-hysteresis: their plastic overlaps in the checkpoint's history
+    ("tests/liggghts/scenes/mepa_cohesive.yaml", None, 2500),
 ]
 
 

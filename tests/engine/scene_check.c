@@ -125,10 +125,13 @@ static void check_bad(const char *dir) {
 static const char *diff_material(const jd_material *x, const jd_material *y) {
     if (strcmp(x->name, y->name) != 0) return "materials.name";
     if (x->has_elastic != y->has_elastic) return "materials.has_elastic";
-    const double u[] = {x->youngs_modulus, x->poisson_ratio, x->density, x->restitution,
-                        x->friction, x->rolling_friction};
-    const double v[] = {y->youngs_modulus, y->poisson_ratio, y->density, y->restitution,
-                        y->friction, y->rolling_friction};
+    if (x->has_mepa != y->has_mepa) return "materials.has_mepa";
+    const double u[] = {x->youngs_modulus,    x->poisson_ratio,       x->density,
+                        x->restitution,       x->friction,            x->rolling_friction,
+                        x->loading_stiffness, x->unloading_stiffness, x->cohesive_stiffness};
+    const double v[] = {y->youngs_modulus,    y->poisson_ratio,       y->density,
+                        y->restitution,       y->friction,            y->rolling_friction,
+                        y->loading_stiffness, y->unloading_stiffness, y->cohesive_stiffness};
     return memcmp(u, v, sizeof u) ? "materials values" : NULL;
 }
 
@@ -190,6 +193,9 @@ static const char *diff_scenes(const jd_scene *a, const jd_scene *b) {
     SAME(xi_limit);
     SAME(mu_r);
     SAME(tangential_rule);
+    SAME(normal_law);
+    SAME(mepa_exponent);
+    SAME(mepa_plastic_depth);
     SAME(watchdog.enabled);
     SAME(watchdog.max_overlap_fraction);
     SAME(watchdog.max_energy_jump);

@@ -49,6 +49,7 @@ def signature(doc):
     """What jd_law_set_select reads from a resolved scene."""
     model = doc.get("model") or {}
     return json.dumps([doc.get("interactions"), model.get("mu_r"), model.get("tangential_stiffness"),
+                       model.get("normal_law"),
                        sorted({p["material"] for p in doc.get("particles") or []}),
                        sorted({w["material"] for w in doc.get("walls") or []}),
                        (doc.get("output") or {}).get("energy")], sort_keys=True)

@@ -389,12 +389,12 @@ def across(tmp, name, writer_deck, reader_deck, want):
 
 
 def history_lengths():
-    """The doubles of a contact's and a rolling history with energy (kernel/jdem_kernel.h's
-    JD_CONTACT_STATE_LEN and JD_ROLLING_STATE_LEN)."""
+    """The doubles of a contact's and a rolling history with energy, without MEPA
+    (kernel/jdem_kernel.h's JD_CONTACT_ENERGY_LEN and JD_ROLLING_STATE_LEN)."""
     with open(os.path.join(ROOT, "kernel", "jdem_kernel.h")) as f:
         text = f.read()
     return tuple(int(re.search(r"#define %s (\d+)" % name, text).group(1))
-                 for name in ("JD_CONTACT_STATE_LEN", "JD_ROLLING_STATE_LEN"))
+                 for name in ("JD_CONTACT_ENERGY_LEN", "JD_ROLLING_STATE_LEN"))
 
 
 def option_mismatch(tmp):
@@ -415,8 +415,9 @@ def option_mismatch(tmp):
     contact, rolling = history_lengths()  # the writer: rolling and energy; the reader: energy only
     want = ("ERROR: pair_style gran/jiang: the restart file was written with pair_style gran/jiang "
             "wall_rule hertz damping jiang2021 tangential_limit coulomb tangential_stiffness jiang2021 "
-            "mu_r 1 rolling on energy yes (%d values of history per contact); this pair_style keeps %d: "
-            "give the rolling and energy options of the run that wrote it (" % (contact + rolling, contact))
+            "mu_r 1 rolling on energy yes normal_law hertz mepa_exponent 1.5 "
+            "mepa_plastic_depth 0.10000000000000001 (%d values of history per contact); this pair_style keeps %d: "
+            "give the rolling, energy and normal_law options of the run that wrote it (" % (contact + rolling, contact))
     check("mismatch_fails", rc != 0, "exit status 0")
     lines = [l for l in log.splitlines() if l.startswith("ERROR")]
     check("mismatch_message", any(l.startswith(want) and re.search(r"\([\w./]+:\d+\)$", l) for l in lines),

@@ -13,7 +13,8 @@
 #include "jdem_kernel.h"
 #include "jdem_laws.h"
 
-enum { ALL = JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY | JD_F_MINDLIN };
+enum { ALL = JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R | JD_F_ENERGY | JD_F_MINDLIN |
+             JD_F_MEPA };
 
 /* Two spheres along z, a at the origin, overlapping by delta. */
 static jd_contact_geom geom_z(double delta, double R, double k_n, double m_eff) {
@@ -50,20 +51,20 @@ static void normal_law_with_damping_and_luding_end(void **state) {
     const jd_contact_geom g = geom_z(d, 0.01, k, m);
     const jd_pair_coeffs c = {.gamma = 0.2, .mu = 0.5, .mu_r = 1.0};
     jd_normal nl;
-    jd_law_normal(0u, &c, &g, 0.7, 0, &nl); /* undamped: Hertz alone, gamma ignored */
+    jd_law_normal(0u, &c, &g, 0.7, 0, 0.0, &nl); /* undamped: Hertz alone, gamma ignored */
     assert_rel(nl.fn, k * pow(d, 1.5), 1e-14);
     assert_rel(nl.Kn, k * sqrt(d), 1e-14);
     assert_true(nl.Cn == 0.0 && nl.carries && !nl.ends);
-    jd_law_normal(JD_F_DAMPING, &c, &g, 0.7, 0, &nl); /* eq. (29), (31) */
+    jd_law_normal(JD_F_DAMPING, &c, &g, 0.7, 0, 0.0, &nl); /* eq. (29), (31) */
     assert_rel(nl.Cn, 2.0 * 0.2 * sqrt(m * k * sqrt(d)), 1e-14);
     assert_rel(nl.fn, k * pow(d, 1.5) + nl.Cn * 0.7, 1e-14);
     /* unloading so fast that the dashpot outpulls the spring: Luding's end, no force */
     const double fast = -2.0 * k * pow(d, 1.5) / nl.Cn;
-    jd_law_normal(JD_F_DAMPING, &c, &g, fast, 0, &nl);
+    jd_law_normal(JD_F_DAMPING, &c, &g, fast, 0, 0.0, &nl);
     assert_true(nl.fn < 0.0 && nl.ends && !nl.carries);
-    jd_law_normal(0u, &c, &g, fast, 0, &nl); /* without damping a contact never ends so */
+    jd_law_normal(0u, &c, &g, fast, 0, 0.0, &nl); /* without damping a contact never ends so */
     assert_true(nl.carries && !nl.ends);
-    jd_law_normal(JD_F_DAMPING, &c, &g, -1e-3, 1, &nl); /* still ended: carries nothing */
+    jd_law_normal(JD_F_DAMPING, &c, &g, -1e-3, 1, 0.0, &nl); /* still ended: carries nothing */
     assert_true(!nl.carries && !nl.ends);
 }
 
@@ -89,7 +90,7 @@ static void tangential_law_sticks_then_slides(void **state) {
     const jd_contact_geom g = geom_z(d, 0.01, k, 1e-3);
     const jd_pair_coeffs c = {.gamma = 0.0, .mu = 0.3, .mu_r = 1.0, .xi_limit = JD_XI_COULOMB};
     jd_normal nl;
-    jd_law_normal(0u, &c, &g, 0.0, 0, &nl);
+    jd_law_normal(0u, &c, &g, 0.0, 0, 0.0, &nl);
     jd_contact_motion m = {.vrel = {0.01, 0, 0}, .vn = 0.0};
     jd_contact_step h = {0};
     double f[3] = {0, 0, nl.fn}, u = 0.0, dash = 0.0;
@@ -118,7 +119,7 @@ static void mindlin_tangential_stiffness_is_8_g_sqrt_r_delta(void **state) {
     const jd_contact_geom g = geom_z(d, R, 1e9, m); /* r_roll = R/2 = R* of two spheres of R */
     const jd_pair_coeffs c = {.gamma = 0.2, .mu = 0.3, .mu_r = 1.0, .g_star = g_star};
     jd_normal nl;
-    jd_law_normal(JD_F_DAMPING, &c, &g, 0.0, 0, &nl);
+    jd_law_normal(JD_F_DAMPING, &c, &g, 0.0, 0, 0.0, &nl);
     const double Kt = jd_tangential_stiffness(JD_F_FRICTION | JD_F_MINDLIN, &c, &g, &nl);
     assert_rel(Kt, 8.0 * g_star * sqrt(0.5 * R * d), 1e-15);
     assert_rel(jd_tangential_damping(JD_F_DAMPING | JD_F_FRICTION | JD_F_MINDLIN, &c, &g, &nl, Kt),
@@ -141,11 +142,12 @@ static void mindlin_over_hertz_tangent_is_2_1mnu_over_2mnu(void **state) {
     const double E = 7.0e10, nu = 0.33, R = 0.1, d = 2e-6;
     jd_pair_coeffs t[1];
     const double e = 1.0, mu = 0.4, eta = 0.0;
-    jd_pair_coeffs_table(1, &e, &mu, &eta, &E, &nu, JD_DAMP_JIANG2021, 1.0, JD_XI_COULOMB, t);
+    jd_pair_coeffs_table(1, &e, &mu, &eta, &E, &nu, JD_DAMP_JIANG2021, 1.0, JD_XI_COULOMB, NULL,
+                         t);
     const double kp = jd_hertz_prefactor(E, nu, R);
     jd_contact_geom g = geom_z(d, R, jd_kn_pair(kp, kp), 1.0);
     jd_normal nl;
-    jd_law_normal(0u, &t[0], &g, 0.0, 0, &nl);
+    jd_law_normal(0u, &t[0], &g, 0.0, 0, 0.0, &nl);
     const double Kt = jd_tangential_stiffness(JD_F_FRICTION | JD_F_MINDLIN, &t[0], &g, &nl);
     assert_rel(Kt / (1.5 * nl.Kn), 2.0 * (1.0 - nu) / (2.0 - nu), 1e-14);
     /* against a rigid wall (r_roll = R, G* of the particle alone): the same ratio to the exact
@@ -153,7 +155,7 @@ static void mindlin_over_hertz_tangent_is_2_1mnu_over_2mnu(void **state) {
     const jd_pair_coeffs w = jd_wall_coeffs(&t[0]);
     g.r_roll = R;
     g.k_n = jd_kn_wall(JD_WALL_HERTZ, E, nu, R);
-    jd_law_normal(0u, &w, &g, 0.0, 0, &nl);
+    jd_law_normal(0u, &w, &g, 0.0, 0, 0.0, &nl);
     assert_rel(jd_tangential_stiffness(JD_F_FRICTION | JD_F_MINDLIN, &w, &g, &nl) / (1.5 * nl.Kn),
                2.0 * (1.0 - nu) / (2.0 - nu), 1e-14);
 }
@@ -164,7 +166,7 @@ static void rolling_law_spring_and_cap(void **state) {
     const jd_contact_geom g = geom_z(d, R, k, 1e-3);
     const jd_pair_coeffs c = {.gamma = 0.1, .eta = 0.05, .mu_r = 1.0, .xi_limit = JD_XI_COULOMB};
     jd_normal nl;
-    jd_law_normal(JD_F_DAMPING, &c, &g, 0.0, 0, &nl);
+    jd_law_normal(JD_F_DAMPING, &c, &g, 0.0, 0, 0.0, &nl);
     const jd_contact_motion m = {.wrel = {0, 2.0, 0}};
     jd_contact_step h = {0};
     double mr[3], u = 0.0, dash = 0.0;
@@ -238,7 +240,8 @@ static void law_sets_are_the_combinations_with_mu_r_and_mindlin_only_with_fricti
         assert_int_equal(jd_law_set_valid(b), expected);
         n += jd_law_set_valid(b);
     }
-    assert_int_equal(n, 40); /* 2 (energy) x (4 without friction + 2 (mindlin) x 8 with it) */
+    /* 2 (MEPA) x 2 (energy) x (4 without friction + 2 (mindlin) x 8 with it) */
+    assert_int_equal(n, 80);
     assert_int_equal(jd_law_set_valid(ALL + 1), 0);
 }
 
@@ -276,22 +279,24 @@ static void law_set_select_counts_only_interactions_that_occur(void **state) {
     mu[3 * NM + 3] = 0.5;  /* unused against unused */
     e[2 * NM + 2] = 0.5;   /* wall against wall: never occurs */
     eta[3 * NM + 0] = 0.1; /* unused against a particle material */
-    const int KT = JD_KT_JIANG2021, MINDLIN = JD_KT_MINDLIN;
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, MINDLIN, 0), 0u);
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, KT, 0), 0u);
+    const int KT = JD_KT_JIANG2021, MINDLIN = JD_KT_MINDLIN, HZ = JD_NORMAL_HERTZ;
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, MINDLIN, HZ, 0), 0u);
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, KT, HZ, 0), 0u);
     e[1 * NM + 2] = 0.9; /* particle against wall */
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, KT, 0), JD_F_DAMPING);
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, NULL, 1.0, KT, 0), 0u);
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, KT, HZ, 0), JD_F_DAMPING);
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, NULL, 1.0, KT, HZ, 0), 0u);
     eta[0 * NM + 1] = 0.1; /* particle against particle */
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 0.5, KT, 1),
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 0.5, KT, HZ, 1),
                      JD_F_DAMPING | JD_F_ROLLING | JD_F_ENERGY); /* mu_R needs friction */
     mu[1 * NM + 0] = 0.3;
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 0.5, KT, 0),
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 0.5, KT, HZ, 0),
                      JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MU_R);
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, KT, 0),
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, KT, HZ, 0),
                      JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING);
-    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, MINDLIN, 0),
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, MINDLIN, HZ, 0),
                      JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MINDLIN);
+    assert_int_equal(jd_law_set_select(NM, e, mu, eta, parts, walls, 1.0, KT, JD_NORMAL_MEPA, 1),
+                     JD_F_DAMPING | JD_F_FRICTION | JD_F_ROLLING | JD_F_MEPA | JD_F_ENERGY);
 }
 
 static void law_set_names(void **state) {
@@ -301,7 +306,7 @@ static void law_set_names(void **state) {
     assert_string_equal(jd_law_set_describe(JD_F_DAMPING | JD_F_FRICTION | JD_F_ENERGY, buf, sizeof buf),
                         "damping+friction+energy");
     assert_string_equal(jd_law_set_describe(ALL, buf, sizeof buf),
-                        "damping+friction+rolling+mu_r+energy+mindlin");
+                        "damping+friction+rolling+mu_r+energy+mindlin+mepa");
     assert_string_equal(jd_law_set_describe(ALL, buf, 8), "damping"); /* truncated, terminated */
 }
 
@@ -310,7 +315,8 @@ static void pair_coeffs_table_maps_each_restitution(void **state) {
     const double e[4] = {0.5, 0.9, 0.9, 1.0}, mu[4] = {0.1, 0.2, 0.3, 0.4}, eta[4] = {0, 0.01, 0.02, 0};
     const double E[2] = {2.08e11, 0.0}, nu[2] = {0.3, 0.0}; /* material 1: wall-only, rigid */
     jd_pair_coeffs t[4];
-    jd_pair_coeffs_table(2, e, mu, eta, E, nu, JD_DAMP_JIANG2021, 0.7, JD_XI_UNCONSTRAINED, t);
+    jd_pair_coeffs_table(2, e, mu, eta, E, nu, JD_DAMP_JIANG2021, 0.7, JD_XI_UNCONSTRAINED, NULL,
+                         t);
     for (int k = 0; k < 4; k++) {
         /* eq. (30) */
         const double le = log(e[k]), gamma = -le / sqrt(3.14159265358979323846 * 3.14159265358979323846 + le * le);
@@ -332,7 +338,9 @@ static void pair_coeffs_table_maps_each_restitution(void **state) {
 static void records_keep_the_law_fields_or_everything(void **state) {
     (void)state;
     assert_int_equal(jd_contact_record_len(0u), 4);
-    assert_int_equal(jd_contact_record_len(JD_F_ENERGY), JD_CONTACT_STATE_LEN);
+    assert_int_equal(jd_contact_record_len(JD_F_ENERGY), JD_CONTACT_ENERGY_LEN);
+    assert_int_equal(jd_contact_record_len(JD_F_MEPA), JD_CONTACT_STATE_LEN); /* dp comes last */
+    assert_int_equal(jd_contact_record_len(JD_F_MEPA | JD_F_ENERGY), JD_CONTACT_STATE_LEN);
     assert_int_equal(jd_rolling_record_len(JD_F_ENERGY), 0);
     assert_int_equal(jd_rolling_record_len(JD_F_ROLLING), 3);
     assert_int_equal(jd_rolling_record_len(JD_F_ROLLING | JD_F_ENERGY), JD_ROLLING_STATE_LEN);
@@ -345,7 +353,7 @@ static void records_keep_the_law_fields_or_everything(void **state) {
     assert_true(st.xi[0] == 1.0 && st.xi[2] == 3.0 && st.flags == 4.0 && st.f_prev[0] == 0.0 &&
                 st.e_fric == 0.0 && rs.theta[2] == -3.0 && rs.m_prev[0] == 0.0);
     jd_record_load(h, JD_CONTACT_STATE_LEN, NULL, 0, &st, &rs);
-    assert_true(st.e_damp == 10.0 && st.e_fric == 11.0 && rs.theta[0] == 0.0);
+    assert_true(st.e_damp == 10.0 && st.e_fric == 11.0 && st.dp == 18.0 && rs.theta[0] == 0.0);
     double h2[JD_CONTACT_STATE_LEN] = {0}, r2[JD_ROLLING_STATE_LEN] = {0};
     jd_record_store(h2, 4, r2, 0, &st, &rs);
     assert_true(h2[3] == 4.0 && h2[4] == 0.0 && r2[0] == 0.0);
@@ -363,6 +371,143 @@ static void records_keep_the_law_fields_or_everything(void **state) {
     assert_int_equal(jd_record_newton(4, 3), 0);
     assert_int_equal(jd_record_newton(4, 4), 1);
     assert_int_equal(jd_record_newton(JD_CONTACT_STATE_LEN, 7), jd_contact_state_newton[7]);
+}
+
+/* ---- MEPA (Del Cid 2015; docs/model.md §13) ---- */
+
+/* Del Cid's copper ore, 5 % moisture (her Table 5.1 script values per atom type, spec §1.6): the
+ * pair values of two like spheres are the series combination, half the type's. */
+static jd_mepa_coeffs copper_ore(double kadh_type) {
+    static double k1[1] = {474788897.8}, k2[1] = {2373944489.0}, kadh[1];
+    kadh[0] = kadh_type;
+    const jd_mepa_inputs in = {.k1 = k1, .k2 = k2, .kadh = kadh, .n = 1.5, .depth = 0.1};
+    return jd_mepa_coeffs_of(&in, 0, 0);
+}
+
+/* F of a MEPA contact driven from dp along overlaps d0 -> d1 in n equal steps (the rate's sign
+ * from the direction); *dp updated; the smallest force and its overlap into *fmin, *dmin. */
+static double mepa_drive(const jd_mepa_coeffs *c, double r_star, double d0, double d1, int n,
+                         double *dp, double *fmin, double *dmin) {
+    double f = 0.0, dn, dpn;
+    for (int k = 1; k <= n; k++) {
+        const double d = d0 + (d1 - d0) * k / n;
+        f = jd_mepa_force(c, d, d1 - d0, r_star, *dp, dp, &dn, &dpn);
+        if (fmin && f < *fmin) *fmin = f, *dmin = d;
+    }
+    return f;
+}
+
+/* Spec §8, "numbers an implementation can be checked against": for two 3.175 mm ore spheres,
+ * dp_max = 0.15875 mm, the virgin branch ends at 0.18421 mm with Fmax = 593.5 N, and the largest
+ * tension is Fmin = -309.7 N (8 %: -474.8 N) at 0.14463 mm. */
+static void mepa_copper_ore_pair_has_del_cids_bounds(void **state) {
+    (void)state;
+    const jd_mepa_coeffs c = copper_ore(356091673.35);
+    const double r_star = 0.5 * 3.175e-3, dp_max = 0.1 * r_star;
+    assert_rel(c.k1, 2.374e8, 1e-3);
+    assert_rel(c.k2, 1.187e9, 1e-3);
+    assert_rel(c.kadh, 1.780e8, 1e-3);
+    assert_rel(c.x_end * dp_max, 0.18421e-3, 1e-4);
+    double dp = 0.0;
+    /* virgin loading: F = k1 d^n with dp = ((k2 - k1)/k2)^(1/n) d */
+    const double d_in = 0.1e-3;
+    double f = mepa_drive(&c, r_star, 0.0, d_in, 1000, &dp, NULL, NULL);
+    assert_rel(f, c.k1 * pow(d_in, 1.5), 1e-14);
+    assert_rel(dp, pow(1.0 - c.k1 / c.k2, 1.0 / 1.5) * d_in, 1e-14);
+    /* to the branch's end: Fmax, dp at its cap */
+    f = mepa_drive(&c, r_star, d_in, c.x_end * dp_max, 1000, &dp, NULL, NULL);
+    assert_rel(f, 593.5, 1e-3);
+    assert_rel(dp, dp_max, 1e-12);
+    /* past it: the k2 branch from dp_max */
+    const double d_deep = 1.1 * c.x_end * dp_max;
+    f = mepa_drive(&c, r_star, c.x_end * dp_max, d_deep, 100, &dp, NULL, NULL);
+    assert_rel(f, c.k2 * (pow(d_deep, 1.5) - pow(dp_max, 1.5)), 1e-14);
+    assert_true(dp == dp_max);
+    /* unloading to separation: elastic along k2, then the adhesive bound down to zero */
+    double fmin = 0.0, dmin = 0.0, dp5 = dp;
+    f = mepa_drive(&c, r_star, d_deep, 1e-9, 200000, &dp5, &fmin, &dmin);
+    assert_rel(fmin, -309.7, 1e-3);
+    assert_rel(dmin, 0.14463e-3, 2e-4);
+    assert_true(f < 0.0 && f > -1e-3 && dp5 < 1e-8); /* on the adhesive bound: dp follows d */
+    const jd_mepa_coeffs c8 = copper_ore(5.93e8);
+    fmin = 0.0;
+    mepa_drive(&c8, r_star, d_deep, 1e-9, 200000, &dp, &fmin, &dmin);
+    assert_rel(fmin, -474.8, 1e-3);
+}
+
+/* A whole contact (jd_contact with MEPA and the energy accounts, n = 1, no dashpot): loaded on
+ * the virgin branch to d_a, unloaded to separation.  What it dissipated is the loop's area,
+ * k1 d_a^2/2 - [k2 ((d_a - dp)^2 - (d_s - dp)^2)/2 - kadh d_s^2/2], dp = (1 - k1/k2) d_a, with
+ * d_s = k2 dp/(k2 + kadh) where the k2 branch meets the adhesive bound. */
+static void mepa_contact_dissipates_its_loop(void **state) {
+    (void)state;
+    double k1t[1] = {2e5}, k2t[1] = {4e5}, kat[1] = {1e5}; /* pair: 1e5, 2e5, 5e4 N/m */
+    const jd_mepa_inputs in = {.k1 = k1t, .k2 = k2t, .kadh = kat, .n = 1.0, .depth = 0.1};
+    jd_pair_coeffs c = {.mepa = jd_mepa_coeffs_of(&in, 0, 0)};
+    const double k1 = 1e5, k2 = 2e5, kadh = 5e4, d_a = 4e-4, v = 1e-3, dt = 1e-4;
+    const unsigned F = JD_F_MEPA | JD_F_ENERGY;
+    jd_contact_state st = {0};
+    jd_contact_result out;
+    double d = 0.0;
+    const int n_load = 4000; /* d_a / (v dt) */
+    for (int k = 1; k <= 2 * n_load; k++) {
+        const int loading = k <= n_load;
+        d += loading ? v * dt : -v * dt;
+        if (d <= 1e-12) break;
+        jd_contact_geom g = geom_z(d, 0.01, 0.0, 1e-3); /* R* 5 mm: dp_max 0.5 mm, never reached */
+        const jd_kinematics kin = {.vb = {0, 0, loading ? -v : v}};
+        assert_int_equal(jd_contact(F, &c, &g, &kin, dt, &st, NULL, &out), 1);
+        if (k == n_load) {
+            assert_rel(out.fn, k1 * d_a, 1e-9);
+            assert_rel(st.dp, (1.0 - k1 / k2) * d_a, 1e-9);
+        }
+    }
+    const double dp = (1.0 - k1 / k2) * d_a, d_s = k2 * dp / (k2 + kadh);
+    const double area = 0.5 * k1 * d_a * d_a -
+                        (0.5 * k2 * ((d_a - dp) * (d_a - dp) - (d_s - dp) * (d_s - dp)) -
+                         0.5 * kadh * d_s * d_s);
+    assert_rel(st.e_damp + st.u_prev, area, 1e-3);
+    assert_true(st.e_fric == 0.0);
+}
+
+/* The guard's MEPA impact: for n = 1 a quarter period on k1 and one on k2; for n = 3/2 its
+ * virgin loading is half of a Hertz impact with k_n = k1 (LIGGGHTS' closed form). */
+static void mepa_impact_time_closed_forms(void **state) {
+    (void)state;
+    const double m = 2e-3, v = 0.7, k1 = 3e5, k2 = 9e5;
+    double d;
+    const double t1 = jd_mepa_impact_time(m, k1, k2, 1.0, v, &d);
+    assert_rel(t1, 0.5 * JD_PI * (sqrt(m / k1) + sqrt(m / k2)), 1e-12);
+    assert_rel(d, v * sqrt(m / k1), 1e-12);
+    const double t15 = jd_mepa_impact_time(m, k1, k2, 1.5, v, &d);
+    assert_rel(d, jd_hertz_peak_overlap(m, k1, v), 1e-12);
+    const double unload = 0.5 * JD_PI * sqrt(m / (1.5 * k2 * sqrt(d)));
+    assert_rel(t15 - unload, 0.5 * jd_hertz_contact_time(m, k1, v), 1e-12);
+}
+
+/* With MEPA an adhesive contact resists sliding by mu |F_n| (Del Cid's fabs), and its tangential
+ * spring takes the virgin secant k1 d^(n-1). */
+static void mepa_friction_caps_at_the_normal_force_magnitude(void **state) {
+    (void)state;
+    double k1t[1] = {2e5}, k2t[1] = {4e5}, kat[1] = {1e5};
+    const jd_mepa_inputs in = {.k1 = k1t, .k2 = k2t, .kadh = kat, .n = 1.0, .depth = 0.1};
+    jd_pair_coeffs c = {.mu = 0.3, .mepa = jd_mepa_coeffs_of(&in, 0, 0)};
+    const jd_contact_geom g = geom_z(1e-4, 0.01, 0.0, 1e-3);
+    jd_normal nl;
+    /* unloading below the k2 branch's zero: k2 (d - dp) = -10 N is beyond the adhesive bound
+     * -kadh d = -5 N, so the contact is on the bound, and dp = ((k2 + kadh)/k2) d */
+    jd_law_mepa(JD_F_MEPA, &c, &g, -1.0, 1.5e-4, &nl);
+    assert_rel(nl.fn, -5.0, 1e-12);
+    assert_rel(nl.dp, 1.25e-4, 1e-12);
+    assert_rel(nl.Kn, 1e5, 1e-12);
+    assert_true(nl.fcap == 5.0 && nl.carries && !nl.ends);
+    /* the tangential law caps at mu |F_n| */
+    jd_contact_state st = {.dp = 1.5e-4};
+    const jd_kinematics kin = {.vb = {2.0, 0, 1e-3}}; /* sliding along x, separating */
+    jd_contact_result out;
+    jd_contact(JD_F_MEPA | JD_F_FRICTION, &c, &g, &kin, 1e-3, &st, NULL, &out);
+    assert_rel(out.f[0], -0.3 * 5.0, 1e-12);
+    assert_rel(out.f[2], -5.0, 1e-12);
 }
 
 static void bond_frequency_bounds(void **state) {
@@ -501,6 +646,10 @@ int run_laws_tests(void) {
         cmocka_unit_test(every_law_set_runs_in_one_compiled_loop),
         cmocka_unit_test(law_set_select_counts_only_interactions_that_occur),
         cmocka_unit_test(law_set_names),
+        cmocka_unit_test(mepa_copper_ore_pair_has_del_cids_bounds),
+        cmocka_unit_test(mepa_contact_dissipates_its_loop),
+        cmocka_unit_test(mepa_impact_time_closed_forms),
+        cmocka_unit_test(mepa_friction_caps_at_the_normal_force_magnitude),
         cmocka_unit_test(pair_coeffs_table_maps_each_restitution),
         cmocka_unit_test(records_keep_the_law_fields_or_everything),
         cmocka_unit_test(bond_frequency_bounds),

@@ -1,0 +1,275 @@
+#!/usr/bin/python3
+"""mepa_drop.py — Del Cid's (2015) MEPA drop test (her §4.3.2, Table 4.1, Figs 4.5 and 4.6) in
+both engines, its force–overlap traces checked against the law's closed-form branches.
+
+    scripts/mepa_drop.py [--out DIR] [--engines jdem,liggghts-jdem] [--quick]
+
+Runs the cases of reference_runs/mepa/drop.yaml (linear: n = 1; hertzian: n = 3/2) in each
+engine and writes DIR/report.md, DIR/summary.json and DIR/drop_CASE.png (default DIR out/mepa).
+--quick (make test): the first impact only, the sphere starting just above the floor with the
+speed of its fall (the same energy), for QUICK_TIME seconds.
+The checks, one PASS/FAIL line each (exit status 1 if any fails):
+  - the first impact loads along the virgin branch k1 delta^n, and unloads along
+    k2 (delta^n - dp^n), dp = ((k2 - k1)/k2)^(1/n) delta_peak, until the adhesive bound
+    -kc delta^n, which it follows to separation: every frame within BRANCH_TOL of the largest
+    force;
+  - every contact frame of the run, the second impact included, lies between the adhesive and
+    the virgin bounds (the run stays short of the virgin branch's end, which is checked);
+  - the peak overlap is the energy balance's, k1 d^(n+1)/(n+1) = m g (h + d) for a drop from
+    gap h at rest, to PEAK_TOL;
+  - the engines' trajectories agree (scripts/compare_trajectories.py, the scene's tolerance).
+"""
+import argparse
+import json
+import os
+import sys
+
+import h5py
+import matplotlib
+import numpy as np
+import yaml
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from scripts import engines  # noqa: E402
+
+SCENE = os.path.join(engines.ROOT, "reference_runs", "mepa", "drop.yaml")
+BRANCH_TOL = 1e-9   # of the largest force: the same law on the same overlaps, round-off apart
+PEAK_TOL = 1e-4     # relative: the frame nearest the peak misses it by O((v dt)^2)
+QUICK_TIME = 0.04   # [s]: both cases' first impacts end within it
+QUICK_GAP = 1e-4    # of the radius: where the quick run's sphere starts above the floor
+ENGINE_LABELS = {"jdem": "jdem", "liggghts-jdem": "liggghts-jdem"}
+
+
+def resolved(case):
+    return yaml.load(engines.resolve(SCENE, case, check=True).stdout, Loader=yaml.CSafeLoader)
+
+
+def quick_scene(case, out_dir):
+    """CASE's first impact alone: the sphere QUICK_GAP radii above the floor with the speed of
+    its fall from the scene's gap, for QUICK_TIME seconds (a resolved scene in OUT_DIR)."""
+    doc = resolved(case)
+    p = doc["particles"][0]
+    R, g = float(p["radius"]), -float(doc["gravity"][2])
+    fall = float(p["position"][2]) - R - QUICK_GAP * R
+    p["position"][2] = R * (1.0 + QUICK_GAP)
+    p["velocity"] = [0.0, 0.0, -(2.0 * g * fall) ** 0.5]
+    doc["time"] = {"dt": doc["time"]["dt"], "end_time": QUICK_TIME}
+    doc.pop("sweep", None)
+    path = os.path.join(out_dir, "quick_%s.yaml" % case)
+    with open(path, "w") as f:
+        yaml.safe_dump(doc, f)
+    return path
+
+
+def law_of(case):
+    """The contact's MEPA constants of CASE: the resolved scene's sphere against the floor
+    (series pairs), its mass, radius and drop gap."""
+    doc = resolved(case)
+    mats, model = doc["materials"], doc["model"]
+    sphere, floor = mats["sphere"], mats["floor"]
+
+    def series(key):
+        a, b = float(sphere.get(key, 0.0)), float(floor.get(key, 0.0))
+        return a * b / (a + b) if a + b > 0 else 0.0
+    p = doc["particles"][0]
+    R = float(p["radius"])
+    return {"k1": series("loading_stiffness"), "k2": series("unloading_stiffness"),
+            "kc": series("cohesive_stiffness"), "n": float(model["mepa_exponent"]),
+            "dp_max": float(model["mepa_plastic_depth"]) * R, "R": R,
+            "m": 4.0 / 3.0 * np.pi * R ** 3 * float(sphere["density"]),
+            "g": -float(doc["gravity"][2]), "gap": float(p["position"][2]) - R}
+
+
+def run(engine, scene, case, out_dir):
+    """Run CASE of SCENE (case None: its only one) in ENGINE, every step written: (trajectory
+    path, wall seconds)."""
+    out = os.path.join(out_dir, "%s_%s.h5" % (case, engine))
+    which = engines.case_args(None if scene != SCENE else case)
+    if engine == "jdem":
+        cmd = [engines.JDEM, "run", scene, *which, "-o", out, "--force", "--quiet"]
+    else:
+        cmd = engines.script("liggghts_run", scene, *which, "-o", out)
+    r, seconds = engines.timed(cmd, check=True)
+    return out, seconds
+
+
+def trace(path, law):
+    """Overlap [m] and the floor's normal force on the sphere [N] at every frame."""
+    with h5py.File(path, "r") as f:
+        z = f["particles/all/position/value"][:, 0, 2]
+        fz = f["particles/all/force/value"][:, 0, 2]
+    return law["R"] - z, fz + law["m"] * law["g"]
+
+
+def first_impact(delta):
+    """Frames [start, end) of the first contact and the frame of its peak overlap."""
+    touching = delta > 0
+    start = int(np.argmax(touching))
+    end = start + int(np.argmin(touching[start:]))
+    return start, end, start + int(np.argmax(delta[start:end]))
+
+
+def branch_residual(delta, force, law):
+    """Largest |F - branch| of the first impact, relative to the largest force, and the
+    reference branch of each of its frames."""
+    k1, k2, kc, n = law["k1"], law["k2"], law["kc"], law["n"]
+    s, e, peak = first_impact(delta)
+    d = delta[s:e]
+    dp = min(((k2 - k1) / k2) ** (1.0 / n) * delta[peak], law["dp_max"])
+    ref = np.where(np.arange(s, e) <= peak, k1 * d ** n,
+                   np.maximum(k2 * (d ** n - dp ** n), -kc * d ** n))
+    return float(np.max(np.abs(force[s:e] - ref)) / np.max(np.abs(force))), dp
+
+
+def within_bounds(delta, force, law):
+    """Worst excursion of any contact frame beyond the bounds, relative to the largest force."""
+    c = delta > 0
+    d, f = delta[c], force[c]
+    above = f - law["k1"] * d ** law["n"]
+    below = -law["kc"] * d ** law["n"] - f
+    return float(max(above.max(), below.max(), 0.0) / np.max(np.abs(force)))
+
+
+def peak_by_energy(law):
+    """The peak overlap of the first impact from the energy balance (bisection)."""
+    k1, n, m, g, h = law["k1"], law["n"], law["m"], law["g"], law["gap"]
+    lo, hi = 0.0, law["R"]
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if k1 * mid ** (n + 1) / (n + 1) - m * g * (h + mid) < 0:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def measure(path, law, seconds):
+    delta, force = trace(path, law)
+    residual, dp = branch_residual(delta, force, law)
+    x_end = (law["k2"] / (law["k2"] - law["k1"])) ** (1.0 / law["n"]) * law["dp_max"]
+    expected = peak_by_energy(law)
+    s, e, peak = first_impact(delta)
+    return {"branch_residual": residual, "bounds_excursion": within_bounds(delta, force, law),
+            "peak_overlap": float(delta[peak]), "peak_overlap_energy": expected,
+            "peak_error": abs(float(delta[peak]) - expected) / expected,
+            "largest_overlap": float(delta.max()), "virgin_branch_end": x_end,
+            "plastic_overlap": dp, "peak_force": float(force[s:e].max()),
+            "largest_tension": float(force[s:e].min()),
+            "contacts": int(np.sum(np.diff((delta > 0).astype(int)) == 1) + (delta[0] > 0)),
+            "seconds": seconds}
+
+
+def figure(case, law, traces, path):
+    """F against delta for each engine, with the bounds and the first unloading branch."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    dmax = max(float(d.max()) for d, _ in traces.values())
+    d = np.linspace(0.0, 1.05 * dmax, 400)
+    n = law["n"]
+    ax.plot(d * 1e3, law["k1"] * d ** n, "k--", lw=0.8, label="virgin bound $k_1\\delta^n$")
+    ax.plot(d * 1e3, -law["kc"] * d ** n, "k:", lw=0.8, label="adhesive bound $-k_c\\delta^n$")
+    styles = {"jdem": dict(color="tab:blue", lw=0.8, zorder=3),
+              "liggghts-jdem": dict(color="tab:orange", lw=0, marker=".", ms=3, zorder=2)}
+    for engine, (delta, force) in sorted(traces.items(), reverse=True):
+        c = delta > 0
+        ax.plot(delta[c] * 1e3, force[c], label=ENGINE_LABELS[engine], **styles[engine])
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    ax.set_xlabel("overlap $\\delta$ [mm]")
+    ax.set_ylabel("normal force on the sphere [N]")
+    ax.set_title("MEPA drop test, n = %g (Del Cid 2015, Fig. %s)" % (n, "4.5" if n == 1 else "4.6"))
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def report(results, agreement, out_dir, checks):
+    engines_run = sorted({e for r in results.values() for e in r["engines"]})
+    lines = ["# MEPA drop test (Del Cid 2015, §4.3.2, Table 4.1, Figs 4.5 and 4.6)", "",
+             "Generated by `scripts/mepa_drop.py` (`make mepa`).  A sphere of R = 50 mm dropped from "
+             "a gap of one radius onto a floor, MEPA's law alone (no dashpot, no friction); the "
+             "table's stiffnesses are the contact's (per-type inputs twice them, combined in series). "
+             "The seed shows the traces as figures only and prints no number: its column says what "
+             "the figures show.", ""]
+    for case, r in results.items():
+        law = r["law"]
+        lines += ["## %s (n = %g)" % (case, law["n"]), "",
+                  "k1 = %.4g, k2 = %.4g, kc = %.4g N/m^%g; dp_max = %.4g mm." % (
+                      law["k1"], law["k2"], law["kc"], law["n"], law["dp_max"] * 1e3), "",
+                  "| | seed | " + " | ".join(engines_run) + " |",
+                  "|---|---|" + "---|" * len(engines_run)]
+        rows = [("virgin loading along k1, unloading along k2, then the adhesive bound "
+                 "(first impact; largest deviation / largest force)", "follows the three branches",
+                 lambda m: "%.1e" % m["branch_residual"]),
+                ("every contact frame within the bounds (worst excursion / largest force)",
+                 "the branches bound the trace", lambda m: "%.1e" % m["bounds_excursion"]),
+                ("peak overlap [mm] (energy balance: %.6g)" % (
+                    list(r["engines"].values())[0]["peak_overlap_energy"] * 1e3), "not given",
+                 lambda m: "%.6g (%.1e off)" % (m["peak_overlap"] * 1e3, m["peak_error"])),
+                ("plastic overlap after the first impact [mm]", "not given",
+                 lambda m: "%.4g" % (m["plastic_overlap"] * 1e3)),
+                ("peak force, largest tension [N]", "not given",
+                 lambda m: "%.4g, %.4g" % (m["peak_force"], m["largest_tension"])),
+                ("impacts in the run", "one shown", lambda m: "%d" % m["contacts"]),
+                ("run time [s] (wall, one core)", "not given", lambda m: "%.2f" % m["seconds"])]
+        for label, seed, fmt in rows:
+            lines.append("| %s | %s | %s |" % (label, seed, " | ".join(
+                fmt(r["engines"][e]) if e in r["engines"] else "—" for e in engines_run)))
+        if case in agreement:
+            lines += ["", "Engines' trajectories: %s." % agreement[case]]
+        lines += ["", "![](drop_%s.png)" % case, ""]
+    lines += ["## Checks", ""] + ["- %s" % c for c in checks]
+    with open(os.path.join(out_dir, "report.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", default=os.path.join(engines.ROOT, "out", "mepa"))
+    ap.add_argument("--engines", default="jdem,liggghts-jdem")
+    ap.add_argument("--quick", action="store_true", help="the first impacts only (make test)")
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    names = a.engines.split(",")
+    results, agreement, checks, failed = {}, {}, [], 0
+
+    def check(name, ok, detail):
+        nonlocal failed
+        failed += not ok
+        line = "%s %s: %s" % ("PASS" if ok else "FAIL", name, detail)
+        print(line, flush=True)
+        checks.append(line)
+
+    for case in engines.cases(SCENE):
+        law = law_of(case)
+        scene = quick_scene(case, a.out) if a.quick else SCENE
+        runs = {e: run(e, scene, case, a.out) for e in names}
+        traces = {e: trace(p, law) for e, (p, _) in runs.items()}
+        measured = {e: measure(p, law, s) for e, (p, s) in runs.items()}
+        for e, m in measured.items():
+            check("%s %s branches" % (case, e), m["branch_residual"] <= BRANCH_TOL,
+                  "largest deviation %.2e of the largest force (<= %g)" % (m["branch_residual"], BRANCH_TOL))
+            check("%s %s bounds" % (case, e),
+                  m["bounds_excursion"] <= BRANCH_TOL and m["largest_overlap"] < m["virgin_branch_end"],
+                  "worst excursion %.2e; largest overlap %.4g mm < the virgin branch's end %.4g mm" % (
+                      m["bounds_excursion"], m["largest_overlap"] * 1e3, m["virgin_branch_end"] * 1e3))
+            check("%s %s peak" % (case, e), m["peak_error"] <= PEAK_TOL,
+                  "peak overlap %.6g mm against the energy balance's %.6g mm" % (
+                      m["peak_overlap"] * 1e3, m["peak_overlap_energy"] * 1e3))
+        if "jdem" in runs and "liggghts-jdem" in runs:
+            r = engines.run(engines.script("compare_trajectories", runs["jdem"][0], runs["liggghts-jdem"][0]))
+            agreement[case] = r.stdout.strip().splitlines()[-1] if r.stdout.strip() else "no output"
+            check("%s engines agree" % case, r.returncode == 0, agreement[case])
+        figure(case, law, traces, os.path.join(a.out, "drop_%s.png" % case))
+        results[case] = {"law": law, "engines": measured}
+    report(results, agreement, a.out, checks)
+    with open(os.path.join(a.out, "summary.json"), "w") as f:
+        json.dump({"results": results, "agreement": agreement, "checks": checks}, f, indent=1)
+    print("report: %s" % os.path.join(a.out, "report.md"))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
