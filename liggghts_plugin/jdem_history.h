@@ -73,6 +73,7 @@ static inline void jd_store_history(double *h, int hw, const jd_contact_state &s
  *    a time step, nothing after the set-up evaluation. */
 template <unsigned F>
 struct JdHistory {
+  enum { RW = (F & JD_F_ROLLING) ? JD_ROLLING_LAWS_LEN : 0 }; /* the short rolling record */
   jd_contact_state *st;
   jd_rolling_state *rs; /* NULL without rolling */
 
@@ -92,8 +93,12 @@ struct JdHistory {
       }
       return;
     }
-    jd_record_load(h, roll_at, h + roll_at, (F & JD_F_ROLLING) ? JD_ROLLING_LAWS_LEN : 0,
-                   &st_copy_, rs);
+    /* the short record of every law set but MEPA's with its length a constant, so that the
+     * copies unroll as they did before MEPA's longer record existed */
+    if (roll_at == JD_CONTACT_LAWS_LEN)
+      jd_record_load(h, JD_CONTACT_LAWS_LEN, h + JD_CONTACT_LAWS_LEN, RW, &st_copy_, rs);
+    else
+      jd_record_load(h, roll_at, h + roll_at, RW, &st_copy_, rs);
   }
   void finish() {
     if (F & JD_F_ENERGY) {
@@ -101,8 +106,10 @@ struct JdHistory {
       return;
     }
     if (!commit_) return;
-    jd_record_store(h_, roll_at_, h_ + roll_at_, (F & JD_F_ROLLING) ? JD_ROLLING_LAWS_LEN : 0,
-                    &st_copy_, rs);
+    if (roll_at_ == JD_CONTACT_LAWS_LEN)
+      jd_record_store(h_, JD_CONTACT_LAWS_LEN, h_ + JD_CONTACT_LAWS_LEN, RW, &st_copy_, rs);
+    else
+      jd_record_store(h_, roll_at_, h_ + roll_at_, RW, &st_copy_, rs);
   }
 
  private:

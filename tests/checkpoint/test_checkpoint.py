@@ -48,7 +48,7 @@ CASES = [  # scene, case, checkpoint every N steps
     # (step 64000): every half skin renewed, the inserted particle's too
     ("tests/checkpoint/scenes/inlet_stream.yaml", None, 63162),
     # MEPA's contacts mid-hysteresis: their plastic overlaps in the checkpoint's history
-    ("tests/liggghts/scenes/mepa_cohesive.yaml", None, 2500),
+    ("tests/liggghts/scenes/mpi_mepa_cohesive.yaml", None, 2500),
 ]
 
 

@@ -183,11 +183,47 @@ def hand_written(tmp):
            rc != 0 and ("ERROR: " + TANGENTIAL_ERROR) in out, "exit %d, log tail: %s" % (rc, out[-400:]))
 
 
+def mepa_hand_written(tmp):
+    """The MEPA scene's deck edited as a user might: each mistake stops with its exact error."""
+    scene = os.path.join(ROOT, "tests", "liggghts", "scenes", "mpi_mepa_cohesive.yaml")
+    resolved = os.path.join(tmp, "mepa.yaml")
+    resolve_short(scene, None, resolved)
+    deck = os.path.join(tmp, "mepa")
+    rc, err = write_deck(resolved, deck)
+    path = os.path.join(deck, "in.jdem")
+    text = open(path).read() if rc == 0 else ""
+    if " normal_law mepa" not in text or "UnloadingStiffness peratomtype 21400000.0 " not in text:
+        report("hand_written MEPA decks", False, "no MEPA deck to edit: " + err)
+        return
+    lines = text.splitlines(True)
+    edits = (
+        ("no normal_law keyword", text.replace(" normal_law mepa", ""),
+         "ERROR: gran/jiang: fix property/global LoadingStiffness is MEPA's, but pair_style "
+         "gran/jiang has no 'normal_law mepa'"),
+        ("UnloadingStiffness not above LoadingStiffness",
+         text.replace("UnloadingStiffness peratomtype 21400000.0 ", "UnloadingStiffness peratomtype 1.0e7 "),
+         "ERROR: gran/jiang: type 1 has LoadingStiffness 1.07e+07, UnloadingStiffness 1e+07, "
+         "CohesiveStiffness 1.07e+07; valid: UnloadingStiffness > LoadingStiffness > 0, "
+         "CohesiveStiffness >= 0"),
+        ("no LoadingStiffness", "".join(l for l in lines if "LoadingStiffness" not in l),
+         "ERROR: Could not locate a fix/property storing value(s) for LoadingStiffness as requested "
+         "by gran/jiang."),  # LIGGGHTS' own message
+        ("normal_law jkr", text.replace(" normal_law mepa", " normal_law jkr"),
+         "ERROR: pair_style gran/jiang: normal_law must be hertz or mepa, not 'jkr'"))
+    for label, edited, want in edits:
+        open(path, "w").write(edited)
+        rc, out = liggghts_deck_run(deck)
+        errors = [l for l in out.splitlines() if l.startswith("ERROR")]
+        report("hand_written MEPA deck, %s: exact error" % label,
+               rc != 0 and any(want in l for l in errors), "exit %d, errors: %s" % (rc, errors[:3]))
+
+
 def main():
     with tempfile.TemporaryDirectory(prefix="law_sets_") as tmp:
         seen = every_scene(tmp)
         report("law_set scenes covered", len(seen) >= 20, "only %d distinct rule inputs" % len(seen))
         hand_written(tmp)
+        mepa_hand_written(tmp)
     return 1 if checks.failed else 0
 
 
