@@ -66,14 +66,6 @@ static springs hertz_springs(double K, double Kt, double r) {
     return (springs){.Kn = 1.5 * K, .Kt = Kt, .Kr = K * r * r};
 }
 
-/* A MEPA contact at peak overlap d: the unloading branch's tangent n k2 d^(n-1), the stiffest the
- * contact has there; its tangential and rolling springs take the virgin secant k1 d^(n-1)
- * (jd_law_mepa). */
-static springs mepa_springs(double k1, double k2, double n, double d, double r) {
-    const double s = pow(d, n - 1.0);
-    return (springs){.Kn = n * k2 * s, .Kt = k1 * s, .Kr = k1 * s * r * r};
-}
-
 /* MEPA's pair stiffness (jd_mepa_coeffs_of's series combination). */
 static double series(double ka, double kb) { return ka * kb / (ka + kb); }
 
@@ -83,6 +75,17 @@ static double tangential_k(int rule, double K, double share_a, double share_b, d
                            double delta) {
     if (rule != JD_KT_MINDLIN) return K;
     return 8.0 / (share_a + share_b) * sqrt(r_star * delta);
+}
+
+/* A MEPA contact at peak overlap d: the unloading branch's tangent n k2 d^(n-1), the stiffest the
+ * contact has there; its rolling spring takes the virgin secant k1 d^(n-1) (jd_law_mepa), its
+ * tangential spring that too, or Mindlin's K_t (tangential_k, with the shares of 1/G*). */
+static springs mepa_springs(const jd_guard_input *in, double k1, double k2, double d, double r,
+                            double share_a, double share_b) {
+    const double K = k1 * pow(d, in->mepa_n - 1.0);
+    return (springs){.Kn = in->mepa_n * k2 * pow(d, in->mepa_n - 1.0),
+                     .Kt = tangential_k(in->tangential_rule, K, share_a, share_b, r, d),
+                     .Kr = K * r * r};
 }
 
 static void tighten(jd_guard_result *r, double dt, double bound, int which) {
@@ -125,7 +128,8 @@ void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
                 double d;
                 out->contact_time = fmin(out->contact_time,
                                          jd_mepa_impact_time(m_eff, k1, k2, in->mepa_n, v, &d));
-                omega2 = fmax(omega2, row_sum(&pa, &pb, mepa_springs(k1, k2, in->mepa_n, d, r)));
+                omega2 = fmax(omega2, row_sum(&pa, &pb, mepa_springs(in, k1, k2, d, r, share_a,
+                                                                      jd_shear_compliance(sb->E, sb->nu))));
                 continue;
             }
             const double kn = jd_kn_pair(kp_a, jd_hertz_prefactor(sb->E, sb->nu, sb->rmin));
@@ -141,8 +145,8 @@ void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
             out->contact_time = fmin(out->contact_time,
                                      jd_mepa_impact_time(pa.m, sa->mepa_k1, sa->mepa_k2,
                                                          in->mepa_n, v, &d));
-            omega2 = fmax(omega2, row_sum(&pa, NULL, mepa_springs(sa->mepa_k1, sa->mepa_k2,
-                                                                  in->mepa_n, d, sa->rmin)));
+            omega2 = fmax(omega2, row_sum(&pa, NULL, mepa_springs(in, sa->mepa_k1, sa->mepa_k2, d,
+                                                                  sa->rmin, share_a, 0.0)));
         } else if (in->has_walls) {
             const double kw = jd_kn_wall(in->wall_rule, sa->E, sa->nu, sa->rmin);
             out->contact_time = fmin(out->contact_time, jd_hertz_contact_time(pa.m, kw, v));
@@ -168,7 +172,8 @@ void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
 /* "BOUND (V s)", with the coordination number where it is that bound. */
 static int describe(const jd_guard_input *in, int bound, double value, char *buf, size_t len) {
     if (bound == JD_GUARD_CONTACT_TIME && in->normal_law == JD_NORMAL_MEPA)
-        return snprintf(buf, len, "1/50 of the shortest MEPA contact time (%.6g s)", value);
+        return snprintf(buf, len, "1/%g of the shortest MEPA contact time (%.6g s)",
+                        JD_GUARD_STEPS_PER_CONTACT, value);
     if (bound == JD_GUARD_COORDINATION)
         return snprintf(buf, len, "%s %g (%.6g s)", jd_guard_bound_name(bound), in->coordination,
                         value);

@@ -10,7 +10,8 @@
  *   contact_time  the shortest Hertz contact (any pair of species, any species against a wall)
  *                 at the scene's max_impact_speed spans JD_GUARD_STEPS_PER_CONTACT steps
  *                 (accuracy of the force curve; erratum 18); with MEPA, its impact
- *                 (jd_mepa_impact_time);
+ *                 (jd_mepa_impact_time); the Rayleigh bound still reads E, nu and the density,
+ *                 which a MEPA scene gives (MEPA's law itself reads none of E, nu);
  *   coordination  stability of velocity Verlet, omega_max dt <= 2, with omega_max bounded for a
  *                 particle with C contacts (Otsubo, O'Sullivan & Shire 2017: the critical step
  *                 depends on m, K_max and the maximum coordination number; see docs/model.md);

@@ -107,8 +107,10 @@ double jd_hertz_peak_overlap(double m_eff, double k_n, double v) {
  * d_pk/v times the integral of (1 - x^(n+1))^(-1/2) over [0, 1], (1/(n+1)) B(1/(n+1), 1/2).
  * Unloading along k2 is taken as a quarter period at the branch's tangent stiffness at the
  * peak, n k2 d_pk^(n-1), its stiffest: exact for n = 1, shorter than the true unloading for
- * n > 1.  The peak ignores the k2 branch past the virgin branch's end (a deeper, hence for
- * n > 1 stiffer, estimate). */
+ * n > 1.  The peak ignores the k2 branch past the virgin branch's end: there the estimate's
+ * peak is deeper (for n > 1 a stiffer tangent, which only tightens the Verlet bound) and its
+ * loading longer than the true impact's, so the contact-time bound is then not conservative
+ * (docs/model.md §13). */
 double jd_mepa_impact_time(double m_eff, double k1, double k2, double n, double v,
                            double *peak_overlap) {
     const double p = 1.0 / (n + 1.0);

@@ -499,10 +499,12 @@ static JD_ALWAYS_INLINE double jd_mepa_force(const jd_mepa_coeffs *c, double del
  * C_n = 2 gamma sqrt(m_eff k2 delta^(n-1)) (with JD_F_DAMPING).  The contact never ends while
  * the bodies overlap: it carries tension on the adhesive bound, and the engines end it when the
  * overlap does (jd_contact_separate).  With JD_F_ENERGY also the stored energy and what the
- * change of dp dissipated (the stored energy at today's overlap before and after it). */
+ * change of dp dissipated during the step of length dt [s]: the stored energy before and after
+ * the change at the step's mid-point overlap delta - ddelta dt/2, or 0 (exact for n = 1, second
+ * order otherwise, like the rest of the accounts). */
 static JD_ALWAYS_INLINE void jd_law_mepa(const unsigned features, const jd_pair_coeffs *c,
                                          const jd_contact_geom *g, double ddelta, double dp_old,
-                                         jd_normal *nl) {
+                                         double dt, jd_normal *nl) {
     const jd_mepa_coeffs *mc = &c->mepa;
     double dn, dpn;
     const double f = jd_mepa_force(mc, g->delta, ddelta, g->r_roll, dp_old, &nl->dp, &dn, &dpn);
@@ -518,18 +520,21 @@ static JD_ALWAYS_INLINE void jd_law_mepa(const unsigned features, const jd_pair_
         const double dp_max = mc->depth * g->r_roll;
         const double up = dp_old < dp_max ? dp_old : dp_max;
         nl->u = jd_mepa_energy(mc, g->delta, dn, nl->dp, dpn);
-        nl->e_plastic = jd_mepa_energy(mc, g->delta, dn, up, pow(up, mc->n)) - nl->u;
+        /* (not below zero: a contact that began less than half a step ago) */
+        const double mid = fmax(g->delta - 0.5 * ddelta * dt, 0.0), mid_n = pow(mid, mc->n);
+        nl->e_plastic = jd_mepa_energy(mc, mid, mid_n, up, pow(up, mc->n)) -
+                        jd_mepa_energy(mc, mid, mid_n, nl->dp, dpn);
     }
 }
 
 /* Normal law with damping and Luding's end of contact (§3, §7, §8): with JD_F_DAMPING the
  * contact ends, never pulling, once the total normal force reaches zero while unloading.  With
- * JD_F_MEPA, MEPA's law instead (jd_law_mepa); dp_old is its plastic overlap. */
+ * JD_F_MEPA, MEPA's law instead (jd_law_mepa); dp_old is its plastic overlap, dt the step. */
 static JD_ALWAYS_INLINE void jd_law_normal(const unsigned features, const jd_pair_coeffs *c,
                                     const jd_contact_geom *g, double ddelta, int still_ended,
-                                    double dp_old, jd_normal *nl) {
+                                    double dp_old, double dt, jd_normal *nl) {
     if (features & JD_F_MEPA) {
-        jd_law_mepa(features, c, g, ddelta, dp_old, nl);
+        jd_law_mepa(features, c, g, ddelta, dp_old, dt, nl);
         return;
     }
     const int damping = (features & JD_F_DAMPING) != 0;
@@ -774,7 +779,7 @@ static JD_ALWAYS_INLINE int jd_contact(const unsigned features, const jd_pair_co
     jd_contact_step h;
     jd_contact_begin(features, g, s, r, m.ddelta, &h);
     jd_normal nl;
-    jd_law_normal(features, c, g, m.ddelta, h.still_ended, h.dp, &nl);
+    jd_law_normal(features, c, g, m.ddelta, h.still_ended, h.dp, dt, &nl);
 
     double f[3] = {nl.fn * g->n[0], nl.fn * g->n[1], nl.fn * g->n[2]};
     double m_roll[3] = {0.0, 0.0, 0.0};

@@ -60,8 +60,7 @@ void FixJdemRestart::write_restart(FILE *fp) {
     const double shared[NPAIR] = {(double)pair->wall_rule, (double)pair->damping_map,
                                   (double)pair->xi_limit, (double)pair->tangential_rule,
                                   pair->mu_r, pair->rolling ? 1.0 : 0.0,
-                                  pair->energy_accounts ? 1.0 : 0.0, (double)pair->normal_law,
-                                  pair->mepa_exponent, pair->mepa_plastic_depth};
+                                  pair->energy_accounts ? 1.0 : 0.0};
     const double sums[NSUMS] = {pair->e_damp_cum, pair->e_fric_cum, pair->e_elastic_now,
                                 pair->contacts_now};
     st.shared.assign(shared, shared + NPAIR);
@@ -72,14 +71,16 @@ void FixJdemRestart::write_restart(FILE *fp) {
   }
   st.shared.push_back(update->atime);
   st.shared.push_back(jdem_restart_pack_i64((int64_t)update->atimestep));
+  st.shared.push_back(pair ? (double)pair->normal_law : -1.0);
+  st.shared.push_back(pair ? pair->mepa_exponent : -1.0);
+  st.shared.push_back(pair ? pair->mepa_plastic_depth : -1.0);
   jdem_restart_write_state(lmp, fp, st);
 }
 
 /* pair_style gran/jiang (the one this run defines) defines this fix at its set-up: it takes
  * the file's contact observables. */
 void FixJdemRestart::restart(char *buf) {
-  const JdemRestartState st = jdem_restart_read_state(lmp, buf, "fix jdem_restart (jdem/restart)",
-                                                      NSHARED, NSUMS);
+  const JdemRestartState st = read_state(lmp, buf);
   /* the clock as the writer had it, so that the time of every later step (atime + (step -
    * atimestep) dt: the dump's, the bond breaks') has the uninterrupted run's bits; LIGGGHTS'
    * restart file does not keep it */
@@ -94,19 +95,34 @@ void FixJdemRestart::restart(char *buf) {
   resuming_ = true;
 }
 
+/* The global state of a file written with or without MEPA's options (before MEPA: Hertz). */
+JdemRestartState FixJdemRestart::read_state(LAMMPS *lmp, const char *buf) {
+  const double written = reinterpret_cast<const double *>(buf)[2]; /* its count of shared values */
+  JdemRestartState st = jdem_restart_read_state(
+      lmp, buf, "fix jdem_restart (jdem/restart)",
+      written == (double)NSHARED_BEFORE_MEPA ? NSHARED_BEFORE_MEPA : NSHARED, NSUMS);
+  if (st.shared.size() == NSHARED_BEFORE_MEPA) {
+    const double hertz[NMEPA] = {(double)JD_NORMAL_HERTZ, 1.5, 0.1};
+    st.shared.insert(st.shared.end(), hertz, hertz + NMEPA);
+  }
+  return st;
+}
+
 std::string FixJdemRestart::describe_pair_options(LAMMPS *lmp, const char *state) {
-  const JdemRestartState st = jdem_restart_read_state(lmp, state, "fix jdem_restart (jdem/restart)",
-                                                      NSHARED, NSUMS);
-  const double *o = st.shared.data();
+  const JdemRestartState st = read_state(lmp, state);
+  const double *o = st.shared.data(), *mepa = o + NPAIR + 2;
   char text[512];
-  std::snprintf(text, sizeof text,
-                "wall_rule %s damping %s tangential_limit %s tangential_stiffness %s mu_r %.17g "
-                "rolling %s energy %s normal_law %s mepa_exponent %.17g mepa_plastic_depth %.17g",
-                o[0] == JD_WALL_HERTZ ? "hertz" : "jiang2021",
-                o[1] == JD_DAMP_JIANG2021 ? "jiang2021" : "exact_restitution",
-                o[2] == JD_XI_COULOMB ? "coulomb" : "unconstrained",
-                o[3] == JD_KT_JIANG2021 ? "jiang2021" : "mindlin", o[4], o[5] != 0.0 ? "on" : "off",
-                o[6] != 0.0 ? "yes" : "no", o[7] == JD_NORMAL_MEPA ? "mepa" : "hertz", o[8], o[9]);
+  int n = std::snprintf(text, sizeof text,
+                        "wall_rule %s damping %s tangential_limit %s tangential_stiffness %s "
+                        "mu_r %.17g rolling %s energy %s",
+                        o[0] == JD_WALL_HERTZ ? "hertz" : "jiang2021",
+                        o[1] == JD_DAMP_JIANG2021 ? "jiang2021" : "exact_restitution",
+                        o[2] == JD_XI_COULOMB ? "coulomb" : "unconstrained",
+                        o[3] == JD_KT_JIANG2021 ? "jiang2021" : "mindlin", o[4],
+                        o[5] != 0.0 ? "on" : "off", o[6] != 0.0 ? "yes" : "no");
+  if (mepa[0] == JD_NORMAL_MEPA && n > 0 && (size_t)n < sizeof text)
+    std::snprintf(text + n, sizeof text - (size_t)n,
+                  " normal_law mepa mepa_exponent %.17g mepa_plastic_depth %.17g", mepa[1], mepa[2]);
   return text;
 }
 

@@ -20,6 +20,7 @@
 #include <string>
 
 #include "fix.h"
+#include "jdem_restart.h"
 
 namespace LAMMPS_NS {
 
@@ -53,8 +54,11 @@ class FixJdemRestart : public Fix {
 
  private:
   enum { SAVED = 6 };                 /* force [N] and torque [N m] */
-  enum { NPAIR = 10 };                /* the pair style's options */
-  enum { NSHARED = NPAIR + 2, NSUMS = 4 }; /* the global state's counts: options, clock, sums */
+  /* the global state: the pair style's options, the clock (2), then MEPA's options (normal_law,
+   * mepa_exponent, mepa_plastic_depth), which files written before MEPA lack; the sums */
+  enum { NPAIR = 7, NMEPA = 3 };
+  enum { NSHARED_BEFORE_MEPA = NPAIR + 2, NSHARED = NPAIR + 2 + NMEPA, NSUMS = 4 };
+  static JdemRestartState read_state(class LAMMPS *lmp, const char *buf);
   bool resuming_;
   double **saved;
   int nmax_saved;

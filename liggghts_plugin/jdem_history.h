@@ -93,12 +93,12 @@ struct JdHistory {
       }
       return;
     }
-    /* the short record of every law set but MEPA's with its length a constant, so that the
-     * copies unroll as they did before MEPA's longer record existed */
-    if (roll_at == JD_CONTACT_LAWS_LEN)
-      jd_record_load(h, JD_CONTACT_LAWS_LEN, h + JD_CONTACT_LAWS_LEN, RW, &st_copy_, rs);
+    /* the laws' fields (xi, flags) of either layout, or MEPA's whole state (its dp comes last),
+     * each with its length a constant so that the copies unroll */
+    if (roll_at == JD_CONTACT_STATE_LEN)
+      jd_record_load(h, JD_CONTACT_STATE_LEN, h + roll_at, RW, &st_copy_, rs);
     else
-      jd_record_load(h, roll_at, h + roll_at, RW, &st_copy_, rs);
+      jd_record_load(h, JD_CONTACT_LAWS_LEN, h + roll_at, RW, &st_copy_, rs);
   }
   void finish() {
     if (F & JD_F_ENERGY) {
@@ -106,10 +106,10 @@ struct JdHistory {
       return;
     }
     if (!commit_) return;
-    if (roll_at_ == JD_CONTACT_LAWS_LEN)
-      jd_record_store(h_, JD_CONTACT_LAWS_LEN, h_ + JD_CONTACT_LAWS_LEN, RW, &st_copy_, rs);
+    if (roll_at_ == JD_CONTACT_STATE_LEN)
+      jd_record_store(h_, JD_CONTACT_STATE_LEN, h_ + roll_at_, RW, &st_copy_, rs);
     else
-      jd_record_store(h_, roll_at_, h_ + roll_at_, RW, &st_copy_, rs);
+      jd_record_store(h_, JD_CONTACT_LAWS_LEN, h_ + roll_at_, RW, &st_copy_, rs);
   }
 
  private:

@@ -45,13 +45,15 @@ PairGranJiang::PairGranJiang(LAMMPS *lmp)
 /* ---------------------------------------------------------------------------------------- */
 
 void PairGranJiang::settings(int narg, char **arg) {
+  std::string mepa_option; /* a MEPA option given, which needs normal_law mepa */
   for (int i = 0; i < narg; i += 2) {
     if (i + 1 >= narg) error->all(FLERR, "pair_style gran/jiang: option without a value");
     const std::string k = arg[i], val = arg[i + 1];
     if (k == "wall_rule") {
       if (val == "hertz") wall_rule = JD_WALL_HERTZ;
       else if (val == "jiang2021") wall_rule = JD_WALL_JIANG2021;
-      else error->all(FLERR, "pair_style gran/jiang: wall_rule must be hertz or jiang2021");
+      else error->all(FLERR, ("pair_style gran/jiang: wall_rule must be hertz or jiang2021, not '" + val +
+                              "'").c_str());
     } else if (k == "damping") {
       if (val == "jiang2021") damping_map = JD_DAMP_JIANG2021;
       else if (val == "exact_restitution") damping_map = JD_DAMP_EXACT;
@@ -74,6 +76,7 @@ void PairGranJiang::settings(int narg, char **arg) {
       const double x = force->numeric(FLERR, arg[i + 1]);
       if (!(x > 0.0)) error->all(FLERR, ("pair_style gran/jiang: " + k + " must be > 0").c_str());
       (k == "mepa_exponent" ? mepa_exponent : mepa_plastic_depth) = x;
+      mepa_option = k;
     } else if (k == "mu_r") {
       mu_r = force->numeric(FLERR, arg[i + 1]);
       if (!(mu_r >= 0.0 && mu_r <= 1.0)) error->all(FLERR, "pair_style gran/jiang: mu_r must be in [0, 1]");
@@ -92,6 +95,9 @@ void PairGranJiang::settings(int narg, char **arg) {
     }
   }
 
+  if (!mepa_option.empty() && !mepa())
+    error->all(FLERR, ("pair_style gran/jiang: " + mepa_option + " is MEPA's option; valid: "
+                       "normal_law mepa with it, or no " + mepa_option).c_str());
   register_history();
   jdem_restart_check_pair_style(lmp, "gran/jiang", state_len());
   present_as_gran();
@@ -540,7 +546,9 @@ void PairGranJiang::compute(int eflag, int vflag) {
 
 /* The pair section of the file (rank 0): our hashcode, a layout version, the options. */
 namespace {
-enum { PAIR_RESTART_VERSION = 2, PAIR_RESTART_OPTIONS = 7 }; /* 2: MEPA's options */
+/* version 1: six options and mu_r; 2 (MEPA): normal_law too, and mu_r, mepa_exponent and
+ * mepa_plastic_depth */
+enum { PAIR_RESTART_VERSION = 2, PAIR_RESTART_OPTIONS = 7 };
 }
 
 void PairGranJiang::write_restart_settings(FILE *fp) {
@@ -557,14 +565,17 @@ void PairGranJiang::write_restart_settings(FILE *fp) {
 
 void PairGranJiang::read_restart_settings(FILE *fp, const int, const int) {
   int64_t mark = 0;
-  int version = 0, options[PAIR_RESTART_OPTIONS] = {0};
-  double values[3] = {0.0, 0.0, 0.0};
+  int version = 0, options[PAIR_RESTART_OPTIONS] = {0, 0, 0, 0, 0, 0, JD_NORMAL_HERTZ};
+  double values[3] = {0.0, 1.5, 0.1}; /* a version 1 file's MEPA options: Hertz */
   int ok = 1;
-  if (comm->me == 0)
+  if (comm->me == 0) {
     ok = std::fread(&mark, sizeof mark, 1, fp) == 1 && std::fread(&version, sizeof version, 1, fp) == 1 &&
-         mark == hashcode() && version == PAIR_RESTART_VERSION &&
-         std::fread(options, sizeof(int), PAIR_RESTART_OPTIONS, fp) == PAIR_RESTART_OPTIONS &&
-         std::fread(values, sizeof(double), 3, fp) == 3;
+         mark == hashcode() && (version == 1 || version == PAIR_RESTART_VERSION);
+    const int n_options = version == 1 ? PAIR_RESTART_OPTIONS - 1 : PAIR_RESTART_OPTIONS;
+    const int n_values = version == 1 ? 1 : 3;
+    ok = ok && std::fread(options, sizeof(int), n_options, fp) == (size_t)n_options &&
+         std::fread(values, sizeof(double), n_values, fp) == (size_t)n_values;
+  }
   MPI_Bcast(&ok, 1, MPI_INT, 0, world);
   if (!ok)
     error->all(FLERR, "read_restart: the pair section of the restart file is not one of "

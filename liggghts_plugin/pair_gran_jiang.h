@@ -7,9 +7,10 @@
  *                         [normal_law hertz|mepa] [mepa_exponent N] [mepa_plastic_depth X]
  *   pair_coeff * *
  *
- * energy no: the contact history keeps no energy accounts (4 doubles per contact instead of 17,
- * jdem_history.h); then no dump h5md/jdem or fix jdem/watchdog may ask for the energies (their
- * own keyword `energy no` / `energy off`), or init stops with a message naming them.
+ * energy no: the contact history keeps no energy accounts (4 doubles per contact instead of 17;
+ * MEPA keeps 18 either way, jdem_history.h); then no dump h5md/jdem or fix jdem/watchdog may ask
+ * for the energies (their own keyword `energy no` / `energy off`), or init stops with a message
+ * naming them.
  *
  * Materials come from fix property/global youngsModulus, poissonsRatio (peratomtype) and
  * coefficientRestitution, coefficientFriction, coefficientRollingFriction (peratomtypepair; the

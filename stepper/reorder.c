@@ -92,15 +92,12 @@ static int rekey(jd_contact_list *l, int pairs, const int32_t *new_of_old, size_
     return 0;
 }
 
-/* List l of n particles re-keyed and sorted through spare, which then takes l's old buffers. */
+/* List l of n particles re-keyed and sorted through spare, which then takes l's old buffers;
+ * kind: the run's (sim_list_kind), which the record lengths alone do not tell (MEPA's contact
+ * record is as long with and without the energy accounts, its rolling record is not). */
 static int reorder_list(jd_contact_list *l, jd_contact_list *spare, int pairs,
-                        const int32_t *new_of_old, size_t n) {
+                        const int32_t *new_of_old, size_t n, unsigned kind) {
     if (l->n == 0) return 0;
-    /* the record lengths tell the kind (jd_contact_record_len): MEPA's whole state, the energy
-     * accounts' leading part, or the laws' */
-    const unsigned kind = (l->rw ? JD_LIST_ROLLING : 0u) |
-                          (l->hw == JD_CONTACT_STATE_LEN ? JD_LIST_MEPA : 0u) |
-                          (l->hw == JD_CONTACT_ENERGY_LEN ? JD_LIST_ENERGY : 0u);
     if (sim_list_reserve(spare, l->n, kind) != 0 ||
         rekey(l, pairs, new_of_old, n, spare) != 0)
         return -1;
@@ -118,8 +115,9 @@ int sim_reorder(jd_sim *s, const int32_t *old_of_new, char *err, size_t errlen) 
     if (!new_of_old) goto oom;
     for (size_t k = 0; k < n; k++) new_of_old[old_of_new[k]] = (int32_t)k;
     /* the lists first: they are the only step that can fail, and the arrays stay untouched */
-    if (reorder_list(&lists->pairs, &lists->spare, 1, new_of_old, n) != 0 ||
-        reorder_list(&lists->wall_pairs, &lists->wall_spare, 0, new_of_old, n) != 0) {
+    const unsigned kind = sim_list_kind(s->run.features);
+    if (reorder_list(&lists->pairs, &lists->spare, 1, new_of_old, n, kind) != 0 ||
+        reorder_list(&lists->wall_pairs, &lists->wall_spare, 0, new_of_old, n, kind) != 0) {
         free(new_of_old);
         goto oom;
     }

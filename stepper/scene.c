@@ -240,6 +240,14 @@ static int read_model(loader *L) {
         sd_opt_enum(&L->c, m, "model", "tangential_stiffness", TANGENTIAL_RULES,
                     &s->tangential_rule))
         return -1;
+    static const char *const mepa_keys[] = {"mepa_exponent", "mepa_plastic_depth"};
+    for (int k = 0; k < 2 && s->normal_law != JD_NORMAL_MEPA; k++)
+        if (sd_get(&L->c, m, mepa_keys[k])) {
+            char sub[SD_PATH_MAX];
+            sd_join(sub, "model", mepa_keys[k]);
+            return sd_fail(&L->c, sd_get(&L->c, m, mepa_keys[k]), sub, "MEPA's option without "
+                           "MEPA's law; valid: model.normal_law: mepa, or no %s", mepa_keys[k]);
+        }
     return sd_opt_num(&L->c, m, "model", "mu_r", UNIT, &s->mu_r);
 }
 

@@ -150,8 +150,10 @@ static int emit_header(yaml_emitter_t *e, const jd_scene *s) {
            key_str(e, "tangential_limit", XI_LIMITS[s->xi_limit]) || key_num(e, "mu_r", s->mu_r) ||
            key_str(e, "tangential_stiffness", TANGENTIAL_RULES[s->tangential_rule]) ||
            key_str(e, "normal_law", NORMAL_LAWS[s->normal_law]) ||
-           key_num(e, "mepa_exponent", s->mepa_exponent) ||
-           key_num(e, "mepa_plastic_depth", s->mepa_plastic_depth) || map_end(e) || emit_watchdog(e, &s->watchdog) || str(e, "neighbour") ||
+           (s->normal_law == JD_NORMAL_MEPA && /* MEPA's options only with MEPA (scene.c) */
+            (key_num(e, "mepa_exponent", s->mepa_exponent) ||
+             key_num(e, "mepa_plastic_depth", s->mepa_plastic_depth))) ||
+           map_end(e) || emit_watchdog(e, &s->watchdog) || str(e, "neighbour") ||
            map_start(e, 0) || key_int(e, "skin_steps", s->skin_steps) || map_end(e);
 }
 

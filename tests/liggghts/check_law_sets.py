@@ -192,14 +192,18 @@ def mepa_hand_written(tmp):
     rc, err = write_deck(resolved, deck)
     path = os.path.join(deck, "in.jdem")
     text = open(path).read() if rc == 0 else ""
-    if " normal_law mepa" not in text or "UnloadingStiffness peratomtype 21400000.0 " not in text:
+    options = " normal_law mepa mepa_exponent 1.5 mepa_plastic_depth 0.1"
+    if options not in text or "UnloadingStiffness peratomtype 21400000.0 " not in text:
         report("hand_written MEPA decks", False, "no MEPA deck to edit: " + err)
         return
     lines = text.splitlines(True)
     edits = (
-        ("no normal_law keyword", text.replace(" normal_law mepa", ""),
+        ("no MEPA keywords", text.replace(options, ""),
          "ERROR: gran/jiang: fix property/global LoadingStiffness is MEPA's, but pair_style "
          "gran/jiang has no 'normal_law mepa'"),
+        ("MEPA's options without normal_law", text.replace(" normal_law mepa", ""),
+         "ERROR: pair_style gran/jiang: mepa_plastic_depth is MEPA's option; valid: normal_law "
+         "mepa with it, or no mepa_plastic_depth"),
         ("UnloadingStiffness not above LoadingStiffness",
          text.replace("UnloadingStiffness peratomtype 21400000.0 ", "UnloadingStiffness peratomtype 1.0e7 "),
          "ERROR: gran/jiang: type 1 has LoadingStiffness 1.07e+07, UnloadingStiffness 1e+07, "

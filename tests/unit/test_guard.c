@@ -112,6 +112,43 @@ static void a_stiff_bond_binds(void **state) {
                              "period (5e-08 s); largest safe dt = 5e-08 s. Use --force to run anyway.");
 }
 
+/* Two copper-ore spheres with MEPA (Del Cid's Table 5.1 per-type values): the contact-time bound
+ * is 1/50 of jd_mepa_impact_time of the series pair, named as MEPA's, and the Verlet bound is
+ * 2/omega with omega^2 = C x 2 [max(n k2 d^(n-1)/m, 3.5 K_t/m) + K_r/I] at the impact's peak d
+ * (equal spheres: the block Gershgorin row of jdem_guard.c, exact in form), with the tangential
+ * spring k1 d^(n-1), or Mindlin's 8 G* sqrt(R* d) when the scene asks for it. */
+static void mepa_pair_bounds(void **state) {
+    (void)state;
+    const double R = 3.175e-3, rho = 2481.3, E = 1.19e11, nu = 0.34, v = 2.0, n = 1.5;
+    const jd_guard_species sp = {.count = 2, .rmin = R, .density = rho, .E = E, .nu = nu,
+                                 .mepa_k1 = 4.75e8, .mepa_k2 = 2.37e9};
+    jd_guard_input in = {.species = &sp, .n_species = 1, .max_impact_speed = v,
+                         .coordination = JD_GUARD_DEFAULT_COORDINATION, .normal_law = JD_NORMAL_MEPA,
+                         .mepa_n = n, .dt = 1e-9};
+    const double m = jd_sphere_mass(R, rho), I = jd_sphere_inertia(m, R), r = 0.5 * R;
+    const double k1 = 0.5 * 4.75e8, k2 = 0.5 * 2.37e9; /* like types in series */
+    double d;
+    const double tc = jd_mepa_impact_time(0.5 * m, k1, k2, n, v, &d);
+    const double K = k1 * sqrt(d), Kn = n * k2 * sqrt(d), G = 1.0 / (2.0 * jd_shear_compliance(E, nu));
+    for (int rule = JD_KT_JIANG2021; rule <= JD_KT_MINDLIN; rule++) {
+        in.tangential_rule = rule;
+        jd_guard_result res;
+        jd_guard_assess(&in, &res);
+        assert_rel(res.contact_bound, tc / JD_GUARD_STEPS_PER_CONTACT, 1e-14);
+        const double Kt = rule == JD_KT_MINDLIN ? 8.0 * G * sqrt(r * d) : K;
+        const double row = 2.0 * (fmax(Kn / m, 3.5 * Kt / m) + K * r * r / I);
+        assert_rel(res.coordination_bound, 2.0 / sqrt(JD_GUARD_DEFAULT_COORDINATION * row), 1e-12);
+    }
+    /* the contact time's bound, when broken, is named as MEPA's */
+    jd_guard_result res;
+    jd_guard_assess(&in, &res);
+    char msg[512];
+    jd_guard_warning(&in, &(jd_guard_result){.violated = JD_GUARD_CONTACT_TIME,
+                                              .violated_value = res.contact_bound},
+                     "--force", msg, sizeof msg);
+    assert_non_null(strstr(msg, "exceeds 1/50 of the shortest MEPA contact time"));
+}
+
 int run_guard_tests(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(bounds_match_published_values),
@@ -119,6 +156,7 @@ int run_guard_tests(void) {
         cmocka_unit_test(coordination_and_damping_scale_the_verlet_limit),
         cmocka_unit_test(mindlin_stiffer_spring_tightens_the_verlet_limit),
         cmocka_unit_test(a_stiff_bond_binds),
+        cmocka_unit_test(mepa_pair_bounds),
     };
     return cmocka_run_group_tests_name("guard", tests, NULL, NULL);
 }

@@ -51,20 +51,20 @@ static void normal_law_with_damping_and_luding_end(void **state) {
     const jd_contact_geom g = geom_z(d, 0.01, k, m);
     const jd_pair_coeffs c = {.gamma = 0.2, .mu = 0.5, .mu_r = 1.0};
     jd_normal nl;
-    jd_law_normal(0u, &c, &g, 0.7, 0, 0.0, &nl); /* undamped: Hertz alone, gamma ignored */
+    jd_law_normal(0u, &c, &g, 0.7, 0, 0.0, 0.0, &nl); /* undamped: Hertz alone, gamma ignored */
     assert_rel(nl.fn, k * pow(d, 1.5), 1e-14);
     assert_rel(nl.Kn, k * sqrt(d), 1e-14);
     assert_true(nl.Cn == 0.0 && nl.carries && !nl.ends);
-    jd_law_normal(JD_F_DAMPING, &c, &g, 0.7, 0, 0.0, &nl); /* eq. (29), (31) */
+    jd_law_normal(JD_F_DAMPING, &c, &g, 0.7, 0, 0.0, 0.0, &nl); /* eq. (29), (31) */
     assert_rel(nl.Cn, 2.0 * 0.2 * sqrt(m * k * sqrt(d)), 1e-14);
     assert_rel(nl.fn, k * pow(d, 1.5) + nl.Cn * 0.7, 1e-14);
     /* unloading so fast that the dashpot outpulls the spring: Luding's end, no force */
     const double fast = -2.0 * k * pow(d, 1.5) / nl.Cn;
-    jd_law_normal(JD_F_DAMPING, &c, &g, fast, 0, 0.0, &nl);
+    jd_law_normal(JD_F_DAMPING, &c, &g, fast, 0, 0.0, 0.0, &nl);
     assert_true(nl.fn < 0.0 && nl.ends && !nl.carries);
-    jd_law_normal(0u, &c, &g, fast, 0, 0.0, &nl); /* without damping a contact never ends so */
+    jd_law_normal(0u, &c, &g, fast, 0, 0.0, 0.0, &nl); /* without damping a contact never ends so */
     assert_true(nl.carries && !nl.ends);
-    jd_law_normal(JD_F_DAMPING, &c, &g, -1e-3, 1, 0.0, &nl); /* still ended: carries nothing */
+    jd_law_normal(JD_F_DAMPING, &c, &g, -1e-3, 1, 0.0, 0.0, &nl); /* still ended: carries nothing */
     assert_true(!nl.carries && !nl.ends);
 }
 
@@ -90,7 +90,7 @@ static void tangential_law_sticks_then_slides(void **state) {
     const jd_contact_geom g = geom_z(d, 0.01, k, 1e-3);
     const jd_pair_coeffs c = {.gamma = 0.0, .mu = 0.3, .mu_r = 1.0, .xi_limit = JD_XI_COULOMB};
     jd_normal nl;
-    jd_law_normal(0u, &c, &g, 0.0, 0, 0.0, &nl);
+    jd_law_normal(0u, &c, &g, 0.0, 0, 0.0, 0.0, &nl);
     jd_contact_motion m = {.vrel = {0.01, 0, 0}, .vn = 0.0};
     jd_contact_step h = {0};
     double f[3] = {0, 0, nl.fn}, u = 0.0, dash = 0.0;
@@ -119,7 +119,7 @@ static void mindlin_tangential_stiffness_is_8_g_sqrt_r_delta(void **state) {
     const jd_contact_geom g = geom_z(d, R, 1e9, m); /* r_roll = R/2 = R* of two spheres of R */
     const jd_pair_coeffs c = {.gamma = 0.2, .mu = 0.3, .mu_r = 1.0, .g_star = g_star};
     jd_normal nl;
-    jd_law_normal(JD_F_DAMPING, &c, &g, 0.0, 0, 0.0, &nl);
+    jd_law_normal(JD_F_DAMPING, &c, &g, 0.0, 0, 0.0, 0.0, &nl);
     const double Kt = jd_tangential_stiffness(JD_F_FRICTION | JD_F_MINDLIN, &c, &g, &nl);
     assert_rel(Kt, 8.0 * g_star * sqrt(0.5 * R * d), 1e-15);
     assert_rel(jd_tangential_damping(JD_F_DAMPING | JD_F_FRICTION | JD_F_MINDLIN, &c, &g, &nl, Kt),
@@ -147,7 +147,7 @@ static void mindlin_over_hertz_tangent_is_2_1mnu_over_2mnu(void **state) {
     const double kp = jd_hertz_prefactor(E, nu, R);
     jd_contact_geom g = geom_z(d, R, jd_kn_pair(kp, kp), 1.0);
     jd_normal nl;
-    jd_law_normal(0u, &t[0], &g, 0.0, 0, 0.0, &nl);
+    jd_law_normal(0u, &t[0], &g, 0.0, 0, 0.0, 0.0, &nl);
     const double Kt = jd_tangential_stiffness(JD_F_FRICTION | JD_F_MINDLIN, &t[0], &g, &nl);
     assert_rel(Kt / (1.5 * nl.Kn), 2.0 * (1.0 - nu) / (2.0 - nu), 1e-14);
     /* against a rigid wall (r_roll = R, G* of the particle alone): the same ratio to the exact
@@ -155,7 +155,7 @@ static void mindlin_over_hertz_tangent_is_2_1mnu_over_2mnu(void **state) {
     const jd_pair_coeffs w = jd_wall_coeffs(&t[0]);
     g.r_roll = R;
     g.k_n = jd_kn_wall(JD_WALL_HERTZ, E, nu, R);
-    jd_law_normal(0u, &w, &g, 0.0, 0, 0.0, &nl);
+    jd_law_normal(0u, &w, &g, 0.0, 0, 0.0, 0.0, &nl);
     assert_rel(jd_tangential_stiffness(JD_F_FRICTION | JD_F_MINDLIN, &w, &g, &nl) / (1.5 * nl.Kn),
                2.0 * (1.0 - nu) / (2.0 - nu), 1e-14);
 }
@@ -166,7 +166,7 @@ static void rolling_law_spring_and_cap(void **state) {
     const jd_contact_geom g = geom_z(d, R, k, 1e-3);
     const jd_pair_coeffs c = {.gamma = 0.1, .eta = 0.05, .mu_r = 1.0, .xi_limit = JD_XI_COULOMB};
     jd_normal nl;
-    jd_law_normal(JD_F_DAMPING, &c, &g, 0.0, 0, 0.0, &nl);
+    jd_law_normal(JD_F_DAMPING, &c, &g, 0.0, 0, 0.0, 0.0, &nl);
     const jd_contact_motion m = {.wrel = {0, 2.0, 0}};
     jd_contact_step h = {0};
     double mr[3], u = 0.0, dash = 0.0;
@@ -439,13 +439,13 @@ static void mepa_copper_ore_pair_has_del_cids_bounds(void **state) {
  * the virgin branch to d_a, unloaded to separation.  What it dissipated is the loop's area,
  * k1 d_a^2/2 - [k2 ((d_a - dp)^2 - (d_s - dp)^2)/2 - kadh d_s^2/2], dp = (1 - k1/k2) d_a, with
  * d_s = k2 dp/(k2 + kadh) where the k2 branch meets the adhesive bound. */
-static void mepa_contact_dissipates_its_loop(void **state) {
-    (void)state;
+/* One MEPA contact driven through the loop of mepa_contact_dissipates_its_loop with law set F;
+ * returns its final state. */
+static jd_contact_state mepa_loop(unsigned F) {
     double k1t[1] = {2e5}, k2t[1] = {4e5}, kat[1] = {1e5}; /* pair: 1e5, 2e5, 5e4 N/m */
     const jd_mepa_inputs in = {.k1 = k1t, .k2 = k2t, .kadh = kat, .n = 1.0, .depth = 0.1};
-    jd_pair_coeffs c = {.mepa = jd_mepa_coeffs_of(&in, 0, 0)};
-    const double k1 = 1e5, k2 = 2e5, kadh = 5e4, d_a = 4e-4, v = 1e-3, dt = 1e-4;
-    const unsigned F = JD_F_MEPA | JD_F_ENERGY;
+    jd_pair_coeffs c = {.mu = 0.3, .mepa = jd_mepa_coeffs_of(&in, 0, 0)};
+    const double d_a = 4e-4, v = 1e-3, dt = 1e-4;
     jd_contact_state st = {0};
     jd_contact_result out;
     double d = 0.0;
@@ -458,16 +458,32 @@ static void mepa_contact_dissipates_its_loop(void **state) {
         const jd_kinematics kin = {.vb = {0, 0, loading ? -v : v}};
         assert_int_equal(jd_contact(F, &c, &g, &kin, dt, &st, NULL, &out), 1);
         if (k == n_load) {
-            assert_rel(out.fn, k1 * d_a, 1e-9);
-            assert_rel(st.dp, (1.0 - k1 / k2) * d_a, 1e-9);
+            assert_rel(out.fn, 1e5 * d_a, 1e-9);
+            assert_rel(st.dp, 0.5 * d_a, 1e-9);
         }
     }
+    return st;
+}
+
+/* A whole contact (jd_contact with MEPA and the energy accounts, n = 1, no dashpot): loaded on
+ * the virgin branch to d_a, unloaded to separation.  What it dissipated is the loop's area,
+ * k1 d_a^2/2 - [k2 ((d_a - dp)^2 - (d_s - dp)^2)/2 - kadh d_s^2/2], dp = (1 - k1/k2) d_a, with
+ * d_s = k2 dp/(k2 + kadh) where the k2 branch meets the adhesive bound; and it is booked as
+ * plastic work (damping), not as friction, when the contact has a tangential law that never
+ * slides (no tangential motion). */
+static void mepa_contact_dissipates_its_loop(void **state) {
+    (void)state;
+    const double k1 = 1e5, k2 = 2e5, kadh = 5e4, d_a = 4e-4;
     const double dp = (1.0 - k1 / k2) * d_a, d_s = k2 * dp / (k2 + kadh);
     const double area = 0.5 * k1 * d_a * d_a -
                         (0.5 * k2 * ((d_a - dp) * (d_a - dp) - (d_s - dp) * (d_s - dp)) -
                          0.5 * kadh * d_s * d_s);
-    assert_rel(st.e_damp + st.u_prev, area, 1e-3);
-    assert_true(st.e_fric == 0.0);
+    const jd_contact_state alone = mepa_loop(JD_F_MEPA | JD_F_ENERGY);
+    assert_rel(alone.e_damp + alone.u_prev, area, 1e-3);
+    assert_true(alone.e_fric == 0.0);
+    const jd_contact_state with_friction = mepa_loop(JD_F_MEPA | JD_F_FRICTION | JD_F_ENERGY);
+    assert_rel(with_friction.e_damp + with_friction.u_prev, area, 1e-3);
+    assert_true(fabs(with_friction.e_fric) <= 1e-6 * area);
 }
 
 /* The guard's MEPA impact: for n = 1 a quarter period on k1 and one on k2; for n = 3/2 its
@@ -496,7 +512,7 @@ static void mepa_friction_caps_at_the_normal_force_magnitude(void **state) {
     jd_normal nl;
     /* unloading below the k2 branch's zero: k2 (d - dp) = -10 N is beyond the adhesive bound
      * -kadh d = -5 N, so the contact is on the bound, and dp = ((k2 + kadh)/k2) d */
-    jd_law_mepa(JD_F_MEPA, &c, &g, -1.0, 1.5e-4, &nl);
+    jd_law_mepa(JD_F_MEPA, &c, &g, -1.0, 1.5e-4, 0.0, &nl);
     assert_rel(nl.fn, -5.0, 1e-12);
     assert_rel(nl.dp, 1.25e-4, 1e-12);
     assert_rel(nl.Kn, 1e5, 1e-12);
