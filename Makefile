@@ -235,7 +235,7 @@ bonds: all
 # copy: reference_runs/mepa/results/.
 .PHONY: mepa
 mepa: all
-	$(PY) scripts/mepa_drop.py --out out/mepa
+	$(PY) scripts/mepa_drop.py --out out/mepa --results reference_runs/mepa/results
 
 # Error against run time: Chung–Ooi tests 1, 3, 4 and a settling bed, dt swept over
 # factors of the time-step guard's dt, in jdem, liggghts-jdem and LIGGGHTS hertz/history; timings
