@@ -66,9 +66,6 @@ static springs hertz_springs(double K, double Kt, double r) {
     return (springs){.Kn = 1.5 * K, .Kt = Kt, .Kr = K * r * r};
 }
 
-/* MEPA's pair stiffness (jd_mepa_coeffs_of's series combination). */
-static double series(double ka, double kb) { return ka * kb / (ka + kb); }
-
 /* The tangential stiffness at overlap delta of a contact with secant stiffness K, effective
  * radius r_star and Mindlin's share of 1/G* of each side (jd_shear_compliance; a wall's is 0). */
 static double tangential_k(int rule, double K, double share_a, double share_b, double r_star,
@@ -82,10 +79,36 @@ static double tangential_k(int rule, double K, double share_a, double share_b, d
  * tangential spring that too, or Mindlin's K_t (tangential_k, with the shares of 1/G*). */
 static springs mepa_springs(const jd_guard_input *in, double k1, double k2, double d, double r,
                             double share_a, double share_b) {
-    const double K = k1 * pow(d, in->mepa_n - 1.0);
-    return (springs){.Kn = in->mepa_n * k2 * pow(d, in->mepa_n - 1.0),
+    const double s = pow(d, in->mepa_n - 1.0), K = k1 * s;
+    return (springs){.Kn = in->mepa_n * k2 * s,
                      .Kt = tangential_k(in->tangential_rule, K, share_a, share_b, r, d),
                      .Kr = K * r * r};
+}
+
+/* One kind of contact at the scene's impact speed: its duration [s] and its springs at the
+ * impact's peak overlap. */
+typedef struct impact {
+    double time;
+    springs k;
+} impact;
+
+/* Jiang's Hertz contact of effective mass m_eff [kg], prefactor kn [N/m^1.5] and radius r [m];
+ * share_a, share_b: the sides' shares of Mindlin's 1/G* (a wall's is 0). */
+static impact hertz_impact(const jd_guard_input *in, double m_eff, double kn, double r,
+                           double share_a, double share_b) {
+    const double v = in->max_impact_speed;
+    const double d = jd_hertz_peak_overlap(m_eff, kn, v), K = kn * sqrt(d);
+    return (impact){.time = jd_hertz_contact_time(m_eff, kn, v),
+                    .k = hertz_springs(K, tangential_k(in->tangential_rule, K, share_a, share_b,
+                                                       r, d), r)};
+}
+
+/* A MEPA contact of pair stiffnesses k1, k2 (jd_mepa_impact_time), the rest as hertz_impact. */
+static impact mepa_impact(const jd_guard_input *in, double m_eff, double k1, double k2, double r,
+                          double share_a, double share_b) {
+    double d;
+    const double t = jd_mepa_impact_time(m_eff, k1, k2, in->mepa_n, in->max_impact_speed, &d);
+    return (impact){.time = t, .k = mepa_springs(in, k1, k2, d, r, share_a, share_b)};
 }
 
 static void tighten(jd_guard_result *r, double dt, double bound, int which) {
@@ -122,37 +145,25 @@ void jd_guard_assess(const jd_guard_input *in, jd_guard_result *out) {
             const side pb = side_of(sb->rmin, sb->density);
             const double m_eff = pa.m * pb.m / (pa.m + pb.m);
             const double r = sa->rmin * sb->rmin / (sa->rmin + sb->rmin);
-            if (in->normal_law == JD_NORMAL_MEPA) {
-                const double k1 = series(sa->mepa_k1, sb->mepa_k1);
-                const double k2 = series(sa->mepa_k2, sb->mepa_k2);
-                double d;
-                out->contact_time = fmin(out->contact_time,
-                                         jd_mepa_impact_time(m_eff, k1, k2, in->mepa_n, v, &d));
-                omega2 = fmax(omega2, row_sum(&pa, &pb, mepa_springs(in, k1, k2, d, r, share_a,
-                                                                      jd_shear_compliance(sb->E, sb->nu))));
-                continue;
-            }
+            const double share_b = jd_shear_compliance(sb->E, sb->nu);
             const double kn = jd_kn_pair(kp_a, jd_hertz_prefactor(sb->E, sb->nu, sb->rmin));
-            out->contact_time = fmin(out->contact_time, jd_hertz_contact_time(m_eff, kn, v));
-            const double d = jd_hertz_peak_overlap(m_eff, kn, v), K = kn * sqrt(d);
-            const double Kt = tangential_k(in->tangential_rule, K, share_a,
-                                           jd_shear_compliance(sb->E, sb->nu), r, d);
-            omega2 = fmax(omega2, row_sum(&pa, &pb, hertz_springs(K, Kt, r)));
+            const impact c =
+                in->normal_law == JD_NORMAL_MEPA
+                    ? mepa_impact(in, m_eff, jd_mepa_series(sa->mepa_k1, sb->mepa_k1),
+                                  jd_mepa_series(sa->mepa_k2, sb->mepa_k2), r, share_a, share_b)
+                    : hertz_impact(in, m_eff, kn, r, share_a, share_b);
+            out->contact_time = fmin(out->contact_time, c.time);
+            omega2 = fmax(omega2, row_sum(&pa, &pb, c.k));
         }
-        if (in->has_walls && in->normal_law == JD_NORMAL_MEPA) {
-            /* the wall's own stiffness only softens the series: taken as rigid */
-            double d;
-            out->contact_time = fmin(out->contact_time,
-                                     jd_mepa_impact_time(pa.m, sa->mepa_k1, sa->mepa_k2,
-                                                         in->mepa_n, v, &d));
-            omega2 = fmax(omega2, row_sum(&pa, NULL, mepa_springs(in, sa->mepa_k1, sa->mepa_k2, d,
-                                                                  sa->rmin, share_a, 0.0)));
-        } else if (in->has_walls) {
-            const double kw = jd_kn_wall(in->wall_rule, sa->E, sa->nu, sa->rmin);
-            out->contact_time = fmin(out->contact_time, jd_hertz_contact_time(pa.m, kw, v));
-            const double d = jd_hertz_peak_overlap(pa.m, kw, v), K = kw * sqrt(d);
-            const double Kt = tangential_k(in->tangential_rule, K, share_a, 0.0, sa->rmin, d);
-            omega2 = fmax(omega2, row_sum(&pa, NULL, hertz_springs(K, Kt, sa->rmin)));
+        if (in->has_walls) {
+            /* MEPA: the wall's own stiffness only softens the series, so it is taken as rigid */
+            const impact c =
+                in->normal_law == JD_NORMAL_MEPA
+                    ? mepa_impact(in, pa.m, sa->mepa_k1, sa->mepa_k2, sa->rmin, share_a, 0.0)
+                    : hertz_impact(in, pa.m, jd_kn_wall(in->wall_rule, sa->E, sa->nu, sa->rmin),
+                                   sa->rmin, share_a, 0.0);
+            out->contact_time = fmin(out->contact_time, c.time);
+            omega2 = fmax(omega2, row_sum(&pa, NULL, c.k));
         }
     }
     out->contact_bound = out->contact_time / JD_GUARD_STEPS_PER_CONTACT;

@@ -115,6 +115,23 @@ typedef struct jd_mepa_coeffs {
     double x_end;    /* the virgin branch's end as a multiple of dp_max, (k2/(k2 - k1))^(1/n) [-] */
 } jd_mepa_coeffs;
 
+/* MEPA's pair stiffness from the two materials' [N/m^n]: Del Cid's series combination
+ * k_a k_b/(k_a + k_b), 0 for two zeros (her code's 0/0; spec §7.12). */
+static inline double jd_mepa_series(double ka, double kb) {
+    return ka + kb > 0.0 ? ka * kb / (ka + kb) : 0.0;
+}
+
+/* A material's MEPA stiffnesses are valid when k2 > k1 > 0 and kadh >= 0 (k1 = k2 would divide
+ * by zero at the virgin branch's end); both engines' readers refuse the others. */
+static inline int jd_mepa_material_valid(double k1, double k2, double kadh) {
+    return k1 > 0.0 && k2 > k1 && kadh >= 0.0;
+}
+
+/* MEPA's defaults: Del Cid's exponent in her production runs, and her code's plasticity depth
+ * dmax = 0.1 R*. */
+#define JD_MEPA_DEFAULT_EXPONENT 1.5
+#define JD_MEPA_DEFAULT_DEPTH 0.1
+
 /* ------------------------------------------------------------------------------------------ */
 /* Coefficients of one interaction (species pair, or species–wall), fixed for a run.           */
 /* ------------------------------------------------------------------------------------------ */
@@ -456,9 +473,10 @@ typedef struct jd_normal {
     double Cn;   /* dashpot coefficient 2 gamma sqrt(m_eff K_n); MEPA: with k2 d^(n-1)  [N s/m] */
     int ends;    /* Luding's end of collision this step (never with MEPA)               [-]    */
     int carries; /* the contact carries force after this step                           [-]    */
+    double u;         /* energy stored in the normal spring (JD_F_ENERGY; else zero): Hertz's
+                         jd_normal_energy, MEPA's jd_mepa_energy                         [J]    */
     /* MEPA only (JD_F_MEPA; else zero) */
     double dp;        /* plastic overlap after the step                                 [m]    */
-    double u;         /* energy stored in the normal spring (jd_mepa_energy)            [J]    */
     double e_plastic; /* energy the plastic overlap's change dissipated this step       [J]    */
 } jd_normal;
 
@@ -470,29 +488,37 @@ static JD_ALWAYS_INLINE double jd_mepa_energy(const jd_mepa_coeffs *c, double de
     return c->k2 * ((delta * dn - dp * dpn) / (c->n + 1.0) - dpn * (delta - dp));
 }
 
+/* The powers a MEPA step computes once: delta^n, the plastic overlap before the step (capped)
+ * and after it, and their n-th powers. */
+typedef struct jd_mepa_step {
+    double dn;       /* delta^n                                              [m^n] */
+    double up, upn;  /* dp before the step, min(dp_old, dp_max), and up^n   [m], [m^n] */
+    double dp, dpn;  /* dp after the step and dp^n                           [m], [m^n] */
+} jd_mepa_step;
+
 /* MEPA's hysteretic force [N] (Del Cid 2015 §4.3.1; her LudingForce, docs/model.md §13) at
  * overlap delta > 0 [m], the overlap rate ddelta [m/s] choosing loading (>= 0) or unloading, the
  * plasticity radius r_star [m] and the plastic overlap dp_old [m] before the step.  On the
  * virgin bound (a new contact starts there, k2 > k1) dp follows x_virgin delta, and past the
  * branch's end x_end dp_max the contact reloads along k2 with dp = dp_max; below the adhesive
- * bound while unloading dp follows x_adh delta; inside the bounds dp stays.  *dp, *dn, *dpn:
- * dp after the step, delta^n and dp^n.  Written with selects. */
+ * bound while unloading dp follows x_adh delta; inside the bounds dp stays.  *s receives the
+ * step's powers and overlaps.  Written with selects. */
 static JD_ALWAYS_INLINE double jd_mepa_force(const jd_mepa_coeffs *c, double delta, double ddelta,
-                                             double r_star, double dp_old, double *dp, double *dn,
-                                             double *dpn) {
+                                             double r_star, double dp_old, jd_mepa_step *s) {
     const double dp_max = c->depth * r_star;
-    const double up = dp_old < dp_max ? dp_old : dp_max;
-    *dn = pow(delta, c->n);
-    const double f1 = c->k1 * *dn, f2 = c->k2 * (*dn - pow(up, c->n)), f3 = -c->kadh * *dn;
+    s->up = dp_old < dp_max ? dp_old : dp_max;
+    s->dn = pow(delta, c->n);
+    s->upn = pow(s->up, c->n);
+    const double f1 = c->k1 * s->dn, f2 = c->k2 * (s->dn - s->upn), f3 = -c->kadh * s->dn;
     const int loading = ddelta >= 0.0;
     const int virgin = loading & (f2 - f1 > 0.0);
     const int beyond = delta > c->x_end * dp_max;
     const int adhesive = !loading & (f2 - f3 < 0.0);
-    double q = virgin ? (beyond ? dp_max : c->x_virgin * delta) : (adhesive ? c->x_adh * delta : up);
+    double q = virgin ? (beyond ? dp_max : c->x_virgin * delta) : (adhesive ? c->x_adh * delta : s->up);
     q = q < dp_max ? q : dp_max;
-    *dp = q > 0.0 ? q : 0.0;
-    *dpn = pow(*dp, c->n);
-    return (virgin & !beyond) ? f1 : (adhesive ? f3 : c->k2 * (*dn - *dpn));
+    s->dp = q > 0.0 ? q : 0.0;
+    s->dpn = pow(s->dp, c->n);
+    return (virgin & !beyond) ? f1 : (adhesive ? f3 : c->k2 * (s->dn - s->dpn));
 }
 
 /* MEPA's normal law (JD_F_MEPA, §13): the hysteretic force plus the dashpot C_n ddelta with
@@ -506,10 +532,11 @@ static JD_ALWAYS_INLINE void jd_law_mepa(const unsigned features, const jd_pair_
                                          const jd_contact_geom *g, double ddelta, double dp_old,
                                          double dt, jd_normal *nl) {
     const jd_mepa_coeffs *mc = &c->mepa;
-    double dn, dpn;
-    const double f = jd_mepa_force(mc, g->delta, ddelta, g->r_roll, dp_old, &nl->dp, &dn, &dpn);
-    nl->Kn = mc->k1 * dn / g->delta;
-    nl->Cn = (features & JD_F_DAMPING) ? 2.0 * c->gamma * sqrt(g->m_eff * mc->k2 * dn / g->delta)
+    jd_mepa_step s;
+    const double f = jd_mepa_force(mc, g->delta, ddelta, g->r_roll, dp_old, &s);
+    nl->dp = s.dp;
+    nl->Kn = mc->k1 * s.dn / g->delta;
+    nl->Cn = (features & JD_F_DAMPING) ? 2.0 * c->gamma * sqrt(g->m_eff * mc->k2 * s.dn / g->delta)
                                        : 0.0;
     nl->fn = f + nl->Cn * ddelta;
     nl->fcap = fabs(nl->fn);
@@ -517,13 +544,11 @@ static JD_ALWAYS_INLINE void jd_law_mepa(const unsigned features, const jd_pair_
     nl->carries = 1;
     nl->u = nl->e_plastic = 0.0;
     if (features & JD_F_ENERGY) {
-        const double dp_max = mc->depth * g->r_roll;
-        const double up = dp_old < dp_max ? dp_old : dp_max;
-        nl->u = jd_mepa_energy(mc, g->delta, dn, nl->dp, dpn);
+        nl->u = jd_mepa_energy(mc, g->delta, s.dn, s.dp, s.dpn);
         /* (not below zero: a contact that began less than half a step ago) */
         const double mid = fmax(g->delta - 0.5 * ddelta * dt, 0.0), mid_n = pow(mid, mc->n);
-        nl->e_plastic = jd_mepa_energy(mc, mid, mid_n, up, pow(up, mc->n)) -
-                        jd_mepa_energy(mc, mid, mid_n, nl->dp, dpn);
+        nl->e_plastic = jd_mepa_energy(mc, mid, mid_n, s.up, s.upn) -
+                        jd_mepa_energy(mc, mid, mid_n, s.dp, s.dpn);
     }
 }
 
@@ -543,7 +568,8 @@ static JD_ALWAYS_INLINE void jd_law_normal(const unsigned features, const jd_pai
     nl->fcap = nl->fn;
     nl->ends = damping ? !still_ended & (nl->fn <= 0.0) : 0;
     nl->carries = !still_ended & !nl->ends;
-    nl->dp = nl->u = nl->e_plastic = 0.0;
+    nl->dp = nl->e_plastic = 0.0;
+    nl->u = (features & JD_F_ENERGY) ? jd_normal_energy(g->k_n, g->delta) : 0.0;
 }
 
 /* Tangential stiffness K_t [N/m] (§4.5): the seed's K_t = K_n (Sec. 2.3.2), or with
@@ -783,11 +809,10 @@ static JD_ALWAYS_INLINE int jd_contact(const unsigned features, const jd_pair_co
 
     double f[3] = {nl.fn * g->n[0], nl.fn * g->n[1], nl.fn * g->n[2]};
     double m_roll[3] = {0.0, 0.0, 0.0};
-    const int mepa = (features & JD_F_MEPA) != 0;
-    double u_new = energy ? (mepa ? nl.u : jd_normal_energy(g->k_n, g->delta)) : 0.0;
+    double u_new = nl.u; /* the normal spring's, with the tangential and rolling springs' added */
     /* the share of the dissipation booked as damping besides the normal dashpot: the tangential
      * and rolling dashpots', and MEPA's plastic work [J] */
-    double dash = mepa ? nl.e_plastic : 0.0;
+    double dash = nl.e_plastic;
     if (features & JD_F_FRICTION) jd_law_tangential(features, c, g, &m, &nl, dt, &h, f, &u_new, &dash);
     if (features & JD_F_ROLLING) jd_law_rolling(features, c, g, &m, &nl, dt, &h, m_roll, &u_new, &dash);
     jd_contact_energy e = {0.0, h.e_damp, h.e_fric};

@@ -86,12 +86,10 @@ static double g_star_of(double share_a, double share_b) {
     return s > 0.0 ? 1.0 / s : 0.0;
 }
 
-/* Del Cid's series combination, 0 for two zeros (her code's 0/0; spec §7.12). */
-static double series(double ka, double kb) { return ka + kb > 0.0 ? ka * kb / (ka + kb) : 0.0; }
-
 jd_mepa_coeffs jd_mepa_coeffs_of(const jd_mepa_inputs *in, size_t a, size_t b) {
-    const double k1 = series(in->k1[a], in->k1[b]), k2 = series(in->k2[a], in->k2[b]);
-    const double kadh = series(in->kadh[a], in->kadh[b]), inv_n = 1.0 / in->n;
+    const double k1 = jd_mepa_series(in->k1[a], in->k1[b]);
+    const double k2 = jd_mepa_series(in->k2[a], in->k2[b]);
+    const double kadh = jd_mepa_series(in->kadh[a], in->kadh[b]), inv_n = 1.0 / in->n;
     return (jd_mepa_coeffs){.k1 = k1, .k2 = k2, .kadh = kadh, .n = in->n, .depth = in->depth,
                             .x_virgin = pow((k2 - k1) / k2, inv_n),
                             .x_adh = pow((k2 + kadh) / k2, inv_n),

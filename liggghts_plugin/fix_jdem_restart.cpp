@@ -97,12 +97,11 @@ void FixJdemRestart::restart(char *buf) {
 
 /* The global state of a file written with or without MEPA's options (before MEPA: Hertz). */
 JdemRestartState FixJdemRestart::read_state(LAMMPS *lmp, const char *buf) {
-  const double written = reinterpret_cast<const double *>(buf)[2]; /* its count of shared values */
-  JdemRestartState st = jdem_restart_read_state(
-      lmp, buf, "fix jdem_restart (jdem/restart)",
-      written == (double)NSHARED_BEFORE_MEPA ? NSHARED_BEFORE_MEPA : NSHARED, NSUMS);
+  JdemRestartState st = jdem_restart_read_state(lmp, buf, "fix jdem_restart (jdem/restart)",
+                                                NSHARED, NSUMS, NSHARED_BEFORE_MEPA);
   if (st.shared.size() == NSHARED_BEFORE_MEPA) {
-    const double hertz[NMEPA] = {(double)JD_NORMAL_HERTZ, 1.5, 0.1};
+    const double hertz[NMEPA] = {(double)JD_NORMAL_HERTZ, JD_MEPA_DEFAULT_EXPONENT,
+                                 JD_MEPA_DEFAULT_DEPTH};
     st.shared.insert(st.shared.end(), hertz, hertz + NMEPA);
   }
   return st;

@@ -62,8 +62,9 @@ void jdem_restart_write_state(LAMMPS *lmp, FILE *fp, const JdemRestartState &min
 }
 
 JdemRestartState jdem_restart_read_state(LAMMPS *lmp, const char *buf, const std::string &who,
-                                         size_t nshared, size_t nsums) {
+                                         size_t nshared, size_t nsums, size_t older_nshared) {
   const double *b = reinterpret_cast<const double *>(buf);
+  if (older_nshared && b[2] == (double)older_nshared) nshared = older_nshared;
   if (b[0] != state_magic || b[1] != state_version || b[2] != (double)nshared ||
       b[3] != (double)nsums)
     lmp->error->all(FLERR, (who + ": the restart file holds this fix's state in another layout "

@@ -44,9 +44,11 @@ void jdem_restart_write_state(LAMMPS *lmp, FILE *fp, const JdemRestartState &min
 
 /* Fix::restart of our fixes: this rank's part of the block `buf`.  `who` names the fix in the
  * messages ("fix ID (style)"); nshared and nsums are the counts this fix writes: a block with
- * other counts (another version of the style) stops with a message. */
+ * other counts (another version of the style) stops with a message, but for older_nshared
+ * shared values (when not 0: an older layout the fix still reads; st.shared's size says which
+ * it got). */
 JdemRestartState jdem_restart_read_state(LAMMPS *lmp, const char *buf, const std::string &who,
-                                         size_t nshared, size_t nsums);
+                                         size_t nshared, size_t nsums, size_t older_nshared = 0);
 
 /* An int64 carried bit for bit in a double of a state block (steps such as INT64_MAX, "never",
  * are not exact as a double's value). */

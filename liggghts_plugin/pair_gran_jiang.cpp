@@ -38,7 +38,8 @@ using namespace LAMMPS_NS;
 PairGranJiang::PairGranJiang(LAMMPS *lmp)
     : PairGran(lmp), wall_rule(JD_WALL_HERTZ), damping_map(JD_DAMP_JIANG2021),
       xi_limit(JD_XI_COULOMB), tangential_rule(JD_KT_JIANG2021), normal_law(JD_NORMAL_HERTZ),
-      mu_r(1.0), mepa_exponent(1.5), mepa_plastic_depth(0.1), rolling(false), energy_accounts(true), energy(false),
+      mu_r(1.0), mepa_exponent(JD_MEPA_DEFAULT_EXPONENT),
+      mepa_plastic_depth(JD_MEPA_DEFAULT_DEPTH), rolling(false), energy_accounts(true), energy(false),
       e_damp_cum(0.0), e_fric_cum(0.0), e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY),
       features_(0), ntypes_(0), kp_ncalls_(-1), kp_nall_(-1), script_checked_(false) {}
 
@@ -211,7 +212,7 @@ void PairGranJiang::read_mepa_stiffnesses() {
     for (int t = 1; f && t <= nt; t++) mepa_k_[q][t] = f->compute_vector(t - 1);
   }
   for (int t = 1; mepa() && t <= nt; t++)
-    if (!(mepa_k_[0][t] > 0.0 && mepa_k_[1][t] > mepa_k_[0][t] && mepa_k_[2][t] >= 0.0)) {
+    if (!jd_mepa_material_valid(mepa_k_[0][t], mepa_k_[1][t], mepa_k_[2][t])) {
       char msg[256];
       std::snprintf(msg, sizeof msg, "gran/jiang: type %d has LoadingStiffness %g, "
                     "UnloadingStiffness %g, CohesiveStiffness %g; valid: UnloadingStiffness > "
@@ -566,7 +567,8 @@ void PairGranJiang::write_restart_settings(FILE *fp) {
 void PairGranJiang::read_restart_settings(FILE *fp, const int, const int) {
   int64_t mark = 0;
   int version = 0, options[PAIR_RESTART_OPTIONS] = {0, 0, 0, 0, 0, 0, JD_NORMAL_HERTZ};
-  double values[3] = {0.0, 1.5, 0.1}; /* a version 1 file's MEPA options: Hertz */
+  /* a version 1 file's MEPA options: Hertz, with the defaults */
+  double values[3] = {0.0, JD_MEPA_DEFAULT_EXPONENT, JD_MEPA_DEFAULT_DEPTH};
   int ok = 1;
   if (comm->me == 0) {
     ok = std::fread(&mark, sizeof mark, 1, fp) == 1 && std::fread(&version, sizeof version, 1, fp) == 1 &&

@@ -53,10 +53,10 @@ def resolved(case):
     return yaml.load(engines.resolve(SCENE, case, check=True).stdout, Loader=yaml.CSafeLoader)
 
 
-def quick_scene(case, out_dir):
-    """CASE's first impact alone: the sphere QUICK_GAP radii above the floor with the speed of
-    its fall from the scene's gap, for QUICK_TIME seconds (a resolved scene in OUT_DIR)."""
-    doc = resolved(case)
+def quick_scene(doc, case, out_dir):
+    """CASE's first impact alone, from its resolved scene DOC (changed in place): the sphere
+    QUICK_GAP radii above the floor with the speed of its fall from the scene's gap, for
+    QUICK_TIME seconds (a resolved scene in OUT_DIR)."""
     p = doc["particles"][0]
     R, g = float(p["radius"]), -float(doc["gravity"][2])
     fall = float(p["position"][2]) - R - QUICK_GAP * R
@@ -71,10 +71,9 @@ def quick_scene(case, out_dir):
     return path
 
 
-def law_of(case):
-    """The contact's MEPA constants of CASE: the resolved scene's sphere against the floor
-    (series pairs), its mass, radius and drop gap."""
-    doc = resolved(case)
+def law_of(doc):
+    """The contact's MEPA constants of a case's resolved scene DOC: the sphere against the floor
+    (series pairs), its mass, radius, drop gap and initial speed."""
     mats, model = doc["materials"], doc["model"]
     sphere, floor = mats["sphere"], mats["floor"]
 
@@ -131,11 +130,11 @@ def first_impact(delta):
     return start, end, start + int(np.argmax(delta[start:end]))
 
 
-def branch_residual(delta, force, law):
-    """Largest |F - branch| of the first impact, relative to the largest force, and the
-    reference branch of each of its frames."""
+def branch_residual(delta, force, law, impact):
+    """Largest |F - branch| of the first impact (its frames and peak, first_impact), relative to
+    the largest force, and the plastic overlap it leaves."""
     k1, k2, kc, n = law["k1"], law["k2"], law["kc"], law["n"]
-    s, e, peak = first_impact(delta)
+    s, e, peak = impact
     d = delta[s:e]
     dp = min(((k2 - k1) / k2) ** (1.0 / n) * delta[peak], law["dp_max"])
     ref = np.where(np.arange(s, e) <= peak, upper_bound(d, law),
@@ -174,12 +173,12 @@ def peak_by_energy(law):
     return 0.5 * (lo + hi)
 
 
-def measure(path, law, seconds):
-    delta, force = trace(path, law)
-    residual, dp = branch_residual(delta, force, law)
+def measure(delta, force, law, seconds):
+    """The checks' figures of one run's trace."""
+    s, e, peak = impact = first_impact(delta)
+    residual, dp = branch_residual(delta, force, law, impact)
     x_end = virgin_end(law)
     expected = peak_by_energy(law)
-    s, e, peak = first_impact(delta)
     return {"branch_residual": residual, "bounds_excursion": within_bounds(delta, force, law),
             "peak_overlap": float(delta[peak]), "peak_overlap_energy": expected,
             "peak_error": abs(float(delta[peak]) - expected) / expected,
@@ -284,11 +283,12 @@ def main():
         checks.append(line)
 
     for case in engines.cases(SCENE):
-        law = law_of(case)
-        scene = quick_scene(case, a.out) if a.quick else SCENE
+        doc = resolved(case)
+        law = law_of(doc)
+        scene = quick_scene(doc, case, a.out) if a.quick else SCENE
         runs = {e: run(e, scene, case, a.out) for e in names}
         traces = {e: trace(p, law) for e, (p, _) in runs.items()}
-        measured = {e: measure(p, law, s) for e, (p, s) in runs.items()}
+        measured = {e: measure(*traces[e], law, s) for e, (_, s) in runs.items()}
         for e, m in measured.items():
             check("%s %s branches" % (case, e), m["branch_residual"] <= BRANCH_TOL,
                   "largest deviation %.2e of the largest force (<= %g)" % (m["branch_residual"], BRANCH_TOL))

@@ -664,7 +664,7 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
                    "model.tangential_stiffness"),
             ("" if energy_bookkeeping(scene) else " energy no") +
             ("" if not mepa else " normal_law mepa mepa_exponent %s mepa_plastic_depth %s" % (
-                num(model.get("mepa_exponent", 1.5)), num(model.get("mepa_plastic_depth", 0.1))))))
+                num(model["mepa_exponent"]), num(model["mepa_plastic_depth"])))))  # resolved: both given
     L.append("pair_coeff      * *\n")
     L.append("neighbor        %s bin\n" % num(skin))
     L.append("neigh_modify    delay 0\n")

@@ -72,11 +72,8 @@ static int list_resize(jd_contact_list *l, size_t cap, int hw, int rw) {
  * the lists (sim_neighbour_build, sim_reorder), and every array a list has is kept at its
  * capacity. */
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind) {
-    const int rolling = (kind & JD_LIST_ROLLING) != 0;
-    const unsigned laws = (rolling ? JD_F_ROLLING : 0u) |
-                          ((kind & JD_LIST_ENERGY) ? JD_F_ENERGY : 0u) |
-                          ((kind & JD_LIST_MEPA) ? JD_F_MEPA : 0u);
-    const int hw = jd_contact_record_len(laws), rw = jd_rolling_record_len(laws);
+    const int rolling = (kind & JD_F_ROLLING) != 0;
+    const int hw = jd_contact_record_len(kind), rw = jd_rolling_record_len(kind);
     const int complete = l->hw == hw && l->rw == rw && (!rolling || l->rhist);
     if (need <= l->cap && complete) return 0;
     size_t cap = l->cap ? l->cap : 256;

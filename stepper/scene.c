@@ -228,8 +228,8 @@ static int read_model(loader *L) {
     s->mu_r = 1.0;
     s->tangential_rule = JD_KT_JIANG2021;
     s->normal_law = JD_NORMAL_HERTZ;
-    s->mepa_exponent = 1.5;       /* Del Cid's production runs */
-    s->mepa_plastic_depth = 0.1;  /* her code's dmax = 0.1 R* */
+    s->mepa_exponent = JD_MEPA_DEFAULT_EXPONENT;
+    s->mepa_plastic_depth = JD_MEPA_DEFAULT_DEPTH;
     if (rc || sd_opt_enum(&L->c, m, "model", "wall_rule", WALL_RULES, &s->wall_rule) ||
         sd_opt_enum(&L->c, m, "model", "normal_law", NORMAL_LAWS, &s->normal_law) ||
         sd_opt_num(&L->c, m, "model", "mepa_exponent", SD_POSITIVE, &s->mepa_exponent) ||

@@ -115,7 +115,8 @@ static int read_mepa(loader *L, const yaml_node_t *m, const char *path, jd_mater
         sd_opt_num(&L->c, m, path, "cohesive_stiffness", SD_NONNEGATIVE,
                    &mat->cohesive_stiffness))
         return -1;
-    if (!(mat->unloading_stiffness > mat->loading_stiffness)) {
+    if (!jd_mepa_material_valid(mat->loading_stiffness, mat->unloading_stiffness,
+                                mat->cohesive_stiffness)) { /* k1 > 0, kadh >= 0 held above */
         sd_join(sub, path, "unloading_stiffness");
         return sd_fail(&L->c, sd_get(&L->c, m, "unloading_stiffness"), sub,
                        "%g is not above loading_stiffness %g; valid: k2 > k1 (MEPA's virgin "

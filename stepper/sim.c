@@ -24,26 +24,30 @@
 #endif
 
 /* The scene's interaction tables, as the kernel's rulebook reads them (jdem_laws.h): nm x nm
- * restitution, friction and rolling friction, row-major, then the materials' Young's moduli,
- * MEPA's loading, unloading and cohesive stiffnesses, and Poisson's ratios (nm each; what a
- * material does not give is 0), in one block (free the first). */
+ * restitution, friction and rolling friction, row-major, the materials' Young's moduli and
+ * Poisson's ratios, and MEPA's inputs (*mepa: the materials' loading, unloading and cohesive
+ * stiffnesses and the scene's exponent and depth); nm each, what a material does not give is 0;
+ * in one block (free the first). */
 static double *interaction_tables(const jd_scene *sc, double **friction, double **rolling,
-                                  double **youngs, double **poisson) {
+                                  double **youngs, double **poisson, jd_mepa_inputs *mepa) {
     const size_t nm = sc->n_materials, nn = nm * nm;
     double *e = malloc((3 * nn + 5 * nm + 1) * sizeof *e);
     if (!e) return NULL;
     *friction = e + nn;
     *rolling = e + 2 * nn;
     *youngs = e + 3 * nn;
-    *poisson = e + 3 * nn + 4 * nm;
-    for (size_t a = 0; a < nm; a++) { /* E, then MEPA's k1, k2, kadh, then nu */
+    *poisson = *youngs + nm;
+    double *k1 = *poisson + nm, *k2 = k1 + nm, *kadh = k2 + nm;
+    for (size_t a = 0; a < nm; a++) {
         const jd_material *m = &sc->materials[a];
         (*youngs)[a] = m->youngs_modulus;
-        (*youngs)[nm + a] = m->loading_stiffness;
-        (*youngs)[2 * nm + a] = m->unloading_stiffness;
-        (*youngs)[3 * nm + a] = m->cohesive_stiffness;
         (*poisson)[a] = m->poisson_ratio;
+        k1[a] = m->loading_stiffness;
+        k2[a] = m->unloading_stiffness;
+        kadh[a] = m->cohesive_stiffness;
     }
+    *mepa = (jd_mepa_inputs){.k1 = k1, .k2 = k2, .kadh = kadh, .n = sc->mepa_exponent,
+                             .depth = sc->mepa_plastic_depth};
     for (size_t k = 0; k < nn; k++) {
         e[k] = sc->interactions[k].restitution;
         (*friction)[k] = sc->interactions[k].friction;
@@ -59,14 +63,13 @@ static int init_laws(jd_sim *s) {
     const jd_scene *sc = s->run.scene;
     const size_t nm = sc->n_materials, nn = nm * nm;
     double *mu = NULL, *eta = NULL, *E = NULL, *nu = NULL;
-    double *e = interaction_tables(sc, &mu, &eta, &E, &nu);
+    jd_mepa_inputs mepa;
+    double *e = interaction_tables(sc, &mu, &eta, &E, &nu, &mepa);
     unsigned char *used = calloc(2 * (nm ? nm : 1), 1), *wall_used = used + nm;
     s->run.n_materials = nm;
     s->run.coeffs = calloc(nn ? nn : 1, sizeof *s->run.coeffs);
     const int rc = (e && used && s->run.coeffs) ? 0 : -1;
     if (rc == 0) {
-        jd_mepa_inputs mepa = {.k1 = E + nm, .k2 = E + 2 * nm, .kadh = E + 3 * nm,
-                               .n = sc->mepa_exponent, .depth = sc->mepa_plastic_depth};
         jd_pair_coeffs_table(nm, e, mu, eta, E, nu, sc->damping_map, sc->mu_r, sc->xi_limit,
                              sc->normal_law == JD_NORMAL_MEPA ? &mepa : NULL, s->run.coeffs);
         for (size_t i = 0; i < sc->n_particles; i++) used[sc->material[i]] = 1;

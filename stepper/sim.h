@@ -449,15 +449,12 @@ int sim_neighbour_walls_moved(const jd_walls *walls, double skin);
 static inline double sim_wall_margin(const jd_neighbour_lists *lists, size_t i) {
     return 0.5 * lists->skin + lists->half_skin[i];
 }
-/* Capacity for `need` entries of a list of this kind (JD_LIST_* bits).  Returns 0 or -1. */
-enum { JD_LIST_ROLLING = 1, JD_LIST_ENERGY = 2, JD_LIST_MEPA = 4 };
-
-/* The kind of list a law set's history needs (its record lengths: jdem_laws.h). */
+/* The kind of list a law set's history needs: the bits its record lengths depend on
+ * (jdem_laws.h). */
 static inline unsigned sim_list_kind(unsigned features) {
-    return ((features & JD_F_ROLLING) ? JD_LIST_ROLLING : 0u) |
-           ((features & JD_F_ENERGY) ? JD_LIST_ENERGY : 0u) |
-           ((features & JD_F_MEPA) ? JD_LIST_MEPA : 0u);
+    return features & (unsigned)(JD_F_ROLLING | JD_F_ENERGY | JD_F_MEPA);
 }
+/* Capacity for `need` entries of a list of this kind (sim_list_kind).  Returns 0 or -1. */
 int sim_list_reserve(jd_contact_list *l, size_t need, unsigned kind);
 void sim_contact_list_free(jd_contact_list *l);
 

@@ -388,10 +388,12 @@ static jd_mepa_coeffs copper_ore(double kadh_type) {
  * from the direction); *dp updated; the smallest force and its overlap into *fmin, *dmin. */
 static double mepa_drive(const jd_mepa_coeffs *c, double r_star, double d0, double d1, int n,
                          double *dp, double *fmin, double *dmin) {
-    double f = 0.0, dn, dpn;
+    double f = 0.0;
     for (int k = 1; k <= n; k++) {
         const double d = d0 + (d1 - d0) * k / n;
-        f = jd_mepa_force(c, d, d1 - d0, r_star, *dp, dp, &dn, &dpn);
+        jd_mepa_step step;
+        f = jd_mepa_force(c, d, d1 - d0, r_star, *dp, &step);
+        *dp = step.dp;
         if (fmin && f < *fmin) *fmin = f, *dmin = d;
     }
     return f;
