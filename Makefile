@@ -237,6 +237,23 @@ bonds: all
 mepa: all
 	$(PY) scripts/mepa_drop.py --out out/mepa --results reference_runs/mepa/results
 
+# Del Cid's (2015) MEPA sandpiles, her Table 4.3 (docs/sandpile.md): per engine and case (dry and
+# kc = 1.07e7, mu_r = 0.1 ... 0.6) the settling, the discharge scene and the discharge, the
+# resumable units of scripts/sandpile/plan.py with progress and an ETA; finished units are skipped.
+#   make sandpile [CASE=kc107_mur04] [ENGINE=jdem|liggghts-jdem] [UNIT=jdem/dry_mur01/fill] [LIST=1]
+#                 [RERUN=1]   outputs: out/sandpile/ENGINE/CASE/{fill,discharge}.h5
+# Then `make sandpile-report`: Table 4.3 seed | jdem | liggghts-jdem with the run times,
+# out/sandpile/report.md and its committed copy reference_runs/sandpile/results/.
+SANDPILE_ENGINE = $(or $(ENGINE),$(firstword $(subst /, ,$(UNIT))))
+.PHONY: sandpile sandpile-report
+sandpile: $(if $(filter jdem,$(SANDPILE_ENGINE)),build/jdem,build/jdem build/liggghts-jdem)
+	$(PY) scripts/campaign.py scripts/sandpile/plan.py $(if $(CASE),--model $(CASE)) \
+	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
+	    $(if $(RERUN),--rerun-committed)
+
+sandpile-report:
+	$(PY) -m scripts.sandpile.report
+
 # Error against run time: Chung–Ooi tests 1, 3, 4 and a settling bed, dt swept over
 # factors of the time-step guard's dt, in jdem, liggghts-jdem and LIGGGHTS hertz/history; timings
 # medians of ACCURACY_REPEATS (default 3); its duration: docs/performance.md.  Report:

@@ -185,6 +185,11 @@ class Times:
         return sum(u.cost * (rates.get(u.engine) or overall) for u in remaining)
 
 
+def times_path(units):
+    """Where a plan's measured times are kept: beside its first unit's first output."""
+    return os.path.join(os.path.dirname(os.path.abspath(units[0].outputs[0])), ".campaign_times.json")
+
+
 def unit_threads(unit):
     """The OpenMP threads a unit's jdem runs on: jdem's default, OMP_NUM_THREADS if set, else 1
     (stepper/main.c); a liggghts-jdem unit's processes are its ranks."""
@@ -420,8 +425,7 @@ def main(argv):
     if problem:
         print(f"campaign: {problem}", file=sys.stderr)
         return 2
-    times = Times(os.path.join(os.path.dirname(os.path.abspath(units[0].outputs[0])),
-                               ".campaign_times.json"))
+    times = Times(times_path(units))
     failed, _ = run(chosen, times, units, to_run=to_run)
     return 1 if failed else 0
 

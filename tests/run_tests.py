@@ -122,6 +122,9 @@ SUITES += [("bonds", [PY, "scripts/bond_checks.py", "--quick", "--engines", "jde
 # Del Cid's MEPA drop test (make mepa), its first impacts: the branches' closed forms, the energy
 # balance's peak overlap and the engines' agreement.
 SUITES += [("mepa", [PY, "scripts/mepa_drop.py", "--quick", "--out", "out/test/mepa"], "lines", {})]
+# The sandpile campaign's angle of repose (scripts/sandpile/angle.py) on synthetic piles of known
+# angle: symmetric, asymmetric, flat-topped, with spheres beside and below the plate.
+SUITES += [("sandpile", [PY, "tests/sandpile/test_angle.py"], "lines", {})]
 # ParaView (Debian's, `make paraview-deps`) opens both engines' sidecars with its default reader:
 # points, cells, arrays and time steps against the .h5, and a rendered PNG with content.
 SUITES += [("paraview", [PY, "tests/paraview/test_paraview.py"], "lines", {})]

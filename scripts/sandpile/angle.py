@@ -1,0 +1,111 @@
+#!/usr/bin/python3
+"""angle.py — the angle of repose of a pile on the plate, from its surface profile.
+
+    python3 -m scripts.sandpile.angle TRAJECTORY.h5 [--frame F]   (prints the measurement as JSON)
+
+Zhou et al.'s (2002) measure, which Del Cid (2015) follows: the pile left on the plate after the
+outlets opened, its surface profile along the slot (y), a straight line fitted to each flank.
+The profile is the top of the spheres, max(z + R), in bins one mean diameter wide across the
+plate.  A flank is the bins between the plate's edge and the crest, less the edge's bin (spheres
+there may overhang the edge) and the bins above CREST of the peak height (a rounded or flat top
+is not the slope).  The angle of a flank is atan |slope| of the least-squares line through its
+bins' tops; the pile's is the mean of its two flanks, with their half-difference and each fit's
+standard error beside it.
+"""
+import argparse
+import json
+import math
+
+import numpy as np
+
+CREST = 0.9          # bins above this fraction of the peak height are the crest, not the flank
+MIN_BINS = 3         # a flank fitted through fewer bins is no flank (no angle)
+
+
+def live_frame(path, frame=-1):
+    """Positions [n][3] and radii [n] of the particles present at `frame` of an H5MD trajectory
+    (a changing set's slots without a particle, id -1, left out), and the frame's time [s]."""
+    import h5py
+    with h5py.File(path, "r") as f:
+        a = f["particles/all"]
+        pos = a["position/value"][frame]
+        time = float(a["position/time"][frame])
+        radius = a["radius"][...]
+        ids = a["id/value"][frame] if "value" in a["id"] else a["id"][...]
+    live = (ids >= 0) & np.all(np.isfinite(pos), axis=1)
+    return pos[live], radius[live], time
+
+
+def profile(y, top, half_width, width):
+    """The surface profile: per bin of `width` across [-half_width, half_width], its centre and
+    the highest top of the spheres centred in it (NaN when none is)."""
+    n = max(1, int(round(2.0 * half_width / width)))
+    edges = np.linspace(-half_width, half_width, n + 1)
+    k = np.clip(np.searchsorted(edges, y, side="right") - 1, 0, n - 1)
+    height = np.full(n, np.nan)
+    for b in range(n):
+        if np.any(k == b):
+            height[b] = top[k == b].max()
+    return 0.5 * (edges[:-1] + edges[1:]), height
+
+
+def fit_flank(y, h):
+    """atan |slope| [deg] of the least-squares line through (y, h), and its standard error [deg]
+    (NaN for fewer than MIN_BINS points)."""
+    if len(y) < MIN_BINS:
+        return math.nan, math.nan
+    A = np.vstack([y, np.ones_like(y)]).T
+    coef, res, _, _ = np.linalg.lstsq(A, h, rcond=None)
+    slope = coef[0]
+    dof = len(y) - 2
+    sigma2 = (float(res[0]) / dof) if (dof > 0 and len(res)) else 0.0
+    se_slope = math.sqrt(sigma2 / np.sum((y - y.mean()) ** 2)) if dof > 0 else math.nan
+    return math.degrees(math.atan(abs(slope))), math.degrees(se_slope / (1.0 + slope * slope))
+
+
+def measure(pos, radius, half_width, plate_z=0.0):
+    """The pile on the plate |y| <= half_width (spheres centred above plate_z): its flanks'
+    angles [deg], their mean and half-difference, the peak height above the plate [m], the count
+    of spheres on the plate and the profile itself."""
+    on = (np.abs(pos[:, 1]) <= half_width) & (pos[:, 2] > plate_z)
+    y, top = pos[on, 1], pos[on, 2] + radius[on] - plate_z
+    width = 2.0 * float(np.mean(radius)) if len(radius) else half_width
+    centre, height = profile(y, top, half_width, width)
+    peak = float(np.nanmax(height)) if np.any(np.isfinite(height)) else 0.0
+    flank = np.isfinite(height) & (height <= CREST * peak)
+    flank[[0, -1]] = False      # the edges' bins
+    crest_at = centre[np.nanargmax(height)] if peak > 0 else 0.0
+    left = flank & (centre < crest_at)
+    right = flank & (centre > crest_at)
+    a_left, se_left = fit_flank(centre[left], height[left])
+    a_right, se_right = fit_flank(centre[right], height[right])
+    return {"angle": 0.5 * (a_left + a_right), "half_difference": 0.5 * abs(a_left - a_right),
+            "left": a_left, "right": a_right, "left_se": se_left, "right_se": se_right,
+            "peak_height": peak, "on_plate": int(on.sum()), "bin_width": width,
+            "profile_y": centre.tolist(), "profile_top": [None if math.isnan(h) else h for h in height],
+            "flank_left": left.tolist(), "flank_right": right.tolist()}
+
+
+def plate_half_width(scene_doc):
+    """Half the plate's extent along y, from the scene's wall named `plate`."""
+    plate = next(w for w in scene_doc["walls"] if w["name"] == "plate")
+    ys = [c[1] for c in plate["corners"]]
+    return 0.5 * (max(ys) - min(ys))
+
+
+def main():
+    import yaml
+    from scripts.sandpile.discharge import SCENE
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("trajectory")
+    ap.add_argument("--frame", type=int, default=-1)
+    a = ap.parse_args()
+    with open(SCENE) as f:
+        half = plate_half_width(yaml.load(f, Loader=yaml.CSafeLoader))
+    pos, radius, time = live_frame(a.trajectory, a.frame)
+    m = measure(pos, radius, half)
+    print(json.dumps(dict(m, time=time), indent=1))
+
+
+if __name__ == "__main__":
+    main()

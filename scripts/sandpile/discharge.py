@@ -1,0 +1,65 @@
+#!/usr/bin/python3
+"""discharge.py — the second stage of a sandpile: the outlets open under the settled deposit.
+
+    python3 -m scripts.sandpile.discharge FILL.h5 --case CASE -o DISCHARGE.yaml [--scene SCENE]
+
+The case of reference_runs/sandpile/sandpile.yaml as `jdem resolve` writes it (every default
+explicit, the same dt), with its generated spheres replaced by the last frame of FILL.h5 (either
+engine's trajectory; positions and velocities kept, particles_from) and the two outlet walls left
+out: Zhou et al.'s "open the outlets instantly".  The run lasts DISCHARGE_TIME, long enough for
+the material beside the plate to leave the domain and the pile to come to rest (the report
+checks both).  Written atomically.
+"""
+import argparse
+import os
+import subprocess
+import sys
+
+import yaml
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+SCENE = os.path.join(ROOT, "reference_runs", "sandpile", "sandpile.yaml")
+OUTLETS = ("outlet_left", "outlet_right")
+DISCHARGE_TIME = 1.5          # [s] after the outlets open
+FRAME_TIME = 0.05             # [s] between trajectory frames
+OBSERVABLE_TIME = 0.005       # [s] between observable samples
+
+
+def discharge_scene(resolved, fill):
+    """The discharge stage of a resolved case (a dict), its spheres from trajectory `fill`."""
+    doc = dict(resolved)
+    dt = doc["time"]["dt"]
+    doc["time"] = dict(doc["time"], end_time=DISCHARGE_TIME)
+    del doc["time"]["steps"]
+    doc["output"] = dict(doc["output"], every=max(1, round(FRAME_TIME / dt)),
+                         observables_every=max(1, round(OBSERVABLE_TIME / dt)))
+    doc["walls"] = [w for w in doc["walls"] if w["name"] not in OUTLETS]
+    if len(doc["walls"]) != len(resolved["walls"]) - len(OUTLETS):
+        sys.exit(f"discharge: the case has no walls named {' and '.join(OUTLETS)}")
+    doc.pop("particles", None)
+    doc["particles_from"] = [{"file": os.path.abspath(fill), "frame": -1, "velocities": "keep"}]
+    return doc
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("fill")
+    ap.add_argument("--case", required=True)
+    ap.add_argument("--scene", default=SCENE)
+    ap.add_argument("-o", "--output", required=True)
+    a = ap.parse_args()
+    jdem = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
+    text = subprocess.run([jdem, "resolve", a.scene, "--case", a.case], check=True,
+                          capture_output=True, text=True).stdout
+    doc = discharge_scene(yaml.load(text, Loader=yaml.CSafeLoader), a.fill)
+    tmp = a.output + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(f"# the discharge of sandpile case {a.case} from {os.path.abspath(a.fill)} "
+                "(scripts/sandpile/discharge.py)\n")
+        yaml.dump(doc, f, Dumper=yaml.CSafeDumper, sort_keys=False, default_flow_style=None)
+    os.replace(tmp, a.output)
+
+
+if __name__ == "__main__":
+    main()

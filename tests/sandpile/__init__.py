@@ -1,0 +1,1 @@
+"""tests/sandpile as a package."""
