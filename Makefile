@@ -251,7 +251,7 @@ sandpile: $(if $(filter jdem,$(SANDPILE_ENGINE)),build/jdem,build/jdem build/lig
 	    $(if $(ENGINE),--engine $(ENGINE)) $(if $(UNIT),--unit $(UNIT)) $(if $(LIST),--list) \
 	    $(if $(RERUN),--rerun-committed)
 
-sandpile-report:
+sandpile-report: build/jdem
 	$(PY) -m scripts.sandpile.report
 
 # Error against run time: Chung–Ooi tests 1, 3, 4 and a settling bed, dt swept over

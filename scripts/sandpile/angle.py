@@ -6,11 +6,13 @@
 Zhou et al.'s (2002) measure, which Del Cid (2015) follows: the pile left on the plate after the
 outlets opened, its surface profile along the slot (y), a straight line fitted to each flank.
 The profile is the top of the spheres, max(z + R), in bins one mean diameter wide across the
-plate.  A flank is the bins between the plate's edge and the crest, less the edge's bin (spheres
-there may overhang the edge) and the bins above CREST of the peak height (a rounded or flat top
-is not the slope).  The angle of a flank is atan |slope| of the least-squares line through its
-bins' tops; the pile's is the mean of its two flanks, with their half-difference and each fit's
-standard error beside it.
+plate.  The crest is found on the profile's running median of three bins, so that one sphere
+perched on top does not move it.  A flank is the bins between the plate's edge and the crest,
+less the edge's bin (spheres there may overhang the edge) and the bins whose median is above
+CREST of the crest's height (a rounded or flat top is not the slope).  The angle of a flank is
+atan |slope| of the least-squares line through its bins' tops; the pile's is the mean of its two
+flanks, with their half-difference, each fit's standard error and the half-range of the mean
+over four shifts of the bin grid beside it (a pile's measurement spread: docs/sandpile.md).
 """
 import argparse
 import json
@@ -20,6 +22,7 @@ import numpy as np
 
 CREST = 0.9          # bins above this fraction of the peak height are the crest, not the flank
 MIN_BINS = 3         # a flank fitted through fewer bins is no flank (no angle)
+OFFSETS = (0.0, 0.25, 0.5, 0.75)   # shifts of the bin grid, in bin widths, for the binning's spread
 
 
 def live_frame(path, frame=-1):
@@ -36,17 +39,30 @@ def live_frame(path, frame=-1):
     return pos[live], radius[live], time
 
 
-def profile(y, top, half_width, width):
-    """The surface profile: per bin of `width` across [-half_width, half_width], its centre and
-    the highest top of the spheres centred in it (NaN when none is)."""
-    n = max(1, int(round(2.0 * half_width / width)))
-    edges = np.linspace(-half_width, half_width, n + 1)
-    k = np.clip(np.searchsorted(edges, y, side="right") - 1, 0, n - 1)
-    height = np.full(n, np.nan)
-    for b in range(n):
+def profile(y, top, half_width, width, offset=0.0):
+    """The surface profile: per bin of `width` inside [-half_width, half_width] (the grid shifted
+    by `offset` in [0, width), the partial bins at the ends left out), its centre and the highest
+    top of the spheres centred in it (NaN when none is)."""
+    edges = np.arange(-half_width + offset, half_width + 1e-12, width)
+    if len(edges) < 2:
+        return np.zeros(0), np.zeros(0)
+    k = np.searchsorted(edges, y, side="right") - 1
+    height = np.full(len(edges) - 1, np.nan)
+    for b in range(len(edges) - 1):
         if np.any(k == b):
             height[b] = top[k == b].max()
     return 0.5 * (edges[:-1] + edges[1:]), height
+
+
+def smoothed(height):
+    """The profile's running median of three bins (the ends and gaps as they are): the crest's
+    height and place without a single sphere perched on it."""
+    out = height.copy()
+    for b in range(1, len(height) - 1):
+        window = height[b - 1:b + 2]
+        if np.all(np.isfinite(window)):
+            out[b] = np.median(window)
+    return out
 
 
 def fit_flank(y, h):
@@ -63,27 +79,42 @@ def fit_flank(y, h):
     return math.degrees(math.atan(abs(slope))), math.degrees(se_slope / (1.0 + slope * slope))
 
 
+def flanks(y, top, half_width, width, offset=0.0):
+    """Both flanks' angles and standard errors [deg], the profile, the flanks' bins and the
+    crest's height [m], for the bin grid shifted by `offset`."""
+    centre, height = profile(y, top, half_width, width, offset)
+    crest = smoothed(height)
+    peak = float(np.nanmax(crest)) if np.any(np.isfinite(crest)) else 0.0
+    flank = np.isfinite(height) & (crest <= CREST * peak)
+    if len(flank):
+        flank[[0, -1]] = False      # the edges' bins
+    crest_at = centre[np.nanargmax(crest)] if peak > 0 else 0.0
+    left, right = flank & (centre < crest_at), flank & (centre > crest_at)
+    a_left, se_left = fit_flank(centre[left], height[left])
+    a_right, se_right = fit_flank(centre[right], height[right])
+    return {"left": a_left, "right": a_right, "left_se": se_left, "right_se": se_right,
+            "peak_height": peak, "centre": centre, "height": height, "flank_left": left,
+            "flank_right": right}
+
+
 def measure(pos, radius, half_width, plate_z=0.0):
     """The pile on the plate |y| <= half_width (spheres centred above plate_z): its flanks'
-    angles [deg], their mean and half-difference, the peak height above the plate [m], the count
-    of spheres on the plate and the profile itself."""
+    angles [deg], their mean and half-difference, each fit's standard error, the half-range of
+    the mean over OFFSETS of the bin grid (how much the binning alone moves it), the crest's
+    height above the plate [m], the count of spheres on the plate and the profile itself."""
     on = (np.abs(pos[:, 1]) <= half_width) & (pos[:, 2] > plate_z)
     y, top = pos[on, 1], pos[on, 2] + radius[on] - plate_z
     width = 2.0 * float(np.mean(radius)) if len(radius) else half_width
-    centre, height = profile(y, top, half_width, width)
-    peak = float(np.nanmax(height)) if np.any(np.isfinite(height)) else 0.0
-    flank = np.isfinite(height) & (height <= CREST * peak)
-    flank[[0, -1]] = False      # the edges' bins
-    crest_at = centre[np.nanargmax(height)] if peak > 0 else 0.0
-    left = flank & (centre < crest_at)
-    right = flank & (centre > crest_at)
-    a_left, se_left = fit_flank(centre[left], height[left])
-    a_right, se_right = fit_flank(centre[right], height[right])
-    return {"angle": 0.5 * (a_left + a_right), "half_difference": 0.5 * abs(a_left - a_right),
-            "left": a_left, "right": a_right, "left_se": se_left, "right_se": se_right,
-            "peak_height": peak, "on_plate": int(on.sum()), "bin_width": width,
-            "profile_y": centre.tolist(), "profile_top": [None if math.isnan(h) else h for h in height],
-            "flank_left": left.tolist(), "flank_right": right.tolist()}
+    f = flanks(y, top, half_width, width)
+    shifted = [flanks(y, top, half_width, width, o * width) for o in OFFSETS]
+    means = [0.5 * (g["left"] + g["right"]) for g in shifted]
+    spread = 0.5 * (max(means) - min(means)) if all(math.isfinite(m) for m in means) else math.nan
+    return {"angle": 0.5 * (f["left"] + f["right"]), "half_difference": 0.5 * abs(f["left"] - f["right"]),
+            "left": f["left"], "right": f["right"], "left_se": f["left_se"], "right_se": f["right_se"],
+            "offset_spread": spread, "peak_height": f["peak_height"], "on_plate": int(on.sum()),
+            "bin_width": width, "profile_y": f["centre"].tolist(),
+            "profile_top": [None if math.isnan(h) else float(h) for h in f["height"]],
+            "flank_left": f["flank_left"].tolist(), "flank_right": f["flank_right"].tolist()}
 
 
 def plate_half_width(scene_doc):

@@ -6,9 +6,9 @@
 The case of reference_runs/sandpile/sandpile.yaml as `jdem resolve` writes it (every default
 explicit, the same dt), with its generated spheres replaced by the last frame of FILL.h5 (either
 engine's trajectory; positions and velocities kept, particles_from) and the two outlet walls left
-out: Zhou et al.'s "open the outlets instantly".  The run lasts DISCHARGE_TIME, long enough for
-the material beside the plate to leave the domain and the pile to come to rest (the report
-checks both).  Written atomically.
+out: Zhou et al.'s "open the outlets instantly".  The run lasts DISCHARGE_TIME (her script: 3.08 s);
+the report shows whether the material beside the plate has left and the pile has come to rest.
+The fill must be one of the same case (its /parameters case_name).  Written atomically.
 """
 import argparse
 import os
@@ -42,6 +42,14 @@ def discharge_scene(resolved, fill):
     return doc
 
 
+def case_of(trajectory):
+    """The case a trajectory of either engine ran (its /parameters case_name)."""
+    import h5py
+    with h5py.File(trajectory, "r") as f:
+        name = f["parameters"].attrs["case_name"]
+    return name.decode() if isinstance(name, bytes) else str(name)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("fill")
@@ -49,6 +57,8 @@ def main():
     ap.add_argument("--scene", default=SCENE)
     ap.add_argument("-o", "--output", required=True)
     a = ap.parse_args()
+    if case_of(a.fill) != a.case:
+        sys.exit(f"discharge: {a.fill} is a fill of case {case_of(a.fill)}, not of {a.case}")
     jdem = os.environ.get("JDEM", os.path.join(ROOT, "build", "jdem"))
     text = subprocess.run([jdem, "resolve", a.scene, "--case", a.case], check=True,
                           capture_output=True, text=True).stdout

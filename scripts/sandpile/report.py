@@ -3,21 +3,24 @@
 
     python3 -m scripts.sandpile.report [--out out/sandpile] [--results reference_runs/sandpile/results]
 
-For every finished discharge (out/sandpile/ENGINE/CASE/discharge.h5) the pile's angle of repose
-(scripts/sandpile/angle.py) at the last frame and SETTLE_CHECK seconds before it (the pile has come
-to rest when the two agree), the spheres left on the plate, the kinetic energy per sphere at the
-end of the settling and of the discharge, the run's code (the trajectory's creator version) and
-its CPU time (the campaign's record of its two runs).  A case not under out/ is taken from the
-committed summary.json.  The qualitative claims of Del Cid's §4.3.4 are checked with numbers:
-the angle grows with mu_r (dry and cohesive), the cohesive pile stands at least as steep as the
-dry one at each mu_r, and each angle's distance from her value against her +-3 deg.  Writes
-report.md, summary.json and piles.png into --out and copies them into --results.
+For every finished discharge (out/sandpile/ENGINE/CASE/discharge.h5): the pile's angle of repose
+(scripts/sandpile/angle.py) and its measurement uncertainty at the last frame, and the angle
+SETTLE_CHECK seconds before; the checks that the pile is at rest (the angle moved less than
+REST_ANGLE, no sphere left beside the plate, at most REST_ENERGY of motion per sphere); the run's
+code (its trajectory's creator version) and its CPU time (the campaign's record of its two runs).
+A case not under out/ is taken from the committed summary.json; a local run replaces a committed
+one, and says so when its code differs.  Del Cid's qualitative claims (§4.3.4) are weighed
+against the piles' uncertainties: the angle grows with mu_r (dry and cohesive), the cohesive pile
+stands steeper than the dry one; and each angle's distance from hers against her +-3 deg.
+Writes report.md, summary.json, piles.png (the surface profiles) and ParaView's pictures of the
+PICTURED cases (pile_CASE_ENGINE.png, with pvbatch) into --out and copies them into --results.
 """
 import argparse
 import json
 import math
 import os
 import shutil
+import sys
 
 import numpy as np
 import yaml
@@ -32,7 +35,11 @@ SEED = {  # Table 4.3 [deg], +-3 (Del Cid 2015 §4.3.4)
 }
 SEED_TOLERANCE = 3.0
 MU_R = {"mur01": 0.1, "mur02": 0.2, "mur04": 0.4, "mur06": 0.6}
+HERE = os.path.dirname(os.path.abspath(__file__))
+PICTURED = ("dry_mur01", "kc107_mur06")   # ParaView's pictures: the flattest and the steepest pile
 SETTLE_CHECK = 0.25       # [s] before the last frame
+REST_ANGLE = 1.0          # [deg]: a pile at rest moves less over SETTLE_CHECK
+REST_ENERGY = 1.0e-7      # [J] of motion per sphere at the end: 3 cm/s for a 2.86 mm grain
 
 
 def creator(path):
@@ -43,13 +50,31 @@ def creator(path):
                           c["version"].decode() if isinstance(c["version"], bytes) else c["version"])
 
 
-def kinetic_per_sphere(path):
-    """The last sample of kinetic_energy over the spheres present then [J]."""
+def motion_per_sphere(path):
+    """The last sample of the kinetic and rotational energy over the spheres present then [J]."""
     import h5py
     with h5py.File(path, "r") as f:
-        ke = float(f["observables/kinetic_energy/value"][-1])
+        e = sum(float(f[f"observables/{k}/value"][-1]) for k in ("kinetic_energy", "rotational_energy"))
     pos, _, _ = angle.live_frame(path)
-    return ke / max(1, len(pos))
+    return e / max(1, len(pos))
+
+
+def uncertainty(m):
+    """A pile's measurement uncertainty [deg]: the largest of its flanks' half-difference, the
+    binning's spread and the flank fits' standard errors (NaN when a flank has no fit)."""
+    return max(m["half_difference"], m["offset_spread"], m["left_se"], m["right_se"])
+
+
+def checks_of(r):
+    """What keeps a run from being a pile at rest, or "at rest"."""
+    bad = []
+    if not abs(r["angle"] - r["angle_earlier"]) <= REST_ANGLE:
+        bad.append("angle still moving")
+    if r["beside"]:
+        bad.append(f"{r['beside']} spheres beside the plate")
+    if not r["discharge_motion_per_sphere"] <= REST_ENERGY:
+        bad.append("still moving")
+    return "; ".join(bad) or "at rest"
 
 
 def measure_run(out, engine, case, half_width, times):
@@ -63,17 +88,22 @@ def measure_run(out, engine, case, half_width, times):
     earlier = int(np.argmin(np.abs(t - (t_end - SETTLE_CHECK))))
     p2, r2, t2 = angle.live_frame(discharge, earlier)
     before = angle.measure(p2, r2, half_width)
-    cpu = [times.get(f"{engine}/{case}/{u}", {}).get("cpu_seconds") for u in ("fill", "discharge")]
-    return {"engine": engine, "case": case, "angle": final["angle"],
-            "half_difference": final["half_difference"], "left": final["left"],
-            "right": final["right"], "fit_se": max(final["left_se"], final["right_se"]),
-            "angle_earlier": before["angle"], "earlier_time": t2, "end_time": t_end,
-            "peak_height": final["peak_height"], "on_plate": final["on_plate"],
-            "fill_ke_per_sphere": kinetic_per_sphere(fill),
-            "discharge_ke_per_sphere": kinetic_per_sphere(discharge),
-            "cpu_seconds": sum(cpu) if all(c is not None for c in cpu) else None,
-            "code": creator(discharge),
-            "profile": {k: final[k] for k in ("profile_y", "profile_top", "flank_left", "flank_right")}}
+    spent = [times.get(f"{engine}/{case}/{u}") for u in ("fill", "discharge")]
+    r = {"engine": engine, "case": case, "angle": final["angle"], "uncertainty": uncertainty(final),
+         "half_difference": final["half_difference"], "offset_spread": final["offset_spread"],
+         "left": final["left"], "right": final["right"],
+         "fit_se": max(final["left_se"], final["right_se"]),
+         "angle_earlier": before["angle"], "earlier_time": t2, "end_time": t_end,
+         "peak_height": final["peak_height"], "on_plate": final["on_plate"], "present": len(pos),
+         "beside": int(np.sum((np.abs(pos[:, 1]) > half_width) & (pos[:, 2] > 0.0))),
+         "fill_motion_per_sphere": motion_per_sphere(fill),
+         "discharge_motion_per_sphere": motion_per_sphere(discharge),
+         "cpu_seconds": sum(s["cpu_seconds"] for s in spent) if all(spent) else None,
+         "threads": max(s.get("threads", 1) for s in spent) if all(spent) else None,
+         "code": creator(discharge),
+         "profile": {k: final[k] for k in ("profile_y", "profile_top", "flank_left", "flank_right")}}
+    r["checks"] = checks_of(r)
+    return r
 
 
 def split(case):
@@ -85,36 +115,62 @@ def fmt(x, spec=".1f"):
     return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
 
 
+def decided(a, b):
+    """+1 when pile a stands steeper than pile b beyond twice their combined uncertainty, -1 when
+    less steep, 0 when the difference is within it (or a measure is missing)."""
+    values = [r and r[k] for r in (a, b) for k in ("angle", "uncertainty")]
+    if None in values:
+        return 0
+    d, u = a["angle"] - b["angle"], 2.0 * math.hypot(a["uncertainty"], b["uncertainty"])
+    if not (math.isfinite(d) and math.isfinite(u)):
+        return 0
+    return 1 if d > u else -1 if d < -u else 0
+
+
+def verdict(signs):
+    """held when every comparison is decided the claimed way, not held when one is decided the
+    other way, else not decided."""
+    return "not held" if -1 in signs else "held" if all(s == 1 for s in signs) else "not decided"
+
+
 def claims(by):
-    """Del Cid's qualitative findings, each held, not held or not decided, per engine."""
+    """Del Cid's qualitative findings per engine, each weighed against the piles' uncertainty."""
     out = []
     for engine in plan.ENGINES:
         for cohesion in SEED:
-            a = [by.get((engine, f"{cohesion}_{r}"), {}).get("angle") for r in MU_R]
-            if None in a:
+            runs = [by.get((engine, f"{cohesion}_{r}")) for r in MU_R]
+            if None in runs:
                 continue
-            rising = all(y > x for x, y in zip(a, a[1:]))
-            out.append((engine, f"the {cohesion} angle grows with mu_r",
-                        "held" if rising else "not held", " < ".join(fmt(x) for x in a)))
-        pairs = [(by.get((engine, f"dry_{r}"), {}).get("angle"),
-                  by.get((engine, f"kc107_{r}"), {}).get("angle")) for r in MU_R]
-        pairs = [(d, c) for d, c in pairs if d is not None and c is not None]
+            signs = [decided(b, a) for a, b in zip(runs, runs[1:])]
+            out.append((engine, f"the {cohesion} pile steepens with each step of mu_r",
+                        verdict(signs), ", ".join(f"mu_r {MU_R[r]:g}: {fmt(x['angle'])} ± {fmt(x['uncertainty'])}"
+                                                 for r, x in zip(MU_R, runs))))
+        pairs = [(r, by.get((engine, f"dry_{r}")), by.get((engine, f"kc107_{r}"))) for r in MU_R]
+        pairs = [(r, d, c) for r, d, c in pairs if d is not None and c is not None]
         if pairs:
-            ok = all(c >= d for d, c in pairs)
-            out.append((engine, "the cohesive pile is at least as steep as the dry one",
-                        "held" if ok else "not held",
-                        ", ".join("%s vs %s" % (fmt(c), fmt(d)) for d, c in pairs)))
+            out.append((engine, "the cohesive pile stands steeper than the dry one",
+                        verdict([decided(c, d) for _, d, c in pairs]),
+                        ", ".join(f"mu_r {MU_R[r]:g}: cohesive {fmt(c['angle'])}, dry {fmt(d['angle'])}"
+                                  for r, d, c in pairs)))
     return out
+
+
+def cpu_text(r):
+    if not r.get("cpu_seconds"):
+        return "–"
+    threads = r.get("threads") or 1
+    return "%.1f" % (r["cpu_seconds"] / 60.0) + ("" if threads == 1 else f" ({threads} threads)")
 
 
 def report(runs, out_dir):
     by = {(r["engine"], r["case"]): r for r in runs}
     lines = ["# Del Cid (2015) Table 4.3: sandpiles of the MEPA material", "",
-             "Generated by `scripts/sandpile/report.py` (`make sandpile-report`).  Angles of repose "
-             "[deg] of the pile left on the plate after the outlets opened (docs/sandpile.md): the "
-             "mean of the two flanks' fitted slopes, ± their half-difference; the seed's are ±3°.  "
-             "Δ: the angle's change over the last %.2f s of the discharge (the pile at rest: "
-             "small).  CPU: the settling and the discharge together [min], one core each." % SETTLE_CHECK, ""]
+             "Generated by `scripts/sandpile/report.py` (`make sandpile-report`); docs/sandpile.md.  "
+             "Angles of repose [deg] of the pile left on the plate after the outlets opened: the mean "
+             "of the two flanks' fitted slopes ± the pile's measurement uncertainty (the largest of "
+             "the flanks' half-difference, the binning's spread and the fits' standard errors); the "
+             "seed's are ±3°.  Δ: the angle's change over the last %.2f s of the discharge.  CPU: the "
+             "settling and the discharge together [min]." % SETTLE_CHECK, ""]
     head = "| μr | seed | jdem | Δ | CPU | liggghts-jdem | Δ | CPU |"
     for cohesion, title in (("dry", "Dry material"), ("kc107", "kadh = 1.07e7 N/m^1.5")):
         lines += [f"### {title}", "", head, "|---|---|---|---|---|---|---|---|"]
@@ -125,31 +181,54 @@ def report(runs, out_dir):
                 if r is None:
                     row += ["not run yet", "", ""]
                     continue
-                row += [f"{fmt(r['angle'])} ± {fmt(r['half_difference'])}",
-                        fmt(r["angle"] - r["angle_earlier"], "+.1f"),
-                        fmt(r["cpu_seconds"] / 60.0 if r["cpu_seconds"] else None)]
+                row += [f"{fmt(r['angle'])} ± {fmt(r['uncertainty'])}",
+                        fmt(r["angle"] - r["angle_earlier"] if None not in (r["angle"], r["angle_earlier"])
+                            else None, "+.1f"), cpu_text(r)]
             lines.append("| " + " | ".join(row) + " |")
         lines.append("")
     lines += ["### Against the seed", "",
               "| engine | case | angle − seed [deg] | within ±3° |", "|---|---|---|---|"]
     for r in runs:
         c, rolling = split(r["case"])
-        d = r["angle"] - SEED[c][rolling]
-        lines.append(f"| {r['engine']} | {r['case']} | {d:+.1f} | {'yes' if abs(d) <= SEED_TOLERANCE else 'no'} |")
-    lines += ["", "### Del Cid's qualitative findings", "", "| engine | claim | verdict | numbers |",
-              "|---|---|---|---|"]
+        d = r["angle"] - SEED[c][rolling] if r["angle"] is not None else math.nan
+        within = "–" if not math.isfinite(d) else "yes" if abs(d) <= SEED_TOLERANCE else "no"
+        lines.append(f"| {r['engine']} | {r['case']} | {fmt(d, '+.1f')} | {within} |")
+    lines += ["", "### Del Cid's qualitative findings", "",
+              "A step is decided when two piles differ by more than twice their combined "
+              "uncertainty; a claim is held when every step is decided its way, not held when one "
+              "is decided the other way, else not decided.", "",
+              "| engine | claim | verdict | numbers |", "|---|---|---|---|"]
     lines += [f"| {e} | {c} | {v} | {n} |" for e, c, v, n in claims(by)]
     lines += ["", "### The runs", "",
-              "| engine | case | spheres on the plate | peak height [mm] | KE/sphere after settling [J] "
-              "| KE/sphere at the end [J] | code |", "|---|---|---|---|---|---|---|"]
+              "| engine | case | flanks left / right [deg] | fits' s.e. | binning spread | spheres on the plate "
+              "| peak [mm] | motion/sphere after settling [J] | at the end [J] | checks | code |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in runs:
-        lines.append(f"| {r['engine']} | {r['case']} | {r['on_plate']} | {1e3 * r['peak_height']:.1f} | "
-                     f"{r['fill_ke_per_sphere']:.2e} | {r['discharge_ke_per_sphere']:.2e} | {r['code']} |")
+        lines.append(f"| {r['engine']} | {r['case']} | {fmt(r['left'])} / {fmt(r['right'])} | "
+                     f"{fmt(r['fit_se'])} | {fmt(r['offset_spread'])} | {r['on_plate']} | "
+                     f"{1e3 * r['peak_height']:.1f} | {r['fill_motion_per_sphere']:.1e} | "
+                     f"{r['discharge_motion_per_sphere']:.1e} | {r['checks']} | {r['code']} |")
     with open(os.path.join(out_dir, "report.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
 
 
-def plot(runs, path):
+def seed_line(ax, r, seed_deg):
+    """The seed's slope drawn through each fitted flank's centroid (the profile is the spheres'
+    tops, about a diameter above a pile's mean surface)."""
+    p = r["profile"]
+    y = np.array(p["profile_y"])
+    top = np.array([np.nan if h is None else h for h in p["profile_top"]])
+    slope = math.tan(math.radians(seed_deg))
+    for mask, sign in ((p["flank_left"], 1.0), (p["flank_right"], -1.0)):
+        m = np.array(mask, dtype=bool)
+        if m.sum() < 2:
+            continue
+        yc, hc = y[m].mean(), top[m].mean()
+        ys = np.array([y[m].min() - 0.01, y[m].max() + 0.01])
+        ax.plot(1e3 * ys, 1e3 * (hc + sign * slope * (ys - yc)), "k:", lw=0.9)
+
+
+def plot(runs, path, half_width):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -157,26 +236,67 @@ def plot(runs, path):
     for i, cohesion in enumerate(SEED):
         for j, rolling in enumerate(MU_R):
             ax = axes[i][j]
+            seed = SEED[cohesion][rolling]
             for engine, style in zip(plan.ENGINES, ("C0-", "C1--")):
                 r = next((r for r in runs if r["engine"] == engine and r["case"] == f"{cohesion}_{rolling}"), None)
                 if r is None:
                     continue
                 y = 1e3 * np.array(r["profile"]["profile_y"])
                 top = np.array([np.nan if h is None else 1e3 * h for h in r["profile"]["profile_top"]])
-                ax.plot(y, top, style, label=f"{engine} {r['angle']:.1f}°")
-            seed = math.radians(SEED[cohesion][rolling])
-            ax.plot([-60, 0, 60], [0, 60 * math.tan(seed), 0], "k:", lw=0.8,
-                    label=f"seed {SEED[cohesion][rolling]}°")
+                ax.plot(y, top, style, label=f"{engine} {fmt(r['angle'])}°")
+                if engine == "jdem":
+                    seed_line(ax, r, seed)
+            ax.plot([], [], "k:", label=f"seed {seed}° (through jdem's flanks)")
+            ax.set_xlim(-1e3 * half_width, 1e3 * half_width)
             ax.set_title(f"{cohesion}, μr = {MU_R[rolling]:g}", fontsize=9)
             ax.legend(fontsize=7, loc="lower center")
             if i == 1:
                 ax.set_xlabel("y [mm]")
             if j == 0:
-                ax.set_ylabel("surface height [mm]")
-    fig.suptitle("Del Cid (2015) Table 4.3: pile profiles on the plate (dotted: a pile at the seed's angle)")
+                ax.set_ylabel("top of the spheres [mm]")
+    fig.suptitle("Del Cid (2015) Table 4.3: the piles' surface profiles on the plate")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def pictures(out_dir, runs):
+    """ParaView's picture of the PICTURED cases' piles (scripts/sandpile/pv_pile.py), where
+    pvbatch is installed (`make paraview-deps`): pile_CASE_ENGINE.png, the names written."""
+    import shutil as sh
+    import subprocess
+    if not sh.which("pvbatch"):
+        print("report: pvbatch not found, no pictures (make paraview-deps)", file=sys.stderr)
+        return []
+    names = []
+    for r in runs:
+        sidecar = os.path.join(out_dir, r["engine"], r["case"], "discharge.xdmf")
+        if r["case"] not in PICTURED or not os.path.exists(sidecar):
+            continue
+        png = os.path.join(out_dir, f"pile_{r['case']}_{r['engine']}.png")
+        for _ in range(2):   # pvbatch 5.11 under xvfb now and then aborts before it draws
+            p = subprocess.run(["xvfb-run", "-a", "pvbatch", os.path.join(HERE, "pv_pile.py"), sidecar, png],
+                               capture_output=True, text=True)
+            drawn = json.loads(p.stdout.strip().splitlines()[-1]) if p.stdout.strip() else None
+            if drawn:
+                break
+        if drawn and drawn["spheres"] == r["present"]:
+            names.append(os.path.basename(png))
+        else:
+            print(f"report: {png}: ParaView drew {drawn and drawn['spheres']} spheres of the "
+                  f"{r['present']} present; picture left out", file=sys.stderr)
+    return names
+
+
+def sanitized(x):
+    """x with every NaN as None (strict JSON)."""
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {k: sanitized(v) for k, v in x.items()}
+    if isinstance(x, list):
+        return [sanitized(v) for v in x]
+    return x
 
 
 def main():
@@ -196,16 +316,24 @@ def main():
     for case in plan.cases():
         for engine in plan.ENGINES:
             if os.path.exists(os.path.join(a.out, engine, case, "discharge.h5")):
-                runs.append(measure_run(a.out, engine, case, half, times))
+                r = measure_run(a.out, engine, case, half, times)
+                old = committed.get((engine, case))
+                if old and old["code"] != r["code"]:
+                    print(f"report: {engine}/{case}: the run here ({r['code']}) replaces the "
+                          f"committed one ({old['code']})", file=sys.stderr)
+                runs.append(r)
             elif (engine, case) in committed:
                 runs.append(committed[(engine, case)])
+    if not runs:
+        sys.exit("report: no finished discharge under %s and none committed: run `make sandpile` first" % a.out)
     os.makedirs(a.out, exist_ok=True)
     with open(os.path.join(a.out, "summary.json"), "w") as f:
-        json.dump({"runs": runs}, f, indent=1)
+        json.dump({"runs": sanitized(runs)}, f, indent=1, allow_nan=False)
     report(runs, a.out)
-    plot(runs, os.path.join(a.out, "piles.png"))
+    plot(runs, os.path.join(a.out, "piles.png"), half)
+    names = ["report.md", "summary.json", "piles.png"] + pictures(a.out, runs)
     os.makedirs(a.results, exist_ok=True)
-    for name in ("report.md", "summary.json", "piles.png"):
+    for name in names:
         shutil.copyfile(os.path.join(a.out, name), os.path.join(a.results, name))
     print(open(os.path.join(a.out, "report.md")).read())
 

@@ -1,0 +1,57 @@
+"""pv_pile.py — run by pvbatch (scripts/sandpile/report.py): a pile at the end of its discharge,
+rendered by ParaView from the trajectory's XDMF sidecar with its default reader.
+
+    xvfb-run -a pvbatch scripts/sandpile/pv_pile.py SIDECAR.xdmf OUT.png
+
+The last frame seen along the slot's normal (+x), as the seed's Fig. 4.10 shows her piles: the
+spheres (Point Gaussian scaled by radius) sand-coloured, the walls grey with their back faces
+culled, so that the slot's near face is not drawn and its far face is the backdrop.  Prints, as
+JSON on its last line, the spheres it drew, which the caller checks against the trajectory.
+"""
+import json
+import os
+import sys
+
+from paraview import servermanager
+from paraview.simple import (ExtractCellsByType, GetActiveViewOrCreate, OpenDataFile, Render,
+                             ResetCamera, SaveScreenshot, Show)
+
+SIZE = [800, 420]
+xdmf, png = os.path.abspath(sys.argv[1]), sys.argv[2]
+reader = OpenDataFile(xdmf)   # Xdmf3 mis-joins a bare relative name
+t = reader.TimestepValues[-1]
+spheres = ExtractCellsByType(Input=reader, CellTypes=["Vertex", "Polyvertex"])
+walls = ExtractCellsByType(Input=reader, CellTypes=["Quadrilateral"])
+view = GetActiveViewOrCreate("RenderView")
+view.ViewSize = SIZE
+view.UseColorPaletteForBackground = 0
+view.Background = [1.0, 1.0, 1.0]
+view.OrientationAxesVisibility = 0
+view.ViewTime = t
+view.CameraPosition = [-1.0, 0.0, 0.05]
+view.CameraFocalPoint = [0.0, 0.0, 0.05]
+view.CameraViewUp = [0.0, 0.0, 1.0]
+d = Show(spheres, view)
+d.SetRepresentationType("Point Gaussian")
+d.ScaleByArray = 1
+d.SetScaleArray = ["POINTS", "radius"]
+d.ScaleTransferFunction.Points = [0.0, 0.0, 0.5, 0.0, 1.0, 1.0, 0.5, 0.0]
+d.GaussianRadius = 1.0
+d.ShaderPreset = "Sphere"
+d.ColorArrayName = ["POINTS", ""]
+d.AmbientColor = d.DiffuseColor = [0.80, 0.62, 0.35]
+w = Show(walls, view)
+w.SetRepresentationType("Surface")
+w.ColorArrayName = ["POINTS", ""]
+w.AmbientColor = w.DiffuseColor = [0.75, 0.75, 0.75]
+w.BackfaceRepresentation = "Cull Backface"
+ResetCamera(view)
+Render(view)
+SaveScreenshot(png, view, ImageResolution=SIZE)
+spheres.UpdatePipeline(t)
+data = servermanager.Fetch(spheres)
+n = data.GetNumberOfPoints() if data.IsA("vtkDataSet") else sum(
+    data.GetBlock(i).GetNumberOfPoints() for i in range(data.GetNumberOfBlocks()) if data.GetBlock(i))
+print(json.dumps({"time": t, "spheres": n}), flush=True)
+# pvbatch 5.11 under xvfb sometimes aborts in its own teardown (tests/paraview/pv_probe.py)
+os._exit(0)
