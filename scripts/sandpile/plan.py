@@ -5,7 +5,8 @@
 Per engine (jdem, liggghts-jdem) and per case of reference_runs/sandpile/sandpile.yaml (Del Cid's
 Table 4.3: dry and kc = 1.07e7, mu_r = 0.1, 0.2, 0.4, 0.6): the settling with the outlets shut
 (`fill`), the discharge scene written from its last frame (`discharge_scene`) and the discharge
-(`discharge`), under out/sandpile/ENGINE/CASE/.  Both runs checkpoint (jdem every
+(`discharge`), under out/sandpile/ENGINE/CASE/; and the restart's control (`control_scene`,
+`control`: the same restart with the outlets kept, 0.05 s, discharge.py --control).  Both runs checkpoint (jdem every
 CHECKPOINT_SECONDS of wall time, LIGGGHTS a restart file every RESTART_STEPS steps) and continue
 after an interruption.  A unit's cost for the ETA is its particle-steps.  A case whose result is
 committed (reference_runs/sandpile/results/summary.json, `make sandpile-report`) is skipped on a
@@ -21,7 +22,7 @@ import yaml
 
 from scripts.campaign import Unit
 from scripts.mixing.plan_ch4 import fill_command, jdem, valid_scene, valid_trajectory
-from scripts.sandpile.discharge import DISCHARGE_TIME, SCENE
+from scripts.sandpile.discharge import CONTROL_TIME, DISCHARGE_TIME, SCENE
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -60,7 +61,8 @@ def committed_cases():
 
 def case_units(engine, case):
     base = os.path.join(OUT, engine, case)
-    fill, scene, discharge = (os.path.join(base, n) for n in ("fill.h5", "discharge.yaml", "discharge.h5"))
+    fill, scene, discharge, control_scene, control = (
+        os.path.join(base, n) for n in ("fill.h5", "discharge.yaml", "discharge.h5", "control.yaml", "control.h5"))
     pre = f"{engine}/{case}"
     doc = resolved()
     n, dt = len(doc["particles"]), doc["time"]["dt"]
@@ -79,6 +81,12 @@ def case_units(engine, case):
              fill_command(engine, scene, False, None, CHECKPOINT_SECONDS, RESTART_STEPS),
              case, engine, needs=[f"{pre}/discharge_scene"], validate=valid_trajectory,
              cost=DISCHARGED * n * DISCHARGE_TIME / dt, resumes=True, committed=kept),
+        Unit(f"{pre}/control_scene", [control_scene],
+             [PY, os.path.join(HERE, "discharge.py"), fill, "--case", case, "--control", "-o", "{out0}"],
+             case, engine, needs=[f"{pre}/fill"], validate=valid_scene, cost=n, committed=kept),
+        Unit(f"{pre}/control", [control], fill_command(engine, control_scene, False),
+             case, engine, needs=[f"{pre}/control_scene"], validate=valid_trajectory,
+             cost=n * CONTROL_TIME / dt, committed=kept),
     ]
 
 
