@@ -117,24 +117,29 @@ def measure(pos, radius, half_width, plate_z=0.0):
             "flank_left": f["flank_left"].tolist(), "flank_right": f["flank_right"].tolist()}
 
 
-def plate_half_width(scene_doc):
-    """Half the plate's extent along y, from the scene's wall named `plate`."""
-    plate = next(w for w in scene_doc["walls"] if w["name"] == "plate")
-    ys = [c[1] for c in plate["corners"]]
-    return 0.5 * (max(ys) - min(ys))
+def plate_half_width(trajectory):
+    """Half the plate's extent along y [m]: the plate is the scene's one mesh wall (type 2 in the
+    trajectory's /jdem/walls, named as the scene does in jdem and by its fix ID in LIGGGHTS),
+    its corners those of its quadrilaterals (docs/output.md)."""
+    import h5py
+    with h5py.File(trajectory, "r") as f:
+        w = f["jdem/walls"]
+        meshes = np.flatnonzero(w["type"][...] == 2)
+        if len(meshes) != 1:
+            raise ValueError(f"{trajectory}: {len(meshes)} mesh walls, not the one plate")
+        quads, wall = w["mesh/quads"][...], w["mesh/wall"][...]
+        vertices = w["mesh/vertices"][...] if "vertices" in w["mesh"] else w["mesh/vertex_position"][0]
+    ys = vertices[quads[wall == meshes[0]].ravel(), 1]
+    return 0.5 * float(ys.max() - ys.min())
 
 
 def main():
-    import yaml
-    from scripts.sandpile.discharge import SCENE
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("trajectory")
     ap.add_argument("--frame", type=int, default=-1)
     a = ap.parse_args()
-    with open(SCENE) as f:
-        half = plate_half_width(yaml.load(f, Loader=yaml.CSafeLoader))
     pos, radius, time = live_frame(a.trajectory, a.frame)
-    m = measure(pos, radius, half)
+    m = measure(pos, radius, plate_half_width(a.trajectory))
     print(json.dumps(dict(m, time=time), indent=1))
 
 

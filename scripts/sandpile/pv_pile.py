@@ -14,9 +14,10 @@ import sys
 
 from paraview import servermanager
 from paraview.simple import (ExtractCellsByType, GetActiveViewOrCreate, OpenDataFile, Render,
-                             ResetCamera, SaveScreenshot, Show)
+                             SaveScreenshot, Show)
 
 SIZE = [800, 420]
+FOCUS_Z, HALF_HEIGHT = 0.04, 0.065   # [m] the picture spans z = -0.025 ... 0.105 (the slot's ends in y)
 xdmf, png = os.path.abspath(sys.argv[1]), sys.argv[2]
 reader = OpenDataFile(xdmf)   # Xdmf3 mis-joins a bare relative name
 t = reader.TimestepValues[-1]
@@ -28,9 +29,6 @@ view.UseColorPaletteForBackground = 0
 view.Background = [1.0, 1.0, 1.0]
 view.OrientationAxesVisibility = 0
 view.ViewTime = t
-view.CameraPosition = [-1.0, 0.0, 0.05]
-view.CameraFocalPoint = [0.0, 0.0, 0.05]
-view.CameraViewUp = [0.0, 0.0, 1.0]
 d = Show(spheres, view)
 d.SetRepresentationType("Point Gaussian")
 d.ScaleByArray = 1
@@ -45,8 +43,12 @@ w.SetRepresentationType("Surface")
 w.ColorArrayName = ["POINTS", ""]
 w.AmbientColor = w.DiffuseColor = [0.75, 0.75, 0.75]
 w.BackfaceRepresentation = "Cull Backface"
-ResetCamera(view)
-Render(view)
+Render(view)   # the first render places the camera on everything: then ours
+view.CameraPosition = [-1.0, 0.0, FOCUS_Z]
+view.CameraFocalPoint = [0.0, 0.0, FOCUS_Z]
+view.CameraViewUp = [0.0, 0.0, 1.0]
+view.CameraParallelProjection = 1
+view.CameraParallelScale = HALF_HEIGHT
 SaveScreenshot(png, view, ImageResolution=SIZE)
 spheres.UpdatePipeline(t)
 data = servermanager.Fetch(spheres)

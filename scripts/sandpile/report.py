@@ -23,11 +23,10 @@ import shutil
 import sys
 
 import numpy as np
-import yaml
 
 from scripts.campaign import Times, times_path
 from scripts.sandpile import angle, plan
-from scripts.sandpile.discharge import CONTROL_TIME, SCENE
+from scripts.sandpile.discharge import CONTROL_TIME
 
 SEED = {  # Table 4.3 [deg], +-3 (Del Cid 2015 §4.3.4)
     "dry": {"mur01": 24, "mur02": 29, "mur04": 36, "mur06": 37},
@@ -36,6 +35,7 @@ SEED = {  # Table 4.3 [deg], +-3 (Del Cid 2015 §4.3.4)
 SEED_TOLERANCE = 3.0
 MU_R = {"mur01": 0.1, "mur02": 0.2, "mur04": 0.4, "mur06": 0.6}
 HERE = os.path.dirname(os.path.abspath(__file__))
+PLOT_HALF_WIDTH = 0.06    # [m] the plots' extent: the plate's (plate.stl)
 PICTURED = ("dry_mur01", "kc107_mur06")   # ParaView's pictures: the flattest and the steepest pile
 SETTLE_CHECK = 0.25       # [s] before the last frame
 REST_ANGLE = 1.0          # [deg]: a pile at rest moves less over SETTLE_CHECK
@@ -109,9 +109,10 @@ def restart_control(fill, control):
             "elastic_fill_end": float(e0[-1]), "elastic_max": float(e1.max()), "elastic_end": float(e1[-1])}
 
 
-def measure_run(out, engine, case, half_width, times):
+def measure_run(out, engine, case, times):
     base = os.path.join(out, engine, case)
     discharge, fill = os.path.join(base, "discharge.h5"), os.path.join(base, "fill.h5")
+    half_width = angle.plate_half_width(discharge)
     pos, radius, t_end = angle.live_frame(discharge)
     final = angle.measure(pos, radius, half_width)
     import h5py
@@ -293,6 +294,7 @@ def plot(runs, path, half_width):
                     seed_line(ax, r, seed)
             ax.plot([], [], "k:", label=f"seed {seed}° (through jdem's flanks)")
             ax.set_xlim(-1e3 * half_width, 1e3 * half_width)
+            ax.set_ylim(bottom=0.0)
             ax.set_title(f"{cohesion}, μr = {MU_R[rolling]:g}", fontsize=9)
             ax.legend(fontsize=7, loc="lower center")
             if i == 1:
@@ -349,8 +351,6 @@ def main():
     ap.add_argument("--out", default=plan.OUT)
     ap.add_argument("--results", default=plan.RESULTS)
     a = ap.parse_args()
-    with open(SCENE) as f:
-        half = angle.plate_half_width(yaml.load(f, Loader=yaml.CSafeLoader))
     times = Times(times_path(plan.units([]))).seconds
     try:
         with open(os.path.join(a.results, "summary.json")) as f:
@@ -361,7 +361,7 @@ def main():
     for case in plan.cases():
         for engine in plan.ENGINES:
             if os.path.exists(os.path.join(a.out, engine, case, "discharge.h5")):
-                r = measure_run(a.out, engine, case, half, times)
+                r = measure_run(a.out, engine, case, times)
                 old = committed.get((engine, case))
                 if old and old["code"] != r["code"]:
                     print(f"report: {engine}/{case}: the run here ({r['code']}) replaces the "
@@ -375,7 +375,7 @@ def main():
     with open(os.path.join(a.out, "summary.json"), "w") as f:
         json.dump({"runs": sanitized(runs)}, f, indent=1, allow_nan=False)
     report(runs, a.out)
-    plot(runs, os.path.join(a.out, "piles.png"), half)
+    plot(runs, os.path.join(a.out, "piles.png"), PLOT_HALF_WIDTH)
     names = ["report.md", "summary.json", "piles.png"] + pictures(a.out, runs)
     os.makedirs(a.results, exist_ok=True)
     for name in names:
