@@ -17,8 +17,11 @@ import os
 import sys
 
 from paraview import servermanager
-from paraview.simple import (ExtractCellsByType, GetActiveViewOrCreate, OpenDataFile, Render,
-                             ResetCamera, SaveScreenshot, Show, Threshold)
+from paraview.simple import (ExtractCellsByType, OpenDataFile, Render, ResetCamera, SaveScreenshot,
+                             Show, Threshold)
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))   # scripts/
+from pv_display import plain_view, show_spheres  # noqa: E402
 
 SIZE = [600, 600]
 SPHERE_SCALE = 0.6
@@ -58,22 +61,9 @@ spheres = ExtractCellsByType(Input=reader, CellTypes=["Vertex", "Polyvertex"])
 bonds = ExtractCellsByType(Input=reader, CellTypes=["Line", "Polyline"])
 big = between(spheres, "radius", BIG_RADIUS, 1.0)
 small = between(spheres, "radius", 0.0, BIG_RADIUS)
-view = GetActiveViewOrCreate("RenderView")
-view.ViewSize = SIZE
-view.UseColorPaletteForBackground = 0
-view.Background = [0.0, 0.0, 0.0]
-view.OrientationAxesVisibility = 0
-view.ViewTime = t
+view = plain_view(SIZE, [0.0, 0.0, 0.0], t)
 for src, colour in ((big, [0.85, 0.1, 0.1]), (small, [0.15, 0.3, 0.85])):
-    d = Show(src, view)
-    d.SetRepresentationType("Point Gaussian")
-    d.ScaleByArray = 1
-    d.SetScaleArray = ["POINTS", "radius"]
-    d.ScaleTransferFunction.Points = [0.0, 0.0, 0.5, 0.0, 1.0, SPHERE_SCALE, 0.5, 0.0]
-    d.GaussianRadius = 1.0
-    d.ShaderPreset = "Sphere"
-    d.ColorArrayName = ["POINTS", ""]
-    d.AmbientColor = d.DiffuseColor = colour
+    show_spheres(src, view, colour, SPHERE_SCALE)
 d = Show(bonds, view)
 d.SetRepresentationType("Surface")
 d.ColorArrayName = ["POINTS", ""]

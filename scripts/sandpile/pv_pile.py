@@ -13,8 +13,10 @@ import os
 import sys
 
 from paraview import servermanager
-from paraview.simple import (ExtractCellsByType, GetActiveViewOrCreate, OpenDataFile, Render,
-                             SaveScreenshot, Show)
+from paraview.simple import ExtractCellsByType, OpenDataFile, Render, SaveScreenshot, Show
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))   # scripts/
+from pv_display import plain_view, show_spheres  # noqa: E402
 
 SIZE = [800, 420]
 FOCUS_Z, HALF_HEIGHT = 0.04, 0.065   # [m] the picture spans z = -0.025 ... 0.105 (the slot's ends in y)
@@ -23,21 +25,8 @@ reader = OpenDataFile(xdmf)   # Xdmf3 mis-joins a bare relative name
 t = reader.TimestepValues[-1]
 spheres = ExtractCellsByType(Input=reader, CellTypes=["Vertex", "Polyvertex"])
 walls = ExtractCellsByType(Input=reader, CellTypes=["Quadrilateral"])
-view = GetActiveViewOrCreate("RenderView")
-view.ViewSize = SIZE
-view.UseColorPaletteForBackground = 0
-view.Background = [1.0, 1.0, 1.0]
-view.OrientationAxesVisibility = 0
-view.ViewTime = t
-d = Show(spheres, view)
-d.SetRepresentationType("Point Gaussian")
-d.ScaleByArray = 1
-d.SetScaleArray = ["POINTS", "radius"]
-d.ScaleTransferFunction.Points = [0.0, 0.0, 0.5, 0.0, 1.0, 1.0, 0.5, 0.0]
-d.GaussianRadius = 1.0
-d.ShaderPreset = "Sphere"
-d.ColorArrayName = ["POINTS", ""]
-d.AmbientColor = d.DiffuseColor = [0.80, 0.62, 0.35]
+view = plain_view(SIZE, [1.0, 1.0, 1.0], t)
+show_spheres(spheres, view, [0.80, 0.62, 0.35])
 w = Show(walls, view)
 w.SetRepresentationType("Surface")
 w.ColorArrayName = ["POINTS", ""]
