@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <mpi.h>
 #include <string>
@@ -32,6 +33,7 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
       e_elastic_now(0.0), contacts_now(0.0), overlap_limit(INFINITY), shape(-1), wtype(0), slen(0), hist(NULL),
       nmax_hist(0), pair(NULL), use_candidates(false), cand_ncalls(-1), cand_nlocal(0) {
   servo = false;
+  until_step = MAXBIGINT;
   servo_state = jd_servo_state();
   servo_hold = servo_area = servo_stress = servo_speed = servo_position = 0.0;
   force_all[0] = force_all[1] = force_all[2] = 0.0;
@@ -82,6 +84,13 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
     } else if (k == "name" && iarg + 1 < narg) {
       name = arg[iarg + 1];
       iarg += 2;
+    } else if (shape != 2 && k == "until_step" && iarg + 1 < narg) {
+      char *end = NULL;
+      const long long step = std::strtoll(arg[iarg + 1], &end, 10);
+      if (end == arg[iarg + 1] || *end != '\0' || step < 1)
+        error->all(FLERR, "fix wall/jiang: until_step must be a step >= 1");
+      until_step = (bigint)step;
+      iarg += 2;
     } else if (shape == 0 && k == "servo") {
       parse_servo(narg, arg, ++iarg);
     } else if (shape == 1 && k == "radius" && iarg + 1 < narg) {
@@ -110,6 +119,8 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
     if (!(jd_dot(ab, ab) > 0.0)) error->all(FLERR, "fix wall/jiang: the cylinder axis has zero length");
   }
 
+  if (servo && until_step != MAXBIGINT)
+    error->all(FLERR, "fix wall/jiang: a servo wall cannot vanish; no until_step with servo");
   if (servo && name.empty()) error->all(FLERR, "fix wall/jiang: a servo wall needs 'name NAME' (its observables)");
   if (servo && (vel[0] != 0.0 || vel[1] != 0.0 || vel[2] != 0.0))
     error->all(FLERR, "fix wall/jiang: a servo wall moves by its servo law; no velocity with servo");
@@ -214,6 +225,11 @@ void FixWallJiang::check_winding() {
 }
 
 void FixWallJiang::post_force(int vflag) {
+  if (update->ntimestep >= until_step) { /* vanished: the same step as build/jdem's walls.c */
+    retire();
+    sum_force_and_servo();
+    return;
+  }
   /* translate the wall first: x += v dt per defining point, as the standalone engine does */
   if (vel[0] != 0.0 || vel[1] != 0.0 || vel[2] != 0.0) {
     const double dt = update->dt;
@@ -282,6 +298,33 @@ void FixWallJiang::refresh_candidates() {
   cand_ncalls = neighbor->ncalls;
   cand_nlocal = nlocal;
   shift[0] = shift[1] = shift[2] = 0.0;
+}
+
+/* The wall has vanished: every contact ends, and the elastic energy its springs held leaves
+ * with the wall, booked as the wall's work (build/jdem's gone_wall_energy).  Repeated at every
+ * later step, when the histories are already empty (a particle cannot touch it again). */
+void FixWallJiang::retire() {
+#define JD_RETIRE_LOOP(b) \
+  case (b): retire_loop<(b)>(); break;
+  JD_DISPATCH(pair->features(), JD_RETIRE_LOOP)
+#undef JD_RETIRE_LOOP
+}
+
+template <unsigned F>
+void FixWallJiang::retire_loop() {
+  const int roll_at = pair->rolling_at();
+  for (int i = 0; i < atom->nlocal; i++) {
+    double *h = hist[i];
+    if (F & JD_F_ENERGY) {
+      JdHistory<F> hs(h, roll_at, false);
+      work_cum -= jd_contact_elastic_energy(hs.st);
+    }
+    for (int k = 0; k < slen; k++) h[k] = 0.0;
+  }
+  e_elastic_now = contacts_now = 0.0;
+  overlap_trip = JdOverlapTrip();
+  contact_x.clear();
+  contact_f.clear();
 }
 
 void FixWallJiang::compute(bool commit) {

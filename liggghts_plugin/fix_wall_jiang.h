@@ -5,6 +5,9 @@
  *                           [servo target S gain G tolerance E max_speed V hold H]
  *   fix ID group wall/jiang cylinder axis x1 y1 z1 x2 y2 z2 radius R side outside|inside type T
  *                           [velocity vx vy vz]
+ *   either with [until_step S]: the wall vanishes, from the forces of step S on (a LIGGGHTS
+ *   user's unfix at S, in one run; build/jdem's `until`): its contacts end, the elastic energy
+ *   their springs held booked as work the wall did (not with servo)
  *
  * The plane is a finite quadrilateral, counter-clockwise seen from the active side (normal
  * (P2-P1) x (P3-P1)); the cylinder is the lateral surface of the axis segment.  T is the
@@ -100,7 +103,9 @@ class FixWallJiang : public Fix {
 
  protected:
   template <unsigned F> JD_SPECIALISED void loop(bool commit);
+  template <unsigned F> void retire_loop();
   void compute(bool commit);
+  void retire();
   void refresh_candidates();
   void sum_force_and_servo();
   void check_winding();
@@ -111,6 +116,7 @@ class FixWallJiang : public Fix {
   jd_cylinder cyl;
   double vel[3];
   double spin; /* cylinder: angular velocity about its axis, right-handed about a1 - a0 [rad/s] */
+  bigint until_step; /* until_step S: gone from the forces of step S on (MAXBIGINT: never) */
   int wtype;
   int slen; /* doubles of history per atom (a mesh: JD_MESH_SLOTS x (normal, state)) */
   double **hist;

@@ -683,9 +683,11 @@ def write_deck_files(scene, particles, deck_dir, resolved_path, deck_path, traj_
         spin = float(w.get("angular_velocity", 0.0)) if w["type"] == "cylinder" else 0.0
         if spin:
             vel = " omega %s" % num(spin) + vel
+        if "until_step" in w:   # a wall that vanishes (resolved: the step)
+            vel += " until_step %d" % int(w["until_step"])
         if builtin:
             if vel:
-                fail("wall %s: --builtin supports fixed walls only (no velocity, spin or servo)" % w["name"])
+                fail("wall %s: --builtin supports fixed walls only (no velocity, spin, servo or until)" % w["name"])
             L.append("fix %s all wall/gran %s primitive type %d %s\n" % (
                 fid, builtin_model, tid[w["material"]], primitive_wall(w)))
         elif w["type"] == "plane":

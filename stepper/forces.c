@@ -78,6 +78,20 @@ static JD_ALWAYS_INLINE void hist_separate(jd_contact_list *L, const unsigned F,
     jd_record_separate(L->hist + (size_t)HW(F) * c, HW(F), L->rhist + (size_t)RW(F) * c, RW(F));
 }
 
+/* Entry c of a wall that has vanished: its contact ends; returns the elastic energy its springs
+ * held [J] (with energy bookkeeping; else 0), which leaves the system with the wall. */
+static JD_ALWAYS_INLINE double gone_wall_energy(jd_contact_list *L, const unsigned F, size_t c) {
+    double u = 0.0;
+    if (F & JD_F_ENERGY) {
+        jd_contact_state st;
+        jd_rolling_state rs;
+        hist_load(L, F, c, &st, &rs);
+        u = jd_contact_elastic_energy(&st);
+    }
+    hist_separate(L, F, c);
+    return u;
+}
+
 /* Is entry c's history already as hist_separate leaves it (bit for bit: +0, not -0)?  Most
  * candidates that did not touch at the build never do: checking spares their history the
  * writes. */
@@ -610,6 +624,10 @@ static JD_ALWAYS_INLINE double wall_loop(const jd_particles *ps, const jd_run_co
         const int32_t i = L->i[c];
         const jd_sim_wall *w = &walls->wall[L->j[c]];
         jd_contact_geom g;
+        if (w->gone) {
+            work -= gone_wall_energy(L, F, c);
+            continue;
+        }
         if (!sim_wall_geom(ps, i, w, &g)) {
             hist_separate(L, F, c);
             continue;
@@ -690,6 +708,10 @@ static double plain_wall_loop(const jd_particles *ps, const jd_run_constants *ru
         const int32_t i = L->i[c];
         const jd_sim_wall *w = &walls->wall[L->j[c]];
         jd_contact_geom g;
+        if (w->gone) {
+            work -= gone_wall_energy(L, F, c);
+            continue;
+        }
         if (!sim_wall_geom(ps, i, w, &g)) {
             hist_separate(L, F, c);
             continue;
@@ -848,6 +870,7 @@ void sim_gravity(jd_particles *ps, const jd_run_constants *run, const jd_thread_
 
 void sim_compute_forces(jd_sim *s) {
     const int nt = s->threads.n;
+    sim_walls_retire(&s->walls, s->step + (s->in_setup ? 0 : 1)); /* the step whose forces these are */
     double work[nt > 0 ? nt : 1];
     double t_pairs_end = 0.0, t_walls_end = 0.0;
     const double t0 = sim_clock();

@@ -498,6 +498,7 @@ typedef struct wall_search {
 static int walls_of(const void *ctx, size_t i, jd_pair_part *p) {
     const wall_search *q = ctx;
     for (size_t w = 0; w < q->walls->n; w++) {
+        if (q->walls->wall[w].gone) continue; /* vanished (sim_walls_retire) */
         if (!q->allpairs &&
             !wall_candidate(&q->walls->wall[w], q->ps->x + 3 * i, q->ps->radius[i],
                             sim_wall_margin(q->lists, i)))

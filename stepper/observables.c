@@ -58,7 +58,7 @@ void sim_observables(const jd_particles *ps, const jd_run_constants *run,
         sim_hist_get(&lists->wall_pairs, c, &st, NULL);
         o->elastic_energy += jd_contact_elastic_energy(&st);
         const jd_sim_wall *w = &walls->wall[lists->wall_pairs.j[c]];
-        if (carries_force(&st) && sim_wall_geom(ps, lists->wall_pairs.i[c], w, &g))
+        if (!w->gone && carries_force(&st) && sim_wall_geom(ps, lists->wall_pairs.i[c], w, &g))
             o->wall_contacts += 1.0;
     }
     o->damping_dissipation = accounts->e_damp_dropped;

@@ -187,7 +187,7 @@ static int auto_dt(loader *L) {
         return sd_fail(&L->c, L->time, "time.dt", "auto: the time-step guard finds no bound (%g s); "
                        "valid: a number > 0", g.safe_dt);
     L->s->dt = JD_DT_AUTO_FACTOR * g.safe_dt;
-    return read_steps(L, L->time) || scene_bond_rule_steps(L);
+    return read_steps(L, L->time) || scene_bond_rule_steps(L) || scene_wall_steps(L);
 }
 
 static int read_time(loader *L) {

@@ -58,7 +58,14 @@ typedef struct jd_wall {
     jd_servo_spec servo;      /* target, gain, tolerance, max_speed; hold_steps is set by the
                                  engine from servo_hold once dt is known (jd_servo_hold_steps) */
     double servo_hold;        /* [s] within tolerance this long completes the test */
+    /* removal (docs/scenes.md "A wall that vanishes"): the wall acts on the forces of the steps
+     * before until_step and is gone from that step's on (LIGGGHTS: unfix) */
+    double until;             /* [s] as the scene gives it; NAN when given as a step, or never */
+    int64_t until_step;       /* JD_WALL_ALWAYS: the whole run */
 } jd_wall;
+
+/* A wall's until_step when it never vanishes. */
+#define JD_WALL_ALWAYS INT64_MAX
 
 /* A static triangle-mesh wall: a walls entry of type mesh, read from an STL file (docs/scenes.md
  * "Mesh walls").  Kept apart from the plane and cylinder walls, whose shapes the engine moves. */

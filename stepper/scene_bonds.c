@@ -136,8 +136,8 @@ static int read_bond(loader *L, const yaml_node_t *b, const char *path) {
 }
 
 /* A rule's time [s] -> step ceil(time/dt - 1e-9) (as end_time). */
-static int time_to_step(loader *L, const yaml_node_t *at, const char *path, double time,
-                        int64_t *step) {
+int scene_time_to_step(loader *L, const yaml_node_t *at, const char *path, double time,
+                       int64_t *step) {
     const double steps = ceil(time / L->s->dt - 1e-9);
     if (!(steps < 9.0e18))
         return sd_fail(&L->c, at, path, "time/dt gives %g steps (dt = %g s); valid: at most 9e18",
@@ -174,7 +174,7 @@ static int read_rule(loader *L, const yaml_node_t *r, const char *path, jd_bond_
         /* an auto dt is known only once the whole scene is (scene_bond_rule_steps); a later
          * rule stays a later rule meanwhile */
         if (s->dt_auto) rule->step = rule->time > 0.0;
-        else if (time_to_step(L, t, sub, rule->time, &rule->step)) return -1;
+        else if (scene_time_to_step(L, t, sub, rule->time, &rule->step)) return -1;
     }
     const yaml_node_t *m = sd_get(&L->c, r, "materials");
     if (!m) {
@@ -374,7 +374,7 @@ int scene_bond_rule_steps(loader *L) {
     jd_scene *s = L->s;
     for (size_t r = 0; r < s->n_bond_rules; r++)
         if (!isnan(s->bond_rules[r].time) &&
-            time_to_step(L, sd_get(&L->c, L->root, "bond_rules"), "bond_rules",
+            scene_time_to_step(L, sd_get(&L->c, L->root, "bond_rules"), "bond_rules",
                          s->bond_rules[r].time, &s->bond_rules[r].step))
             return -1;
     sort_rules(s);

@@ -228,6 +228,7 @@ static int emit_wall(yaml_emitter_t *e, const jd_scene *s, const jd_wall *w) {
                     key_num(e, "angular_velocity", w->angular_velocity))
         return 1;
     if (key_str(e, "material", s->materials[w->material].name)) return 1;
+    if (w->until_step != JD_WALL_ALWAYS && key_int(e, "until_step", w->until_step)) return 1;
     if (!w->has_servo) return key_vec(e, "velocity", w->velocity) || map_end(e);
     const jd_servo_spec *sp = &w->servo;
     return str(e, "servo") || map_start(e, 1) || key_num(e, "target", sp->target) ||

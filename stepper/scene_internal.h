@@ -127,6 +127,7 @@ int scene_read_deposit_list(loader *L, const yaml_node_t *list, const char *path
 
 /* scene_walls.c */
 int scene_read_walls(loader *L);
+int scene_wall_steps(loader *L);      /* an auto dt's vanishing walls: until -> until_step */
 /* After the particles: no plane wound away from the particles over it (the kernel's rule). */
 int scene_check_plane_winding(loader *L);
 
@@ -143,6 +144,9 @@ int scene_add_bond(loader *L, const yaml_node_t *node, int64_t a, int64_t b, int
 int scene_read_bonds(loader *L);      /* bonds and bond_rules; before the sort */
 int scene_resolve_bonds(loader *L);   /* after the sort: ids exist, step-0 rules, duplicates */
 int scene_bond_rule_steps(loader *L); /* an auto dt's rules: their times -> steps, once dt is set */
+/* A time [s] -> step ceil(time/dt - 1e-9) (as end_time); the node and path name it in errors. */
+int scene_time_to_step(loader *L, const yaml_node_t *at, const char *path, double time,
+                       int64_t *step);
 
 /* scene_bond_generators.c: one generator entry (key is "bonded_block" or "bonded_sphere"). */
 int scene_generate_bonded(loader *L, const yaml_node_t *g, const char *key, const char *path,

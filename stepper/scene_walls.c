@@ -2,6 +2,7 @@
  * scene_walls.c — the walls section: planar quadrilaterals and cylinders, with their geometry
  * checks (a plane wound away from the particles is refused), and STL meshes (scene_mesh.c).
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -11,12 +12,12 @@
 /* Relative tolerance of docs/scenes.md: wall geometry, fraction of the wall's size. */
 #define GEOM_TOL 1e-9
 
-static const char *const PLANE_KEYS[] = {"name",     "type",    "corners", "material",
-                                         "velocity", "present", "servo",   NULL};
+static const char *const PLANE_KEYS[] = {"name",    "type",    "corners", "material", "velocity",
+                                         "present", "servo",   "until",   "until_step", NULL};
 static const char *const SERVO_KEYS[] = {"target", "gain", "tolerance", "max_speed", "hold", NULL};
 static const char *const CYLINDER_KEYS[] = {"name",     "type",     "axis",    "radius",
                                             "side",     "material", "velocity", "present",
-                                            "angular_velocity", NULL};
+                                            "angular_velocity", "until", "until_step", NULL};
 static const char *const MESH_KEYS[] = {"name",     "type",     "file",     "material",
                                         "scale",    "velocity", "rotation", "surface_velocity",
                                         "surface_angular_velocity", NULL};
@@ -182,6 +183,34 @@ static int read_mesh(loader *L, const yaml_node_t *w, const char *path, const jd
     return 0;
 }
 
+/* until [s] (a step once dt is known: here, or in scene_wall_steps for an auto dt), or
+ * until_step, the resolved form: the wall is gone from that step's forces on.  Not on a servo
+ * wall (its test holds it in place to the end). */
+static int read_until(loader *L, const yaml_node_t *w, const char *path, jd_wall *wall) {
+    wall->until = NAN;
+    wall->until_step = JD_WALL_ALWAYS;
+    const yaml_node_t *t = sd_get(&L->c, w, "until"), *st = sd_get(&L->c, w, "until_step");
+    if (!t && !st) return 0;
+    char sub[SD_PATH_MAX];
+    sd_join(sub, path, t ? "until" : "until_step");
+    if (t && st) return sd_fail(&L->c, st, path, "until and until_step given together; valid: one of them");
+    if (wall->has_servo)
+        return sd_fail(&L->c, t ? t : st, sub, "a servo wall cannot vanish; valid: until on a wall "
+                       "without servo");
+    if (st) return sd_int(&L->c, st, sub, 1, &wall->until_step);
+    if (sd_num(&L->c, t, sub, SD_POSITIVE, &wall->until)) return -1;
+    return L->s->dt_auto ? 0 : scene_time_to_step(L, t, sub, wall->until, &wall->until_step);
+}
+
+int scene_wall_steps(loader *L) {
+    for (size_t k = 0; k < L->s->n_walls; k++)
+        if (!isnan(L->s->walls[k].until) &&
+            scene_time_to_step(L, sd_get(&L->c, L->root, "walls"), "walls", L->s->walls[k].until,
+                               &L->s->walls[k].until_step))
+            return -1;
+    return 0;
+}
+
 /* Reads the wall at PATH into walls[index]; *present = 0 for a wall that the case leaves out
  * (present: false, so that one swept scene can hold the obstacles of every model): it is checked
  * like the others but takes no slot and marks no material as in use.  A mesh wall goes to
@@ -216,12 +245,13 @@ static int read_wall(loader *L, const yaml_node_t *w, const char *path, size_t i
         sd_opt_vec3(&L->c, w, path, "velocity", wall->velocity))
         return -1;
     if (*present) L->by_wall[wall->material] = 1;
-    if (!plane) return read_cylinder(L, w, path, wall);
+    if (!plane) return read_cylinder(L, w, path, wall) || read_until(L, w, path, wall);
     sd_join(sub, path, "corners");
     const yaml_node_t *corners = sd_get(&L->c, w, "corners");
     if (!corners) return sd_missing(&L->c, w, path, "corners", "four points [[x, y, z], ...]");
     if (sd_points(&L->c, corners, sub, 4, &wall->corners[0][0])) return -1;
-    return check_plane(L, w, path, wall) || read_servo(L, w, path, wall);
+    return check_plane(L, w, path, wall) || read_servo(L, w, path, wall) ||
+           read_until(L, w, path, wall);
 }
 
 int scene_read_walls(loader *L) {

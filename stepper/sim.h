@@ -172,6 +172,9 @@ typedef struct jd_sim_wall {
     double stress;          /* measured at the last evaluation [Pa] */
     double speed;           /* along n, for the next step [m/s] */
     double position;        /* displacement along n since the start [m] */
+    /* a wall that vanishes (the scene's until): gone from the forces of step until_step on */
+    int64_t until_step;     /* JD_WALL_ALWAYS: never */
+    int gone;               /* set by sim_walls_retire for the forces being evaluated */
 } jd_sim_wall;
 
 /* A thread's share of the force loops (see "Threads" above; forces.c). */
@@ -478,6 +481,10 @@ static inline long long sim_particle_id(const jd_particles *ps, size_t i) {
 int sim_walls_init(jd_walls *walls, const jd_run_constants *run, char *err, size_t errlen);
 /* Translate every wall by its velocity times dt [s]. */
 void sim_walls_move(jd_walls *walls, double dt);
+/* Mark the walls gone whose until_step is at or before `step`, the step whose forces are about
+ * to be evaluated.  A gone wall's contacts end in the force loops, their stored elastic energy
+ * booked as work the vanishing wall did (wall_work), and the neighbour search skips it. */
+void sim_walls_retire(jd_walls *walls, int64_t step);
 void sim_walls_free(jd_walls *walls);
 /* With walls->forces: room for an entry record per wall-list entry (n of them; after every
  * list build). */

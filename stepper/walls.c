@@ -23,6 +23,7 @@ int sim_walls_init(jd_walls *walls, const jd_run_constants *run, char *err, size
         jd_sim_wall *w = &walls->wall[k];
         w->type = in->type;
         w->material = in->material;
+        w->until_step = in->until_step;
         memcpy(w->v, in->velocity, sizeof w->v);
         if (in->has_servo) {
             w->servo = 1;
@@ -130,6 +131,10 @@ int sim_walls_write_observables(const jd_walls *walls, const jd_run_constants *r
                          walls->stress_tensor[k], err, errlen))
             return -1;
     return 0;
+}
+
+void sim_walls_retire(jd_walls *walls, int64_t step) {
+    for (size_t k = 0; k < walls->n; k++) walls->wall[k].gone = walls->wall[k].until_step <= step;
 }
 
 /* x_wall += v dt for every point that defines the wall. */

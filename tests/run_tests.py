@@ -23,7 +23,7 @@ import time
 PY = "/usr/bin/python3"
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
-ENGINE_TESTS = ["neighbour", "fastpaths", "free_flight", "hertz_impact", "energy_balance", "guard",
+ENGINE_TESTS = ["wall_vanishes", "neighbour", "fastpaths", "free_flight", "hertz_impact", "energy_balance", "guard",
                 "guard_coordination", "dt_auto", "watchdog",
                 "signals", "bench_tiling", "deposit", "servo", "domain"]
 SANITIZED = {"JDEM": "build/san/jdem"}

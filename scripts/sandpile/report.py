@@ -3,11 +3,11 @@
 
     python3 -m scripts.sandpile.report [--out out/sandpile] [--results reference_runs/sandpile/results]
 
-For every finished discharge (out/sandpile/ENGINE/CASE/discharge.h5): the pile's angle of repose
+For every finished run (out/sandpile/ENGINE/CASE/pile.h5): the angle of repose of its pile
 (scripts/sandpile/angle.py) and its measurement uncertainty at the last frame, and the angle
 SETTLE_CHECK seconds before; the checks that the pile is at rest (the angle moved less than
 REST_ANGLE, no sphere left beside the plate, at most REST_ENERGY of motion per sphere); the run's
-code (its trajectory's creator version) and its CPU time (the campaign's record of its two runs).
+code (its trajectory's creator version) and its CPU time (the campaign's record).
 A case not under out/ is taken from the committed summary.json; a local run replaces a committed
 one, and says so when its code differs.  Del Cid's qualitative claims (§4.3.4) are weighed
 against the piles' uncertainties: the angle grows with mu_r (dry and cohesive), the cohesive pile
@@ -26,7 +26,6 @@ import numpy as np
 
 from scripts.campaign import Times, times_path
 from scripts.sandpile import angle, plan
-from scripts.sandpile.discharge import CONTROL_TIME
 
 SEED = {  # Table 4.3 [deg], +-3 (Del Cid 2015 §4.3.4)
     "dry": {"mur01": 24, "mur02": 29, "mur04": 36, "mur06": 37},
@@ -72,56 +71,46 @@ def checks_of(r):
         bad.append("angle still moving")
     if r["beside"]:
         bad.append(f"{r['beside']} spheres beside the plate")
-    if not r["discharge_motion_per_sphere"] <= REST_ENERGY:
+    if not r["end_motion_per_sphere"] <= REST_ENERGY:
         bad.append("still moving")
     return "; ".join(bad) or "at rest"
 
 
-def observable(path, name):
+def motion_at(path, time):
+    """The kinetic and rotational energy per sphere present [J] at the last observable sample at
+    or before `time` [s]."""
     import h5py
     with h5py.File(path, "r") as f:
-        return f[f"observables/{name}/value"][...]
+        t = f["observables/kinetic_energy/time"][()]
+        k = int(np.flatnonzero(t <= time + 1e-12)[-1])
+        e = sum(float(f[f"observables/{n}/value"][k]) for n in ("kinetic_energy", "rotational_energy"))
+        ids = f["particles/all/id"]
+        n = len(f["particles/all/radius"]) if not isinstance(ids, h5py.Group) else None
+    if n is None:   # a changing set: the spheres present at the frame nearest that time
+        with h5py.File(path, "r") as f:
+            ft = f["particles/all/position/time"][()]
+            n = int(np.sum(f["particles/all/id/value"][int(np.argmin(np.abs(ft - time)))] >= 0))
+    return e / max(1, n)
 
 
-def ids_and_positions(path, frame):
-    """A frame's particle ids and positions, the empty slots of a changing set left out."""
-    import h5py
-    with h5py.File(path, "r") as f:
-        a = f["particles/all"]
-        ids = a["id/value"][frame] if "value" in a["id"] else a["id"][...]
-        pos = a["position/value"][frame]
-    live = ids >= 0
-    return ids[live], pos[live]
-
-
-def restart_control(fill, control):
-    """What the restart alone did to the settled deposit (the control run: the outlets kept):
-    the spheres' largest and median displacement [m] at its end, and the elastic energy at the
-    fill's end, the control's largest and its last [J]; None without a control run."""
-    if not os.path.exists(control):
-        return None
-    i0, x0 = ids_and_positions(fill, -1)
-    i1, x1 = ids_and_positions(control, -1)
-    d = np.linalg.norm(x1[np.argsort(i1)] - x0[np.argsort(i0)], axis=1) if np.array_equal(np.sort(i0), np.sort(i1)) else None
-    e0, e1 = observable(fill, "elastic_energy"), observable(control, "elastic_energy")
-    return {"max_displacement": float(d.max()) if d is not None else None,
-            "median_displacement": float(np.median(d)) if d is not None else None,
-            "elastic_fill_end": float(e0[-1]), "elastic_max": float(e1.max()), "elastic_end": float(e1[-1])}
+def opening_time():
+    """When the outlets vanish [s]: their until_step in the resolved scene, times dt."""
+    doc = plan.resolved()
+    return min(w["until_step"] for w in doc["walls"] if "until_step" in w) * doc["time"]["dt"]
 
 
 def measure_run(out, engine, case, times):
-    base = os.path.join(out, engine, case)
-    discharge, fill = os.path.join(base, "discharge.h5"), os.path.join(base, "fill.h5")
-    half_width = angle.plate_half_width(discharge)
-    pos, radius, t_end = angle.live_frame(discharge)
+    pile = os.path.join(out, engine, case, "pile.h5")
+    half_width = angle.plate_half_width(pile)
+    pos, radius, t_end = angle.live_frame(pile)
     final = angle.measure(pos, radius, half_width)
     import h5py
-    with h5py.File(discharge, "r") as f:
+    with h5py.File(pile, "r") as f:
         t = f["particles/all/position/time"][...]
     earlier = int(np.argmin(np.abs(t - (t_end - SETTLE_CHECK))))
-    p2, r2, t2 = angle.live_frame(discharge, earlier)
+    p2, r2, t2 = angle.live_frame(pile, earlier)
     before = angle.measure(p2, r2, half_width)
-    spent = [times.get(f"{engine}/{case}/{u}") for u in ("fill", "discharge")]
+    spent = times.get(f"{engine}/{case}/pile")
     r = {"engine": engine, "case": case, "angle": final["angle"], "uncertainty": uncertainty(final),
          "half_difference": final["half_difference"], "offset_spread": final["offset_spread"],
          "left": final["left"], "right": final["right"],
@@ -129,12 +118,11 @@ def measure_run(out, engine, case, times):
          "angle_earlier": before["angle"], "earlier_time": t2, "end_time": t_end,
          "peak_height": final["peak_height"], "on_plate": final["on_plate"], "present": len(pos),
          "beside": int(np.sum((np.abs(pos[:, 1]) > half_width) & (pos[:, 2] > 0.0))),
-         "fill_motion_per_sphere": motion_per_sphere(fill),
-         "discharge_motion_per_sphere": motion_per_sphere(discharge),
-         "cpu_seconds": sum(s["cpu_seconds"] for s in spent) if all(spent) else None,
-         "threads": max(s.get("threads", 1) for s in spent) if all(spent) else None,
-         "code": creator(discharge),
-         "restart_control": restart_control(fill, os.path.join(base, "control.h5")),
+         "settled_motion_per_sphere": motion_at(pile, opening_time()),
+         "end_motion_per_sphere": motion_at(pile, t_end),
+         "cpu_seconds": spent["cpu_seconds"] if spent else None,
+         "threads": spent.get("threads", 1) if spent else None,
+         "code": creator(pile),
          "profile": {k: final[k] for k in ("profile_y", "profile_top", "flank_left", "flank_right")}}
     r["checks"] = checks_of(r)
     return r
@@ -204,7 +192,7 @@ def report(runs, out_dir):
              "of the two flanks' fitted slopes ± the pile's measurement uncertainty (the largest of "
              "the flanks' half-difference, the binning's spread and the fits' standard errors); the "
              "seed's are ±3°.  Δ: the angle's change over the last %.2f s of the discharge.  CPU: the "
-             "settling and the discharge together [min]." % SETTLE_CHECK, ""]
+             "whole run, settling and discharge [min]." % SETTLE_CHECK, ""]
     head = "| μr | seed | jdem | Δ | CPU | liggghts-jdem | Δ | CPU |"
     for cohesion, title in (("dry", "Dry material"), ("kc107", "kadh = 1.07e7 N/m^1.5")):
         lines += [f"### {title}", "", head, "|---|---|---|---|---|---|---|---|"]
@@ -235,25 +223,13 @@ def report(runs, out_dir):
     lines += [f"| {e} | {c} | {v} | {n} |" for e, c, v, n in claims(by)]
     lines += ["", "### The runs", "",
               "| engine | case | flanks left / right [deg] | fits' s.e. | binning spread | spheres on the plate "
-              "| peak [mm] | motion/sphere after settling [J] | at the end [J] | checks | code |",
+              "| peak [mm] | motion/sphere at the opening [J] | at the end [J] | checks | code |",
               "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in runs:
         lines.append(f"| {r['engine']} | {r['case']} | {fmt(r['left'])} / {fmt(r['right'])} | "
                      f"{fmt(r['fit_se'])} | {fmt(r['offset_spread'])} | {r['on_plate']} | "
-                     f"{1e3 * r['peak_height']:.1f} | {r['fill_motion_per_sphere']:.1e} | "
-                     f"{r['discharge_motion_per_sphere']:.1e} | {r['checks']} | {r['code']} |")
-    lines += ["", "### The restart's control", "",
-              "The discharge restarts from the settled deposit with fresh contact history "
-              "(docs/sandpile.md); the control restarts it with the outlets kept, %.2f s: how far "
-              "the spheres moved, and the elastic energy stored in the contacts." % CONTROL_TIME, "",
-              "| engine | case | largest displacement [mm] | median [µm] | elastic energy, fill's end [J] "
-              "| the control's largest | at its end |", "|---|---|---|---|---|---|---|"]
-    for r in runs:
-        c = r.get("restart_control")
-        if c:
-            lines.append(f"| {r['engine']} | {r['case']} | {fmt(c['max_displacement'] and 1e3 * c['max_displacement'], '.3f')} | "
-                         f"{fmt(c['median_displacement'] and 1e6 * c['median_displacement'], '.2f')} | "
-                         f"{c['elastic_fill_end']:.2e} | {c['elastic_max']:.2e} | {c['elastic_end']:.2e} |")
+                     f"{1e3 * r['peak_height']:.1f} | {r['settled_motion_per_sphere']:.1e} | "
+                     f"{r['end_motion_per_sphere']:.1e} | {r['checks']} | {r['code']} |")
     with open(os.path.join(out_dir, "report.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
 
@@ -317,7 +293,7 @@ def pictures(out_dir, runs):
         return []
     names = []
     for r in runs:
-        sidecar = os.path.join(out_dir, r["engine"], r["case"], "discharge.xdmf")
+        sidecar = os.path.join(out_dir, r["engine"], r["case"], "pile.xdmf")
         if r["case"] not in PICTURED or not os.path.exists(sidecar):
             continue
         png = os.path.join(out_dir, f"pile_{r['case']}_{r['engine']}.png")
@@ -360,7 +336,7 @@ def main():
     runs = []
     for case in plan.cases():
         for engine in plan.ENGINES:
-            if os.path.exists(os.path.join(a.out, engine, case, "discharge.h5")):
+            if os.path.exists(os.path.join(a.out, engine, case, "pile.h5")):
                 r = measure_run(a.out, engine, case, times)
                 old = committed.get((engine, case))
                 if old and old["code"] != r["code"]:
@@ -370,7 +346,7 @@ def main():
             elif (engine, case) in committed:
                 runs.append(committed[(engine, case)])
     if not runs:
-        sys.exit("report: no finished discharge under %s and none committed: run `make sandpile` first" % a.out)
+        sys.exit("report: no finished pile under %s and none committed: run `make sandpile` first" % a.out)
     os.makedirs(a.out, exist_ok=True)
     with open(os.path.join(a.out, "summary.json"), "w") as f:
         json.dump({"runs": sanitized(runs)}, f, indent=1, allow_nan=False)
