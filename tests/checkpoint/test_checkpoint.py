@@ -7,7 +7,8 @@ on a meshed conveyor (the mesh's moved corners, its contact history and candidat
 leaving the domain (the shrinking set, its bonds and loads), spheres raining onto a bed (each
 particle's half skin), a sparse rain (the partial builds' reference positions), the inlet
 stream again just before an insertion whose build is full (every half skin renewed), cohesive
-MEPA contacts (their plastic overlaps); SIGTERM
+MEPA contacts (their plastic overlaps), a floor that has vanished (docs/scenes.md "A wall that
+vanishes"); SIGTERM
 writes a checkpoint and exits 143; bad checkpoints are refused with their messages; a failed
 checkpoint write keeps the previous checkpoint and stops the run (exit 3)."""
 import math
@@ -49,6 +50,8 @@ CASES = [  # scene, case, checkpoint every N steps
     ("tests/checkpoint/scenes/inlet_stream.yaml", None, 63162),
     # MEPA's contacts mid-hysteresis: their plastic overlaps in the checkpoint's history
     ("tests/liggghts/scenes/mpi_mepa_cohesive.yaml", None, 2500),
+    # a checkpoint after a wall vanished (step 15000): resumed, it stays gone
+    ("tests/liggghts/scenes/mpi_wall_vanishes.yaml", None, 17000),
 ]
 
 
