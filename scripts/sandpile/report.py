@@ -6,7 +6,7 @@
 For every finished run (out/sandpile/ENGINE/CASE/pile.h5): the angle of repose of its pile
 (scripts/sandpile/angle.py) and its measurement uncertainty at the last frame, and the angle
 SETTLE_CHECK seconds before; the checks that the pile is at rest (the angle moved less than
-REST_ANGLE, no sphere left beside the plate, at most REST_ENERGY of motion per sphere); the run's
+REST_ANGLE, no sphere left hanging beside the plate (beyond its edge by more than its radius), at most REST_ENERGY of motion per sphere); the run's
 code (its trajectory's creator version) and its CPU time (the campaign's record).
 A case not under out/ is taken from the committed summary.json; a local run replaces a committed
 one, and says so when its code differs.  Del Cid's qualitative claims (§4.3.4) are weighed
@@ -117,7 +117,9 @@ def measure_run(out, engine, case, times):
          "fit_se": max(final["left_se"], final["right_se"]),
          "angle_earlier": before["angle"], "earlier_time": t2, "end_time": t_end,
          "peak_height": final["peak_height"], "on_plate": final["on_plate"], "present": len(pos),
-         "beside": int(np.sum((np.abs(pos[:, 1]) > half_width) & (pos[:, 2] > 0.0))),
+         # spheres that cannot touch the plate (beyond its edge by more than their radius) and
+         # have not fallen: material hanging beside the pile, not its foot against the edge
+         "beside": int(np.sum((np.abs(pos[:, 1]) - radius > half_width) & (pos[:, 2] > 0.0))),
          "settled_motion_per_sphere": motion_at(pile, opening_time()),
          "end_motion_per_sphere": motion_at(pile, t_end),
          "cpu_seconds": spent["cpu_seconds"] if spent else None,
