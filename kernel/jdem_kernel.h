@@ -868,6 +868,16 @@ static inline double jd_load_work(const double prev[6], const double now[6], con
  * evaluation [J] (JD_F_ENERGY); zero once the contact has ended. */
 static inline double jd_contact_elastic_energy(const jd_contact_state *s) { return s->u_prev; }
 
+/* A wall that vanishes (a scene's `until`, fix wall/jiang `until_step`): whether it is gone from
+ * the forces of step `step` [-], until_step the first step without it. */
+static inline int jd_wall_gone(int64_t step, int64_t until_step) { return step >= until_step; }
+
+/* The work [J] a vanishing wall does on a contact it leaves: the elastic energy the contact's
+ * springs held leaves the system with the wall (JD_F_ENERGY). */
+static inline double jd_wall_vanish_work(const jd_contact_state *s) {
+    return -jd_contact_elastic_energy(s);
+}
+
 /* Moves the energies contact s has dissipated so far (damping, friction; JD_F_ENERGY), weighted
  * by w [-] (1, or 1/2 for a pair that two ranks evaluate), into *damp and *fric [J] and zeroes
  * them in s.  The one harvest of both engines; they call it at different times because their

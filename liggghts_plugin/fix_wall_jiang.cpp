@@ -34,6 +34,7 @@ FixWallJiang::FixWallJiang(LAMMPS *lmp, int narg, char **arg)
       nmax_hist(0), pair(NULL), use_candidates(false), cand_ncalls(-1), cand_nlocal(0) {
   servo = false;
   until_step = MAXBIGINT;
+  retired = false;
   servo_state = jd_servo_state();
   servo_hold = servo_area = servo_stress = servo_speed = servo_position = 0.0;
   force_all[0] = force_all[1] = force_all[2] = 0.0;
@@ -225,9 +226,12 @@ void FixWallJiang::check_winding() {
 }
 
 void FixWallJiang::post_force(int vflag) {
-  if (update->ntimestep >= until_step) { /* vanished: the same step as build/jdem's walls.c */
-    retire();
-    sum_force_and_servo();
+  if (jd_wall_gone(update->ntimestep, until_step)) { /* vanished, once (the kernel's rule) */
+    if (!retired) {
+      retire();
+      sum_force_and_servo();
+      retired = true;
+    }
     return;
   }
   /* translate the wall first: x += v dt per defining point, as the standalone engine does */
@@ -300,9 +304,10 @@ void FixWallJiang::refresh_candidates() {
   shift[0] = shift[1] = shift[2] = 0.0;
 }
 
-/* The wall has vanished: every contact ends, and the elastic energy its springs held leaves
- * with the wall, booked as the wall's work (build/jdem's gone_wall_energy).  Repeated at every
- * later step, when the histories are already empty (a particle cannot touch it again). */
+/* The wall has vanished: every contact ends, the work the wall does leaving it booked
+ * (jd_wall_vanish_work, as build/jdem's force loops).  Once: afterwards no particle can touch
+ * the wall, so the histories, the force and the energies stay zero (a run continued from a
+ * restart file retires it again, on histories already empty). */
 void FixWallJiang::retire() {
 #define JD_RETIRE_LOOP(b) \
   case (b): retire_loop<(b)>(); break;
@@ -317,7 +322,7 @@ void FixWallJiang::retire_loop() {
     double *h = hist[i];
     if (F & JD_F_ENERGY) {
       JdHistory<F> hs(h, roll_at, false);
-      work_cum -= jd_contact_elastic_energy(hs.st);
+      work_cum += jd_wall_vanish_work(hs.st);
     }
     for (int k = 0; k < slen; k++) h[k] = 0.0;
   }

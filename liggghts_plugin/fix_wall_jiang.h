@@ -117,6 +117,7 @@ class FixWallJiang : public Fix {
   double vel[3];
   double spin; /* cylinder: angular velocity about its axis, right-handed about a1 - a0 [rad/s] */
   bigint until_step; /* until_step S: gone from the forces of step S on (MAXBIGINT: never) */
+  bool retired;      /* retire() has run: the wall is gone and its contacts are cleared */
   int wtype;
   int slen; /* doubles of history per atom (a mesh: JD_MESH_SLOTS x (normal, state)) */
   double **hist;

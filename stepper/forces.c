@@ -78,18 +78,18 @@ static JD_ALWAYS_INLINE void hist_separate(jd_contact_list *L, const unsigned F,
     jd_record_separate(L->hist + (size_t)HW(F) * c, HW(F), L->rhist + (size_t)RW(F) * c, RW(F));
 }
 
-/* Entry c of a wall that has vanished: its contact ends; returns the elastic energy its springs
- * held [J] (with energy bookkeeping; else 0), which leaves the system with the wall. */
-static JD_ALWAYS_INLINE double gone_wall_energy(jd_contact_list *L, const unsigned F, size_t c) {
-    double u = 0.0;
+/* Entry c of a wall that has vanished: its contact ends; returns the work the wall did on it
+ * leaving (jd_wall_vanish_work; with energy bookkeeping, else 0) [J]. */
+static JD_ALWAYS_INLINE double gone_wall_work(jd_contact_list *L, const unsigned F, size_t c) {
+    double work = 0.0;
     if (F & JD_F_ENERGY) {
         jd_contact_state st;
         jd_rolling_state rs;
         hist_load(L, F, c, &st, &rs);
-        u = jd_contact_elastic_energy(&st);
+        work = jd_wall_vanish_work(&st);
     }
     hist_separate(L, F, c);
-    return u;
+    return work;
 }
 
 /* Is entry c's history already as hist_separate leaves it (bit for bit: +0, not -0)?  Most
@@ -625,7 +625,7 @@ static JD_ALWAYS_INLINE double wall_loop(const jd_particles *ps, const jd_run_co
         const jd_sim_wall *w = &walls->wall[L->j[c]];
         jd_contact_geom g;
         if (w->gone) {
-            work -= gone_wall_energy(L, F, c);
+            work += gone_wall_work(L, F, c);
             continue;
         }
         if (!sim_wall_geom(ps, i, w, &g)) {
@@ -709,7 +709,7 @@ static double plain_wall_loop(const jd_particles *ps, const jd_run_constants *ru
         const jd_sim_wall *w = &walls->wall[L->j[c]];
         jd_contact_geom g;
         if (w->gone) {
-            work -= gone_wall_energy(L, F, c);
+            work += gone_wall_work(L, F, c);
             continue;
         }
         if (!sim_wall_geom(ps, i, w, &g)) {

@@ -134,7 +134,7 @@ int sim_walls_write_observables(const jd_walls *walls, const jd_run_constants *r
 }
 
 void sim_walls_retire(jd_walls *walls, int64_t step) {
-    for (size_t k = 0; k < walls->n; k++) walls->wall[k].gone = walls->wall[k].until_step <= step;
+    for (size_t k = 0; k < walls->n; k++) walls->wall[k].gone = jd_wall_gone(step, walls->wall[k].until_step);
 }
 
 /* x_wall += v dt for every point that defines the wall. */

@@ -22,19 +22,19 @@ import numpy as np
 
 CREST = 0.9          # bins above this fraction of the peak height are the crest, not the flank
 MIN_BINS = 3         # a flank fitted through fewer bins is no flank (no angle)
-OFFSETS = (0.0, 0.25, 0.5, 0.75)   # shifts of the bin grid, in bin widths, for the binning's spread
+OFFSETS = (0.25, 0.5, 0.75)   # shifts of the bin grid beyond the unshifted one, in bin widths,
+                              # for the binning's spread
 
 
-def live_frame(path, frame=-1):
-    """Positions [n][3] and radii [n] of the particles present at `frame` of an H5MD trajectory
-    (a changing set's slots without a particle, id -1, left out), and the frame's time [s]."""
-    import h5py
-    with h5py.File(path, "r") as f:
-        a = f["particles/all"]
-        pos = a["position/value"][frame]
-        time = float(a["position/time"][frame])
-        radius = a["radius"][...]
-        ids = a["id/value"][frame] if "value" in a["id"] else a["id"][...]
+def live_frame(f, frame=-1):
+    """Positions [n][3] and radii [n] of the particles present at `frame` of the open H5MD
+    trajectory f (a changing set's slots without a particle, id -1, left out), and the frame's
+    time [s]."""
+    a = f["particles/all"]
+    pos = a["position/value"][frame]
+    time = float(a["position/time"][frame])
+    radius = a["radius"][...]
+    ids = a["id/value"][frame] if "value" in a["id"] else a["id"][...]
     live = (ids >= 0) & np.all(np.isfinite(pos), axis=1)
     return pos[live], radius[live], time
 
@@ -100,13 +100,13 @@ def flanks(y, top, half_width, width, offset=0.0):
 def measure(pos, radius, half_width, plate_z=0.0):
     """The pile on the plate |y| <= half_width (spheres centred above plate_z): its flanks'
     angles [deg], their mean and half-difference, each fit's standard error, the half-range of
-    the mean over OFFSETS of the bin grid (how much the binning alone moves it), the crest's
+    the mean over the bin grid and its OFFSETS (how much the binning alone moves it), the crest's
     height above the plate [m], the count of spheres on the plate and the profile itself."""
     on = (np.abs(pos[:, 1]) <= half_width) & (pos[:, 2] > plate_z)
     y, top = pos[on, 1], pos[on, 2] + radius[on] - plate_z
     width = 2.0 * float(np.mean(radius)) if len(radius) else half_width
     f = flanks(y, top, half_width, width)
-    shifted = [flanks(y, top, half_width, width, o * width) for o in OFFSETS]
+    shifted = [f] + [flanks(y, top, half_width, width, o * width) for o in OFFSETS]
     means = [0.5 * (g["left"] + g["right"]) for g in shifted]
     spread = 0.5 * (max(means) - min(means)) if all(math.isfinite(m) for m in means) else math.nan
     return {"angle": 0.5 * (f["left"] + f["right"]), "half_difference": 0.5 * abs(f["left"] - f["right"]),
@@ -117,18 +117,16 @@ def measure(pos, radius, half_width, plate_z=0.0):
             "flank_left": f["flank_left"].tolist(), "flank_right": f["flank_right"].tolist()}
 
 
-def plate_half_width(trajectory):
-    """Half the plate's extent along y [m]: the plate is the scene's one mesh wall (type 2 in the
-    trajectory's /jdem/walls, named as the scene does in jdem and by its fix ID in LIGGGHTS),
-    its corners those of its quadrilaterals (docs/output.md)."""
-    import h5py
-    with h5py.File(trajectory, "r") as f:
-        w = f["jdem/walls"]
-        meshes = np.flatnonzero(w["type"][...] == 2)
-        if len(meshes) != 1:
-            raise ValueError(f"{trajectory}: {len(meshes)} mesh walls, not the one plate")
-        quads, wall = w["mesh/quads"][...], w["mesh/wall"][...]
-        vertices = w["mesh/vertices"][...] if "vertices" in w["mesh"] else w["mesh/vertex_position"][0]
+def plate_half_width(f):
+    """Half the plate's extent along y [m] in the open trajectory f: the plate is the scene's
+    one mesh wall (type 2 in /jdem/walls, named as the scene does in jdem and by its fix ID in
+    LIGGGHTS), its corners those of its quadrilaterals (docs/output.md)."""
+    w = f["jdem/walls"]
+    meshes = np.flatnonzero(w["type"][...] == 2)
+    if len(meshes) != 1:
+        raise ValueError(f"{f.filename}: {len(meshes)} mesh walls, not the one plate")
+    quads, wall = w["mesh/quads"][...], w["mesh/wall"][...]
+    vertices = w["mesh/vertices"][...] if "vertices" in w["mesh"] else w["mesh/vertex_position"][0]
     ys = vertices[quads[wall == meshes[0]].ravel(), 1]
     return 0.5 * float(ys.max() - ys.min())
 
@@ -138,8 +136,11 @@ def main():
     ap.add_argument("trajectory")
     ap.add_argument("--frame", type=int, default=-1)
     a = ap.parse_args()
-    pos, radius, time = live_frame(a.trajectory, a.frame)
-    m = measure(pos, radius, plate_half_width(a.trajectory))
+    import h5py
+    with h5py.File(a.trajectory, "r") as f:
+        pos, radius, time = live_frame(f, a.frame)
+        half_width = plate_half_width(f)
+    m = measure(pos, radius, half_width)
     print(json.dumps(dict(m, time=time), indent=1))
 
 

@@ -41,21 +41,10 @@ REST_ANGLE = 1.0          # [deg]: a pile at rest moves less over SETTLE_CHECK
 REST_ENERGY = 1.0e-7      # [J] of motion per sphere at the end: 3 cm/s for a 2.86 mm grain
 
 
-def creator(path):
-    import h5py
-    with h5py.File(path, "r") as f:
-        c = f["h5md/creator"].attrs
-        return "%s %s" % (c["name"].decode() if isinstance(c["name"], bytes) else c["name"],
-                          c["version"].decode() if isinstance(c["version"], bytes) else c["version"])
-
-
-def motion_per_sphere(path):
-    """The last sample of the kinetic and rotational energy over the spheres present then [J]."""
-    import h5py
-    with h5py.File(path, "r") as f:
-        e = sum(float(f[f"observables/{k}/value"][-1]) for k in ("kinetic_energy", "rotational_energy"))
-    pos, _, _ = angle.live_frame(path)
-    return e / max(1, len(pos))
+def creator(f):
+    """The code that wrote the open trajectory f: its H5MD creator's name and version."""
+    c = f["h5md/creator"].attrs
+    return " ".join(v.decode() if isinstance(v, bytes) else str(v) for v in (c["name"], c["version"]))
 
 
 def uncertainty(m):
@@ -76,21 +65,14 @@ def checks_of(r):
     return "; ".join(bad) or "at rest"
 
 
-def motion_at(path, time):
-    """The kinetic and rotational energy per sphere present [J] at the last observable sample at
-    or before `time` [s]."""
-    import h5py
-    with h5py.File(path, "r") as f:
-        t = f["observables/kinetic_energy/time"][()]
-        k = int(np.flatnonzero(t <= time + 1e-12)[-1])
-        e = sum(float(f[f"observables/{n}/value"][k]) for n in ("kinetic_energy", "rotational_energy"))
-        ids = f["particles/all/id"]
-        n = len(f["particles/all/radius"]) if not isinstance(ids, h5py.Group) else None
-    if n is None:   # a changing set: the spheres present at the frame nearest that time
-        with h5py.File(path, "r") as f:
-            ft = f["particles/all/position/time"][()]
-            n = int(np.sum(f["particles/all/id/value"][int(np.argmin(np.abs(ft - time)))] >= 0))
-    return e / max(1, n)
+def motion_at(f, time):
+    """The kinetic and rotational energy per sphere present [J] in the open trajectory f at its
+    last observable sample at or before `time` [s] (the spheres of the frame nearest it)."""
+    t = f["observables/kinetic_energy/time"][()]
+    k = int(np.flatnonzero(t <= time + 1e-12)[-1])
+    e = sum(float(f[f"observables/{n}/value"][k]) for n in ("kinetic_energy", "rotational_energy"))
+    frame = int(np.argmin(np.abs(f["particles/all/position/time"][()] - t[k])))
+    return e / max(1, len(angle.live_frame(f, frame)[0]))
 
 
 def opening_time():
@@ -100,16 +82,15 @@ def opening_time():
 
 
 def measure_run(out, engine, case, times):
-    pile = os.path.join(out, engine, case, "pile.h5")
-    half_width = angle.plate_half_width(pile)
-    pos, radius, t_end = angle.live_frame(pile)
-    final = angle.measure(pos, radius, half_width)
     import h5py
-    with h5py.File(pile, "r") as f:
+    with h5py.File(os.path.join(out, engine, case, "pile.h5"), "r") as f:
+        half_width = angle.plate_half_width(f)
+        pos, radius, t_end = angle.live_frame(f)
         t = f["particles/all/position/time"][...]
-    earlier = int(np.argmin(np.abs(t - (t_end - SETTLE_CHECK))))
-    p2, r2, t2 = angle.live_frame(pile, earlier)
-    before = angle.measure(p2, r2, half_width)
+        p2, r2, t2 = angle.live_frame(f, int(np.argmin(np.abs(t - (t_end - SETTLE_CHECK)))))
+        settled, end = motion_at(f, opening_time()), motion_at(f, t_end)
+        code = creator(f)
+    final, before = angle.measure(pos, radius, half_width), angle.measure(p2, r2, half_width)
     spent = times.get(f"{engine}/{case}/pile")
     r = {"engine": engine, "case": case, "angle": final["angle"], "uncertainty": uncertainty(final),
          "half_difference": final["half_difference"], "offset_spread": final["offset_spread"],
@@ -120,11 +101,10 @@ def measure_run(out, engine, case, times):
          # spheres that cannot touch the plate (beyond its edge by more than their radius) and
          # have not fallen: material hanging beside the pile, not its foot against the edge
          "beside": int(np.sum((np.abs(pos[:, 1]) - radius > half_width) & (pos[:, 2] > 0.0))),
-         "settled_motion_per_sphere": motion_at(pile, opening_time()),
-         "end_motion_per_sphere": motion_at(pile, t_end),
+         "settled_motion_per_sphere": settled, "end_motion_per_sphere": end,
          "cpu_seconds": spent["cpu_seconds"] if spent else None,
          "threads": spent.get("threads", 1) if spent else None,
-         "code": creator(pile),
+         "code": code,
          "profile": {k: final[k] for k in ("profile_y", "profile_top", "flank_left", "flank_right")}}
     r["checks"] = checks_of(r)
     return r
@@ -288,9 +268,8 @@ def plot(runs, path, half_width):
 def pictures(out_dir, runs):
     """ParaView's picture of the PICTURED cases' piles (scripts/sandpile/pv_pile.py), where
     pvbatch is installed (`make paraview-deps`): pile_CASE_ENGINE.png, the names written."""
-    import shutil as sh
     import subprocess
-    if not sh.which("pvbatch"):
+    if not shutil.which("pvbatch"):
         print("report: pvbatch not found, no pictures (make paraview-deps)", file=sys.stderr)
         return []
     names = []
